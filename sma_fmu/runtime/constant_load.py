@@ -1,0 +1,139 @@
+"""Constant-load model with a direction-switched hysteresis centre (spec sections 3-4).
+
+    tau(f, d)  = a_h + b_h f (heating), a_c + b_c f (cooling)        [degC]
+    xi_Fmin(f) = xi_F_inf (1 - exp(-f/f_F))                           residual F when hot
+    dH(f)      = nu (eps_T - g f x_T / N)                             [J] per cooperative domain
+    Lambda     = ln(xi_P/xi_MF) = (dH/k_B)(1/tau_K - 1/T_K)
+    xi_MF      = M/(1 + e^Lambda),  xi_P = M - xi_MF,  M = 1 - xi_Fmin
+    xi_M = xi_MF/2,  xi_F = xi_Fmin + xi_MF/2
+
+The load-dependent constants of one branch are bundled in :class:`BranchConstants`
+so a stepper computes them once per load, not once per step.
+"""
+import math
+from collections import namedtuple
+
+from .checks import direction_sign, require_finite, require_nonnegative
+from .constants import BOLTZMANN, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
+from .phases import PhaseFractions, resistance_of
+
+__all__ = [
+    "BranchConstants", "hysteresis_centre", "residual_f_fraction", "domain_energy",
+    "branch_constants", "logistic_split", "branch_fractions", "phase_fractions",
+    "constant_load_fractions", "constant_load_resistance", "require_temperature", "BranchCache",
+]
+
+BranchConstants = namedtuple(
+    "BranchConstants", ["M", "xi_F_min", "energy_over_kB", "inv_centre_K", "centre"])
+BranchConstants.__doc__ = """Constants of one major branch at one load.
+
+M : 1 - xi_Fmin, the fraction that can transform [1]
+xi_F_min : residual F fraction [1]
+energy_over_kB : dH(f)/k_B [K]
+inv_centre_K : 1/tau_K [1/K]
+centre : hysteresis centre tau [degC]
+"""
+
+
+def require_temperature(name, value):
+    """Return ``value`` [degC] as float if finite and above absolute zero, else raise."""
+    temperature = require_finite(name, value)
+    if temperature <= -KELVIN_OFFSET:
+        raise ValueError(f"{name} must be above -273.15 degC, got {value!r}")
+    return temperature
+
+
+def hysteresis_centre(load, direction, params):
+    """Hysteresis centre tau [degC] for a load [kg] and direction (+1 heating, -1 cooling)."""
+    if direction_sign(direction) == HEATING:
+        return params.a_h + params.b_h * load
+    return params.a_c + params.b_c * load
+
+
+def residual_f_fraction(load, params):
+    """Residual F fraction xi_Fmin(f) [1] left when the wire under ``load`` [kg] is fully heated."""
+    return params.xi_F_inf * (1.0 - math.exp(-load / params.f_F))
+
+
+def domain_energy(load, params):
+    """Transformation energy per cooperative domain dH(f) [J]; must stay positive."""
+    energy = params.nu * (params.eps_T - STANDARD_GRAVITY * load * params.x_T / params.N)
+    if not energy > 0.0:
+        raise ValueError(
+            f"load = {load!r} kg is beyond the model's range: dH(f) = {energy!r} J <= 0")
+    return energy
+
+
+def branch_constants(load, direction, params):
+    """The :class:`BranchConstants` of the major branch for ``load`` [kg] and ``direction``."""
+    load = require_nonnegative("load", load)
+    centre = hysteresis_centre(load, direction, params)
+    if centre <= -KELVIN_OFFSET:
+        raise ValueError(f"hysteresis centre {centre!r} degC at load {load!r} kg is below 0 K")
+    xi_f_min = residual_f_fraction(load, params)
+    return BranchConstants(
+        M=1.0 - xi_f_min,
+        xi_F_min=xi_f_min,
+        energy_over_kB=domain_energy(load, params) / BOLTZMANN,
+        inv_centre_K=1.0 / (centre + KELVIN_OFFSET),
+        centre=centre,
+    )
+
+
+def logistic_split(total, exponent):
+    """Split ``total`` into (total/(1+e^z), total e^z/(1+e^z)) without overflow or cancellation."""
+    if exponent > 0.0:
+        e = math.exp(-exponent)
+        return total * e / (1.0 + e), total / (1.0 + e)
+    e = math.exp(exponent)
+    return total / (1.0 + e), total * e / (1.0 + e)
+
+
+def branch_fractions(temperature, constants):
+    """(xi_MF, xi_P) [1] on a major branch at ``temperature`` [degC] (no argument checks)."""
+    exponent = constants.energy_over_kB * (
+        constants.inv_centre_K - 1.0 / (temperature + KELVIN_OFFSET))
+    return logistic_split(constants.M, exponent)
+
+
+def phase_fractions(xi_mf, xi_p, xi_f_min):
+    """PhaseFractions from the mixed fraction xi_MF, xi_P and the residual F (xi_M = xi_F')."""
+    half = 0.5 * xi_mf
+    return PhaseFractions(xi_p, half, xi_f_min + half)
+
+
+def constant_load_fractions(temperature, load, direction, params):
+    """Phase fractions on the major branch at ``temperature`` [degC], ``load`` [kg], ``direction``."""
+    temperature = require_temperature("temperature", temperature)
+    constants = branch_constants(load, direction, params)
+    xi_mf, xi_p = branch_fractions(temperature, constants)
+    return phase_fractions(xi_mf, xi_p, constants.xi_F_min)
+
+
+def constant_load_resistance(temperature, load, direction, params):
+    """Resistance R(T, f, d) [ohm] on the major branch (paper eq. 30)."""
+    return resistance_of(constant_load_fractions(temperature, load, direction, params), params)
+
+
+class BranchCache:
+    """Memo of :func:`branch_constants` per (load, direction) for steppers.
+
+    Loads are usually piecewise constant, so a few entries serve a whole run; the memo
+    is emptied when it reaches ``size`` entries so a continuously varying load stays cheap.
+    """
+
+    def __init__(self, params, size=64):
+        self.params = params
+        self.size = size
+        self._entries = {}
+
+    def get(self, load, direction):
+        """BranchConstants for ``load`` [kg] and ``direction`` (+1/-1)."""
+        key = (load, direction)
+        constants = self._entries.get(key)
+        if constants is None:
+            constants = branch_constants(load, direction, self.params)
+            if len(self._entries) >= self.size:
+                self._entries.clear()
+            self._entries[key] = constants
+        return constants

@@ -1,0 +1,213 @@
+"""The wire parameter set: its schema (name, section, unit, rule) and the validated values.
+
+The numbers themselves live only in a parameter file (``models/*.toml``); this module
+says what a parameter set must contain and derives the constants the models use
+(lattice, thermal gain and time constant, the lengths x_T and x_f).
+"""
+import math
+from collections import namedtuple
+from dataclasses import dataclass, field
+
+from .lattice import lattice_constants
+from .thermal import thermal_gain, thermal_time_constant
+
+__all__ = ["ParameterError", "ParameterSpec", "PARAMETER_SPECS", "WireParameters"]
+
+
+class ParameterError(ValueError):
+    """A parameter set or parameter file is malformed; the message names the key and value."""
+
+
+ParameterSpec = namedtuple("ParameterSpec", ["name", "section", "unit", "rule", "required"])
+ParameterSpec.__doc__ = "One entry of the parameter schema: where it lives, its unit, its rule."
+
+# rule: "positive" (> 0), "nonnegative" (>= 0), "fraction" (0 <= v < 1), "finite",
+#       "margin" (0 < v < 0.5)
+PARAMETER_SPECS = (
+    ParameterSpec("x0", "geometry", "m", "positive", True),
+    ParameterSpec("x_min", "geometry", "m", "positive", True),
+    ParameterSpec("diameter", "geometry", "m", "positive", True),
+    ParameterSpec("theta", "geometry", "1", "fraction", True),
+    ParameterSpec("mass", "geometry", "kg", "positive", True),
+    ParameterSpec("R_P", "phases", "ohm", "positive", True),
+    ParameterSpec("R_M", "phases", "ohm", "positive", True),
+    ParameterSpec("R_F", "phases", "ohm", "positive", True),
+    ParameterSpec("l_M", "phases", "m", "positive", True),
+    ParameterSpec("l_F", "phases", "m", "positive", True),
+    ParameterSpec("a_h", "hysteresis", "degC", "finite", True),
+    ParameterSpec("b_h", "hysteresis", "degC/kg", "finite", True),
+    ParameterSpec("a_c", "hysteresis", "degC", "finite", True),
+    ParameterSpec("b_c", "hysteresis", "degC/kg", "finite", True),
+    ParameterSpec("xi_F_inf", "constant_load", "1", "fraction", True),
+    ParameterSpec("f_F", "constant_load", "kg", "positive", True),
+    ParameterSpec("eps_T", "constant_load", "J", "positive", True),
+    ParameterSpec("nu", "constant_load", "1", "positive", True),
+    ParameterSpec("eps_f", "constant_temperature", "J", "finite", True),
+    ParameterSpec("nu_f", "constant_temperature", "1", "positive", True),
+    ParameterSpec("A_s", "thermal", "m2", "positive", True),
+    ParameterSpec("c_p", "thermal", "J/(kg.K)", "positive", True),
+    ParameterSpec("h_c", "thermal", "W/(m2.K)", "positive", True),
+    ParameterSpec("T_room", "thermal", "degC", "finite", True),
+    ParameterSpec("saturation_margin", "sensing", "1", "margin", True),
+    ParameterSpec("model_load", "control", "kg", "nonnegative", True),
+    ParameterSpec("alpha", "control", "s", "nonnegative", False),
+    ParameterSpec("beta", "control", "s", "positive", True),
+    ParameterSpec("Kp", "control", "W/ohm", "nonnegative", True),
+    ParameterSpec("Ki", "control", "W/(ohm.s)", "nonnegative", True),
+)
+
+SPEC_BY_NAME = {spec.name: spec for spec in PARAMETER_SPECS}
+
+_RULE_TEXT = {
+    "positive": "must be > 0",
+    "nonnegative": "must be >= 0",
+    "fraction": "must be in [0, 1)",
+    "finite": "must be finite",
+    "margin": "must be in (0, 0.5)",
+}
+
+
+def _rule_holds(rule, value):
+    if not math.isfinite(value):
+        return False
+    if rule == "positive":
+        return value > 0.0
+    if rule == "nonnegative":
+        return value >= 0.0
+    if rule == "fraction":
+        return 0.0 <= value < 1.0
+    if rule == "margin":
+        return 0.0 < value < 0.5
+    return True
+
+
+@dataclass(frozen=True)
+class WireParameters:
+    """Validated parameters of one SMA wire (units as in :data:`PARAMETER_SPECS`).
+
+    Derived constants are attributes too: ``lattice`` (N, x_P, N_l, N_S), ``N`` [1],
+    ``line_density`` = mass/x0 [kg/m], ``l_P`` = x_min [m], ``x_T`` = l_P - (l_M + l_F)/2 [m],
+    ``x_f`` = l_F - (l_P + l_M)/2 [m], ``R_MF`` = (R_M + R_F)/2 [ohm], ``K_th`` [K/W],
+    ``tau_th`` [s], ``phase_lag_alpha`` = alpha, or tau_th when alpha is not given [s].
+    """
+
+    x0: float
+    x_min: float
+    diameter: float
+    theta: float
+    mass: float
+    R_P: float
+    R_M: float
+    R_F: float
+    l_M: float
+    l_F: float
+    a_h: float
+    b_h: float
+    a_c: float
+    b_c: float
+    xi_F_inf: float
+    f_F: float
+    eps_T: float
+    nu: float
+    eps_f: float
+    nu_f: float
+    A_s: float
+    c_p: float
+    h_c: float
+    T_room: float
+    saturation_margin: float
+    model_load: float
+    beta: float
+    Kp: float
+    Ki: float
+    alpha: float = None
+    source: str = field(default="<parameters>", compare=False, repr=False)
+
+    lattice: tuple = field(init=False, repr=False, compare=False)
+    N: float = field(init=False, repr=False, compare=False)
+    line_density: float = field(init=False, repr=False, compare=False)
+    l_P: float = field(init=False, repr=False, compare=False)
+    x_T: float = field(init=False, repr=False, compare=False)
+    x_f: float = field(init=False, repr=False, compare=False)
+    R_MF: float = field(init=False, repr=False, compare=False)
+    K_th: float = field(init=False, repr=False, compare=False)
+    tau_th: float = field(init=False, repr=False, compare=False)
+    phase_lag_alpha: float = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        for spec in PARAMETER_SPECS:
+            value = getattr(self, spec.name)
+            if value is None and not spec.required:
+                continue
+            self._check(spec, value)
+        derived = self._derive()
+        for name, value in derived.items():
+            object.__setattr__(self, name, value)
+        self._check_consistency()
+
+    def _fail(self, message):
+        raise ParameterError(f"{self.source}: {message}")
+
+    def _check(self, spec, value):
+        key = f"{spec.section}.{spec.name}"
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self._fail(f"parameter {key} must be a number [{spec.unit}], got {value!r}")
+        value = float(value)
+        if not _rule_holds(spec.rule, value):
+            self._fail(f"parameter {key} = {value!r} {_RULE_TEXT[spec.rule]} [{spec.unit}]")
+        object.__setattr__(self, spec.name, value)
+
+    def _derive(self):
+        line_density = self.mass / self.x0
+        lattice = lattice_constants(self.x0, self.x_min, self.diameter, self.theta, line_density)
+        tau_th = thermal_time_constant(self.mass, self.c_p, self.h_c, self.A_s)
+        return dict(
+            lattice=lattice,
+            N=lattice.N,
+            line_density=line_density,
+            l_P=self.x_min,
+            x_T=self.x_min - 0.5 * (self.l_M + self.l_F),
+            x_f=self.l_F - 0.5 * (self.x_min + self.l_M),
+            R_MF=0.5 * (self.R_M + self.R_F),
+            K_th=thermal_gain(self.h_c, self.A_s),
+            tau_th=tau_th,
+            phase_lag_alpha=tau_th if self.alpha is None else self.alpha,
+        )
+
+    def _check_consistency(self):
+        if not self.R_MF > self.R_P:
+            self._fail(
+                f"(R_M + R_F)/2 = {self.R_MF!r} ohm must exceed R_P = {self.R_P!r} ohm: "
+                "resistance must fall as the wire transforms to P, or it cannot sense temperature")
+        if not self.x_f > 0.0:
+            self._fail(
+                f"x_f = l_F - (x_min + l_M)/2 = {self.x_f!r} m must be > 0: "
+                "the F phase must be the longest")
+        if not self.T_room > -273.15:
+            self._fail(f"parameter thermal.T_room = {self.T_room!r} degC is below absolute zero")
+
+    def values(self):
+        """Parameter values by name (only the schema's entries; alpha omitted when not given)."""
+        return {spec.name: getattr(self, spec.name) for spec in PARAMETER_SPECS
+                if getattr(self, spec.name) is not None}
+
+    def replace(self, **changes):
+        """A copy with some parameter values changed (validated again)."""
+        values = self.values()
+        unknown = sorted(set(changes) - set(SPEC_BY_NAME))
+        if unknown:
+            raise ParameterError(f"{self.source}: unknown parameter(s) {', '.join(unknown)}")
+        values.update(changes)
+        return WireParameters(**values, source=self.source)
+
+    @classmethod
+    def from_values(cls, values, source="<parameters>"):
+        """Build from a name -> value mapping; unknown or missing names raise ParameterError."""
+        unknown = sorted(set(values) - set(SPEC_BY_NAME))
+        if unknown:
+            raise ParameterError(f"{source}: unknown parameter(s) {', '.join(unknown)}")
+        missing = [s.name for s in PARAMETER_SPECS if s.required and s.name not in values]
+        if missing:
+            raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
+        return cls(**values, source=source)
+

@@ -1,0 +1,121 @@
+"""Stateful plant: thermal model + resistance hysteresis of one wire (spec sections 4, 6, 9, 11).
+
+One :meth:`PlantStepper.step` advances from t_k to t_k + h with the input power and the
+load held, and evaluates the outputs at the end of the step with the held load.
+The direction is sgn(T+ - T) (unchanged when T+ = T). In mode "switch" (the paper's)
+the fractions follow the major branch of that direction; in mode "continuous" a
+reversal found in a step stores (T_k, xi_MF_k) and the minor branch of section 6 follows.
+"""
+from collections import namedtuple
+
+from .checks import (fast_nonnegative, fast_positive, require_mode, require_nonnegative)
+from .constant_load import BranchCache, branch_fractions, require_temperature
+from .constants import COOLING, HEATING
+from .minor_loops import Reversal, minor_branch_fractions
+from .thermal import step_decay, thermal_step
+
+__all__ = ["PlantOutputs", "PlantStepper"]
+
+PlantOutputs = namedtuple("PlantOutputs", ["R", "T", "x", "xi_P", "xi_M", "xi_F", "heating"])
+PlantOutputs.__doc__ = """Plant outputs at a communication point.
+
+R : resistance [ohm]; T : temperature [degC]; x : wire length [m];
+xi_P, xi_M, xi_F : phase fractions [1]; heating : True while dT/dt > 0 (last sign kept).
+"""
+
+
+class PlantStepper:
+    """The SMA wire actuator: electric power and load in, resistance and state out.
+
+    Parameters
+    ----------
+    params : WireParameters
+    T_start : float, optional
+        Initial temperature [degC]; default the room temperature T_room.
+    mode : "switch" | "continuous"
+        Hysteresis mode: the paper's branch switch (default) or continuous minor loops.
+    load : float
+        Load during initialization [kg]; the initial outputs reflect it.
+
+    The wire starts heating, on the major branch.
+    """
+
+    def __init__(self, params, T_start=None, mode="switch", load=0.0):
+        self.params = params
+        self.mode = require_mode(mode, "hysteresis mode")
+        self._continuous = self.mode == "continuous"
+        self._branches = BranchCache(params)
+        self._decay = (None, None)
+        self.temperature = (params.T_room if T_start is None
+                            else require_temperature("T_start", T_start))
+        self.direction = HEATING
+        self.reversal = None
+        self.load = require_nonnegative("load", load)
+        constants = self._branches.get(self.load, HEATING)
+        self.xi_MF, self.xi_P = branch_fractions(self.temperature, constants)
+        self.outputs = self._evaluate(constants)
+
+    def step(self, power, load, step_size):
+        """Advance one step of ``step_size`` [s] with ``power`` [W] and ``load`` [kg] held.
+
+        Invalid inputs raise ``ValueError`` before any state changes.
+        """
+        power = fast_nonnegative("P_in", power)
+        load = fast_nonnegative("load", load)
+        step_size = fast_positive("step_size", step_size)
+        params = self.params
+        if step_size != self._decay[0]:
+            self._decay = (step_size, step_decay(step_size, params.tau_th))
+        before = self.temperature
+        after = thermal_step(before, power, params.T_room, params.K_th, self._decay[1])
+        direction = HEATING if after > before else (COOLING if after < before else self.direction)
+        constants = self._branches.get(load, direction)
+        reversal = self.reversal
+        if self._continuous:
+            if direction != self.direction:
+                reversal = Reversal(before, self.xi_MF)
+            if reversal is None:
+                xi_mf, xi_p = branch_fractions(after, constants)
+            else:
+                xi_mf, xi_p = minor_branch_fractions(after, constants, direction, reversal)
+        else:
+            xi_mf, xi_p = branch_fractions(after, constants)
+        self.temperature, self.direction, self.reversal, self.load = (
+            after, direction, reversal, load)
+        self.xi_MF, self.xi_P = xi_mf, xi_p
+        self.outputs = self._evaluate(constants)
+        return self.outputs
+
+    def _evaluate(self, constants):
+        params = self.params
+        xi_p = self.xi_P
+        xi_m = 0.5 * self.xi_MF
+        xi_f = constants.xi_F_min + xi_m
+        return PlantOutputs(
+            params.R_P * xi_p + params.R_M * xi_m + params.R_F * xi_f,
+            self.temperature,
+            params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f,
+            xi_p, xi_m, xi_f,
+            self.direction == HEATING,
+        )
+
+    def state(self):
+        """JSON-ready hidden state (temperature, direction, minor-loop memory, fractions, load)."""
+        return {
+            "temperature": self.temperature,
+            "direction": self.direction,
+            "reversal": None if self.reversal is None else list(self.reversal),
+            "load": self.load,
+            "xi_MF": self.xi_MF,
+            "xi_P": self.xi_P,
+        }
+
+    def restore(self, state):
+        """Restore a state saved by :meth:`state` and re-evaluate the outputs."""
+        self.temperature = state["temperature"]
+        self.direction = state["direction"]
+        self.reversal = None if state["reversal"] is None else Reversal(*state["reversal"])
+        self.load = state["load"]
+        self.xi_MF = state["xi_MF"]
+        self.xi_P = state["xi_P"]
+        self.outputs = self._evaluate(self._branches.get(self.load, self.direction))

@@ -1,0 +1,77 @@
+"""Temperature-sensing model: the inverse of the constant-load model (spec section 5, paper eq. 31).
+
+    xi_MF = (R - R_P - xi_Fmin (R_F - R_P)) / (R_MF - R_P),   valid for 0 < xi_MF < M
+    Lambda = ln((M - xi_MF)/xi_MF),   T_K = 1 / (1/tau_K - k_B Lambda / dH(f))
+
+Outside the transformation the resistance is saturated and carries no temperature
+information. There xi_MF is clamped into [delta, M - delta], delta = saturation_margin * M,
+the clamped temperature is returned and ``saturated`` is set. The flag is set whenever
+the clamp acts: outside (0, M) and also within delta of either end.
+"""
+import math
+from collections import namedtuple
+
+from .checks import direction_sign, require_positive
+from .constant_load import branch_constants
+from .constants import KELVIN_OFFSET
+from .minor_loops import major_equivalent
+
+__all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of_fractions",
+           "sense_temperature"]
+
+SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
+SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
+
+
+def mixed_fractions_of_resistance(resistance, constants, params):
+    """(xi_MF, xi_P) [1] that give ``resistance`` [ohm] on a branch with ``constants``.
+
+    Both are computed as differences from the saturated ends, so each is accurate
+    near its own end of the transformation.
+    """
+    span = params.R_MF - params.R_P
+    r_hot = params.R_P + constants.xi_F_min * (params.R_F - params.R_P)
+    r_cold = r_hot + constants.M * span
+    return (resistance - r_hot) / span, (r_cold - resistance) / span
+
+
+def temperature_of_fractions(xi_mf, xi_p, constants, margin):
+    """Invert a major branch: (xi_MF, xi_P) [1] -> :class:`SensedTemperature`.
+
+    ``margin`` is the relative clamp delta/M [1].
+    """
+    delta = margin * constants.M
+    saturated = False
+    if not xi_mf >= delta:
+        xi_mf, xi_p, saturated = delta, constants.M - delta, True
+    elif not xi_p >= delta:
+        xi_mf, xi_p, saturated = constants.M - delta, delta, True
+    exponent = math.log(xi_p / xi_mf)
+    inverse_kelvin = constants.inv_centre_K - exponent / constants.energy_over_kB
+    if not inverse_kelvin > 0.0:
+        raise ValueError(
+            f"temperature-sensing inverse diverges at Lambda = {exponent!r}: dH(f)/k_B = "
+            f"{constants.energy_over_kB!r} K is too small for the hysteresis centre")
+    return SensedTemperature(1.0 / inverse_kelvin - KELVIN_OFFSET, saturated)
+
+
+def sense_temperature(resistance, load, direction, params, reversal=None):
+    """Temperature [degC] of a wire with ``resistance`` [ohm] under ``load`` [kg].
+
+    ``direction`` is +1/"heating" or -1/"cooling". With ``reversal`` (a
+    :class:`~.minor_loops.Reversal`) the point is on the continuous-mode minor branch
+    that left that reversal; otherwise on the major branch (what the compensator uses).
+    """
+    resistance = require_positive("resistance", resistance)
+    sign = direction_sign(direction)
+    constants = branch_constants(load, sign, params)
+    xi_mf, xi_p = mixed_fractions_of_resistance(resistance, constants, params)
+    if reversal is not None:
+        inside = 0.0 < xi_mf < constants.M
+        major = major_equivalent(xi_mf, xi_p, constants, sign, reversal)
+        if major is None:
+            return SensedTemperature(reversal.temperature, True)
+        sensed = temperature_of_fractions(major[0], major[1], constants,
+                                          params.saturation_margin)
+        return SensedTemperature(sensed.temperature, sensed.saturated or not inside)
+    return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin)
