@@ -1,0 +1,153 @@
+"""Read and write wire parameter files (TOML, every entry with value, unit and meaning).
+
+A parameter file looks like ``models/reference_wire.toml``::
+
+    [wire]
+    name = "reference"
+    description = "..."
+
+    [geometry]
+    x0 = { value = 0.800, unit = "m", meaning = "length at low temperature, never loaded" }
+
+Sections and keys follow :data:`sma_fmu.runtime.parameters.PARAMETER_SPECS`; unknown or
+missing keys, wrong units, non-numbers and values breaking a rule raise
+:class:`ParameterError` naming the file, the key and the value.
+"""
+import json
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .project_files import default_parameter_file
+from .runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+__all__ = ["ParameterSet", "load_parameter_set", "load_parameters", "parse_parameter_document",
+           "write_parameter_file", "ParameterError"]
+
+_ENTRY_FIELDS = {"value", "unit", "meaning"}
+_SECTIONS = {spec.section for spec in PARAMETER_SPECS}
+
+
+@dataclass(frozen=True)
+class ParameterSet:
+    """A parameter file's content: the validated parameters plus their descriptions."""
+
+    params: WireParameters
+    name: str
+    description: str
+    meanings: dict = field(default_factory=dict)
+    path: Path = None
+
+    def as_json(self):
+        """JSON-ready dict {name, description, parameters: {key: {value, unit, meaning}}}."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "parameters": {
+                spec.name: {"value": getattr(self.params, spec.name), "unit": spec.unit,
+                            "meaning": self.meanings.get(spec.name, "")}
+                for spec in PARAMETER_SPECS if getattr(self.params, spec.name) is not None
+            },
+        }
+
+
+def parse_parameter_document(document, source):
+    """Validate a parsed TOML document and return a :class:`ParameterSet`."""
+    wire = document.get("wire", {})
+    if not isinstance(wire, dict):
+        raise ParameterError(f"{source}: [wire] must be a table")
+    unknown_sections = sorted(set(document) - _SECTIONS - {"wire"})
+    if unknown_sections:
+        raise ParameterError(f"{source}: unknown section(s) {', '.join(unknown_sections)}; "
+                             f"expected {', '.join(sorted(_SECTIONS | {'wire'}))}")
+    values, meanings = {}, {}
+    specs_by_section = {}
+    for spec in PARAMETER_SPECS:
+        specs_by_section.setdefault(spec.section, {})[spec.name] = spec
+    for section, entries in document.items():
+        if section == "wire":
+            continue
+        if not isinstance(entries, dict):
+            raise ParameterError(f"{source}: [{section}] must be a table")
+        for key, entry in entries.items():
+            spec = specs_by_section[section].get(key)
+            if spec is None:
+                raise ParameterError(f"{source}: unknown parameter {section}.{key}; expected one "
+                                     f"of {', '.join(specs_by_section[section])}")
+            values[key], meanings[key] = _parse_entry(entry, spec, source)
+    missing = [f"{s.section}.{s.name}" for s in PARAMETER_SPECS if s.required and s.name not in values]
+    if missing:
+        raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
+    params = WireParameters.from_values(values, source=str(source))
+    return ParameterSet(params, str(wire.get("name", Path(str(source)).stem)),
+                        str(wire.get("description", "")), meanings)
+
+
+def _parse_entry(entry, spec, source):
+    key = f"{spec.section}.{spec.name}"
+    if not isinstance(entry, dict):
+        raise ParameterError(f"{source}: parameter {key} must be a table "
+                             f"{{ value = ..., unit = \"{spec.unit}\", meaning = \"...\" }}, got {entry!r}")
+    extra = sorted(set(entry) - _ENTRY_FIELDS)
+    if extra:
+        raise ParameterError(f"{source}: parameter {key} has unknown field(s) {', '.join(extra)}")
+    for name in ("value", "unit"):
+        if name not in entry:
+            raise ParameterError(f"{source}: parameter {key} has no {name}")
+    if entry["unit"] != spec.unit:
+        raise ParameterError(f"{source}: parameter {key} has unit {entry['unit']!r}; "
+                             f"expected {spec.unit!r}")
+    value = entry["value"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError(f"{source}: parameter {key} value must be a number "
+                             f"[{spec.unit}], got {value!r}")
+    return float(value), str(entry.get("meaning", ""))
+
+
+def load_parameter_set(path=None):
+    """Load a parameter file (default: the reference wire) as a :class:`ParameterSet`."""
+    path = Path(path) if path is not None else default_parameter_file()
+    try:
+        with open(path, "rb") as stream:
+            document = tomllib.load(stream)
+    except FileNotFoundError:
+        raise ParameterError(f"{path}: parameter file not found") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ParameterError(f"{path}: not valid TOML: {error}") from None
+    parsed = parse_parameter_document(document, path)
+    return ParameterSet(parsed.params, parsed.name, parsed.description, parsed.meanings, path)
+
+
+def load_parameters(path=None):
+    """Load only the :class:`WireParameters` of a parameter file (default: the reference wire)."""
+    return load_parameter_set(path).params
+
+
+def write_parameter_file(path, params, name, description="", meanings=None, header=()):
+    """Write ``params`` as a parameter file in the format of ``models/`` and return the path.
+
+    ``meanings`` maps parameter names to one-line meanings; ``header`` lines become comments.
+    Values are written with full precision (``repr``) so the file reloads exactly.
+    """
+    meanings = meanings or {}
+    lines = [f"# {line}" for line in header]
+    lines += ["", "[wire]", f"name = {json.dumps(name)}",
+              f"description = {json.dumps(description)}"]
+    section = None
+    for spec in PARAMETER_SPECS:
+        value = getattr(params, spec.name)
+        if value is None:
+            continue
+        if spec.section != section:
+            section = spec.section
+            lines += ["", f"[{section}]"]
+        lines.append(f"{spec.name} = {{ value = {float(value)!r}, unit = {json.dumps(spec.unit)}, "
+                     f"meaning = {json.dumps(meanings.get(spec.name, ''))} }}")
+    path = Path(path)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
