@@ -1,0 +1,134 @@
+"""Command line ``sma-fmu``: thin wrappers; each flag maps onto one API argument.
+
+Every command prints ``name = value unit`` lines, or one JSON object with ``--json``.
+Errors go to stderr as ``sma-fmu: error: ...`` with exit status 2.
+"""
+import argparse
+import json
+import sys
+
+from .parameter_file import load_parameter_set
+from .runtime.checks import direction_name, direction_sign, require_finite
+from .runtime.constant_length import load_temperature_slope
+from .runtime.constant_load import constant_load_fractions
+from .runtime.phases import length_of, resistance_of
+from .runtime.sensing import sense_temperature
+
+__all__ = ["main", "build_parser"]
+
+
+class CommandError(Exception):
+    """A command failed for a reason the user can fix; the message says which."""
+
+
+def _report(rows, as_json):
+    """Print rows of (name, value, unit) as text lines or one JSON object."""
+    if as_json:
+        print(json.dumps({name: value for name, value, _ in rows}))
+        return
+    for name, value, unit in rows:
+        text = f"{value:.6g}" if isinstance(value, float) else str(value)
+        print(f"{name} = {text}{' ' + unit if unit else ''}")
+
+
+def _number(text):
+    """argparse type: a finite float (NaN/inf rejected with the value in the message)."""
+    try:
+        return require_finite("value", float(text))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}") from None
+
+
+def _cmd_lattice(args, parameter_set):
+    lattice = parameter_set.params.lattice
+    return [("N", lattice.N, ""), ("x_P", lattice.x_P, "m"), ("N_l", lattice.N_l, ""),
+            ("N_S", lattice.N_S, "")]
+
+
+def _cmd_resistance(args, parameter_set):
+    params = parameter_set.params
+    fractions = constant_load_fractions(args.temperature, args.load, args.direction, params)
+    return [("temperature", args.temperature, "degC"), ("load", args.load, "kg"),
+            ("direction", direction_name(args.direction), ""),
+            ("R", resistance_of(fractions, params), "ohm"),
+            ("xi_P", fractions.xi_P, ""), ("xi_M", fractions.xi_M, ""),
+            ("xi_F", fractions.xi_F, ""), ("x", length_of(fractions, params), "m")]
+
+
+def _cmd_sense(args, parameter_set):
+    sensed = sense_temperature(args.resistance, args.load, args.direction, parameter_set.params)
+    return [("resistance", args.resistance, "ohm"), ("load", args.load, "kg"),
+            ("direction", direction_name(args.direction), ""),
+            ("T", sensed.temperature, "degC"), ("saturated", sensed.saturated, "")]
+
+
+def _cmd_constant_length(args, parameter_set):
+    slope = load_temperature_slope(args.xi_p, args.xi_m, args.xi_f, parameter_set.params)
+    return [("xi_P", args.xi_p, ""), ("xi_M", args.xi_m, ""), ("xi_F", args.xi_f, ""),
+            ("df_dT", slope, "kg/K")]
+
+
+def _direction(text):
+    """argparse type: "heating" or "cooling" -> +1 or -1."""
+    try:
+        return direction_sign(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def _add_direction(parser):
+    parser.add_argument("--direction", required=True, type=_direction,
+                        metavar="heating|cooling", help="sign of dT/dt")
+
+
+def build_parser():
+    """The argparse parser of ``sma-fmu``."""
+    parser = argparse.ArgumentParser(
+        prog="sma-fmu", description="SMA wire actuator model, compensator and FMUs.")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--model", metavar="FILE",
+                        help="parameter file (default: models/reference_wire.toml)")
+    common.add_argument("--json", action="store_true", help="print one JSON object")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    lattice = commands.add_parser("lattice", parents=[common],
+                                  help="lattice constants N, x_P, N_l, N_S")
+    lattice.set_defaults(handler=_cmd_lattice)
+
+    resistance = commands.add_parser("resistance", parents=[common],
+                                     help="resistance, fractions and length at T, load, direction")
+    resistance.add_argument("--temperature", required=True, type=_number, metavar="C",
+                            help="wire temperature [degC]")
+    resistance.add_argument("--load", required=True, type=_number, metavar="KG",
+                            help="hung mass [kg]")
+    _add_direction(resistance)
+    resistance.set_defaults(handler=_cmd_resistance)
+
+    sense = commands.add_parser("sense", parents=[common],
+                                help="temperature from resistance (inverse model)")
+    sense.add_argument("--resistance", required=True, type=_number, metavar="OHM",
+                       help="wire resistance [ohm]")
+    sense.add_argument("--load", required=True, type=_number, metavar="KG", help="hung mass [kg]")
+    _add_direction(sense)
+    sense.set_defaults(handler=_cmd_sense)
+
+    length = commands.add_parser("constant-length", parents=[common],
+                                 help="(df/dT)_x of a wire held at constant length [kg/K]")
+    length.add_argument("--xi-p", required=True, type=_number, help="P fraction [1]")
+    length.add_argument("--xi-m", required=True, type=_number, help="M fraction [1]")
+    length.add_argument("--xi-f", required=True, type=_number, help="F fraction [1]")
+    length.set_defaults(handler=_cmd_constant_length)
+    return parser
+
+
+def main(argv=None):
+    """Run the command line; returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        parameter_set = load_parameter_set(args.model)
+        _report(args.handler(args, parameter_set), args.json)
+    except (ValueError, CommandError, FileNotFoundError) as error:
+        print(f"sma-fmu: error: {error}", file=sys.stderr)
+        return 2
+    return 0
