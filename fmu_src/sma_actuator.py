@@ -1,0 +1,85 @@
+"""SmaActuator: the SMA wire plant (thermal model + resistance hysteresis) as an FMI 2.0 CS FMU.
+
+A thin adapter over ``sma_fmu.runtime.plant.PlantStepper``. At build time ``sma_fmu.runtime``
+is renamed to a version-stamped package shipped in resources/, so FMUs of different
+versions loaded into one process never share a module.
+
+Semantics: doStep(t, h) holds P_in and load over the step; the outputs are then the
+state at t + h with the held load (no direct feedthrough). After initialization the
+outputs reflect T_start and the load set during initialization. Invalid parameters are
+logged as fmi2Error at exitInitializationMode; the outputs are then NaN and every
+doStep is discarded (pythonfmu would turn an exception there into fmi2Fatal).
+"""
+from pythonfmu import Fmi2Slave
+from pythonfmu.default_experiment import DefaultExperiment
+
+from sma_fmu.runtime.fmi_slave import SlaveInterface
+from sma_fmu.runtime.plant import PlantStepper
+
+OUTPUTS = (
+    ("R", "ohm", "wire resistance"),
+    ("T", "degC", "wire temperature"),
+    ("x", "m", "wire length"),
+    ("xi_P", "1", "P-phase (austenite) fraction"),
+    ("xi_M", "1", "M-phase (twinned martensite) fraction"),
+    ("xi_F", "1", "F-phase (detwinned martensite) fraction"),
+)
+INVALID_OUTPUTS = (float("nan"),) * len(OUTPUTS) + (False,)
+
+
+class SmaActuator(Fmi2Slave):
+
+    author = "sma-fmu"
+    description = "SMA wire actuator: Joule heating, first-order thermal model, resistance hysteresis under load"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.interface = fmi = SlaveInterface(self)
+        fmi.input("P_in", 0.0, "W", "electric power I^2 R into the wire (>= 0)")
+        fmi.input("load", 0.0, "kg", "hung mass on the wire (>= 0); force = g * load")
+        for name, unit, text in OUTPUTS:
+            fmi.output(name, unit, text)
+        fmi.boolean_output("heating", "true while dT/dt > 0 (the last sign is kept when dT/dt = 0)")
+        fmi.parameter("T_start", fmi.defaults.T_room, "degC", "initial wire temperature")
+        fmi.string_parameter("hysteresis_mode", "switch",
+                             "'switch' (paper: branch follows sgn dT/dt) or 'continuous' (minor loops)")
+        fmi.model_parameters()
+        self.stepper = None
+        self._publish(PlantStepper(fmi.defaults, self.T_start, self.hysteresis_mode, self.load).outputs)
+
+    def _publish(self, outputs):
+        self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.heating = outputs
+
+    def _start(self):
+        stepper = PlantStepper(self.interface.wire_parameters(), self.T_start,
+                               self.hysteresis_mode, self.load)
+        return stepper, stepper.outputs
+
+    def exit_initialization_mode(self):
+        self.stepper, outputs = self.interface.initialize(self._start, INVALID_OUTPUTS)
+        self._publish(outputs)
+
+    def do_step(self, current_time, step_size):
+        if self.stepper is None:
+            return self.interface.not_initialized(current_time)
+        try:
+            self._publish(self.stepper.step(self.P_in, self.load, step_size))
+        except Exception as error:  # an exception here would reach the host as fmi2Fatal
+            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
+        return True
+
+    def to_xml(self, model_options=dict()):
+        return self.interface.decorate(super().to_xml(model_options))
+
+    def _get_fmu_state(self):
+        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
+
+    def _set_fmu_state(self, state):
+        variables, stepper_state = self.interface.split_state(state)
+        super()._set_fmu_state(variables)
+        if stepper_state is not None:
+            if self.stepper is None:
+                self.stepper = self._start()[0]
+            self.stepper.restore(stepper_state)
+            self._publish(self.stepper.outputs)

@@ -1,0 +1,73 @@
+"""What pythonfmu 0.7.0 leaves out of modelDescription.xml, added with xml.etree (stdlib only).
+
+- ``<UnitDefinitions>`` and a ``unit`` attribute on every Real variable that has one;
+- ``ModelStructure/Outputs`` dependencies (empty: outputs change only in doStep);
+- ``ModelStructure/InitialUnknowns`` listing the outputs computed at initialization.
+"""
+from xml.etree.ElementTree import Element, SubElement
+
+__all__ = ["UNIT_DEFINITIONS", "decorate_model_description"]
+
+# FMI 2.0 BaseUnit exponents (kg, m, s, A, K) and offset for every unit the FMUs use
+UNIT_DEFINITIONS = {
+    "1": {},
+    "W": {"kg": 1, "m": 2, "s": -3},
+    "kg": {"kg": 1},
+    "ohm": {"kg": 1, "m": 2, "s": -3, "A": -2},
+    "degC": {"K": 1, "offset": 273.15},
+    "m": {"m": 1},
+    "s": {"s": 1},
+    "degC/kg": {"K": 1, "kg": -1},
+    "J": {"kg": 1, "m": 2, "s": -2},
+    "m2": {"m": 2},
+    "J/(kg.K)": {"m": 2, "s": -2, "K": -1},
+    "W/(m2.K)": {"kg": 1, "s": -3, "K": -1},
+    "W/ohm": {"A": 2},
+    "W/(ohm.s)": {"A": 2, "s": -1},
+}
+
+# schema order of fmiModelDescription's children (FMI 2.0 XSD)
+_ORDER = ["CoSimulation", "UnitDefinitions", "TypeDefinitions", "LogCategories",
+          "DefaultExperiment", "VendorAnnotations", "ModelVariables", "ModelStructure"]
+
+
+def _unit_definitions(units):
+    node = Element("UnitDefinitions")
+    for name in sorted(set(units)):
+        if name not in UNIT_DEFINITIONS:
+            raise ValueError(f"unit {name!r} has no FMI definition; add it to UNIT_DEFINITIONS")
+        unit = SubElement(node, "Unit", name=name)
+        SubElement(unit, "BaseUnit", {k: str(v) for k, v in UNIT_DEFINITIONS[name].items()})
+    return node
+
+
+def decorate_model_description(root, units):
+    """Complete pythonfmu's ``root`` element in place and return it.
+
+    ``units`` maps variable names to unit names (keys of :data:`UNIT_DEFINITIONS`).
+    """
+    variables = root.find("ModelVariables")
+    output_indices = []
+    for index, variable in enumerate(variables, start=1):
+        name = variable.get("name")
+        real = variable.find("Real")
+        if real is not None and name in units:
+            real.set("unit", units[name])
+        if variable.get("causality") == "output" and variable.get("initial") in ("calculated", "approx"):
+            output_indices.append(index)
+    if units:
+        root.insert(_ORDER.index("UnitDefinitions"), _unit_definitions(units.values()))
+        children = sorted(root, key=lambda child: _ORDER.index(child.tag))
+        for child in list(root):
+            root.remove(child)
+        root.extend(children)
+    structure = root.find("ModelStructure")
+    outputs = structure.find("Outputs")
+    if outputs is not None:
+        for unknown in outputs:
+            unknown.set("dependencies", "")
+    if output_indices:
+        initial = SubElement(structure, "InitialUnknowns")
+        for index in output_indices:
+            SubElement(initial, "Unknown", index=str(index))
+    return root
