@@ -1,12 +1,16 @@
 """Command line ``sma-fmu``: thin wrappers; each flag maps onto one API argument.
 
-Every command prints ``name = value unit`` lines, or one JSON object with ``--json``.
-Errors go to stderr as ``sma-fmu: error: ...`` with exit status 2.
+The model commands print ``name = value unit`` lines, or one JSON object with ``--json``.
+Errors go to stderr as ``sma-fmu: error: ...`` with exit status 2; ``validate`` exits 1
+when an FMU has problems.
 """
 import argparse
 import json
 import sys
 
+from pathlib import Path
+
+from . import fmu_build
 from .parameter_file import load_parameter_set
 from .runtime.checks import direction_name, direction_sign, require_finite
 from .runtime.constant_length import load_temperature_slope
@@ -76,6 +80,37 @@ def _direction(text):
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
+def _model_command(compute):
+    """Handler that loads the parameter file, computes rows and prints them."""
+    def handler(args):
+        _report(compute(args, load_parameter_set(args.model)), args.json)
+        return 0
+    return handler
+
+
+def _cmd_build(args):
+    paths = fmu_build.build_fmus(args.out, args.model)
+    for name, path in paths.items():
+        print(f"{name}: {path}")
+    return 0
+
+
+def _cmd_validate(args):
+    paths = args.fmus or list(fmu_build.default_fmu_paths(args.out).values())
+    failed = False
+    for path, problems in fmu_build.validate_fmus(paths).items():
+        print(f"{path}: {'valid (fmpy: no problems)' if not problems else f'{len(problems)} problem(s)'}")
+        for problem in problems:
+            print(f"  - {problem}")
+        failed = failed or bool(problems)
+    return 1 if failed else 0
+
+
+def _cmd_bench(args):
+    from .benchmark import main as bench_main
+    return bench_main(args.out, args.runs)
+
+
 def _add_direction(parser):
     parser.add_argument("--direction", required=True, type=_direction,
                         metavar="heating|cooling", help="sign of dT/dt")
@@ -93,7 +128,7 @@ def build_parser():
 
     lattice = commands.add_parser("lattice", parents=[common],
                                   help="lattice constants N, x_P, N_l, N_S")
-    lattice.set_defaults(handler=_cmd_lattice)
+    lattice.set_defaults(handler=_model_command(_cmd_lattice))
 
     resistance = commands.add_parser("resistance", parents=[common],
                                      help="resistance, fractions and length at T, load, direction")
@@ -102,7 +137,7 @@ def build_parser():
     resistance.add_argument("--load", required=True, type=_number, metavar="KG",
                             help="hung mass [kg]")
     _add_direction(resistance)
-    resistance.set_defaults(handler=_cmd_resistance)
+    resistance.set_defaults(handler=_model_command(_cmd_resistance))
 
     sense = commands.add_parser("sense", parents=[common],
                                 help="temperature from resistance (inverse model)")
@@ -110,14 +145,34 @@ def build_parser():
                        help="wire resistance [ohm]")
     sense.add_argument("--load", required=True, type=_number, metavar="KG", help="hung mass [kg]")
     _add_direction(sense)
-    sense.set_defaults(handler=_cmd_sense)
+    sense.set_defaults(handler=_model_command(_cmd_sense))
 
     length = commands.add_parser("constant-length", parents=[common],
                                  help="(df/dT)_x of a wire held at constant length [kg/K]")
     length.add_argument("--xi-p", required=True, type=_number, help="P fraction [1]")
     length.add_argument("--xi-m", required=True, type=_number, help="M fraction [1]")
     length.add_argument("--xi-f", required=True, type=_number, help="F fraction [1]")
-    length.set_defaults(handler=_cmd_constant_length)
+    length.set_defaults(handler=_model_command(_cmd_constant_length))
+
+    build = commands.add_parser("build", help="build the SmaActuator and SmaFeedforward FMUs")
+    build.add_argument("--out", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
+                       help=f"output folder (default: {fmu_build.DEFAULT_FMU_DIR})")
+    build.add_argument("--model", metavar="FILE",
+                       help="parameter file the FMUs carry (default: models/reference_wire.toml)")
+    build.set_defaults(handler=_cmd_build)
+
+    validate = commands.add_parser("validate", help="validate FMUs with fmpy (exit 1 on problems)")
+    validate.add_argument("fmus", nargs="*", type=Path, metavar="FMU",
+                          help="FMU files (default: both FMUs in --out)")
+    validate.add_argument("--out", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
+                          help=f"folder of the default FMUs (default: {fmu_build.DEFAULT_FMU_DIR})")
+    validate.set_defaults(handler=_cmd_validate)
+
+    bench = commands.add_parser("bench", help="measure speed; print a table and write JSON")
+    bench.add_argument("--out", type=Path, default=Path("results/benchmark"), metavar="DIR",
+                       help="output folder (default: results/benchmark)")
+    bench.add_argument("--runs", type=int, default=5, help="repetitions per measurement")
+    bench.set_defaults(handler=_cmd_bench)
     return parser
 
 
@@ -126,9 +181,7 @@ def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        parameter_set = load_parameter_set(args.model)
-        _report(args.handler(args, parameter_set), args.json)
+        return args.handler(args)
     except (ValueError, CommandError, FileNotFoundError) as error:
         print(f"sma-fmu: error: {error}", file=sys.stderr)
         return 2
-    return 0
