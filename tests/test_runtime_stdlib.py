@@ -9,9 +9,13 @@ import sma_fmu.runtime
 RUNTIME = Path(sma_fmu.runtime.__file__).parent
 
 
+# fmi_slave.py runs only inside an FMU (or its build), and every pythonfmu FMU ships pythonfmu
+FMU_ONLY = {"fmi_slave.py": {"pythonfmu"}}
+
+
 def test_runtime_imports_only_stdlib_and_itself():
-    allowed = set(sys.stdlib_module_names)
     for path in sorted(RUNTIME.glob("*.py")):
+        allowed = set(sys.stdlib_module_names) | FMU_ONLY.get(path.name, set())
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.Import):
                 roots = [alias.name.split(".")[0] for alias in node.names]
@@ -23,17 +27,23 @@ def test_runtime_imports_only_stdlib_and_itself():
                 assert root in allowed, f"{path.name} imports {root}"
 
 
-def test_runtime_runs_with_numpy_blocked():
-    """Import and use every runtime module in a fresh interpreter where numpy cannot load."""
-    code = (
-        "import sys; sys.modules['numpy'] = None; sys.modules['scipy'] = None\n"
-        "import importlib, pkgutil, sma_fmu.runtime as rt\n"
-        "for m in pkgutil.iter_modules(rt.__path__): importlib.import_module('sma_fmu.runtime.' + m.name)\n"
-        "from sma_fmu.runtime.parameters import WireParameters\n"
-        "from sma_fmu.runtime.plant import PlantStepper\n"
-        "assert 'numpy' not in [k for k, v in sys.modules.items() if v is not None]\n"
-        "print('ok')\n"
-    )
+def _run_blocked(blocked, body):
+    code = "import sys\n" + "".join(f"sys.modules[{name!r}] = None\n" for name in blocked) + body
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "ok"
+
+
+def test_library_runtime_runs_without_numpy_scipy_or_pythonfmu():
+    """Every runtime module but fmi_slave imports and steps with those packages unavailable."""
+    _run_blocked(["numpy", "scipy", "pythonfmu"], (
+        "import importlib, pkgutil, sma_fmu.runtime as rt\n"
+        "for m in pkgutil.iter_modules(rt.__path__):\n"
+        "    if m.name != 'fmi_slave': importlib.import_module('sma_fmu.runtime.' + m.name)\n"
+        "from sma_fmu.runtime.parameters import WireParameters\n"
+        "from sma_fmu.runtime.plant import PlantStepper\n"
+        "print('ok')\n"))
+
+
+def test_fmi_slave_needs_only_pythonfmu_besides_stdlib():
+    _run_blocked(["numpy", "scipy"], "import sma_fmu.runtime.fmi_slave\nprint('ok')\n")

@@ -1,0 +1,104 @@
+"""Bad inputs to the FMUs: a discard with a logged message naming the input; nothing is lost."""
+import math
+
+import pytest
+
+from fmu_signals import STEP
+from sma_fmu.fmu_instance import FmuError, FmuInstance
+from sma_fmu.runtime.feedforward import FeedforwardStepper
+from sma_fmu.runtime.plant import PlantStepper
+
+DISCARD, FATAL = 2, 4
+
+
+@pytest.mark.parametrize("power,load,step,message", [
+    (math.nan, 0.05, STEP, "P_in must be finite, got nan"),
+    (math.inf, 0.05, STEP, "P_in must be finite, got inf"),
+    (-0.5, 0.05, STEP, "P_in must be >= 0, got -0.5"),
+    (0.8, -0.01, STEP, "load must be >= 0, got -0.01"),
+    (0.8, math.nan, STEP, "load must be finite, got nan"),
+    (0.8, 0.05, 0.0, "step_size must be > 0, got 0.0"),
+    (0.8, 0.05, -STEP, "step_size must be > 0, got -0.001"),
+])
+def test_plant_discards_bad_input_and_stays_usable(fmus, params, power, load, step, message):
+    library = PlantStepper(params, load=0.05)
+    with FmuInstance(fmus["SmaActuator"], "plant", {"load": 0.05}) as fmu:
+        for k in range(100):
+            fmu.set_real(("P_in", "load"), (0.8, 0.05))
+            fmu.step(k * STEP, STEP)
+            library.step(0.8, 0.05, STEP)
+        fmu.set_real(("P_in", "load"), (power, load))
+        with pytest.raises(FmuError, match="fmi2DoStep failed \\(discard\\)") as raised:
+            fmu.step(100 * STEP, step)
+        assert raised.value.status == DISCARD
+        assert message in str(raised.value)
+        assert "plant" in str(raised.value) and "t = 0.1" in str(raised.value)
+        assert fmu.messages[-1][0] == "error"
+        # the rejected step changed nothing: the instance goes on like the library
+        for k in range(100, 200):
+            fmu.set_real(("P_in", "load"), (0.8, 0.05))
+            fmu.step(k * STEP, STEP)
+            out = library.step(0.8, 0.05, STEP)
+        assert fmu.get_real(("R", "T")) == [out.R, out.T]
+
+
+@pytest.mark.parametrize("reference,load,step,message", [
+    (math.nan, 0.05, STEP, "R_ref must be finite, got nan"),
+    (-41.0, 0.05, STEP, "R_ref must be > 0, got -41.0"),
+    (41.0, -0.2, STEP, "load must be >= 0, got -0.2"),
+    (41.0, math.inf, STEP, "load must be finite, got inf"),
+    (41.0, 0.05, 0.0, "step_size must be > 0, got 0.0"),
+])
+def test_feedforward_discards_bad_input_and_stays_usable(fmus, params, reference, load, step, message):
+    library = FeedforwardStepper(params)
+    with FmuInstance(fmus["SmaFeedforward"], "ff", {"R_ref": 44.0, "load": 0.05}) as fmu:
+        for k in range(50):
+            fmu.set_real(("R_ref", "load"), (44.0 - 0.01 * k, 0.05))
+            fmu.step(k * STEP, STEP)
+            library.step(44.0 - 0.01 * k, 0.05, STEP)
+        fmu.set_real(("R_ref", "load"), (reference, load))
+        with pytest.raises(FmuError) as raised:
+            fmu.step(50 * STEP, step)
+        assert raised.value.status == DISCARD and message in str(raised.value)
+        fmu.set_real(("R_ref", "load"), (43.0, 0.05))
+        fmu.step(50 * STEP, STEP)
+        out = library.step(43.0, 0.05, STEP)
+        assert fmu.get_real(("P_ff", "T_ref")) == [out.P_ff, out.T_ref]
+
+
+@pytest.mark.parametrize("name,start,message", [
+    ("SmaActuator", {"hysteresis_mode": "smooth"},
+     "hysteresis mode must be one of switch, continuous, got 'smooth'"),
+    ("SmaActuator", {"T_start": math.nan}, "T_start must be finite, got nan"),
+    ("SmaActuator", {"R_P": -33.0}, "parameter phases.R_P = -33.0 must be > 0 [ohm]"),
+    ("SmaActuator", {"load": -1.0}, "load must be >= 0, got -1.0"),
+    ("SmaFeedforward", {"beta": 0.0}, "parameter control.beta = 0.0 must be > 0 [s]"),
+    ("SmaFeedforward", {"R_ref": math.nan}, "R_ref must be finite, got nan"),
+])
+def test_bad_parameters_fail_initialization_with_a_message(fmus, name, start, message):
+    with pytest.raises(FmuError, match="initialization failed") as raised:
+        FmuInstance(fmus[name], "bad", start)
+    assert message in str(raised.value)
+
+
+def test_bad_parameter_seen_by_a_plain_fmpy_host(fmus, tmp_path):
+    """Straight fmpy: exitInitializationMode does not go fatal; outputs are NaN; steps discard."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi2 import FMU2Slave
+
+    description = read_model_description(str(fmus["SmaActuator"]))
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    fmu = FMU2Slave(guid=description.guid, unzipDirectory=extract(str(fmus["SmaActuator"]), tmp_path),
+                    modelIdentifier="SmaActuator", instanceName="raw")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.setReal([refs["h_c"]], [-106.0])
+    assert fmu.exitInitializationMode() == 0          # fmi2OK, the reason is logged as fmi2Error
+    assert all(math.isnan(v) for v in fmu.getReal([refs["R"], refs["T"]]))
+    with pytest.raises(FMICallException) as raised:
+        fmu.doStep(0.0, STEP)
+    assert raised.value.status == DISCARD
+    fmu.terminate()
+    fmu.freeInstance()                                 # allowed: nothing went fatal
