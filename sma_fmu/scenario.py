@@ -1,0 +1,225 @@
+"""Scenario files (TOML): what to simulate, with which controller, for how long.
+
+Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
+
+    [scenario]
+    description = "..."
+    stop_time_s = 30.0
+    step_s = 0.001
+    # model = "../models/reference_wire.toml"   (parameter file, relative to this file)
+
+    [reference]                 # R_ref(t) in ohm; kinds: constant step ramp sine cosine table
+    kind = "cosine"
+    offset_ohm = 41.85
+    amplitude_ohm = 6.05
+    frequency_hz = 0.5
+
+    [load]                      # piecewise constant: values_kg[i] from times_s[i] on
+    times_s = [0.0, 10.0, 20.0]
+    values_kg = [0.0032, 0.05, 0.15]
+
+    [controller]                # pi | pi+ff-fixed | pi+ff-adaptive
+    kind = "pi+ff-adaptive"     # optional, default from the parameter file's [control]:
+                                # Kp_W_per_ohm, Ki_W_per_ohm_s, alpha_s, beta_s, model_load_kg
+    [plant]
+    hysteresis_mode = "switch"  # or "continuous"; optional T_start_degC (default T_room)
+
+Every problem raises :class:`ScenarioError` naming the file, the key and what is wrong.
+"""
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from .parameter_file import load_parameter_set
+from .project_files import project_folder
+from .runtime.parameters import ParameterError
+from .signals import load_from_table, reference_from_table
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = ["ScenarioError", "ControllerSettings", "Scenario", "CONTROLLERS", "PAPER_SET",
+           "load_scenario", "scenario_names", "resolve_scenarios"]
+
+CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")
+PAPER_SET = tuple(f"{profile}-{controller}" for profile in ("load-step", "heavy")
+                  for controller in CONTROLLERS)
+_SECTIONS = {
+    "scenario": {"description", "stop_time_s", "step_s", "model"},
+    "reference": None,  # checked by signals.reference_from_table
+    "load": None,       # checked by signals.load_from_table
+    "controller": {"kind", "Kp_W_per_ohm", "Ki_W_per_ohm_s", "alpha_s", "beta_s", "model_load_kg"},
+    "plant": {"hysteresis_mode", "T_start_degC"},
+}
+_GAIN_KEYS = {"Kp_W_per_ohm": "Kp", "Ki_W_per_ohm_s": "Ki", "alpha_s": "phase_lag_alpha",
+              "beta_s": "beta", "model_load_kg": "model_load"}
+
+
+class ScenarioError(ValueError):
+    """A scenario file or name is wrong; the message names the file, the key and the problem."""
+
+
+@dataclass(frozen=True)
+class ControllerSettings:
+    """Controller of a scenario: kind and gains (Kp [W/ohm], Ki [W/(ohm.s)], alpha, beta [s],
+    model_load [kg] of the fixed compensator)."""
+
+    kind: str
+    Kp: float
+    Ki: float
+    alpha: float
+    beta: float
+    model_load: float
+
+    @property
+    def feedforward(self):
+        """True when the controller uses the compensator."""
+        return self.kind != "pi"
+
+    @property
+    def adapt_to_load(self):
+        """True when the compensator's inverse uses the measured load."""
+        return self.kind == "pi+ff-adaptive"
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario (see the module docstring for the file format)."""
+
+    name: str
+    path: Path
+    description: str
+    stop_time_s: float
+    step_s: float
+    reference: object
+    load: object
+    controller: ControllerSettings
+    hysteresis_mode: str
+    T_start: float
+    parameter_set: object
+
+    @property
+    def params(self):
+        """The wire's WireParameters."""
+        return self.parameter_set.params
+
+    @property
+    def steps(self):
+        """Number of communication steps n = stop_time / step."""
+        return int(round(self.stop_time_s / self.step_s))
+
+    @property
+    def group(self):
+        """Name without the controller suffix: scenarios of one group differ only in controller."""
+        suffix = "-" + self.controller.kind
+        return self.name[:-len(suffix)] if self.name.endswith(suffix) else self.name
+
+
+def _fail(path, message):
+    raise ScenarioError(f"{path}: {message}")
+
+
+def _number(path, section, table, key, default=None, positive=False):
+    if key not in table:
+        if default is None:
+            _fail(path, f"[{section}] missing key {key}")
+        return default
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        _fail(path, f"[{section}] {key} must be a finite number, got {value!r}")
+    if positive and not value > 0:
+        _fail(path, f"[{section}] {key} must be > 0, got {value!r}")
+    return float(value)
+
+
+def _controller(path, table, params):
+    kind = table.get("kind")
+    if kind not in CONTROLLERS:
+        _fail(path, f"[controller] kind must be one of {', '.join(CONTROLLERS)}, got {kind!r}")
+    values = {}
+    for key, attribute in _GAIN_KEYS.items():
+        value = _number(path, "controller", table, key, default=getattr(params, attribute))
+        if value < 0 or (key == "beta_s" and value == 0):
+            _fail(path, f"[controller] {key} must be {'> 0' if key == 'beta_s' else '>= 0'}, got {value!r}")
+        values[attribute] = value
+    return ControllerSettings(kind, values["Kp"], values["Ki"], values["phase_lag_alpha"],
+                              values["beta"], values["model_load"])
+
+
+def load_scenario(path):
+    """Read and validate a scenario file; returns a :class:`Scenario`."""
+    path = Path(path)
+    try:
+        with open(path, "rb") as stream:
+            document = tomllib.load(stream)
+    except FileNotFoundError:
+        raise ScenarioError(f"{path}: scenario file not found") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ScenarioError(f"{path}: not valid TOML: {error}") from None
+    for section, table in document.items():
+        if section not in _SECTIONS:
+            _fail(path, f"unknown section [{section}]; expected {', '.join(_SECTIONS)}")
+        if not isinstance(table, dict):
+            _fail(path, f"[{section}] must be a table")
+        allowed = _SECTIONS[section]
+        if allowed is not None and set(table) - allowed:
+            _fail(path, f"[{section}] unknown key(s) {', '.join(sorted(set(table) - allowed))}; "
+                        f"expected {', '.join(sorted(allowed))}")
+    for section in ("scenario", "reference", "load", "controller"):
+        if section not in document:
+            _fail(path, f"missing section [{section}]")
+    head = document["scenario"]
+    stop = _number(path, "scenario", head, "stop_time_s", positive=True)
+    step = _number(path, "scenario", head, "step_s", positive=True)
+    if abs(stop / step - round(stop / step)) > 1e-9 * (stop / step):
+        _fail(path, f"[scenario] stop_time_s = {stop!r} is not a whole number of steps of {step!r} s")
+    model = head.get("model")
+    try:
+        parameter_set = load_parameter_set(None if model is None else path.parent / model)
+    except ParameterError as error:
+        _fail(path, f"[scenario] model: {error}")
+    signals = {}
+    for section, build in (("reference", reference_from_table), ("load", load_from_table)):
+        try:
+            signals[section] = build(document[section])
+        except ValueError as error:
+            _fail(path, f"[{section}] {error}")
+    plant = document.get("plant", {})
+    mode = plant.get("hysteresis_mode", "switch")
+    if mode not in ("switch", "continuous"):
+        _fail(path, f"[plant] hysteresis_mode must be 'switch' or 'continuous', got {mode!r}")
+    t_start = _number(path, "plant", plant, "T_start_degC", default=parameter_set.params.T_room)
+    return Scenario(
+        name=path.stem, path=path, description=str(head.get("description", "")),
+        stop_time_s=stop, step_s=step, reference=signals["reference"], load=signals["load"],
+        controller=_controller(path, document["controller"], parameter_set.params),
+        hysteresis_mode=mode, T_start=t_start, parameter_set=parameter_set)
+
+
+def scenario_names():
+    """Names (file stems) of the scenarios shipped in ``scenarios/``, sorted."""
+    return sorted(p.stem for p in project_folder("scenarios").glob("*.toml"))
+
+
+def resolve_scenarios(items, everything=False):
+    """Scenario files for names, paths, ``"paper"`` (the paper's set) or ``everything``."""
+    folder = project_folder("scenarios")
+    names = list(scenario_names()) if everything else []
+    for item in items:
+        names.extend(PAPER_SET if item == "paper" else [item])
+    if not names:
+        raise ScenarioError("no scenario given; name one, or use 'paper' or --all")
+    paths = []
+    for name in names:
+        candidate = Path(name)
+        if candidate.suffix == ".toml" and candidate.is_file():
+            paths.append(candidate)
+        elif (folder / f"{name}.toml").is_file():
+            paths.append(folder / f"{name}.toml")
+        else:
+            raise ScenarioError(f"unknown scenario {name!r}; known: {', '.join(scenario_names())}, "
+                                f"paper, or a path to a .toml file")
+    return list(dict.fromkeys(paths))

@@ -1,0 +1,159 @@
+"""Scenario signals: the reference R_ref(t) [ohm] and the piecewise-constant load f(t) [kg].
+
+Built from the ``[reference]`` and ``[load]`` tables of a scenario file. Problems raise
+``ValueError`` naming the key; the scenario loader adds the file and section.
+"""
+import bisect
+import math
+
+__all__ = ["REFERENCE_KINDS", "ReferenceSignal", "LoadProfile", "reference_from_table",
+           "load_from_table"]
+
+# kind -> (required keys, optional keys with defaults)
+REFERENCE_KINDS = {
+    "constant": (("value_ohm",), {}),
+    "step": (("initial_ohm", "final_ohm", "time_s"), {}),
+    "ramp": (("start_ohm", "end_ohm", "start_time_s", "end_time_s"), {}),
+    "sine": (("offset_ohm", "amplitude_ohm", "frequency_hz"), {"phase_deg": 0.0}),
+    "cosine": (("offset_ohm", "amplitude_ohm", "frequency_hz"), {"phase_deg": 0.0}),
+    "table": (("times_s", "values_ohm"), {}),
+}
+
+
+def _number(table, key):
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{key} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _numbers(table, key):
+    values = table[key]
+    if not isinstance(values, list) or not values:
+        raise ValueError(f"{key} must be a non-empty list of numbers, got {values!r}")
+    return [_number({key: v}, key) for v in values]
+
+
+def _increasing(times, key):
+    if any(b <= a for a, b in zip(times, times[1:])):
+        raise ValueError(f"{key} must be strictly increasing, got {times!r}")
+
+
+class ReferenceSignal:
+    """R_ref(t) [ohm]: one of :data:`REFERENCE_KINDS`, with its settings."""
+
+    def __init__(self, kind, settings):
+        self.kind = kind
+        self.settings = dict(settings)
+        s = self.settings
+        if kind == "table":
+            self._times, self._values = s["times_s"], s["values_ohm"]
+        lowest = self._lowest()
+        if not lowest > 0.0:
+            raise ValueError(f"the reference must stay > 0 ohm, but reaches {lowest!r} ohm")
+
+    def _lowest(self):
+        s = self.settings
+        if self.kind == "constant":
+            return s["value_ohm"]
+        if self.kind == "step":
+            return min(s["initial_ohm"], s["final_ohm"])
+        if self.kind == "ramp":
+            return min(s["start_ohm"], s["end_ohm"])
+        if self.kind in ("sine", "cosine"):
+            return s["offset_ohm"] - abs(s["amplitude_ohm"])
+        return min(self._values)
+
+    def value(self, t):
+        """R_ref [ohm] at time ``t`` [s]."""
+        s = self.settings
+        if self.kind == "constant":
+            return s["value_ohm"]
+        if self.kind == "step":
+            return s["final_ohm"] if t >= s["time_s"] else s["initial_ohm"]
+        if self.kind == "ramp":
+            t0, t1 = s["start_time_s"], s["end_time_s"]
+            share = min(1.0, max(0.0, (t - t0) / (t1 - t0)))
+            return s["start_ohm"] + share * (s["end_ohm"] - s["start_ohm"])
+        if self.kind in ("sine", "cosine"):
+            wave = math.sin if self.kind == "sine" else math.cos
+            angle = 2.0 * math.pi * s["frequency_hz"] * t + math.radians(s["phase_deg"])
+            return s["offset_ohm"] + s["amplitude_ohm"] * wave(angle)
+        return _interpolate(self._times, self._values, t)
+
+
+def _interpolate(times, values, t):
+    if t <= times[0]:
+        return values[0]
+    if t >= times[-1]:
+        return values[-1]
+    i = bisect.bisect_right(times, t) - 1
+    share = (t - times[i]) / (times[i + 1] - times[i])
+    return values[i] + share * (values[i + 1] - values[i])
+
+
+class LoadProfile:
+    """Piecewise-constant load: ``values_kg[i]`` from ``times_s[i]`` on (the first time is 0 s)."""
+
+    def __init__(self, times, values):
+        self.times = list(times)
+        self.values = list(values)
+
+    def value(self, t, tolerance=1e-9):
+        """Load [kg] at ``t`` [s]; a switching time within ``tolerance`` [s] counts as reached."""
+        return self.values[bisect.bisect_right(self.times, t + tolerance) - 1]
+
+    def segments(self, stop_time):
+        """[(start [s], end [s], load [kg])] of the segments that begin before ``stop_time``."""
+        ends = self.times[1:] + [math.inf]
+        return [(start, min(end, stop_time), value)
+                for start, end, value in zip(self.times, ends, self.values) if start < stop_time]
+
+
+def reference_from_table(table):
+    """A :class:`ReferenceSignal` from a scenario's ``[reference]`` table."""
+    kind = table.get("kind")
+    if kind not in REFERENCE_KINDS:
+        raise ValueError(f"kind must be one of {', '.join(REFERENCE_KINDS)}, got {kind!r}")
+    required, optional = REFERENCE_KINDS[kind]
+    unknown = sorted(set(table) - set(required) - set(optional) - {"kind"})
+    if unknown:
+        raise ValueError(f"unknown key(s) {', '.join(unknown)} for kind {kind!r}; expected "
+                         f"{', '.join(required + tuple(optional))}")
+    missing = [key for key in required if key not in table]
+    if missing:
+        raise ValueError(f"missing key(s) {', '.join(missing)} for kind {kind!r}")
+    settings = dict(optional)
+    for key in table:
+        if key == "kind":
+            continue
+        settings[key] = _numbers(table, key) if key.startswith(("times", "values")) else _number(table, key)
+    if kind == "table":
+        if len(settings["times_s"]) != len(settings["values_ohm"]):
+            raise ValueError("times_s and values_ohm must have the same length")
+        _increasing(settings["times_s"], "times_s")
+    if kind == "ramp" and not settings["end_time_s"] > settings["start_time_s"]:
+        raise ValueError("end_time_s must be after start_time_s")
+    if kind in ("sine", "cosine") and settings["frequency_hz"] < 0.0:
+        raise ValueError(f"frequency_hz must be >= 0, got {settings['frequency_hz']!r}")
+    return ReferenceSignal(kind, settings)
+
+
+def load_from_table(table):
+    """A :class:`LoadProfile` from a scenario's ``[load]`` table (times_s, values_kg)."""
+    unknown = sorted(set(table) - {"times_s", "values_kg"})
+    if unknown:
+        raise ValueError(f"unknown key(s) {', '.join(unknown)}; expected times_s, values_kg")
+    for key in ("times_s", "values_kg"):
+        if key not in table:
+            raise ValueError(f"missing key {key}")
+    times, values = _numbers(table, "times_s"), _numbers(table, "values_kg")
+    if len(times) != len(values):
+        raise ValueError("times_s and values_kg must have the same length")
+    if times[0] != 0.0:
+        raise ValueError(f"times_s must start at 0, got {times[0]!r}")
+    _increasing(times, "times_s")
+    negative = [v for v in values if v < 0.0]
+    if negative:
+        raise ValueError(f"values_kg must be >= 0, got {negative[0]!r}")
+    return LoadProfile(times, values)
