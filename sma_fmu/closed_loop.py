@@ -1,0 +1,111 @@
+"""The closed loop of the paper's Fig. 9, sequenced as in spec section 11, for any plant/compensator.
+
+One loop serves both paths: the FMU path (:mod:`sma_fmu.master`, plant and compensator
+are FMUs under fmpy) and the library path (here, the runtime steppers directly). Per
+step k = 0 ... n-1 (t_k = k h): read R_k; e_k = R_k - R_ref(t_k); the compensator takes
+R_ref(t_k), f(t_k) -> u_ff,k; the PI gives u_k = max(0, u_ff,k + Kp e_k + Ki I_k); the plant
+steps t_k -> t_k+1 with u_k and f(t_k) held. Sample n records R_n and T_n only.
+"""
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .runtime.feedforward import FeedforwardStepper
+from .runtime.pi_control import PIController
+from .runtime.plant import PlantStepper
+
+__all__ = ["COLUMNS", "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator",
+           "run_library"]
+
+COLUMNS = (("t", "s"), ("R_ref", "ohm"), ("R", "ohm"), ("T", "degC"), ("T_ref", "degC"),
+           ("P_ff", "W"), ("P_fb", "W"), ("P", "W"), ("load", "kg"), ("saturated", ""))
+_DTYPE = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
+
+
+@dataclass
+class LoopResult:
+    """Time series of one run: ``data`` is a structured array with the fields of :data:`COLUMNS`."""
+
+    scenario: object
+    data: np.ndarray
+    path: str
+    wall_time_s: float
+
+
+class LibraryPlant:
+    """The plant as the runtime :class:`PlantStepper` (library path)."""
+
+    def __init__(self, scenario):
+        self.stepper = PlantStepper(scenario.params, scenario.T_start, scenario.hysteresis_mode,
+                                    scenario.load.value(0.0))
+
+    def outputs(self):
+        """(R [ohm], T [degC]) now."""
+        return self.stepper.outputs.R, self.stepper.outputs.T
+
+    def step(self, time_s, power, load, step_size):
+        """Advance one step; returns (R, T) at its end."""
+        out = self.stepper.step(power, load, step_size)
+        return out.R, out.T
+
+    def close(self):
+        """Nothing to release."""
+
+
+class LibraryCompensator:
+    """The compensator as the runtime :class:`FeedforwardStepper` (library path)."""
+
+    def __init__(self, scenario):
+        c = scenario.controller
+        self.stepper = FeedforwardStepper(scenario.params, c.alpha, c.beta, c.model_load,
+                                          c.adapt_to_load)
+
+    def step(self, time_s, reference, load, step_size):
+        """(P_ff [W], T_ref [degC], saturated) for the sample at ``time_s``."""
+        return self.stepper.step(reference, load, step_size)
+
+    def close(self):
+        """Nothing to release."""
+
+
+def run_loop(scenario, plant, compensator=None):
+    """Close the loop over ``scenario``; returns the structured time-series array.
+
+    ``plant`` has ``outputs()`` and ``step(t, power, load, h)`` returning (R, T);
+    ``compensator`` (None for the "pi" controller) has ``step(t, R_ref, load, h)``
+    returning (P_ff, T_ref, saturated).
+    """
+    h, n = scenario.step_s, scenario.steps
+    times = [k * h for k in range(n + 1)]
+    references = [scenario.reference.value(t) for t in times]
+    loads = [scenario.load.value(t) for t in times]
+    gains = scenario.controller
+    pi = PIController(gains.Kp, gains.Ki)
+    nan = math.nan
+    rows = []
+    resistance, temperature = plant.outputs()
+    for k in range(n):
+        time_s, reference, load = times[k], references[k], loads[k]
+        error = resistance - reference
+        if compensator is None:
+            p_ff, t_ref, saturated = 0.0, nan, False
+        else:
+            p_ff, t_ref, saturated = compensator.step(time_s, reference, load, h)
+        power, feedback = pi.step(error, p_ff, h)
+        rows.append((time_s, reference, resistance, temperature, t_ref, p_ff, feedback, power,
+                     load, saturated))
+        resistance, temperature = plant.step(time_s, power, load, h)
+    rows.append((times[n], references[n], resistance, temperature, nan, nan, nan, nan, loads[n],
+                 False))
+    return np.array(rows, dtype=_DTYPE)
+
+
+def run_library(scenario):
+    """Run ``scenario`` on the library steppers (no FMUs); returns a :class:`LoopResult`."""
+    start = time.perf_counter()
+    plant = LibraryPlant(scenario)
+    compensator = LibraryCompensator(scenario) if scenario.controller.feedforward else None
+    data = run_loop(scenario, plant, compensator)
+    return LoopResult(scenario, data, "library", time.perf_counter() - start)
