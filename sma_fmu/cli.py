@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from . import fmu_build
+from .fmu_instance import FmuError
 from .parameter_file import load_parameter_set
 from .runtime.checks import direction_name, direction_sign, require_finite
 from .runtime.constant_length import load_temperature_slope
@@ -106,6 +107,14 @@ def _cmd_validate(args):
     return 1 if failed else 0
 
 
+def _cmd_run(args):
+    from .runner import timed_run
+    from .scenario import resolve_scenarios
+    paths = resolve_scenarios(args.scenarios, everything=args.all)
+    timed_run(paths, args.out, args.path, args.fmus)
+    return 0
+
+
 def _cmd_bench(args):
     from .benchmark import main as bench_main
     return bench_main(args.out, args.runs)
@@ -168,6 +177,19 @@ def build_parser():
                           help=f"folder of the default FMUs (default: {fmu_build.DEFAULT_FMU_DIR})")
     validate.set_defaults(handler=_cmd_validate)
 
+    run = commands.add_parser(
+        "run", help="run scenarios (names, files, 'paper' or --all): CSV, metrics, figures")
+    run.add_argument("scenarios", nargs="*", metavar="SCENARIO",
+                     help="scenario name from scenarios/, a .toml file, or 'paper'")
+    run.add_argument("--all", action="store_true", help="every scenario in scenarios/")
+    run.add_argument("--out", type=Path, default=Path("results"), metavar="DIR",
+                     help="output folder (default: results)")
+    run.add_argument("--path", choices=("fmu", "library"), default="fmu",
+                     help="fmu: the FMUs under fmpy (default); library: the steppers directly")
+    run.add_argument("--fmus", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
+                     help=f"folder of the built FMUs (default: {fmu_build.DEFAULT_FMU_DIR})")
+    run.set_defaults(handler=_cmd_run)
+
     bench = commands.add_parser("bench", help="measure speed; print a table and write JSON")
     bench.add_argument("--out", type=Path, default=Path("results/benchmark"), metavar="DIR",
                        help="output folder (default: results/benchmark)")
@@ -182,6 +204,6 @@ def main(argv=None):
     args = parser.parse_args(argv)
     try:
         return args.handler(args)
-    except (ValueError, CommandError, FileNotFoundError) as error:
+    except (ValueError, CommandError, FileNotFoundError, FmuError) as error:
         print(f"sma-fmu: error: {error}", file=sys.stderr)
         return 2
