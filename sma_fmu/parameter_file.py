@@ -27,7 +27,7 @@ else:  # pragma: no cover - exercised on Python 3.10 only
     import tomli as tomllib
 
 __all__ = ["ParameterSet", "load_parameter_set", "load_parameters", "parse_parameter_document",
-           "write_parameter_file", "ParameterError"]
+           "parameter_file_text", "write_parameter_file", "ParameterError"]
 
 _ENTRY_FIELDS = {"value", "unit", "meaning"}
 _SECTIONS = {spec.section for spec in PARAMETER_SPECS}
@@ -128,8 +128,8 @@ def load_parameters(path=None):
     return load_parameter_set(path).params
 
 
-def write_parameter_file(path, params, name, description="", meanings=None, header=()):
-    """Write ``params`` as a parameter file in the format of ``models/`` and return the path.
+def parameter_file_text(params, name, description="", meanings=None, header=()):
+    """``params`` as the text of a parameter file in the format of ``models/``.
 
     ``meanings`` maps parameter names to one-line meanings; ``header`` lines become comments.
     Values are written with full precision (``repr``) so the file reloads exactly.
@@ -148,6 +148,11 @@ def write_parameter_file(path, params, name, description="", meanings=None, head
             lines += ["", f"[{section}]"]
         lines.append(f"{spec.name} = {{ value = {float(value)!r}, unit = {json.dumps(spec.unit)}, "
                      f"meaning = {json.dumps(meanings.get(spec.name, ''))} }}")
+    return "\n".join(lines) + "\n"
+
+
+def write_parameter_file(path, params, name, description="", meanings=None, header=()):
+    """Write :func:`parameter_file_text` to ``path``; returns the path."""
     path = Path(path)
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    path.write_text(parameter_file_text(params, name, description, meanings, header), encoding="utf-8")
     return path
