@@ -115,6 +115,39 @@ def _cmd_run(args):
     return 0
 
 
+def _cmd_fit(args):
+    from .fit_runner import format_report, run_fit
+    out = args.out or Path("results") / f"fit-{args.experiment}"
+    report = run_fit(args.experiment, args.files, out, args.model)
+    print(format_report(report))
+    print(f"written: {out}/identified.toml, report.json, figures")
+    return 0
+
+
+def _number_list(text):
+    """argparse type: comma-separated finite numbers."""
+    try:
+        return [require_finite("value", float(item)) for item in text.split(",") if item.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+
+
+def _cmd_synth(args):
+    from .synthetic import constant_load_rows, constant_temperature_rows, write_rows
+    params = load_parameter_set(args.model).params
+    if args.experiment == "constant-load":
+        rows = constant_load_rows(params, args.loads or [0.0032, 0.05, 0.15, 0.25], args.t_min,
+                                  args.t_max, args.t_step, args.noise_ohm, args.noise_K, args.seed,
+                                  not args.no_direction)
+    else:
+        rows = constant_temperature_rows(params, args.temperature,
+                                         args.loads or [0.0, 0.1, 0.03, 0.2, 0.03, 0.3],
+                                         args.load_step, args.noise_ohm, args.noise_K, args.seed)
+    write_rows(args.out, rows)
+    print(f"{args.out}: {len(rows)} rows ({args.experiment}, seed {args.seed})")
+    return 0
+
+
 def _cmd_bench(args):
     from .benchmark import main as bench_main
     return bench_main(args.out, args.runs)
@@ -189,6 +222,36 @@ def build_parser():
     run.add_argument("--fmus", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
                      help=f"folder of the built FMUs (default: {fmu_build.DEFAULT_FMU_DIR})")
     run.set_defaults(handler=_cmd_run)
+
+    fit = commands.add_parser("fit", help="identify parameters from measurements (CSV)")
+    fit.add_argument("experiment", choices=("constant-load", "constant-temperature"))
+    fit.add_argument("files", nargs="+", metavar="FILE", help="measurement CSV file(s)")
+    fit.add_argument("--out", type=Path, metavar="DIR",
+                     help="output folder (default: results/fit-EXPERIMENT)")
+    fit.add_argument("--model", metavar="FILE",
+                     help="base parameter file for everything not fitted (default: reference wire)")
+    fit.set_defaults(handler=_cmd_fit)
+
+    synth = commands.add_parser("synth", help="synthetic measurement CSV from a parameter file")
+    synth.add_argument("experiment", choices=("constant-load", "constant-temperature"))
+    synth.add_argument("--out", type=Path, required=True, metavar="FILE", help="CSV file to write")
+    synth.add_argument("--model", metavar="FILE", help="parameter file (default: reference wire)")
+    synth.add_argument("--loads", type=_number_list, metavar="KG,KG,...",
+                       help="constant-load: the loads [kg] (default 0.0032,0.05,0.15,0.25); "
+                            "constant-temperature: the load path (default 0,0.1,0.03,0.2,0.03,0.3)")
+    synth.add_argument("--t-min", type=_number, default=10.0, help="sweep start [degC] (10)")
+    synth.add_argument("--t-max", type=_number, default=110.0, help="sweep end [degC] (110)")
+    synth.add_argument("--t-step", type=_number, default=1.0, help="sweep step [K] (1)")
+    synth.add_argument("--temperature", type=_number, default=20.0,
+                       help="constant-temperature: the temperature [degC] (20)")
+    synth.add_argument("--load-step", type=_number, default=0.005,
+                       help="constant-temperature: load sampling step [kg] (0.005)")
+    synth.add_argument("--noise-ohm", type=_number, default=0.0, help="resistance noise sigma [ohm]")
+    synth.add_argument("--noise-K", type=_number, default=0.0, help="temperature noise sigma [K]")
+    synth.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    synth.add_argument("--no-direction", action="store_true",
+                       help="constant-load: leave out the direction column")
+    synth.set_defaults(handler=_cmd_synth)
 
     bench = commands.add_parser("bench", help="measure speed; print a table and write JSON")
     bench.add_argument("--out", type=Path, default=Path("results/benchmark"), metavar="DIR",

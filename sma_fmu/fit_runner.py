@@ -1,0 +1,75 @@
+"""``sma-fmu fit``: read measurement files, identify parameters, write the results.
+
+Writes into ``out_dir``: ``identified.toml`` (a complete parameter file in the format of
+``models/``, ready for the FMUs and scenarios), ``report.json`` and PNG figures. All of it
+is computed first; nothing is written when reading, checking or fitting fails.
+"""
+import json
+from datetime import datetime, timezone
+from pathlib import Path
+
+from . import fit_constant_load, fit_constant_temperature
+from .fit_plots import constant_load_figures, constant_temperature_figures
+from .measurements import read_constant_load, read_constant_temperature
+from .parameter_file import load_parameter_set, parameter_file_text
+
+__all__ = ["EXPERIMENTS", "run_fit", "format_report"]
+
+EXPERIMENTS = ("constant-load", "constant-temperature")
+
+
+def _fit(experiment, files, base):
+    """(FitResult, report, {figure name: PNG bytes}) of one experiment."""
+    if experiment == "constant-load":
+        data = read_constant_load(files)
+        result, report = fit_constant_load.fit_constant_load(data, base)
+        sensed, _, _ = fit_constant_load.sensing_comparison(result.params, data)
+        return result, report, constant_load_figures(result.params, data, sensed)
+    experiments = [read_constant_temperature(f) for f in files]
+    result, report = fit_constant_temperature.fit_constant_temperature(experiments, base)
+    model = fit_constant_temperature.model_resistance(result.params, experiments)
+    return result, report, constant_temperature_figures(result.params, experiments, model)
+
+
+def run_fit(experiment, files, out_dir, model=None):
+    """Identify from ``files``; write identified.toml, report.json and figures; return report."""
+    if experiment not in EXPERIMENTS:
+        raise ValueError(f"experiment must be one of {', '.join(EXPERIMENTS)}, got {experiment!r}")
+    if not files:
+        raise ValueError("no measurement file given")
+    base_set = load_parameter_set(model)
+    result, report, figures = _fit(experiment, [Path(f) for f in files], base_set.params)
+    fitted = ", ".join(p.name for p in result.parameters)
+    stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    report["base_parameter_file"] = str(base_set.path)
+    text = parameter_file_text(
+        result.params, f"{base_set.name}-identified",
+        f"{experiment} fit of {', '.join(Path(f).name for f in files)}; MAPE "
+        f"{report['mape_percent']:.3g} %", base_set.meanings,
+        header=[f"Identified by sma-fmu fit {experiment} on {stamp}.",
+                f"Fitted: {fitted}; everything else from {base_set.path}.",
+                f"Data: {', '.join(str(f) for f in files)}"])
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "identified.toml").write_text(text, encoding="utf-8")
+    (out_dir / "report.json").write_text(json.dumps(report, indent=2), encoding="utf-8")
+    for name, png in figures.items():
+        (out_dir / name).write_bytes(png)
+    return report
+
+
+def format_report(report):
+    """A short text summary of a fit report."""
+    lines = [f"{report['experiment']} fit: {report['points']} points, MAPE "
+             f"{report['mape_percent']:.3f} %, max |error| {report['max_abs_error_ohm']:.4g} ohm, "
+             f"{report['solver']['seconds']:.3f} s ({report['solver']['evaluations']} evaluations)",
+             f"{'parameter':<12}{'value':>14}{'std error':>12}{'start':>14}"]
+    for name, row in report["parameters"].items():
+        flag = "  (at bound)" if row["at_bound"] else ""
+        lines.append(f"{name:<12}{row['value']:>14.6g}{row['std_error']:>12.3g}{row['start']:>14.6g}{flag}")
+    sensing = report.get("temperature_sensing")
+    if sensing:
+        core = sensing["core_5_95_percent"]
+        lines.append(f"temperature sensing (5-95 % of the transformation): {core['points']} points, "
+                     f"RMSE {core['rmse_K']:.3g} K, max {core['max_abs_K']:.3g} K")
+    return "\n".join(lines)
