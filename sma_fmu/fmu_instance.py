@@ -2,14 +2,18 @@
 
 Collects the FMU's log messages per instance and turns a failed FMI call into an
 :class:`FmuError` that quotes them, so a discarded step says which input was wrong.
+The stepping calls (set/get Real, get Boolean, doStep) go straight to the FMU's exported
+C functions with preallocated arrays; everything else uses fmpy's wrappers.
 """
 import shutil
-from ctypes import byref
+import sys
+from pathlib import Path
+from ctypes import POINTER, PyDLL, c_double, c_int, c_size_t, c_uint, c_void_p
 
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2CallbackFunctions,
-                       fmi2CallbackLoggerTYPE, fmi2Real, fmi2ValueReference)
+                       fmi2CallbackLoggerTYPE)
 
 __all__ = ["FmuError", "FmuInstance"]
 
@@ -22,6 +26,44 @@ class FmuError(RuntimeError):
     def __init__(self, message, status):
         super().__init__(message)
         self.status = status
+
+
+class Port:
+    """A fixed tuple of variables with preallocated C arrays: the stepping hot path.
+
+    ``set(values)`` / ``get()`` call the FMU's exported C function directly (fmpy's
+    Python wrappers skipped) and raise :class:`FmuError` on a status above fmi2Warning.
+    """
+
+    def __init__(self, owner, names, references, ctype, setter, getter):
+        self.owner = owner
+        self.names = names
+        self.count = len(references)
+        self.references = (c_uint * self.count)(*references)
+        self.values = (ctype * self.count)()
+        self._setter, self._getter = setter, getter
+
+    def set(self, values):
+        """Set the variables to ``values`` (same order as the names)."""
+        self.values[:] = values
+        status = self._setter(self.owner.component, self.references, self.count, self.values)
+        if status > 1:
+            raise self.owner.failure(f"set {', '.join(self.names)}", status)
+
+    def get(self):
+        """The variables' values, as a list."""
+        status = self._getter(self.owner.component, self.references, self.count, self.values)
+        if status > 1:
+            raise self.owner.failure(f"get {', '.join(self.names)}", status)
+        return self.values[:]
+
+
+def _raw(library, name, argtypes):
+    """The FMU's exported C function ``name`` with its types set (fmpy's own wrappers skipped)."""
+    function = getattr(library, name)
+    function.argtypes = argtypes
+    function.restype = c_int
+    return function
 
 
 class FmuInstance:
@@ -54,17 +96,30 @@ class FmuInstance:
         self._callbacks.logger = self._logger
         self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
         self._callbacks.freeMemory = defaultCallbacks.freeMemory
-        try:
-            from fmpy.logging import addLoggerProxy
-            addLoggerProxy(byref(self._callbacks))
-        except Exception:  # pragma: no cover - fmpy's optional native proxy is missing
-            pass
-        self._vr_cache = {}
+        # No fmpy.logging.addLoggerProxy: it keeps ONE logger in a C global, so messages of
+        # every instance would reach the last instance's logger, and a freed logger would be
+        # called later (heap corruption). pythonfmu passes the finished message as the
+        # format argument without varargs, so a plain per-instance callback receives it whole.
+        self._ports = {}
+        self._reported = 0  # messages before this index are in an earlier FmuError already
+        # the library fmpy loaded, called without releasing the GIL: pythonfmu's C++ takes it
+        # back at once anyway (PyGILState_Ensure), so keeping it saves a hand-off per call
+        library = PyDLL(self._fmu.dll._name, handle=self._fmu.dll._handle)
+        reals = [c_void_p, POINTER(c_uint), c_size_t, POINTER(c_double)]
+        booleans = [c_void_p, POINTER(c_uint), c_size_t, POINTER(c_int)]
+        self._raw = {
+            "Real": (_raw(library, "fmi2SetReal", reals), _raw(library, "fmi2GetReal", reals), c_double),
+            "Boolean": (_raw(library, "fmi2SetBoolean", booleans),
+                        _raw(library, "fmi2GetBoolean", booleans), c_int),
+        }
+        self._do_step_c = _raw(library, "fmi2DoStep", [c_void_p, c_double, c_double, c_int])
+        self.component = None
         self._alive = False
         try:
             self._call("fmi2Instantiate", self._fmu.instantiate, callbacks=self._callbacks,
                        loggingOn=True)
             self._alive = True
+            self.component = self._fmu.component
             self._call("fmi2SetupExperiment", self._fmu.setupExperiment, startTime=start_time)
             self._call("fmi2EnterInitializationMode", self._fmu.enterInitializationMode)
             if start_values:
@@ -83,30 +138,45 @@ class FmuInstance:
                               message.decode("utf-8", "replace")))
 
     def _call(self, name, function, *args, **kwargs):
-        seen = len(self.messages)
+        """Call one of fmpy's wrappers; a failure becomes :class:`FmuError`."""
+        self._reported = len(self.messages)
         try:
             return function(*args, **kwargs)
         except FMICallException as error:
-            status = error.status
+            raise self.failure(name, error.status) from None
         except Exception as error:  # fmpy raises a bare Exception when instantiation fails
-            status, error = 4, error
-        log = "; ".join(text for _, text in self.messages[seen:]) or str(error)
+            raise self.failure(name, 4, str(error)) from None
+
+    def _error(self, name, status, seen, fallback):
+        """FmuError quoting the FMU's log lines since ``seen`` (or ``fallback``)."""
+        log = "; ".join(text for _, text in self.messages[seen:]) or fallback
         if status == 4:  # fmi2Fatal: FMI allows no further call, not even fmi2FreeInstance
             self._alive = False
-        raise FmuError(f"{self.instance_name}: {name} failed ({_STATUS[status]}): {log}", status)
+        return FmuError(f"{self.instance_name}: {name} failed ({_STATUS[status]}): {log}", status)
 
-    def _references(self, names):
-        key = tuple(names)
-        cached = self._vr_cache.get(key)
-        if cached is None:
+    def port(self, names):
+        """A :class:`Port` for the variables ``names`` (a tuple; all Real or all Boolean)."""
+        names = tuple(names)
+        port = self._ports.get(names)
+        if port is None:
             try:
-                refs = [self.variables[name].valueReference for name in names]
+                variables = [self.variables[name] for name in names]
             except KeyError as error:
                 raise KeyError(f"{self.instance_name}: no variable {error.args[0]!r} in "
                                f"{self.path}") from None
-            cached = (fmi2ValueReference * len(refs))(*refs)
-            self._vr_cache[key] = cached
-        return cached
+            kinds = {v.type for v in variables}
+            if len(kinds) != 1 or not kinds <= set(self._raw):
+                raise TypeError(f"{self.instance_name}: a port needs all-Real or all-Boolean "
+                                f"variables, got {', '.join(sorted(kinds))}")
+            setter, getter, ctype = self._raw[kinds.pop()]
+            port = Port(self, names, [v.valueReference for v in variables], ctype, setter, getter)
+            self._ports[names] = port
+        return port
+
+    def failure(self, what, status, fallback=None):
+        """FmuError for a call that returned ``status``, quoting the new log lines."""
+        seen, self._reported = self._reported, len(self.messages)
+        return self._error(what, status, seen, fallback or f"{what} returned status {status}")
 
     def set(self, values):
         """Set variables by name: {name: value} (Real, Boolean or String)."""
@@ -123,27 +193,22 @@ class FmuInstance:
                 self._call(f"fmi2Set{kind}", setter, refs, list(groups[kind].values()))
 
     def set_real(self, names, values):
-        """Set Real variables ``names`` (a tuple, reused as a cache key) to ``values``."""
-        refs = self._references(names)
-        self._call("fmi2SetReal", self._fmu.fmi2SetReal, self._fmu.component, refs, len(refs),
-                   (fmi2Real * len(refs))(*values))
+        """Set Real variables ``names`` (a tuple) to ``values``."""
+        self.port(names).set(values)
 
     def get_real(self, names):
         """Values of the Real variables ``names`` (a tuple)."""
-        refs = self._references(names)
-        values = (fmi2Real * len(refs))()
-        self._call("fmi2GetReal", self._fmu.fmi2GetReal, self._fmu.component, refs, len(refs),
-                   values)
-        return list(values)
+        return self.port(names).get()
 
     def get_boolean(self, names):
         """Values of the Boolean variables ``names`` as bools."""
-        refs = [self.variables[name].valueReference for name in names]
-        return [bool(v) for v in self._call("fmi2GetBoolean", self._fmu.getBoolean, refs)]
+        return [value != 0 for value in self.port(names).get()]
 
     def step(self, time, step_size):
         """doStep from ``time`` [s] over ``step_size`` [s]; raises FmuError unless fmi2OK/warning."""
-        self._call("fmi2DoStep", self._fmu.doStep, time, step_size)
+        status = self._do_step_c(self.component, time, step_size, 1)
+        if status > 1:
+            raise self.failure("fmi2DoStep", status)
 
     def get_state(self):
         """Save the FMU state (fmi2GetFMUstate); free it with :meth:`free_state`."""
@@ -166,7 +231,11 @@ class FmuInstance:
         return self._call("fmi2DeSerializeFMUstate", self._fmu.deSerializeFMUstate, data)
 
     def close(self):
-        """Terminate, free the instance and remove the unpacked FMU."""
+        """Terminate, free the instance and remove the unpacked FMU.
+
+        pythonfmu puts each instance's resources folder on ``sys.path`` and leaves it there;
+        it is taken off again here, as the folder is deleted.
+        """
         if self._alive:
             self._alive = False
             try:
@@ -175,6 +244,8 @@ class FmuInstance:
                 pass
             self._fmu.freeInstance()
         shutil.rmtree(self._unzipped, ignore_errors=True)
+        resources = str(Path(self._unzipped) / "resources")
+        sys.path[:] = [entry for entry in sys.path if entry.rstrip("/") != resources]
 
     def __enter__(self):
         return self

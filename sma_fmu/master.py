@@ -13,8 +13,6 @@ from .fmu_instance import FmuError, FmuInstance
 
 __all__ = ["FmuPlant", "FmuCompensator", "run_fmus", "MissingFmuError"]
 
-_PLANT_IN, _PLANT_OUT = ("P_in", "load"), ("R", "T")
-_FF_IN, _FF_OUT = ("R_ref", "load"), ("P_ff", "T_ref")
 
 
 class MissingFmuError(FileNotFoundError):
@@ -38,17 +36,18 @@ class FmuPlant:
         start.update(T_start=scenario.T_start, hysteresis_mode=scenario.hysteresis_mode,
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
+        self._inputs = self.fmu.port(("P_in", "load"))
+        self._outputs = self.fmu.port(("R", "T"))
 
     def outputs(self):
         """(R [ohm], T [degC]) now."""
-        return self.fmu.get_real(_PLANT_OUT)
+        return self._outputs.get()
 
     def step(self, time_s, power, load, step_size):
         """Set P_in and load, doStep, return (R, T) at the end of the step."""
-        fmu = self.fmu
-        fmu.set_real(_PLANT_IN, (power, load))
-        fmu.step(time_s, step_size)
-        return fmu.get_real(_PLANT_OUT)
+        self._inputs.set((power, load))
+        self.fmu.step(time_s, step_size)
+        return self._outputs.get()
 
     def close(self):
         """Free the instance."""
@@ -65,14 +64,16 @@ class FmuCompensator:
                      adapt_to_load=c.adapt_to_load, R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
+        self._inputs = self.fmu.port(("R_ref", "load"))
+        self._outputs = self.fmu.port(("P_ff", "T_ref"))
+        self._saturated = self.fmu.port(("saturated",))
 
     def step(self, time_s, reference, load, step_size):
         """Set R_ref and load, doStep, return (P_ff, T_ref, saturated) for this sample."""
-        fmu = self.fmu
-        fmu.set_real(_FF_IN, (reference, load))
-        fmu.step(time_s, step_size)
-        p_ff, t_ref = fmu.get_real(_FF_OUT)
-        return p_ff, t_ref, fmu.get_boolean(("saturated",))[0]
+        self._inputs.set((reference, load))
+        self.fmu.step(time_s, step_size)
+        p_ff, t_ref = self._outputs.get()
+        return p_ff, t_ref, self._saturated.get()[0] != 0
 
     def close(self):
         """Free the instance."""

@@ -126,9 +126,13 @@ class BranchCache:
         self.params = params
         self.size = size
         self._entries = {}
+        self._last = (None, None, None)  # (load, direction, constants) of the last call
 
     def get(self, load, direction):
         """BranchConstants for ``load`` [kg] and ``direction`` (+1/-1)."""
+        last_load, last_direction, constants = self._last
+        if load == last_load and direction == last_direction:
+            return constants
         key = (load, direction)
         constants = self._entries.get(key)
         if constants is None:
@@ -136,4 +140,5 @@ class BranchCache:
             if len(self._entries) >= self.size:
                 self._entries.clear()
             self._entries[key] = constants
+        self._last = (load, direction, constants)
         return constants

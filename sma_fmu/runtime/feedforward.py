@@ -18,6 +18,7 @@ from .sensing import mixed_fractions_of_resistance, temperature_of_fractions
 __all__ = ["FeedforwardOutputs", "FeedforwardStepper"]
 
 FeedforwardOutputs = namedtuple("FeedforwardOutputs", ["P_ff", "T_ref", "saturated"])
+_new_tuple = tuple.__new__  # builds the namedtuple in C (see plant.py)
 FeedforwardOutputs.__doc__ = """Compensator outputs for one reference sample.
 
 P_ff : feedforward power u_ff [W] (may be negative; the loop clamps the sum at 0 W);
@@ -90,7 +91,7 @@ class FeedforwardStepper:
         output = self.filter.step(power, step_size)
         self.direction = direction
         self.previous_reference = reference
-        return FeedforwardOutputs(output, sensed.temperature, sensed.saturated)
+        return _new_tuple(FeedforwardOutputs, (output, sensed.temperature, sensed.saturated))
 
     def state(self):
         """JSON-ready hidden state (reference direction, last reference, filter memory)."""

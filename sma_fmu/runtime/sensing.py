@@ -21,6 +21,7 @@ __all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of
 
 SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
 SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
+_new_tuple = tuple.__new__  # builds the namedtuple in C (see plant.py)
 
 
 def mixed_fractions_of_resistance(resistance, constants, params):
@@ -52,7 +53,7 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin):
         raise ValueError(
             f"temperature-sensing inverse diverges at Lambda = {exponent!r}: dH(f)/k_B = "
             f"{constants.energy_over_kB!r} K is too small for the hysteresis centre")
-    return SensedTemperature(1.0 / inverse_kelvin - KELVIN_OFFSET, saturated)
+    return _new_tuple(SensedTemperature, (1.0 / inverse_kelvin - KELVIN_OFFSET, saturated))
 
 
 def sense_temperature(resistance, load, direction, params, reversal=None):
