@@ -1,83 +1,235 @@
-"""Benchmarks: how fast the FMUs step under fmpy (median of several runs, microseconds).
+"""Benchmarks: how fast the FMUs, the co-simulation and the fits run (medians of several runs).
 
-``python benchmarks/run.py`` or ``sma-fmu bench``: prints a table and writes JSON. Speed is
-measured here, never asserted in tests.
+``python benchmarks/run.py`` or ``sma-fmu bench``: prints a table against the targets and
+writes ``benchmark.json``. Speed is measured here and never asserted in tests. The same
+run measures two baselines, so the numbers compare across machines: a trivial pythonfmu
+FMU (y = u) stepped the same way, and a plain Python loop.
 """
 import json
 import math
 import platform
 import statistics
+import tempfile
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from .closed_loop import run_library
 from .fmu_build import build_fmus
 from .fmu_instance import FmuInstance
+from .master import run_fmus
+from .project_files import project_folder
+from .scenario import CONTROLLERS, load_scenario, resolve_scenarios
 
-__all__ = ["fmu_step_costs", "run_benchmarks", "main"]
+__all__ = ["TARGETS", "run_benchmarks", "format_table", "main"]
 
 STEP = 1e-3
+TARGETS = {  # issue 6, on a 2-core machine
+    "closed_loop_fmu_s": 0.5,                  # 30 s load-step through both FMUs + PI
+    "feedforward_step_us": 15.0,               # SmaFeedforward set + doStep + get
+    "library_real_time_factor": 150.0,         # per scenario
+    "identification_s": 2.0,                   # the 4-load constant-load fit
+}
+_TRIVIAL_SLAVE = '''
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
 
 
-def _median_us(samples):
-    return statistics.median(samples) * 1e6
+class Trivial(Fmi2Slave):
+    """Benchmark baseline: y = u."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.u = 0.0
+        self.y = 0.0
+        self.register_variable(Real("u", causality=Fmi2Causality.input))
+        self.register_variable(Real("y", causality=Fmi2Causality.output,
+                                    variability=Fmi2Variability.continuous,
+                                    initial=Fmi2Initial.exact))
+
+    def do_step(self, current_time, step_size):
+        self.y = self.u
+        return True
+'''
 
 
-def _time_steps(fmu, inputs, outputs, values, steps, with_io):
-    start = time.perf_counter()
-    t = 0.0
-    for k in range(steps):
-        if with_io:
-            fmu.set_real(inputs, values(k))
-        fmu.step(t, STEP)
-        if with_io:
-            fmu.get_real(outputs)
-        t += STEP
-    return (time.perf_counter() - start) / steps
+def _median(samples):
+    return statistics.median(samples)
+
+
+def _fmu_step_us(path, inputs, outputs, values, runs, steps, with_io, fmpy_api=False):
+    """Median cost [us] of one step: doStep alone, or set inputs + doStep + get outputs."""
+    costs = []
+    for run in range(runs):
+        with FmuInstance(path, f"bench-{run}") as fmu:
+            put, take = fmu.port(inputs), fmu.port(outputs)
+            if fmpy_api:  # fmpy's own FMU2Slave methods, as a plain fmpy user would call them
+                raw = fmu._fmu
+                refs_in, refs_out = list(put.references), list(take.references)
+                put_values = lambda k: raw.setReal(refs_in, values(k))
+                take_values = lambda: raw.getReal(refs_out)
+                do_step = raw.doStep
+            else:
+                put_values = lambda k: put.set(values(k))
+                take_values = take.get
+                do_step = fmu.step
+            t = 0.0
+            start = time.perf_counter()
+            for k in range(steps):
+                if with_io:
+                    put_values(k)
+                do_step(t, STEP)
+                if with_io:
+                    take_values()
+                t += STEP
+            costs.append((time.perf_counter() - start) / steps * 1e6)
+    return round(_median(costs), 2)
 
 
 FMU_CASES = {
-    "SmaActuator": (("P_in", "load"), ("R", "T", "x", "xi_P", "xi_M", "xi_F"),
+    "SmaActuator": (("P_in", "load"), ("R", "T"),
                     lambda k: (1.9 + 0.9 * math.sin(math.pi * k * STEP), 0.05)),
     "SmaFeedforward": (("R_ref", "load"), ("P_ff", "T_ref"),
                        lambda k: (41.85 + 6.05 * math.cos(math.pi * k * STEP), 0.05)),
+    "Trivial (baseline)": (("u",), ("y",), lambda k: (float(k),)),
 }
 
 
-def fmu_step_costs(fmu_paths, runs=5, steps=2000):
-    """Per-step cost [us] of each FMU: {name: {"doStep": median, "set+doStep+get": median}}."""
+def fmu_step_costs(paths, runs, steps=3000):
+    """{FMU: {doStep, set+doStep+get, same via fmpy FMU2Slave API}} in us (medians)."""
     results = {}
     for name, (inputs, outputs, values) in FMU_CASES.items():
-        costs = {"doStep": [], "set+doStep+get": []}
-        for run in range(runs):
-            for label, with_io in (("doStep", False), ("set+doStep+get", True)):
-                with FmuInstance(fmu_paths[name], f"bench-{run}") as fmu:
-                    fmu.set_real(inputs, values(0))
-                    costs[label].append(_time_steps(fmu, inputs, outputs, values, steps, with_io))
-        results[name] = {label: round(_median_us(samples), 2) for label, samples in costs.items()}
+        args = (paths[name], inputs, outputs, values, runs, steps)
+        results[name] = {"doStep_us": _fmu_step_us(*args, with_io=False),
+                         "set_doStep_get_us": _fmu_step_us(*args, with_io=True),
+                         "fmpy_api_set_doStep_get_us": _fmu_step_us(*args, with_io=True, fmpy_api=True)}
     return results
 
 
+def closed_loop_times(fmu_dir, runs):
+    """load-step, 30 s at 1 ms, per controller and path: median wall [s] and real-time factor."""
+    results = {}
+    for controller in CONTROLLERS:
+        scenario = load_scenario(project_folder("scenarios") / f"load-step-{controller}.toml")
+        for path, run in (("fmu", lambda: run_fmus(scenario, fmu_dir)),
+                          ("library", lambda: run_library(scenario))):
+            walls = [run().wall_time_s for _ in range(runs)]
+            wall = _median(walls)
+            results[f"{controller} ({path})"] = {
+                "wall_s": round(wall, 4), "min_s": round(min(walls), 4), "max_s": round(max(walls), 4),
+                "real_time_factor": round(scenario.stop_time_s / wall, 1)}
+    return results
+
+
+def _library_run(path):
+    return run_library(load_scenario(path)).wall_time_s
+
+
+def library_throughput(workers=2):
+    """Runs per second of the library path over every shipped scenario, 1 and ``workers`` processes."""
+    paths = [str(p) for p in resolve_scenarios([], everything=True)]
+    start = time.perf_counter()
+    for path in paths:
+        _library_run(path)
+    sequential = time.perf_counter() - start
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        list(pool.map(_library_run, paths[:workers]))  # start the workers
+        start = time.perf_counter()
+        list(pool.map(_library_run, paths))
+        parallel = time.perf_counter() - start
+    return {"scenarios": len(paths), "runs_per_s_1_process": round(len(paths) / sequential, 2),
+            f"runs_per_s_{workers}_processes": round(len(paths) / parallel, 2)}
+
+
+def identification_time(runs):
+    """Median time [s] of the 4-load constant-load fit (808 noisy points, seeded)."""
+    from .fit_constant_load import fit_constant_load
+    from .measurements import read_constant_load
+    from .parameter_file import load_parameters
+    from .synthetic import constant_load_rows, write_rows
+
+    params = load_parameters()
+    with tempfile.TemporaryDirectory() as folder:
+        path = write_rows(Path(folder) / "sweeps.csv", constant_load_rows(
+            params, [3.2e-3, 0.05, 0.15, 0.25], noise_ohm=0.05, noise_K=0.3, seed=1))
+        seconds = []
+        for _ in range(runs):
+            start = time.perf_counter()
+            fit_constant_load(read_constant_load([path]), params)
+            seconds.append(time.perf_counter() - start)
+    return round(_median(seconds), 4)
+
+
+def python_loop_ns(iterations=2_000_000):
+    """Machine baseline: ns per iteration of a plain Python multiply-add loop."""
+    start = time.perf_counter()
+    x = 0.0
+    for i in range(iterations):
+        x = x * 0.999 + 1.0
+    return round((time.perf_counter() - start) / iterations * 1e9, 2)
+
+
+def _build_trivial(folder):
+    from pythonfmu.builder import FmuBuilder
+    script = Path(folder) / "trivial_benchmark_slave.py"
+    script.write_text(_TRIVIAL_SLAVE, encoding="utf-8")
+    return Path(FmuBuilder.build_FMU(script, dest=Path(folder) / "Trivial.fmu"))
+
+
 def run_benchmarks(out_dir, runs=5):
-    """Run every benchmark; returns the results dict (also written to out_dir/benchmark.json)."""
+    """Run every benchmark; returns the results (also written to out_dir/benchmark.json)."""
     out_dir = Path(out_dir)
     fmu_paths = build_fmus(out_dir / "fmus")
+    with tempfile.TemporaryDirectory() as folder:
+        fmu_paths["Trivial (baseline)"] = _build_trivial(folder)
+        steps = fmu_step_costs(fmu_paths, runs)
     results = {
-        "machine": {"python": platform.python_version(), "processor": platform.processor(),
-                    "system": platform.platform()},
+        "machine": {"python": platform.python_version(), "system": platform.platform(),
+                    "python_loop_ns_per_iteration": python_loop_ns()},
         "runs": runs,
-        "fmu_step_us": fmu_step_costs(fmu_paths, runs=runs),
+        "fmu_step": steps,
+        "closed_loop_load_step_30s": closed_loop_times(out_dir / "fmus", runs),
+        "library_throughput": library_throughput(),
+        "identification_4_loads_s": identification_time(runs),
+        "targets": TARGETS,
     }
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "benchmark.json").write_text(json.dumps(results, indent=2), encoding="utf-8")
     return results
 
 
+def _verdict(value, target, larger_is_better=False):
+    met = value >= target if larger_is_better else value <= target
+    return f"{'meets' if met else 'MISSES'} target {'>=' if larger_is_better else '<='} {target:g}"
+
+
 def format_table(results):
-    """The results as a plain-text table."""
-    lines = ["FMU per-step cost under fmpy (median of %d runs, us)" % results["runs"],
-             f"{'FMU':<16}{'doStep':>10}{'set+doStep+get':>18}"]
-    for name, costs in results["fmu_step_us"].items():
-        lines.append(f"{name:<16}{costs['doStep']:>10.1f}{costs['set+doStep+get']:>18.1f}")
+    """The results as plain-text tables, with each target's verdict."""
+    lines = [f"sma-fmu benchmark (median of {results['runs']} runs; Python "
+             f"{results['machine']['python']}; plain Python loop "
+             f"{results['machine']['python_loop_ns_per_iteration']} ns/iteration)", "",
+             "FMU per step [us]       doStep  set+doStep+get  (same via fmpy FMU2Slave API)"]
+    for name, cost in results["fmu_step"].items():
+        lines.append(f"{name:<22}{cost['doStep_us']:>8.2f}{cost['set_doStep_get_us']:>16.2f}"
+                     f"{cost['fmpy_api_set_doStep_get_us']:>16.2f}")
+    trivial = results["fmu_step"]["Trivial (baseline)"]["set_doStep_get_us"]
+    ff = results["fmu_step"]["SmaFeedforward"]["set_doStep_get_us"]
+    lines += [f"SmaFeedforward step: {ff:.2f} us = {ff / trivial:.2f} x trivial FMU; "
+              f"{_verdict(ff, TARGETS['feedforward_step_us'])} us", "",
+              "load-step, 30 s at 1 ms          wall [s]   x real time   (min ... max of runs)"]
+    for name, row in results["closed_loop_load_step_30s"].items():
+        lines.append(f"{name:<32}{row['wall_s']:>9.3f}{row['real_time_factor']:>13.1f}"
+                     f"   ({row['min_s']:.3f} ... {row['max_s']:.3f})")
+    loop = results["closed_loop_load_step_30s"]
+    fmu_wall = max(v["wall_s"] for k, v in loop.items() if k.endswith("(fmu)"))
+    library_factor = min(v["real_time_factor"] for k, v in loop.items() if k.endswith("(library)"))
+    throughput = results["library_throughput"]
+    lines += [f"slowest FMU closed loop {fmu_wall:.3f} s: {_verdict(fmu_wall, TARGETS['closed_loop_fmu_s'])} s",
+              f"slowest library run {library_factor:.0f} x real time: "
+              f"{_verdict(library_factor, TARGETS['library_real_time_factor'], True)}", "",
+              f"library batch ({throughput['scenarios']} scenarios): "
+              + ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in throughput.items() if k != "scenarios"),
+              f"identification, 4 loads, 808 points: {results['identification_4_loads_s']:.3f} s: "
+              f"{_verdict(results['identification_4_loads_s'], TARGETS['identification_s'])} s"]
     return "\n".join(lines)
 
 

@@ -102,3 +102,18 @@ def test_bad_parameter_seen_by_a_plain_fmpy_host(fmus, tmp_path):
     assert raised.value.status == DISCARD
     fmu.terminate()
     fmu.freeInstance()                                 # allowed: nothing went fatal
+
+
+def test_log_messages_stay_with_their_instance(fmus):
+    """Each instance keeps its own FMU log (no shared logger between instances)."""
+    first = FmuInstance(fmus["SmaActuator"], "first", {"load": 0.05})
+    second = FmuInstance(fmus["SmaActuator"], "second", {"load": 0.05})
+    try:
+        first.set_real(("P_in", "load"), (-1.0, 0.05))
+        with pytest.raises(FmuError, match="SmaActuator 'first' step at t = 0.0 s discarded"):
+            first.step(0.0, STEP)
+        assert any("'first'" in text for _, text in first.messages)
+        assert not any("'first'" in text for _, text in second.messages)
+    finally:
+        second.close()
+        first.close()

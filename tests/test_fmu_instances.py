@@ -60,3 +60,12 @@ def test_feedforward_runs_standalone_in_fmpy_simulate(fmus, params):
     assert np.all(np.isfinite(result["P_ff"]))
     assert result["T_ref"].min() > params.T_room and result["T_ref"].max() < 150.0
     assert result["saturated"].any() and not result["saturated"].all()
+
+
+def test_closing_an_instance_takes_its_resources_off_sys_path(fmus):
+    import sys
+    fmu = FmuInstance(fmus["SmaActuator"], "path-check")
+    resources = f"{fmu._unzipped}/resources"
+    assert any(entry.rstrip("/") == resources for entry in sys.path)  # pythonfmu put it there
+    fmu.close()
+    assert not any(entry.rstrip("/") == resources for entry in sys.path)

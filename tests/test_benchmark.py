@@ -1,0 +1,18 @@
+"""The benchmark script runs and reports every section (speed is never asserted here)."""
+import json
+
+from sma_fmu.cli import main
+
+
+def test_benchmark_runs_and_reports_every_section(tmp_path, capsys):
+    assert main(["bench", "--runs", "1", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    for text in ("FMU per step", "Trivial (baseline)", "load-step, 30 s at 1 ms",
+                 "pi+ff-adaptive (fmu)", "pi+ff-adaptive (library)", "library batch",
+                 "identification, 4 loads", "target"):
+        assert text in out
+    results = json.loads((tmp_path / "benchmark.json").read_text())
+    assert set(results["fmu_step"]) == {"SmaActuator", "SmaFeedforward", "Trivial (baseline)"}
+    assert len(results["closed_loop_load_step_30s"]) == 6
+    assert all(row["wall_s"] > 0 for row in results["closed_loop_load_step_30s"].values())
+    assert results["identification_4_loads_s"] > 0
