@@ -22,10 +22,6 @@ from .runtime.sensing import sense_temperature
 __all__ = ["main", "build_parser"]
 
 
-class CommandError(Exception):
-    """A command failed for a reason the user can fix; the message says which."""
-
-
 def _report(rows, as_json):
     """Print rows of (name, value, unit) as text lines or one JSON object."""
     if as_json:
@@ -267,6 +263,6 @@ def main(argv=None):
     args = parser.parse_args(argv)
     try:
         return args.handler(args)
-    except (ValueError, CommandError, FileNotFoundError, FmuError) as error:
+    except (ValueError, FileNotFoundError, FmuError) as error:
         print(f"sma-fmu: error: {error}", file=sys.stderr)
         return 2

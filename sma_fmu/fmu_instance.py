@@ -147,13 +147,6 @@ class FmuInstance:
         except Exception as error:  # fmpy raises a bare Exception when instantiation fails
             raise self.failure(name, 4, str(error)) from None
 
-    def _error(self, name, status, seen, fallback):
-        """FmuError quoting the FMU's log lines since ``seen`` (or ``fallback``)."""
-        log = "; ".join(text for _, text in self.messages[seen:]) or fallback
-        if status == 4:  # fmi2Fatal: FMI allows no further call, not even fmi2FreeInstance
-            self._alive = False
-        return FmuError(f"{self.instance_name}: {name} failed ({_STATUS[status]}): {log}", status)
-
     def port(self, names):
         """A :class:`Port` for the variables ``names`` (a tuple; all Real or all Boolean)."""
         names = tuple(names)
@@ -174,9 +167,13 @@ class FmuInstance:
         return port
 
     def failure(self, what, status, fallback=None):
-        """FmuError for a call that returned ``status``, quoting the new log lines."""
+        """FmuError for a call that returned ``status``, quoting the FMU's new log lines."""
         seen, self._reported = self._reported, len(self.messages)
-        return self._error(what, status, seen, fallback or f"{what} returned status {status}")
+        log = "; ".join(text for _, text in self.messages[seen:]) or fallback or \
+            f"{what} returned status {status}"
+        if status == 4:  # fmi2Fatal: FMI allows no further call, not even fmi2FreeInstance
+            self._alive = False
+        return FmuError(f"{self.instance_name}: {what} failed ({_STATUS[status]}): {log}", status)
 
     def set(self, values):
         """Set variables by name: {name: value} (Real, Boolean or String)."""
