@@ -1,6 +1,6 @@
 """Build both FMUs (SmaActuator, SmaFeedforward): ``python build_fmu.py [--out DIR] [--model FILE]``.
 
-The same as ``sma-fmu build``; the work is done by :mod:`sma_fmu.fmu_build`.
+The same as ``sma-fmu build``; the work is done by :mod:`sma_fmu.fmi.build`.
 """
 import sys
 

@@ -1,4 +1,4 @@
 """``python -m sma_fmu`` runs the command line."""
-from .cli import main
+from sma_fmu.cli import main
 
 raise SystemExit(main())

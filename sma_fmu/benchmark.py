@@ -5,7 +5,6 @@ writes ``benchmark.json``. Speed is measured here and never asserted in tests. T
 run measures two baselines, so the numbers compare across machines: a trivial pythonfmu
 FMU (y = u) stepped the same way, and a plain Python loop.
 """
-import json
 import math
 import platform
 import statistics
@@ -14,12 +13,14 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from .closed_loop import run_library
-from .fmu_build import build_fmus
-from .fmu_instance import FmuInstance
-from .master import run_fmus
-from .project_files import project_folder
-from .scenario import CONTROLLERS, load_scenario, resolve_scenarios
+from sma_fmu.cosim.loop import run_library
+from sma_fmu.fmi.build import build_fmus
+from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.cosim.master import run_fmus
+from sma_fmu.json_output import json_text
+from sma_fmu.output_folder import staged_folder
+from sma_fmu.package_data import shipped_file
+from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario, resolve_scenarios
 
 __all__ = ["TARGETS", "run_benchmarks", "format_table", "main"]
 
@@ -109,7 +110,7 @@ def closed_loop_times(fmu_dir, runs):
     """load-step, 30 s at 1 ms, per controller and path: median wall [s] and real-time factor."""
     results = {}
     for controller in CONTROLLERS:
-        scenario = load_scenario(project_folder("scenarios") / f"load-step-{controller}.toml")
+        scenario = load_scenario(shipped_file("scenarios", f"load-step-{controller}.toml"))
         for path, run in (("fmu", lambda: run_fmus(scenario, fmu_dir)),
                           ("library", lambda: run_library(scenario))):
             walls = [run().wall_time_s for _ in range(runs)]
@@ -142,10 +143,10 @@ def library_throughput(workers=2):
 
 def identification_time(runs):
     """Median time [s] of the 4-load constant-load fit (808 noisy points, seeded)."""
-    from .fit_constant_load import fit_constant_load
-    from .measurements import read_constant_load
-    from .parameter_file import load_parameters
-    from .synthetic import constant_load_rows, write_rows
+    from sma_fmu.identification.constant_load import fit_constant_load
+    from sma_fmu.identification.measurements import read_constant_load
+    from sma_fmu.parameter_file import load_parameters
+    from sma_fmu.identification.synthetic import constant_load_rows, write_rows
 
     params = load_parameters()
     with tempfile.TemporaryDirectory() as folder:
@@ -175,25 +176,29 @@ def _build_trivial(folder):
     return Path(FmuBuilder.build_FMU(script, dest=Path(folder) / "Trivial.fmu"))
 
 
-def run_benchmarks(out_dir, runs=5):
+def run_benchmarks(out_dir, runs=5, progress=print):
     """Run every benchmark; returns the results (also written to out_dir/benchmark.json)."""
-    out_dir = Path(out_dir)
-    fmu_paths = build_fmus(out_dir / "fmus")
-    with tempfile.TemporaryDirectory() as folder:
+    if runs < 1:
+        raise ValueError(f"runs must be >= 1, got {runs!r}")
+    with staged_folder(out_dir) as stage, tempfile.TemporaryDirectory() as folder:
+        progress("building the FMUs ...")
+        fmu_paths = build_fmus(stage / "fmus")
         fmu_paths["Trivial (baseline)"] = _build_trivial(folder)
+        progress(f"FMU step costs ({runs} runs) ...")
         steps = fmu_step_costs(fmu_paths, runs)
-    results = {
-        "machine": {"python": platform.python_version(), "system": platform.platform(),
-                    "python_loop_ns_per_iteration": python_loop_ns()},
-        "runs": runs,
-        "fmu_step": steps,
-        "closed_loop_load_step_30s": closed_loop_times(out_dir / "fmus", runs),
-        "library_throughput": library_throughput(),
-        "identification_4_loads_s": identification_time(runs),
-        "targets": TARGETS,
-    }
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "benchmark.json").write_text(json.dumps(results, indent=2), encoding="utf-8")
+        machine = {"python": platform.python_version(), "system": platform.platform(),
+                   "python_loop_ns_per_iteration": python_loop_ns()}
+        progress(f"closed loops, load-step 30 s ({runs} runs per controller and path) ...")
+        loops = closed_loop_times(stage / "fmus", runs)
+        progress("library throughput over the shipped scenarios ...")
+        throughput = library_throughput()
+        progress("identification ...")
+        results = {
+            "machine": machine, "runs": runs, "fmu_step": steps,
+            "closed_loop_load_step_30s": loops, "library_throughput": throughput,
+            "identification_4_loads_s": identification_time(runs), "targets": TARGETS,
+        }
+        (stage / "benchmark.json").write_text(json_text(results), encoding="utf-8")
     return results
 
 
@@ -235,7 +240,7 @@ def format_table(results):
 
 def main(out_dir="results/benchmark", runs=5):
     """Run, print the table, write JSON; returns 0."""
-    results = run_benchmarks(out_dir, runs)
+    results = run_benchmarks(out_dir, runs, progress=lambda text: print(text, flush=True))
     print(format_table(results))
     print(f"written: {Path(out_dir) / 'benchmark.json'}")
     return 0

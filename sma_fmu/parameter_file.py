@@ -18,8 +18,8 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .project_files import default_parameter_file
-from .runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
+from sma_fmu.package_data import default_parameter_file
+from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
 
 if sys.version_info >= (3, 11):
     import tomllib

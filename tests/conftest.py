@@ -17,5 +17,5 @@ def params(parameter_set):
 @pytest.fixture(scope="session")
 def fmus(tmp_path_factory):
     """Both FMUs, built once per test session from the reference parameter file."""
-    from sma_fmu.fmu_build import build_fmus
+    from sma_fmu.fmi.build import build_fmus
     return build_fmus(tmp_path_factory.mktemp("fmus"))

@@ -2,15 +2,15 @@
 import numpy as np
 import pytest
 
-from sma_fmu.closed_loop import run_library
-from sma_fmu.master import run_fmus
-from sma_fmu.metrics import scenario_metrics
-from sma_fmu.project_files import project_folder
-from sma_fmu.scenario import CONTROLLERS, load_scenario
+from sma_fmu.cosim.loop import run_library
+from sma_fmu.cosim.master import run_fmus
+from sma_fmu.cosim.metrics import scenario_metrics
+from sma_fmu.package_data import shipped_file
+from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
 
 
 def _scenario(name):
-    return load_scenario(project_folder("scenarios") / f"{name}.toml")
+    return load_scenario(shipped_file("scenarios", f"{name}.toml"))
 
 
 @pytest.fixture(scope="module")

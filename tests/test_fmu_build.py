@@ -8,9 +8,9 @@ from fmpy import read_model_description
 
 from sma_fmu import load_parameter_set
 from sma_fmu.cli import main
-from sma_fmu.fmu_build import build_fmu, code_stamp, validate_fmus
+from sma_fmu.fmi.build import build_fmu, code_stamp, validate_fmus
 from sma_fmu.parameter_file import write_parameter_file
-from sma_fmu.runtime.fmi_description import UNIT_DEFINITIONS
+from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
 
 PLANT_OUTPUTS = {"R": "ohm", "T": "degC", "x": "m", "xi_P": "1", "xi_M": "1", "xi_F": "1"}
 FEEDFORWARD_OUTPUTS = {"P_ff": "W", "T_ref": "degC"}
@@ -76,10 +76,12 @@ def test_shipped_code_imports_only_stdlib_pythonfmu_and_its_own_runtime(fmus, na
         slave_module = archive.read("resources/slavemodule.txt").decode().strip()
         sources = {n: archive.read(n).decode() for n in archive.namelist()
                    if n.endswith(".py") and not n.startswith("resources/pythonfmu/")}
-    runtime = f"{slave_module.rsplit('_', 1)[0]}_rt_{stamp}"
+    stem = slave_module.rsplit('_', 1)[0]
+    runtime, glue = f"{stem}_rt_{stamp}", f"{stem}_fmi_{stamp}"
     assert slave_module.endswith(stamp)
     assert any(n.startswith(f"resources/{runtime}/") for n in sources)
-    allowed = set(sys.stdlib_module_names) | {"pythonfmu", runtime}
+    assert any(n.startswith(f"resources/{glue}/") for n in sources)
+    allowed = set(sys.stdlib_module_names) | {"pythonfmu", runtime, glue}
     for source_name, source in sources.items():
         for node in ast.walk(ast.parse(source)):
             if isinstance(node, ast.Import):

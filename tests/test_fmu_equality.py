@@ -2,7 +2,7 @@
 import pytest
 
 from fmu_signals import STEP, plant_load, plant_power, wide_reference as reference
-from sma_fmu.fmu_instance import FmuInstance
+from sma_fmu.fmi.instance import FmuInstance
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
 

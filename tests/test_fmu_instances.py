@@ -4,7 +4,7 @@ import pytest
 from fmpy import simulate_fmu
 
 from fmu_signals import STEP, plant_power, reference
-from sma_fmu.fmu_instance import FmuInstance
+from sma_fmu.fmi.instance import FmuInstance
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
 

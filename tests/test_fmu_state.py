@@ -2,7 +2,7 @@
 import pytest
 
 from fmu_signals import STEP, plant_load, plant_power, reference
-from sma_fmu.fmu_instance import FmuInstance
+from sma_fmu.fmi.instance import FmuInstance
 
 SAVE_AT, RUN_TO = 5000, 8000  # steps: 5 s and 8 s
 

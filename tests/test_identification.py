@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 from sma_fmu.cli import main
-from sma_fmu.fit_constant_load import FITTED, fit_constant_load, starting_parameters
-from sma_fmu.fit_constant_temperature import fit_constant_temperature
-from sma_fmu.measurements import MeasurementError, read_constant_load, read_constant_temperature
+from sma_fmu.identification.constant_load import FITTED, fit_constant_load, starting_parameters
+from sma_fmu.identification.constant_temperature import fit_constant_temperature
+from sma_fmu.identification.measurements import MeasurementError, read_constant_load, read_constant_temperature
 from sma_fmu.parameter_file import load_parameter_set, write_parameter_file
-from sma_fmu.synthetic import constant_load_rows, constant_temperature_rows, write_rows
+from sma_fmu.identification.synthetic import constant_load_rows, constant_temperature_rows, write_rows
 
 LOADS = [3.2e-3, 0.05, 0.15, 0.25]
 CYCLE = [0.0, 0.1, 0.03, 0.2, 0.03, 0.3]
@@ -132,7 +132,7 @@ def test_cli_fit_writes_a_usable_parameter_file_and_report(tmp_path, parameter_s
                  "--out", str(cycle)]) == 0
     assert main(["fit", "constant-temperature", str(cycle), "--model", str(out / "identified.toml"),
                  "--out", str(tmp_path / "fit2")]) == 0
-    from sma_fmu.fmu_build import build_fmu
+    from sma_fmu.fmi.build import build_fmu
     from fmpy import read_model_description
     fmu = build_fmu("SmaActuator", tmp_path / "fmus", out / "identified.toml")
     starts = {v.name: v.start for v in read_model_description(str(fmu)).modelVariables}

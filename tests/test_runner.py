@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from sma_fmu.cli import main
-from sma_fmu.closed_loop import COLUMNS
+from sma_fmu.cosim.loop import COLUMNS
 
 
 def test_run_paper_library_path_writes_everything(tmp_path, capsys):

@@ -9,13 +9,10 @@ import sma_fmu.runtime
 RUNTIME = Path(sma_fmu.runtime.__file__).parent
 
 
-# fmi_slave.py runs only inside an FMU (or its build), and every pythonfmu FMU ships pythonfmu
-FMU_ONLY = {"fmi_slave.py": {"pythonfmu"}}
-
 
 def test_runtime_imports_only_stdlib_and_itself():
     for path in sorted(RUNTIME.glob("*.py")):
-        allowed = set(sys.stdlib_module_names) | FMU_ONLY.get(path.name, set())
+        allowed = set(sys.stdlib_module_names)
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.Import):
                 roots = [alias.name.split(".")[0] for alias in node.names]
@@ -35,15 +32,15 @@ def _run_blocked(blocked, body):
 
 
 def test_library_runtime_runs_without_numpy_scipy_or_pythonfmu():
-    """Every runtime module but fmi_slave imports and steps with those packages unavailable."""
+    """Every runtime module imports and steps with those packages unavailable."""
     _run_blocked(["numpy", "scipy", "pythonfmu"], (
         "import importlib, pkgutil, sma_fmu.runtime as rt\n"
         "for m in pkgutil.iter_modules(rt.__path__):\n"
-        "    if m.name != 'fmi_slave': importlib.import_module('sma_fmu.runtime.' + m.name)\n"
+        "    importlib.import_module('sma_fmu.runtime.' + m.name)\n"
         "from sma_fmu.runtime.parameters import WireParameters\n"
         "from sma_fmu.runtime.plant import PlantStepper\n"
         "print('ok')\n"))
 
 
-def test_fmi_slave_needs_only_pythonfmu_besides_stdlib():
-    _run_blocked(["numpy", "scipy"], "import sma_fmu.runtime.fmi_slave\nprint('ok')\n")
+def test_slave_support_needs_only_pythonfmu_besides_stdlib():
+    _run_blocked(["numpy", "scipy"], "import sma_fmu.fmi.slave_support.interface\nprint('ok')\n")

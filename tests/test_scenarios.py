@@ -3,10 +3,10 @@ import math
 
 import pytest
 
-from sma_fmu.project_files import project_folder
-from sma_fmu.scenario import (CONTROLLERS, PAPER_SET, ScenarioError, load_scenario,
+from sma_fmu.package_data import shipped_file
+from sma_fmu.cosim.scenario import (CONTROLLERS, PAPER_SET, ScenarioError, load_scenario,
                               resolve_scenarios, scenario_names)
-from sma_fmu.signals import load_from_table, reference_from_table
+from sma_fmu.runtime.signals import load_from_table, reference_from_table
 
 EXPECTED = {f"{profile}{mode}-{controller}" for profile in ("load-step", "heavy")
             for mode in ("", "-continuous") for controller in CONTROLLERS}
@@ -15,7 +15,7 @@ EXPECTED = {f"{profile}{mode}-{controller}" for profile in ("load-step", "heavy"
 def test_shipped_scenarios_cover_both_profiles_controllers_and_modes():
     assert EXPECTED <= set(scenario_names())
     for name in EXPECTED:
-        scenario = load_scenario(project_folder("scenarios") / f"{name}.toml")
+        scenario = load_scenario(shipped_file("scenarios", f"{name}.toml"))
         assert scenario.steps == 30000 and scenario.step_s == 1e-3
         assert scenario.hysteresis_mode == ("continuous" if "continuous" in name else "switch")
         assert name.endswith("-" + scenario.controller.kind)
@@ -24,17 +24,16 @@ def test_shipped_scenarios_cover_both_profiles_controllers_and_modes():
 
 
 def test_paper_profiles_match_spec():
-    folder = project_folder("scenarios")
-    step = load_scenario(folder / "load-step-pi.toml")
+    step = load_scenario(shipped_file("scenarios", "load-step-pi.toml"))
     h = step.step_s
     assert [step.load.value(k * h) for k in (0, 9999, 10000, 19999, 20000, 30000)] == \
         [3.2e-3, 3.2e-3, 0.05, 0.05, 0.15, 0.15]
-    assert load_scenario(folder / "heavy-pi.toml").load.segments(30.0) == [(0.0, 30.0, 0.25)]
+    assert load_scenario(shipped_file("scenarios", "heavy-pi.toml")).load.segments(30.0) == [(0.0, 30.0, 0.25)]
     assert set(PAPER_SET) == {n for n in EXPECTED if "continuous" not in n}
 
 
 def test_controller_gains_default_to_the_parameter_file(params):
-    scenario = load_scenario(project_folder("scenarios") / "heavy-pi+ff-fixed.toml")
+    scenario = load_scenario(shipped_file("scenarios", "heavy-pi+ff-fixed.toml"))
     c = scenario.controller
     assert (c.Kp, c.Ki, c.alpha, c.beta, c.model_load) == \
         (params.Kp, params.Ki, params.tau_th, params.beta, params.model_load)
@@ -66,7 +65,7 @@ def test_load_profile_is_piecewise_constant():
 
 def _write(tmp_path, text):
     path = tmp_path / "custom.toml"
-    base = (project_folder("scenarios") / "load-step-pi+ff-adaptive.toml").read_text()
+    base = (shipped_file("scenarios", "load-step-pi+ff-adaptive.toml")).read_text()
     path.write_text(text(base) if callable(text) else text)
     return path
 
@@ -110,14 +109,14 @@ def test_malformed_scenario_names_file_key_and_problem(tmp_path, change, message
 
 
 def test_missing_section_is_named(tmp_path):
-    text = (project_folder("scenarios") / "heavy-pi.toml").read_text()
+    text = (shipped_file("scenarios", "heavy-pi.toml")).read_text()
     path = _write(tmp_path, text[:text.index("[controller]")])
     with pytest.raises(ScenarioError, match=r"missing section \[controller\]"):
         load_scenario(path)
 
 
 def test_unknown_scenario_name_lists_the_known_ones():
-    with pytest.raises(ScenarioError, match=r"unknown scenario 'load-stpe-pi'; known: .*heavy-pi"):
+    with pytest.raises(ScenarioError, match=r"unknown scenario 'load-stpe-pi': no such file, .*shipped scenarios .*heavy-pi"):
         resolve_scenarios(["load-stpe-pi"])
 
 

@@ -3,6 +3,8 @@
 Modules, by section of the model specification:
 constants, checks, parameters (schema), lattice (1), phases (2), constant_load (3-4),
 sensing (5), minor_loops (6), constant_temperature (7), constant_length (8),
-thermal (9), phase_lag and pi_control (10), plant and feedforward (the steppers).
-Nothing here may import numpy, scipy or anything outside the standard library.
+thermal (9), phase_lag and pi_control (10), plant and feedforward (the steppers), and
+signals (the scenario signals R_ref(t) and load(t)).
+Nothing here may import numpy, scipy, pythonfmu or anything outside the standard library;
+the FMI glue the FMUs also ship is in :mod:`sma_fmu.fmi.slave_support`.
 """

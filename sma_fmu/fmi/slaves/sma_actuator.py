@@ -13,7 +13,7 @@ doStep is discarded (pythonfmu would turn an exception there into fmi2Fatal).
 from pythonfmu import Fmi2Slave
 from pythonfmu.default_experiment import DefaultExperiment
 
-from sma_fmu.runtime.fmi_slave import SlaveInterface
+from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.runtime.plant import PlantStepper
 
 OUTPUTS = (

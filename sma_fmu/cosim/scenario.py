@@ -31,10 +31,10 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from .parameter_file import load_parameter_set
-from .project_files import project_folder
-from .runtime.parameters import ParameterError
-from .signals import load_from_table, reference_from_table
+from sma_fmu.parameter_file import load_parameter_set
+from sma_fmu.package_data import shipped_file, shipped_files
+from sma_fmu.runtime.parameters import ParameterError
+from sma_fmu.runtime.signals import load_from_table, reference_from_table
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -200,13 +200,16 @@ def load_scenario(path):
 
 
 def scenario_names():
-    """Names (file stems) of the scenarios shipped in ``scenarios/``, sorted."""
-    return sorted(p.stem for p in project_folder("scenarios").glob("*.toml"))
+    """Names (file stems) of the scenarios shipped with the package, sorted."""
+    return [name[:-len(".toml")] for name in shipped_files("scenarios", ".toml")]
 
 
 def resolve_scenarios(items, everything=False):
-    """Scenario files for names, paths, ``"paper"`` (the paper's set) or ``everything``."""
-    folder = project_folder("scenarios")
+    """Scenario files for names, paths, ``"paper"`` (the paper's set) or ``everything``.
+
+    An item that names an existing file is that file, whatever its name; otherwise it must
+    be the name of a shipped scenario.
+    """
     names = list(scenario_names()) if everything else []
     for item in items:
         names.extend(PAPER_SET if item == "paper" else [item])
@@ -215,11 +218,13 @@ def resolve_scenarios(items, everything=False):
     paths = []
     for name in names:
         candidate = Path(name)
-        if candidate.suffix == ".toml" and candidate.is_file():
+        if candidate.is_file():
             paths.append(candidate)
-        elif (folder / f"{name}.toml").is_file():
-            paths.append(folder / f"{name}.toml")
+        elif candidate.exists():
+            raise ScenarioError(f"{candidate}: is not a file (a scenario is a .toml file)")
+        elif name in scenario_names():
+            paths.append(shipped_file("scenarios", f"{name}.toml"))
         else:
-            raise ScenarioError(f"unknown scenario {name!r}; known: {', '.join(scenario_names())}, "
-                                f"paper, or a path to a .toml file")
+            raise ScenarioError(f"unknown scenario {name!r}: no such file, and not one of the "
+                                f"shipped scenarios ({', '.join(scenario_names())}) or 'paper'")
     return list(dict.fromkeys(paths))

@@ -16,7 +16,7 @@ from pythonfmu.default_experiment import DefaultExperiment
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.feedforward import FeedforwardStepper
-from sma_fmu.runtime.fmi_slave import SlaveInterface
+from sma_fmu.fmi.slave_support.interface import SlaveInterface
 
 INVALID_OUTPUTS = (float("nan"), float("nan"), False)
 

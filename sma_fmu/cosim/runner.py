@@ -5,18 +5,18 @@ and ``NAME/figure.png``. For each group of scenarios that differ only in the con
 ``comparison-GROUP.png``. Over the whole run: ``comparison.md``, which ranks the
 controllers by RMSE in each group, and ``summary.json``.
 """
-import json
 import time
-from pathlib import Path
 
 import numpy as np
 
-from .closed_loop import COLUMNS, run_library
-from .fmu_build import DEFAULT_FMU_DIR
-from .master import run_fmus
-from .metrics import METRIC_START_S, scenario_metrics
-from .plots import plot_comparison, plot_run
-from .scenario import CONTROLLERS, load_scenario
+from sma_fmu.cosim.loop import COLUMNS, run_library
+from sma_fmu.fmi.build import DEFAULT_FMU_DIR
+from sma_fmu.cosim.master import run_fmus
+from sma_fmu.cosim.metrics import METRIC_START_S, scenario_metrics
+from sma_fmu.cosim.plots import plot_comparison, plot_run
+from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
+from sma_fmu.json_output import json_text
+from sma_fmu.output_folder import staged_folder
 
 __all__ = ["PATHS", "run_scenarios", "write_timeseries", "summary_table", "comparison_markdown"]
 
@@ -86,31 +86,31 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     if path not in PATHS:
         raise ValueError(f"path must be one of {', '.join(PATHS)}, got {path!r}")
     scenarios = [load_scenario(p) for p in paths]
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     rows, series = [], {}
-    for index, scenario in enumerate(scenarios, start=1):
-        if len(scenarios) > 1:
-            progress(f"[{index}/{len(scenarios)}] {scenario.name} ({path}) ...")
-        result = PATHS[path](scenario, fmu_dir)
-        folder = out_dir / scenario.name
-        folder.mkdir(exist_ok=True)
-        write_timeseries(result.data, folder / "timeseries.csv")
-        metrics = scenario_metrics(result.data, scenario)
-        metrics.update(path=path, wall_time_s=result.wall_time_s)
-        (folder / "metrics.json").write_text(json.dumps(metrics, indent=2), encoding="utf-8")
-        plot_run(result.data, scenario, folder / "figure.png")
-        rows.append({"scenario": scenario.name, "group": scenario.group, "metrics": metrics,
-                     "wall_time_s": result.wall_time_s,
-                     "real_time_factor": scenario.stop_time_s / result.wall_time_s})
-        series[scenario.name] = (scenario, result.data)
-    for group, members in _groups(rows).items():
-        if len(members) > 1:
-            runs = {series[r["scenario"]][0].controller.kind: series[r["scenario"]][1] for r in members}
-            plot_comparison(runs, f"{group}: controllers compared",
-                            out_dir / f"comparison-{group}.png")
-    (out_dir / "comparison.md").write_text(comparison_markdown(rows), encoding="utf-8")
-    (out_dir / "summary.json").write_text(json.dumps(rows, indent=2), encoding="utf-8")
+    with staged_folder(out_dir) as stage:
+        for index, scenario in enumerate(scenarios, start=1):
+            if len(scenarios) > 1:
+                progress(f"[{index}/{len(scenarios)}] {scenario.name} ({path}) ...")
+            result = PATHS[path](scenario, fmu_dir)
+            folder = stage / scenario.name
+            folder.mkdir()
+            write_timeseries(result.data, folder / "timeseries.csv")
+            metrics = scenario_metrics(result.data, scenario)
+            metrics.update(path=path, wall_time_s=result.wall_time_s)
+            (folder / "metrics.json").write_text(json_text(metrics), encoding="utf-8")
+            plot_run(result.data, scenario, folder / "figure.png")
+            rows.append({"scenario": scenario.name, "group": scenario.group, "metrics": metrics,
+                         "wall_time_s": result.wall_time_s,
+                         "real_time_factor": scenario.stop_time_s / result.wall_time_s})
+            series[scenario.name] = (scenario, result.data)
+        for group, members in _groups(rows).items():
+            if len(members) > 1:
+                runs = {series[r["scenario"]][0].controller.kind: series[r["scenario"]][1]
+                        for r in members}
+                plot_comparison(runs, f"{group}: controllers compared",
+                                stage / f"comparison-{group}.png")
+        (stage / "comparison.md").write_text(comparison_markdown(rows), encoding="utf-8")
+        (stage / "summary.json").write_text(json_text(rows), encoding="utf-8")
     return rows
 
 

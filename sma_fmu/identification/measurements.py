@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .runtime.constants import COOLING, HEATING
+from sma_fmu.runtime.constants import COOLING, HEATING
 
 __all__ = ["MeasurementError", "ConstantLoadData", "ConstantTemperatureData",
            "read_constant_load", "read_constant_temperature", "TEMPERATURE_SPREAD_LIMIT_K"]

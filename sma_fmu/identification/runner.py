@@ -4,14 +4,16 @@ Writes into ``out_dir``: ``identified.toml`` (a complete parameter file in the f
 ``models/``, ready for the FMUs and scenarios), ``report.json`` and PNG figures. All of it
 is computed first; nothing is written when reading, checking or fitting fails.
 """
-import json
 from datetime import datetime, timezone
 from pathlib import Path
 
-from . import fit_constant_load, fit_constant_temperature
-from .fit_plots import constant_load_figures, constant_temperature_figures
-from .measurements import read_constant_load, read_constant_temperature
-from .parameter_file import load_parameter_set, parameter_file_text
+from sma_fmu.identification import constant_load as fit_constant_load
+from sma_fmu.identification import constant_temperature as fit_constant_temperature
+from sma_fmu.identification.figures import constant_load_figures, constant_temperature_figures
+from sma_fmu.identification.measurements import read_constant_load, read_constant_temperature
+from sma_fmu.json_output import json_text
+from sma_fmu.output_folder import staged_folder
+from sma_fmu.parameter_file import load_parameter_set, parameter_file_text
 
 __all__ = ["EXPERIMENTS", "run_fit", "format_report"]
 
@@ -49,12 +51,11 @@ def run_fit(experiment, files, out_dir, model=None):
         header=[f"Identified by sma-fmu fit {experiment} on {stamp}.",
                 f"Fitted: {fitted}; everything else from {base_set.path}.",
                 f"Data: {', '.join(str(f) for f in files)}"])
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "identified.toml").write_text(text, encoding="utf-8")
-    (out_dir / "report.json").write_text(json.dumps(report, indent=2), encoding="utf-8")
-    for name, png in figures.items():
-        (out_dir / name).write_bytes(png)
+    with staged_folder(out_dir) as folder:
+        (folder / "identified.toml").write_text(text, encoding="utf-8")
+        (folder / "report.json").write_text(json_text(report), encoding="utf-8")
+        for name, png in figures.items():
+            (folder / name).write_bytes(png)
     return report
 
 

@@ -1,15 +1,15 @@
 """The fmpy co-simulation master: SmaActuator (+ SmaFeedforward) FMUs in the closed loop.
 
-Built on fmpy's ``FMU2Slave`` (through :class:`~sma_fmu.fmu_instance.FmuInstance`). The
-loop and the PI block are those of :mod:`sma_fmu.closed_loop`; the compensator FMU is
+Built on fmpy's ``FMU2Slave`` (through :class:`~sma_fmu.fmi.instance.FmuInstance`). The
+loop and the PI block are those of :mod:`sma_fmu.cosim.loop`; the compensator FMU is
 stepped before the plant (Gauss-Seidel), so u_ff,k reaches the plant's step k.
 """
 import time
 from pathlib import Path
 
-from .closed_loop import LoopResult, run_loop
-from .fmu_build import DEFAULT_FMU_DIR, default_fmu_paths
-from .fmu_instance import FmuError, FmuInstance
+from sma_fmu.cosim.loop import LoopResult, run_loop
+from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths
+from sma_fmu.fmi.instance import FmuError, FmuInstance
 
 __all__ = ["FmuPlant", "FmuCompensator", "run_fmus", "MissingFmuError"]
 

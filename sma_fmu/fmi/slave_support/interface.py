@@ -1,8 +1,7 @@
-"""Shared plumbing of the FMU slave classes (fmu_src/): variables with units, parameters, guards.
+"""Shared plumbing of the FMU slave classes (``fmi/slaves/``): variables with units, parameters, guards.
 
-This is the one runtime module that imports pythonfmu: it runs only inside an FMU (or
-while one is built), and every pythonfmu FMU ships pythonfmu in its resources/. The
-library path never imports it.
+It imports pythonfmu: it runs only inside an FMU (or while one is built), and every
+pythonfmu FMU ships pythonfmu in its resources/. The library path never imports it.
 
 The build writes the wire's parameter set to ``resources/parameters.json``; a slave
 exposes some of those parameters as FMI parameters (start values from that file) and
@@ -14,8 +13,8 @@ import os
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Variability, Real, String
 from pythonfmu.enums import Fmi2Status
 
-from .fmi_description import decorate_model_description
-from .parameters import PARAMETER_SPECS, WireParameters
+from sma_fmu.fmi.slave_support.model_description import decorate_model_description
+from sma_fmu.runtime.parameters import PARAMETER_SPECS, WireParameters
 
 __all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
 

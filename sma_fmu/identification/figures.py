@@ -1,14 +1,14 @@
-"""Fit figures: data vs model like the paper's Figs. 4-6, and residuals; returned as PNG bytes."""
+"""Fit figures: data vs model like the paper's Figs. 4-6, and residuals; returned as PNG bytes.
+
+Drawn on :class:`matplotlib.figure.Figure` objects (no pyplot, no backend switch).
+"""
 import io
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from .runtime.constant_load import constant_load_resistance  # noqa: E402
-from .runtime.sensing import sense_temperature  # noqa: E402
+from sma_fmu.runtime.constant_load import constant_load_resistance
+from sma_fmu.runtime.sensing import sense_temperature
 
 __all__ = ["constant_load_figures", "constant_temperature_figures"]
 
@@ -19,14 +19,14 @@ def _png(figure):
     buffer = io.BytesIO()
     figure.tight_layout()
     figure.savefig(buffer, format="png", dpi=100)
-    plt.close(figure)
     return buffer.getvalue()
 
 
 def _load_grid(count):
     columns = min(count, 2)
     rows = int(np.ceil(count / columns))
-    figure, axes = plt.subplots(rows, columns, figsize=(6 * columns, 4 * rows), squeeze=False)
+    figure = Figure(figsize=(6 * columns, 4 * rows))
+    axes = figure.subplots(rows, columns, squeeze=False)
     for axis in axes.flat[count:]:
         axis.set_visible(False)
     return figure, axes.flat
@@ -70,7 +70,8 @@ def constant_load_figures(params, data, sensed):
 
 def constant_temperature_figures(params, experiments, model):
     """{file name: PNG bytes}: resistance against load (Fig. 6) with the model, and residuals."""
-    figure, (top, bottom) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    figure = Figure(figsize=(8, 7))
+    top, bottom = figure.subplots(2, 1, sharex=True)
     offset = 0
     for e in experiments:
         rows = slice(offset, offset + e.load.size)

@@ -10,12 +10,12 @@ import math
 
 import numpy as np
 
-from .identification import FitParameter, fit_parameters, percentage_errors
-from .measurements import MeasurementError
-from .runtime.checks import direction_name
-from .runtime.constant_load import branch_constants, branch_fractions
-from .runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
-from .runtime.sensing import mixed_fractions_of_resistance, sense_temperature
+from sma_fmu.identification.least_squares import FitParameter, fit_parameters, percentage_errors
+from sma_fmu.identification.measurements import MeasurementError
+from sma_fmu.runtime.checks import direction_name
+from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
+from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
+from sma_fmu.runtime.sensing import mixed_fractions_of_resistance, sense_temperature
 
 __all__ = ["FITTED", "MIN_LOADS", "model_resistance", "starting_parameters", "fit_constant_load",
            "sensing_comparison"]

@@ -10,10 +10,10 @@ import math
 
 import numpy as np
 
-from .identification import FitParameter, fit_parameters, percentage_errors
-from .measurements import MeasurementError
-from .runtime.constant_temperature import ConstantTemperatureModel
-from .runtime.constants import BOLTZMANN, KELVIN_OFFSET, STANDARD_GRAVITY
+from sma_fmu.identification.least_squares import FitParameter, fit_parameters, percentage_errors
+from sma_fmu.identification.measurements import MeasurementError
+from sma_fmu.runtime.constant_temperature import ConstantTemperatureModel
+from sma_fmu.runtime.constants import BOLTZMANN, KELVIN_OFFSET, STANDARD_GRAVITY
 
 __all__ = ["FITTED", "model_resistance", "starting_parameters", "fit_constant_temperature"]
 

@@ -9,14 +9,16 @@ Noise: Gaussian resistance noise [ohm] on each reading, and Gaussian temperature
 noise [K] on the reported temperature (the wire's true temperature drives the model).
 """
 import csv
+import io
 from pathlib import Path
 
 import numpy as np
 
-from .runtime.checks import direction_name
-from .runtime.constant_load import constant_load_resistance
-from .runtime.constant_temperature import ConstantTemperatureModel
-from .runtime.constants import COOLING, HEATING
+from sma_fmu.output_folder import write_file
+from sma_fmu.runtime.checks import direction_name
+from sma_fmu.runtime.constant_load import constant_load_resistance
+from sma_fmu.runtime.constant_temperature import ConstantTemperatureModel
+from sma_fmu.runtime.constants import COOLING, HEATING
 
 __all__ = ["constant_load_rows", "constant_temperature_rows", "load_path", "write_rows"]
 
@@ -74,11 +76,14 @@ def constant_temperature_rows(params, temperature, loads, load_step=0.005, noise
 
 
 def write_rows(path, rows):
-    """Write rows (dicts with the same keys) as CSV; numbers exactly (shortest round-trip repr)."""
-    path = Path(path)
-    with open(path, "w", newline="", encoding="utf-8") as stream:
-        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: (repr(float(v)) if isinstance(v, float) else v) for k, v in row.items()})
-    return path
+    """Write rows (dicts with the same keys) as CSV; numbers exactly (shortest round-trip repr).
+
+    The file is written whole or not at all (temporary file, then a rename).
+    """
+    stream = io.StringIO(newline="")
+    writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: (repr(float(v)) if isinstance(v, float) else v) for k, v in row.items()})
+    write_file(path, stream.getvalue())
+    return Path(path)

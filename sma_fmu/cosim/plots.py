@@ -1,8 +1,9 @@
-"""Figures like the paper's Figs. 10-11, drawn with matplotlib (Agg, no screen needed)."""
-import matplotlib
+"""Figures like the paper's Figs. 10-11, drawn with matplotlib.
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+Drawn on :class:`matplotlib.figure.Figure` objects, not through pyplot: no screen is
+needed, and importing this module leaves the process's matplotlib backend alone.
+"""
+from matplotlib.figure import Figure
 
 __all__ = ["plot_run", "plot_comparison"]
 
@@ -11,7 +12,8 @@ _COLOURS = {"pi": "tab:red", "pi+ff-fixed": "tab:orange", "pi+ff-adaptive": "tab
 
 def plot_run(data, scenario, path):
     """Power and load on top, R_ref and R below (paper Fig. 10); saved as PNG at ``path``."""
-    figure, (top, bottom) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True)
+    figure = Figure(figsize=(10, 6.5))
+    top, bottom = figure.subplots(2, 1, sharex=True)
     t = data["t"]
     top.plot(t[:-1], data["P"][:-1], color="black", lw=0.8, label="P (input power)")
     top.set_ylabel("power P [W]")
@@ -29,7 +31,6 @@ def plot_run(data, scenario, path):
         axis.grid(alpha=0.3)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
-    plt.close(figure)
 
 
 def plot_comparison(runs, title, path, zoom=(24.0, 28.0)):
@@ -37,7 +38,8 @@ def plot_comparison(runs, title, path, zoom=(24.0, 28.0)):
 
     ``runs`` maps controller kind -> time-series array of the same scenario group.
     """
-    figure, axes = plt.subplots(3, 1, figsize=(10, 9))
+    figure = Figure(figsize=(10, 9))
+    axes = figure.subplots(3, 1)
     first = next(iter(runs.values()))
     t = first["t"]
     zoomed = (t >= zoom[0]) & (t <= zoom[1])
@@ -59,4 +61,3 @@ def plot_comparison(runs, title, path, zoom=(24.0, 28.0)):
         axis.legend(loc="upper right", fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
-    plt.close(figure)

@@ -1,6 +1,6 @@
 """The closed loop of the paper's Fig. 9, sequenced as in spec section 11, for any plant/compensator.
 
-One loop serves both paths: the FMU path (:mod:`sma_fmu.master`, plant and compensator
+One loop serves both paths: the FMU path (:mod:`sma_fmu.cosim.master`, plant and compensator
 are FMUs under fmpy) and the library path (here, the runtime steppers directly). Per
 step k = 0 ... n-1 (t_k = k h): read R_k; e_k = R_k - R_ref(t_k); the compensator takes
 R_ref(t_k), f(t_k) -> u_ff,k; the PI gives u_k = max(0, u_ff,k + Kp e_k + Ki I_k); the plant
@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .runtime.feedforward import FeedforwardStepper
-from .runtime.pi_control import PIController
-from .runtime.plant import PlantStepper
+from sma_fmu.runtime.feedforward import FeedforwardStepper
+from sma_fmu.runtime.pi_control import PIController
+from sma_fmu.runtime.plant import PlantStepper
 
 __all__ = ["COLUMNS", "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator",
            "run_library"]

@@ -1,0 +1,96 @@
+"""Argument parsing shared by the commands: one-line errors, defaults in --help, checked types."""
+import argparse
+import math
+import sys
+
+from sma_fmu.runtime.checks import direction_sign
+
+__all__ = ["Parser", "HelpFormatter", "finite_number", "positive_number", "nonnegative_number",
+           "positive_integer", "number_list", "direction", "fail"]
+
+
+def fail(message):
+    """Print ``sma-fmu: error: message`` on stderr (one line); returns exit status 2."""
+    text = " ".join(str(message).split()) or "unknown error"
+    print(f"sma-fmu: error: {text}", file=sys.stderr)
+    return 2
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Help that states every option's default (except None and False, which mean 'not given')."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if ("%(default)" not in text and action.default not in (None, False, argparse.SUPPRESS)
+                and action.option_strings):
+            text += " (default: %(default)s)"
+        return text
+
+
+class Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line, ``sma-fmu: error: ...``, exit status 2."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+    def error(self, message):
+        command = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
+        self.exit(fail(f"{command}{message} (see {self.prog} --help)"))
+
+
+def _number(text, rule=None, rule_text=""):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    if rule is not None and not rule(value):
+        raise argparse.ArgumentTypeError(f"expected a number {rule_text}, got {text!r}")
+    return value
+
+
+def finite_number(text):
+    """argparse type: a finite float."""
+    return _number(text)
+
+
+def positive_number(text):
+    """argparse type: a finite float > 0."""
+    return _number(text, lambda v: v > 0.0, "> 0")
+
+
+def nonnegative_number(text):
+    """argparse type: a finite float >= 0."""
+    return _number(text, lambda v: v >= 0.0, ">= 0")
+
+
+def positive_integer(text):
+    """argparse type: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
+def number_list(text):
+    """argparse type: comma-separated finite numbers."""
+    items = [item for item in text.split(",") if item.strip()]
+    if not items:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}")
+    try:
+        return [_number(item) for item in items]
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated finite numbers, got {text!r}") from None
+
+
+def direction(text):
+    """argparse type: "heating" or "cooling" -> +1 or -1."""
+    try:
+        return direction_sign(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None

@@ -1,0 +1,20 @@
+"""Benchmark command: how fast the FMUs, the co-simulation and the fits run."""
+from pathlib import Path
+
+from .arguments import positive_integer
+
+__all__ = ["register"]
+
+
+def _bench(args):
+    from sma_fmu.benchmark import main as bench_main
+    return bench_main(args.out, args.runs)
+
+
+def register(commands):
+    """Add ``bench`` to the ``commands`` subparsers."""
+    bench = commands.add_parser("bench", help="measure speed; print a table and write JSON")
+    bench.add_argument("--out", type=Path, default=Path("results/benchmark"), metavar="DIR",
+                       help="output folder")
+    bench.add_argument("--runs", type=positive_integer, default=5, help="repetitions per measurement")
+    bench.set_defaults(handler=_bench)

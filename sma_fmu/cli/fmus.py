@@ -1,0 +1,41 @@
+"""FMU commands: build, validate."""
+from pathlib import Path
+
+from sma_fmu.fmi import build as fmu_build
+
+__all__ = ["register"]
+
+
+def _build(args):
+    paths = fmu_build.build_fmus(args.out, args.model)
+    for name, path in paths.items():
+        print(f"{name}: {path}")
+    return 0
+
+
+def _validate(args):
+    paths = args.fmus or list(fmu_build.default_fmu_paths(args.out).values())
+    failed = False
+    for path, problems in fmu_build.validate_fmus(paths).items():
+        print(f"{path}: {'valid (fmpy: no problems)' if not problems else f'{len(problems)} problem(s)'}")
+        for problem in problems:
+            print(f"  - {problem}")
+        failed = failed or bool(problems)
+    return 1 if failed else 0
+
+
+def register(commands):
+    """Add ``build`` and ``validate`` to the ``commands`` subparsers."""
+    build = commands.add_parser("build", help="build the FMUs")
+    build.add_argument("--out", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
+                       help="output folder")
+    build.add_argument("--model", metavar="FILE",
+                       help="parameter file the FMUs carry (default: the shipped reference_wire.toml)")
+    build.set_defaults(handler=_build)
+
+    validate = commands.add_parser("validate", help="validate FMUs with fmpy (exit 1 on problems)")
+    validate.add_argument("fmus", nargs="*", type=Path, metavar="FMU",
+                          help="FMU files (default: the built FMUs in --out)")
+    validate.add_argument("--out", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
+                          help="folder of the default FMUs")
+    validate.set_defaults(handler=_validate)

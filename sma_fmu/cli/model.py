@@ -1,0 +1,101 @@
+"""Model commands: lattice, resistance, sense, constant-length (``name = value unit`` or JSON)."""
+import json
+
+from sma_fmu.parameter_file import load_parameter_set
+from sma_fmu.runtime.checks import direction_name
+from sma_fmu.runtime.constant_length import load_temperature_slope
+from sma_fmu.runtime.constant_load import constant_load_fractions
+from sma_fmu.runtime.phases import length_of, resistance_of
+from sma_fmu.runtime.sensing import sense_temperature
+
+from .arguments import Parser, direction, finite_number
+
+__all__ = ["register"]
+
+
+def _report(rows, as_json):
+    """Print rows of (name, value, unit) as text lines or one JSON object."""
+    if as_json:
+        print(json.dumps({name: value for name, value, _ in rows}, allow_nan=False))
+        return
+    for name, value, unit in rows:
+        text = f"{value:.6g}" if isinstance(value, float) else str(value)
+        print(f"{name} = {text}{' ' + unit if unit else ''}")
+
+
+def _lattice(args, parameter_set):
+    lattice = parameter_set.params.lattice
+    return [("N", lattice.N, ""), ("x_P", lattice.x_P, "m"), ("N_l", lattice.N_l, ""),
+            ("N_S", lattice.N_S, "")]
+
+
+def _resistance(args, parameter_set):
+    params = parameter_set.params
+    fractions = constant_load_fractions(args.temperature, args.load, args.direction, params)
+    return [("temperature", args.temperature, "degC"), ("load", args.load, "kg"),
+            ("direction", direction_name(args.direction), ""),
+            ("R", resistance_of(fractions, params), "ohm"),
+            ("xi_P", fractions.xi_P, ""), ("xi_M", fractions.xi_M, ""),
+            ("xi_F", fractions.xi_F, ""), ("x", length_of(fractions, params), "m")]
+
+
+def _sense(args, parameter_set):
+    sensed = sense_temperature(args.resistance, args.load, args.direction, parameter_set.params)
+    return [("resistance", args.resistance, "ohm"), ("load", args.load, "kg"),
+            ("direction", direction_name(args.direction), ""),
+            ("T", sensed.temperature, "degC"), ("saturated", sensed.saturated, "")]
+
+
+def _constant_length(args, parameter_set):
+    slope = load_temperature_slope(args.xi_p, args.xi_m, args.xi_f, parameter_set.params)
+    return [("xi_P", args.xi_p, ""), ("xi_M", args.xi_m, ""), ("xi_F", args.xi_f, ""),
+            ("df_dT", slope, "kg/K")]
+
+
+def _handler(compute):
+    """Handler that loads the parameter file, computes rows and prints them."""
+    def handler(args):
+        _report(compute(args, load_parameter_set(args.model)), args.json)
+        return 0
+    return handler
+
+
+def register(commands):
+    """Add the model commands to the ``commands`` subparsers."""
+    common = Parser(add_help=False)
+    common.add_argument("--model", metavar="FILE",
+                        help="parameter file (default: the shipped reference_wire.toml)")
+    common.add_argument("--json", action="store_true", help="print one JSON object")
+
+    lattice = commands.add_parser("lattice", parents=[common],
+                                  help="lattice constants N, x_P, N_l, N_S")
+    lattice.set_defaults(handler=_handler(_lattice))
+
+    resistance = commands.add_parser("resistance", parents=[common],
+                                     help="resistance, fractions and length at T, load, direction")
+    resistance.add_argument("--temperature", required=True, type=finite_number, metavar="C",
+                            help="wire temperature [degC]")
+    resistance.add_argument("--load", required=True, type=finite_number, metavar="KG",
+                            help="hung mass [kg]")
+    _add_direction(resistance)
+    resistance.set_defaults(handler=_handler(_resistance))
+
+    sense = commands.add_parser("sense", parents=[common],
+                                help="temperature from resistance (inverse model)")
+    sense.add_argument("--resistance", required=True, type=finite_number, metavar="OHM",
+                       help="wire resistance [ohm]")
+    sense.add_argument("--load", required=True, type=finite_number, metavar="KG", help="hung mass [kg]")
+    _add_direction(sense)
+    sense.set_defaults(handler=_handler(_sense))
+
+    length = commands.add_parser("constant-length", parents=[common],
+                                 help="(df/dT)_x of a wire held at constant length [kg/K]")
+    length.add_argument("--xi-p", required=True, type=finite_number, help="P fraction [1]")
+    length.add_argument("--xi-m", required=True, type=finite_number, help="M fraction [1]")
+    length.add_argument("--xi-f", required=True, type=finite_number, help="F fraction [1]")
+    length.set_defaults(handler=_handler(_constant_length))
+
+
+def _add_direction(parser):
+    parser.add_argument("--direction", required=True, type=direction,
+                        metavar="heating|cooling", help="sign of dT/dt")

@@ -1,0 +1,151 @@
+"""Build the FMUs with pythonfmu, and validate FMUs with fmpy.
+
+Each FMU ships, in resources/:
+- its slave script from ``sma_fmu/fmi/slaves/``, renamed ``<script>_<stamp>``;
+- a copy of ``sma_fmu/runtime`` (the physics, standard library only) renamed
+  ``<script>_rt_<stamp>``, and a copy of ``sma_fmu/fmi/slave_support`` (the FMI glue, which
+  needs pythonfmu) renamed ``<script>_fmi_<stamp>``, with their imports rewritten to match;
+- ``parameters.json``: the wire parameter file used at build time.
+
+``<stamp>`` is a hash of all shipped code. pythonfmu FMUs loaded into one process share
+``sys.modules``: with these names an FMU never runs another FMU type's modules, another
+version's stale copy, or the ``sma_fmu`` installed in the host's environment. Instances
+of one FMU built from the same code share modules of identical content; the slave
+imports everything it needs when it loads, so a later instance unpacked elsewhere
+finds nothing missing.
+"""
+import hashlib
+import json
+import re
+import sys
+import tempfile
+from importlib import resources
+from pathlib import Path
+
+from sma_fmu import __version__
+from sma_fmu.output_folder import staged_folder
+from sma_fmu.package_data import shipped_file
+from sma_fmu.parameter_file import load_parameter_set
+
+__all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "code_stamp", "build_fmu", "build_fmus",
+           "validate_fmus", "default_fmu_paths"]
+
+FMU_SCRIPTS = {"SmaActuator": "sma_actuator.py", "SmaFeedforward": "sma_feedforward.py"}
+DEFAULT_FMU_DIR = Path("fmus")
+# shipped package -> suffix of its renamed copy inside an FMU
+_SHIPPED_PACKAGES = {"sma_fmu.runtime": "rt", "sma_fmu.fmi.slave_support": "fmi"}
+
+
+def _package_sources(package):
+    """{file name: bytes} of the Python modules of ``package`` (a shipped package)."""
+    return {entry.name: entry.read_bytes() for entry in resources.files(package).iterdir()
+            if entry.is_file() and entry.name.endswith(".py")}
+
+
+def _shipped_sources():
+    sources = [(f"{package}/{name}", data) for package in _SHIPPED_PACKAGES
+               for name, data in sorted(_package_sources(package).items())]
+    sources += [(f"slaves/{name}", shipped_file("slaves", name).read_bytes())
+                for name in sorted(FMU_SCRIPTS.values())]
+    return sources
+
+
+def code_stamp():
+    """10-hex-digit hash of the package version and every shipped source file."""
+    digest = hashlib.sha256(__version__.encode())
+    for name, data in _shipped_sources():
+        digest.update(name.encode())
+        digest.update(data)
+    return digest.hexdigest()[:10]
+
+
+def _renamer(stem, stamp):
+    """Function rewriting imports of the shipped packages to their renamed copies."""
+    names = {package: f"{stem}_{suffix}_{stamp}" for package, suffix in _SHIPPED_PACKAGES.items()}
+    pattern = re.compile("|".join(re.escape(p) + r"\b" for p in sorted(names, key=len, reverse=True)))
+    return names, lambda text: pattern.sub(lambda match: names[match.group(0)], text)
+
+
+def _stage(script_name, stage, parameter_set, stamp):
+    """Write the renamed packages, the rewritten slave script and parameters.json into ``stage``."""
+    stem = Path(script_name).stem
+    names, rename = _renamer(stem, stamp)
+    project_files = []
+    for package, renamed in names.items():
+        folder = stage / renamed
+        folder.mkdir()
+        for name, data in _package_sources(package).items():
+            (folder / name).write_text(rename(data.decode("utf-8")), encoding="utf-8")
+        project_files.append(folder)
+    source = shipped_file("slaves", script_name).read_text(encoding="utf-8")
+    if "sma_fmu.runtime" not in source:
+        raise ValueError(f"{script_name}: slave script does not import sma_fmu.runtime")
+    staged_script = stage / f"{stem}_{stamp}.py"
+    staged_script.write_text(rename(source), encoding="utf-8")
+    document = parameter_set.as_json()
+    document.update(source=str(parameter_set.path), sma_fmu_version=__version__, stamp=stamp)
+    parameters = stage / "parameters.json"
+    parameters.write_text(json.dumps(document, indent=2), encoding="utf-8")
+    return staged_script, project_files + [parameters]
+
+
+def _forget_staged_modules(stamp):
+    """Drop modules imported from a staging folder, so a later load imports the FMU's own copy."""
+    for name in [name for name in sys.modules if name.endswith(stamp) or f"_{stamp}." in name]:
+        del sys.modules[name]
+
+
+def _build_into(model_name, folder, parameter_set, stamp):
+    """Build one FMU into ``folder`` (a staging folder); returns its path."""
+    from pythonfmu.builder import FmuBuilder
+
+    with tempfile.TemporaryDirectory(prefix="sma_fmu_stage_") as stage:
+        script, project_files = _stage(FMU_SCRIPTS[model_name], Path(stage), parameter_set, stamp)
+        try:
+            return Path(FmuBuilder.build_FMU(
+                script, dest=folder / f"{model_name}.fmu", project_files=project_files,
+                canGetAndSetFMUstate=True, canSerializeFMUstate=True))
+        finally:
+            _forget_staged_modules(stamp)
+            if str(Path(stage)) in sys.path:  # pythonfmu leaves the script's folder on sys.path
+                sys.path.remove(str(Path(stage)))
+
+
+def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None):
+    """Build FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``; return {name: path}.
+
+    They are built in a temporary folder beside ``out_dir`` and moved there at the end, so
+    a failed build leaves ``out_dir`` as it was.
+    """
+    names = list(FMU_SCRIPTS) if names is None else list(names)
+    unknown = [name for name in names if name not in FMU_SCRIPTS]
+    if unknown:
+        raise ValueError(f"unknown FMU {unknown[0]!r}; expected one of {', '.join(FMU_SCRIPTS)}")
+    parameter_set = load_parameter_set(parameter_file)
+    stamp = code_stamp()
+    with staged_folder(out_dir) as folder:
+        for name in names:
+            _build_into(name, folder, parameter_set, stamp)
+    return {name: Path(out_dir) / f"{name}.fmu" for name in names}
+
+
+def build_fmu(model_name, out_dir=DEFAULT_FMU_DIR, parameter_file=None):
+    """Build one FMU (a key of :data:`FMU_SCRIPTS`) into ``out_dir``; return its path."""
+    return build_fmus(out_dir, parameter_file, [model_name])[model_name]
+
+
+def default_fmu_paths(out_dir=DEFAULT_FMU_DIR):
+    """{model name: path} where :func:`build_fmus` puts the FMUs."""
+    return {name: Path(out_dir) / f"{name}.fmu" for name in FMU_SCRIPTS}
+
+
+def validate_fmus(paths):
+    """fmpy's validation of each FMU: {path: list of problems} (empty list = valid)."""
+    from fmpy.validation import validate_fmu
+
+    results = {}
+    for path in paths:
+        path = Path(path)
+        results[path] = ([f"{path}: no such file"] if not path.is_file()
+                         else validate_fmu(str(path)))
+    return results

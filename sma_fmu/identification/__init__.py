@@ -1,0 +1,1 @@
+"""Parameter identification from measurements: CSV readers, least squares, fits, synthetic data, figures."""
