@@ -49,7 +49,6 @@ def test_sense_rejects(params, resistance, match):
 
 @pytest.mark.parametrize("power,load,step,match", [
     (NAN, 0.05, 1e-3, "P_in must be finite, got nan"),
-    (-0.1, 0.05, 1e-3, r"P_in must be >= 0, got -0.1"),
     (INF, 0.05, 1e-3, "P_in must be finite, got inf"),
     (0.5, -1e-3, 1e-3, r"load must be >= 0, got -0.001"),
     (0.5, NAN, 1e-3, "load must be finite, got nan"),
@@ -68,6 +67,17 @@ def test_plant_step_rejects_and_keeps_state(params, power, load, step, match):
     twin = PlantStepper(params, load=0.05)
     twin.step(0.8, 0.05, 1e-3)
     assert plant.step(0.8, 0.05, 1e-3) == twin.step(0.8, 0.05, 1e-3)
+
+
+def test_plant_applies_negative_power_as_zero(params):
+    """The paper's rule: a power of 0 W or less is 0 W; the plant reports what it applied."""
+    negative, zero = PlantStepper(params, load=0.05), PlantStepper(params, load=0.05)
+    for stepper in (negative, zero):
+        stepper.step(2.0, 0.05, 1e-3)
+    assert negative.outputs.P == 2.0
+    out = negative.step(-0.7, 0.05, 1e-3)
+    assert out == zero.step(0.0, 0.05, 1e-3)
+    assert out.P == 0.0 and out.T < negative.state()["temperature"] + 1.0
 
 
 @pytest.mark.parametrize("reference,load,step,match", [

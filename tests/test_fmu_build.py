@@ -12,7 +12,7 @@ from sma_fmu.fmi.build import build_fmu, code_stamp, validate_fmus
 from sma_fmu.parameter_file import write_parameter_file
 from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
 
-PLANT_OUTPUTS = {"R": "ohm", "T": "degC", "x": "m", "xi_P": "1", "xi_M": "1", "xi_F": "1"}
+PLANT_OUTPUTS = {"R": "ohm", "T": "degC", "x": "m", "xi_P": "1", "xi_M": "1", "xi_F": "1", "P": "W"}
 FEEDFORWARD_OUTPUTS = {"P_ff": "W", "T_ref": "degC"}
 
 
@@ -45,7 +45,7 @@ def test_plant_interface(fmus, parameter_set):
         assert (variables[name].causality, variables[name].unit) == ("output", unit)
     heating = variables["heating"]
     assert (heating.type, heating.causality, heating.variability) == ("Boolean", "output", "discrete")
-    assert variables["hysteresis_mode"].start == "switch"
+    assert variables["hysteresis_mode"].start == "continuous"
     params = parameter_set.params
     assert float(variables["T_start"].start) == params.T_room
     for name in ("R_P", "a_h", "b_c", "eps_T", "nu", "A_s", "c_p", "h_c", "T_room", "mass"):

@@ -16,12 +16,14 @@ from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper
 
-__all__ = ["COLUMNS", "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator",
+__all__ = ["COLUMNS", "PLANT_OUTPUTS", "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator",
            "run_library"]
 
 COLUMNS = (("t", "s"), ("R_ref", "ohm"), ("R", "ohm"), ("T", "degC"), ("T_ref", "degC"),
+           ("x", "m"), ("stroke", "m"), ("xi_P", ""), ("xi_M", ""), ("xi_F", ""),
            ("P_ff", "W"), ("P_fb", "W"), ("P", "W"), ("load", "kg"), ("saturated", ""))
 _DTYPE = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
+PLANT_OUTPUTS = ("R", "T", "x", "xi_P", "xi_M", "xi_F", "P")  # what a loop plant returns
 
 
 @dataclass
@@ -42,13 +44,12 @@ class LibraryPlant:
                                     scenario.load.value(0.0))
 
     def outputs(self):
-        """(R [ohm], T [degC]) now."""
-        return self.stepper.outputs.R, self.stepper.outputs.T
+        """The :data:`PLANT_OUTPUTS` now."""
+        return self.stepper.outputs[:7]
 
     def step(self, time_s, power, load, step_size):
-        """Advance one step; returns (R, T) at its end."""
-        out = self.stepper.step(power, load, step_size)
-        return out.R, out.T
+        """Advance one step; returns the :data:`PLANT_OUTPUTS` at its end."""
+        return self.stepper.step(power, load, step_size)[:7]
 
     def close(self):
         """Nothing to release."""
@@ -73,9 +74,11 @@ class LibraryCompensator:
 def run_loop(scenario, plant, compensator=None):
     """Close the loop over ``scenario``; returns the structured time-series array.
 
-    ``plant`` has ``outputs()`` and ``step(t, power, load, h)`` returning (R, T);
-    ``compensator`` (None for the "pi" controller) has ``step(t, R_ref, load, h)``
-    returning (P_ff, T_ref, saturated).
+    ``plant`` has ``outputs()`` and ``step(t, power, load, h)`` returning the
+    :data:`PLANT_OUTPUTS` (R, T, x, xi_P, xi_M, xi_F, applied power P); ``compensator``
+    (None for the "pi" controller) has ``step(t, R_ref, load, h)`` returning
+    (P_ff, T_ref, saturated). Row k holds the samples at t_k and the powers applied over
+    [t_k, t_k+1); the stroke is the contraction x_0 - x_k [m] (positive: the wire shortened).
     """
     h, n = scenario.step_s, scenario.steps
     times = [k * h for k in range(n + 1)]
@@ -85,7 +88,8 @@ def run_loop(scenario, plant, compensator=None):
     pi = PIController(gains.Kp, gains.Ki)
     nan = math.nan
     rows = []
-    resistance, temperature = plant.outputs()
+    resistance, temperature, length, xi_p, xi_m, xi_f, _ = plant.outputs()
+    start_length = length
     for k in range(n):
         time_s, reference, load = times[k], references[k], loads[k]
         error = resistance - reference
@@ -94,11 +98,13 @@ def run_loop(scenario, plant, compensator=None):
         else:
             p_ff, t_ref, saturated = compensator.step(time_s, reference, load, h)
         power, feedback = pi.step(error, p_ff, h)
-        rows.append((time_s, reference, resistance, temperature, t_ref, p_ff, feedback, power,
-                     load, saturated))
-        resistance, temperature = plant.step(time_s, power, load, h)
-    rows.append((times[n], references[n], resistance, temperature, nan, nan, nan, nan, loads[n],
-                 False))
+        sample = (time_s, reference, resistance, temperature, t_ref, length, start_length - length,
+                  xi_p, xi_m, xi_f, p_ff, feedback)
+        resistance, temperature, length, xi_p, xi_m, xi_f, applied = plant.step(
+            time_s, power, load, h)
+        rows.append(sample + (applied, load, saturated))
+    rows.append((times[n], references[n], resistance, temperature, nan, length,
+                 start_length - length, xi_p, xi_m, xi_f, nan, nan, nan, loads[n], False))
     return np.array(rows, dtype=_DTYPE)
 
 

@@ -7,7 +7,7 @@ stepped before the plant (Gauss-Seidel), so u_ff,k reaches the plant's step k.
 import time
 from pathlib import Path
 
-from sma_fmu.cosim.loop import LoopResult, run_loop
+from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
 from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths
 from sma_fmu.fmi.instance import FmuError, FmuInstance
 
@@ -37,14 +37,14 @@ class FmuPlant:
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
         self._inputs = self.fmu.port(("P_in", "load"))
-        self._outputs = self.fmu.port(("R", "T"))
+        self._outputs = self.fmu.port(PLANT_OUTPUTS)
 
     def outputs(self):
-        """(R [ohm], T [degC]) now."""
+        """The loop's :data:`~sma_fmu.cosim.loop.PLANT_OUTPUTS` now."""
         return self._outputs.get()
 
     def step(self, time_s, power, load, step_size):
-        """Set P_in and load, doStep, return (R, T) at the end of the step."""
+        """Set P_in and load, doStep, return the PLANT_OUTPUTS at the end of the step."""
         self._inputs.set((power, load))
         self.fmu.step(time_s, step_size)
         return self._outputs.get()

@@ -22,7 +22,7 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     kind = "pi+ff-adaptive"     # optional, default from the parameter file's [control]:
                                 # Kp_W_per_ohm, Ki_W_per_ohm_s, alpha_s, beta_s, model_load_kg
     [plant]
-    hysteresis_mode = "switch"  # or "continuous"; optional T_start_degC (default T_room)
+    hysteresis_mode = "switch"  # default "continuous"; optional T_start_degC (default T_room)
 
 Every problem raises :class:`ScenarioError` naming the file, the key and what is wrong.
 """
@@ -188,7 +188,7 @@ def load_scenario(path):
         except ValueError as error:
             _fail(path, f"[{section}] {error}")
     plant = document.get("plant", {})
-    mode = plant.get("hysteresis_mode", "switch")
+    mode = plant.get("hysteresis_mode", "continuous")
     if mode not in ("switch", "continuous"):
         _fail(path, f"[plant] hysteresis_mode must be 'switch' or 'continuous', got {mode!r}")
     t_start = _number(path, "plant", plant, "T_start_degC", default=parameter_set.params.T_room)

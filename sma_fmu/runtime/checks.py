@@ -10,7 +10,7 @@ from .constants import COOLING, HEATING
 __all__ = [
     "require_finite", "require_nonnegative", "require_positive",
     "direction_sign", "direction_name", "require_mode", "HYSTERESIS_MODES",
-    "fast_nonnegative", "fast_positive",
+    "fast_finite", "fast_nonnegative", "fast_positive",
 ]
 
 HYSTERESIS_MODES = ("switch", "continuous")
@@ -76,6 +76,16 @@ def require_mode(mode, name="mode"):
 
 
 _INF = float("inf")
+
+
+def fast_finite(name, value):
+    """:func:`require_finite` with a fast path for plain finite numbers (stepper hot path)."""
+    try:
+        if -_INF < value < _INF:
+            return value
+    except TypeError:
+        pass
+    return require_finite(name, value)
 
 
 def fast_nonnegative(name, value):

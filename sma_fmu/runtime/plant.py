@@ -2,13 +2,16 @@
 
 One :meth:`PlantStepper.step` advances from t_k to t_k + h with the input power and the
 load held, and evaluates the outputs at the end of the step with the held load.
-The direction is sgn(T+ - T) (unchanged when T+ = T). In mode "switch" (the paper's)
-the fractions follow the major branch of that direction; in mode "continuous" a
-reversal found in a step stores (T_k, xi_MF_k) and the minor branch of section 6 follows.
+The direction is sgn(T+ - T) (unchanged when T+ = T). In mode "continuous" (the
+default) a reversal found in a step stores (T_k, xi_MF_k) and the minor branch of
+section 6 follows; in mode "switch" (the paper's) the fractions follow the major branch
+of that direction. A power of 0 W or less is applied as 0 W (the paper's rule), so a
+compensator output wired straight to the plant is valid; non-finite power is rejected.
 """
 from collections import namedtuple
 
-from .checks import (fast_nonnegative, fast_positive, require_mode, require_nonnegative)
+from .checks import (fast_finite, fast_nonnegative, fast_positive, require_mode,
+                     require_nonnegative)
 from .constant_load import BranchCache, branch_fractions, require_temperature
 from .constants import COOLING, HEATING
 from .minor_loops import Reversal, minor_branch_fractions
@@ -16,12 +19,13 @@ from .thermal import step_decay, thermal_step
 
 __all__ = ["PlantOutputs", "PlantStepper"]
 
-PlantOutputs = namedtuple("PlantOutputs", ["R", "T", "x", "xi_P", "xi_M", "xi_F", "heating"])
+PlantOutputs = namedtuple("PlantOutputs", ["R", "T", "x", "xi_P", "xi_M", "xi_F", "P", "heating"])
 _new_tuple = tuple.__new__
 PlantOutputs.__doc__ = """Plant outputs at a communication point.
 
 R : resistance [ohm]; T : temperature [degC]; x : wire length [m];
-xi_P, xi_M, xi_F : phase fractions [1]; heating : True while dT/dt > 0 (last sign kept).
+xi_P, xi_M, xi_F : phase fractions [1]; P : power applied over the last step, max(0, P_in) [W]
+(0 before the first step); heating : True while dT/dt > 0 (last sign kept).
 """
 
 
@@ -33,15 +37,16 @@ class PlantStepper:
     params : WireParameters
     T_start : float, optional
         Initial temperature [degC]; default the room temperature T_room.
-    mode : "switch" | "continuous"
-        Hysteresis mode: the paper's branch switch (default) or continuous minor loops.
+    mode : "continuous" | "switch"
+        Hysteresis mode: continuous minor loops (default: it holds a constant set-point)
+        or the paper's branch switch (which limit-cycles at a constant set-point).
     load : float
         Load during initialization [kg]; the initial outputs reflect it.
 
     The wire starts heating, on the major branch.
     """
 
-    def __init__(self, params, T_start=None, mode="switch", load=0.0):
+    def __init__(self, params, T_start=None, mode="continuous", load=0.0):
         self.params = params
         self.mode = require_mode(mode, "hysteresis mode")
         self._continuous = self.mode == "continuous"
@@ -52,6 +57,7 @@ class PlantStepper:
         self.direction = HEATING
         self.reversal = None
         self.load = require_nonnegative("load", load)
+        self.power = 0.0
         constants = self._branches.get(self.load, HEATING)
         self.xi_MF, self.xi_P = branch_fractions(self.temperature, constants)
         self.outputs = self._evaluate(constants)
@@ -59,9 +65,12 @@ class PlantStepper:
     def step(self, power, load, step_size):
         """Advance one step of ``step_size`` [s] with ``power`` [W] and ``load`` [kg] held.
 
-        Invalid inputs raise ``ValueError`` before any state changes.
+        A power <= 0 W is applied as 0 W. Invalid inputs (non-finite power, negative or
+        non-finite load, step <= 0) raise ``ValueError`` before any state changes.
         """
-        power = fast_nonnegative("P_in", power)
+        power = fast_finite("P_in", power)
+        if not power > 0.0:
+            power = 0.0
         load = fast_nonnegative("load", load)
         step_size = fast_positive("step_size", step_size)
         params = self.params
@@ -81,8 +90,8 @@ class PlantStepper:
                 xi_mf, xi_p = minor_branch_fractions(after, constants, direction, reversal)
         else:
             xi_mf, xi_p = branch_fractions(after, constants)
-        self.temperature, self.direction, self.reversal, self.load = (
-            after, direction, reversal, load)
+        self.temperature, self.direction, self.reversal, self.load, self.power = (
+            after, direction, reversal, load, power)
         self.xi_MF, self.xi_P = xi_mf, xi_p
         self.outputs = self._evaluate(constants)
         return self.outputs
@@ -98,6 +107,7 @@ class PlantStepper:
             self.temperature,
             params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f,
             xi_p, xi_m, xi_f,
+            self.power,
             self.direction == HEATING,
         ))
 
@@ -110,6 +120,7 @@ class PlantStepper:
             "load": self.load,
             "xi_MF": self.xi_MF,
             "xi_P": self.xi_P,
+            "power": self.power,
         }
 
     def restore(self, state):
@@ -120,4 +131,5 @@ class PlantStepper:
         self.load = state["load"]
         self.xi_MF = state["xi_MF"]
         self.xi_P = state["xi_P"]
+        self.power = state.get("power", 0.0)
         self.outputs = self._evaluate(self._branches.get(self.load, self.direction))

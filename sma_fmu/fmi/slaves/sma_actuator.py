@@ -4,8 +4,8 @@ A thin adapter over ``sma_fmu.runtime.plant.PlantStepper``. At build time ``sma_
 is renamed to a version-stamped package shipped in resources/, so FMUs of different
 versions loaded into one process never share a module.
 
-Semantics: doStep(t, h) holds P_in and load over the step; the outputs are then the
-state at t + h with the held load (no direct feedthrough). After initialization the
+Semantics: doStep(t, h) holds P_in and load over the step (P_in <= 0 is applied as 0 W);
+the outputs are then the state at t + h with the held load (no direct feedthrough). After initialization the
 outputs reflect T_start and the load set during initialization. Invalid parameters are
 logged as fmi2Error at exitInitializationMode; the outputs are then NaN and every
 doStep is discarded (pythonfmu would turn an exception there into fmi2Fatal).
@@ -23,6 +23,7 @@ OUTPUTS = (
     ("xi_P", "1", "P-phase (austenite) fraction"),
     ("xi_M", "1", "M-phase (twinned martensite) fraction"),
     ("xi_F", "1", "F-phase (detwinned martensite) fraction"),
+    ("P", "W", "power applied to the wire over the last step: max(0, P_in)"),
 )
 INVALID_OUTPUTS = (float("nan"),) * len(OUTPUTS) + (False,)
 
@@ -36,20 +37,21 @@ class SmaActuator(Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.interface = fmi = SlaveInterface(self)
-        fmi.input("P_in", 0.0, "W", "electric power I^2 R into the wire (>= 0)")
+        fmi.input("P_in", 0.0, "W", "electric power I^2 R into the wire; <= 0 is applied as 0 W")
         fmi.input("load", 0.0, "kg", "hung mass on the wire (>= 0); force = g * load")
         for name, unit, text in OUTPUTS:
             fmi.output(name, unit, text)
         fmi.boolean_output("heating", "true while dT/dt > 0 (the last sign is kept when dT/dt = 0)")
         fmi.parameter("T_start", fmi.defaults.T_room, "degC", "initial wire temperature")
-        fmi.string_parameter("hysteresis_mode", "switch",
-                             "'switch' (paper: branch follows sgn dT/dt) or 'continuous' (minor loops)")
+        fmi.string_parameter("hysteresis_mode", "continuous",
+                             "'continuous' (minor loops; holds a set-point) or 'switch' "
+                             "(paper: branch follows sgn dT/dt; limit-cycles at a set-point)")
         fmi.model_parameters()
         self.stepper = None
         self._publish(PlantStepper(fmi.defaults, self.T_start, self.hysteresis_mode, self.load).outputs)
 
     def _publish(self, outputs):
-        self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.heating = outputs
+        self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.P, self.heating = outputs
 
     def _start(self):
         stepper = PlantStepper(self.interface.wire_parameters(), self.T_start,
