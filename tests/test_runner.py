@@ -15,7 +15,8 @@ def test_run_paper_library_path_writes_everything(tmp_path, capsys):
     for name in ("load-step-pi", "heavy-pi+ff-adaptive"):
         folder = tmp_path / name
         header = (folder / "timeseries.csv").read_text().splitlines()[0]
-        assert header == "t_s,R_ref_ohm,R_ohm,T_degC,T_ref_degC,P_ff_W,P_fb_W,P_W,load_kg,saturated"
+        assert header == ("t_s,R_ref_ohm,R_ohm,T_degC,T_ref_degC,x_m,stroke_m,xi_P,xi_M,xi_F,"
+                          "P_ff_W,P_fb_W,P_W,load_kg,saturated")
         table = np.genfromtxt(folder / "timeseries.csv", delimiter=",", skip_header=1)
         assert table.shape == (30001, len(COLUMNS))
         metrics = json.loads((folder / "metrics.json").read_text())
