@@ -1,6 +1,6 @@
 """Read and write wire parameter files (TOML, every entry with value, unit and meaning).
 
-A parameter file looks like ``models/reference_wire.toml``::
+A parameter file looks like ``sma_fmu/models/reference_wire.toml``::
 
     [wire]
     name = "reference"
@@ -14,17 +14,12 @@ missing keys, wrong units, non-numbers and values breaking a rule raise
 :class:`ParameterError` naming the file, the key and the value.
 """
 import json
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from sma_fmu.package_data import default_parameter_file
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
+from sma_fmu.toml_files import read_toml
 
 __all__ = ["ParameterSet", "load_parameter_set", "load_parameters", "parse_parameter_document",
            "parameter_file_text", "write_parameter_file", "ParameterError"]
@@ -112,13 +107,7 @@ def _parse_entry(entry, spec, source):
 def load_parameter_set(path=None):
     """Load a parameter file (default: the reference wire) as a :class:`ParameterSet`."""
     path = Path(path) if path is not None else default_parameter_file()
-    try:
-        with open(path, "rb") as stream:
-            document = tomllib.load(stream)
-    except FileNotFoundError:
-        raise ParameterError(f"{path}: parameter file not found") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ParameterError(f"{path}: not valid TOML: {error}") from None
+    document = read_toml(path, ParameterError, "parameter file")
     parsed = parse_parameter_document(document, path)
     return ParameterSet(parsed.params, parsed.name, parsed.description, parsed.meanings, path)
 

@@ -20,7 +20,7 @@ def test_run_paper_library_path_writes_everything(tmp_path, capsys):
         table = np.genfromtxt(folder / "timeseries.csv", delimiter=",", skip_header=1)
         assert table.shape == (30001, len(COLUMNS))
         metrics = json.loads((folder / "metrics.json").read_text())
-        assert metrics["overall"]["rmse_ohm"] > 0 and metrics["window"] == "t >= 2.0 s"
+        assert metrics["overall"]["rmse_ohm"] > 0 and metrics["window"] == "t >= 2 s"
         assert (folder / "figure.png").stat().st_size > 20000
     assert (tmp_path / "comparison-load-step.png").stat().st_size > 20000
     comparison = (tmp_path / "comparison.md").read_text()

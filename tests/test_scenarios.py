@@ -96,7 +96,7 @@ def _write(tmp_path, text):
     (lambda s: s.replace("step_s = 0.001", 'step_s = "1 ms"'),
      r"\[scenario\] step_s must be a finite number, got '1 ms'"),
     (lambda s: s.replace("[scenario]\n", '[scenario]\nmodel = "nowhere.toml"\n'),
-     r"\[scenario\] model: .*nowhere.toml: parameter file not found"),
+     r"\[scenario\] model = 'nowhere.toml': .*nowhere.toml: parameter file not found"),
     (lambda s: s.replace("[load]", "[loads]"), r"unknown section \[loads\]"),
     (lambda s: s.replace("[controller]", "[control]"), r"unknown section \[control\]"),
     (lambda s: s + "\n[plant\n", r"not valid TOML"),

@@ -1,24 +1,29 @@
 """Run scenarios and write their results: CSV, metrics JSON, figures, comparison table.
 
 For each scenario ``NAME`` in ``out_dir``: ``NAME/timeseries.csv``, ``NAME/metrics.json``
-and ``NAME/figure.png``. For each group of scenarios that differ only in the controller:
-``comparison-GROUP.png``. Over the whole run: ``comparison.md``, which ranks the
-controllers by RMSE in each group, and ``summary.json``.
+and ``NAME/figure.png``. Scenarios with the same file name from different folders get
+``FOLDER-NAME`` instead, so none overwrites another. For each group of scenarios (see
+:attr:`~sma_fmu.cosim.scenario.Scenario.group`): ``comparison-GROUP.png``. Over the whole
+run: ``comparison.md``, which ranks the runs by RMSE in each group, and ``summary.json``.
+Everything is written into a temporary folder and moved into ``out_dir`` at the end.
 """
 import time
+from collections import Counter
 
 import numpy as np
 
 from sma_fmu.cosim.loop import COLUMNS, run_library
-from sma_fmu.fmi.build import DEFAULT_FMU_DIR
 from sma_fmu.cosim.master import run_fmus
-from sma_fmu.cosim.metrics import METRIC_START_S, scenario_metrics
+from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.plots import plot_comparison, plot_run
-from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
+from sma_fmu.cosim.report import comparison_markdown, groups, summary_table
+from sma_fmu.cosim.scenario import load_scenario
+from sma_fmu.fmi.build import DEFAULT_FMU_DIR
 from sma_fmu.json_output import json_text
 from sma_fmu.output_folder import staged_folder
 
-__all__ = ["PATHS", "run_scenarios", "write_timeseries", "summary_table", "comparison_markdown"]
+__all__ = ["PATHS", "run_scenarios", "timed_run", "write_timeseries", "result_names",
+           "comparison_labels"]
 
 PATHS = {"fmu": run_fmus, "library": lambda scenario, fmu_dir: run_library(scenario)}
 
@@ -30,85 +35,67 @@ def write_timeseries(data, path):
     np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.10g")
 
 
-def summary_table(rows):
-    """Plain-text table of runs (one dict per run with metrics and timing)."""
-    lines = [f"{'scenario':<38}{'controller':<16}{'mode':<12}{'RMSE':>8}{'max|e|':>8}"
-             f"{'IAE':>8}{'wall s':>8}{'x real':>8}",
-             f"{'':<66}{'[ohm]':>8}{'[ohm]':>8}{'[ohm.s]':>8}"]
-    for row in rows:
-        m = row["metrics"]["overall"]
-        lines.append(f"{row['scenario']:<38}{row['metrics']['controller']:<16}"
-                     f"{row['metrics']['hysteresis_mode']:<12}{m['rmse_ohm']:>8.3f}"
-                     f"{m['max_abs_ohm']:>8.3f}{m['iae_ohm_s']:>8.2f}{row['wall_time_s']:>8.2f}"
-                     f"{row['real_time_factor']:>8.0f}")
-    return "\n".join(lines)
+def result_names(scenarios):
+    """A distinct result-folder name per scenario: its name, or FOLDER-NAME where names clash."""
+    counts = Counter(s.name for s in scenarios)
+    names = [s.name if counts[s.name] == 1 else f"{s.path.parent.name}-{s.name}" for s in scenarios]
+    seen = Counter()
+    unique = []
+    for name in names:
+        seen[name] += 1
+        unique.append(name if seen[name] == 1 else f"{name}-{seen[name]}")
+    return unique
 
 
-def _groups(rows):
-    groups = {}
-    for row in rows:
-        groups.setdefault(row["group"], []).append(row)
-    return groups
-
-
-def comparison_markdown(rows):
-    """Markdown ranking the controllers by RMSE within each scenario group."""
-    lines = ["# Controller comparison", "",
-             f"Error e = R - R_ref over t >= {METRIC_START_S:g} s. Ranked by RMSE, best first.", ""]
-    for group, members in _groups(rows).items():
-        ranked = sorted(members, key=lambda r: r["metrics"]["overall"]["rmse_ohm"])
-        mode = members[0]["metrics"]["hysteresis_mode"]
-        lines += [f"## {group} ({mode} hysteresis)", "",
-                  "| rank | controller | RMSE [ohm] | max abs e [ohm] | IAE [ohm s] | RMSE per load segment [ohm] |",
-                  "|---:|---|---:|---:|---:|---|"]
-        for rank, row in enumerate(ranked, start=1):
-            m = row["metrics"]
-            segments = ", ".join(f"{s['load_kg']:g} kg: {s['rmse_ohm']:.3f}"
-                                 for s in m["segments"] if s["samples"])
-            lines.append(f"| {rank} | {m['controller']} | {m['overall']['rmse_ohm']:.3f} | "
-                         f"{m['overall']['max_abs_ohm']:.3f} | {m['overall']['iae_ohm_s']:.2f} | "
-                         f"{segments} |")
-        rmse = {r["metrics"]["controller"]: r["metrics"]["overall"]["rmse_ohm"] for r in members}
-        if set(rmse) == set(CONTROLLERS):
-            holds = rmse["pi"] > rmse["pi+ff-fixed"] > rmse["pi+ff-adaptive"]
-            lines += ["", f"Paper's ordering RMSE(pi) > RMSE(pi+ff-fixed) > RMSE(pi+ff-adaptive): "
-                          f"**{'holds' if holds else 'does not hold'}**; fixed - adaptive = "
-                          f"{rmse['pi+ff-fixed'] - rmse['pi+ff-adaptive']:.3f} ohm."]
-        lines.append("")
-    return "\n".join(lines)
+def comparison_labels(scenarios, names):
+    """Label of each run in its group's comparison: the controller kind where it is the only
+    run of that kind in the group, otherwise its result name without the group prefix."""
+    kinds = Counter((s.group, s.controller.kind) for s in scenarios)
+    labels = []
+    for scenario, name in zip(scenarios, names):
+        if kinds[scenario.group, scenario.controller.kind] == 1:
+            labels.append(scenario.controller.kind)
+        else:
+            prefix = scenario.group + "-"
+            labels.append(name[len(prefix):] if name.startswith(prefix) else name)
+    return labels
 
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print):
     """Run scenario files through ``path`` ("fmu" or "library"); write results; return rows.
 
-    All files are read and checked before the first run, so a bad file costs no time.
+    All files are read and checked before the first run, so a bad file costs no time, and
+    a failed run leaves ``out_dir`` as it was.
     """
     if path not in PATHS:
         raise ValueError(f"path must be one of {', '.join(PATHS)}, got {path!r}")
     scenarios = [load_scenario(p) for p in paths]
+    names = result_names(scenarios)
+    labels = comparison_labels(scenarios, names)
     rows, series = [], {}
     with staged_folder(out_dir) as stage:
-        for index, scenario in enumerate(scenarios, start=1):
+        for index, (scenario, name, label) in enumerate(zip(scenarios, names, labels), start=1):
             if len(scenarios) > 1:
-                progress(f"[{index}/{len(scenarios)}] {scenario.name} ({path}) ...")
+                progress(f"[{index}/{len(scenarios)}] {name} ({path}) ...")
             result = PATHS[path](scenario, fmu_dir)
-            folder = stage / scenario.name
+            folder = stage / name
             folder.mkdir()
             write_timeseries(result.data, folder / "timeseries.csv")
             metrics = scenario_metrics(result.data, scenario)
             metrics.update(path=path, wall_time_s=result.wall_time_s)
             (folder / "metrics.json").write_text(json_text(metrics), encoding="utf-8")
             plot_run(result.data, scenario, folder / "figure.png")
-            rows.append({"scenario": scenario.name, "group": scenario.group, "metrics": metrics,
-                         "wall_time_s": result.wall_time_s,
+            rows.append({"scenario": name, "label": label, "group": scenario.group,
+                         "metrics": metrics, "wall_time_s": result.wall_time_s,
                          "real_time_factor": scenario.stop_time_s / result.wall_time_s})
-            series[scenario.name] = (scenario, result.data)
-        for group, members in _groups(rows).items():
+            series[name] = (scenario, result.data)
+        for group, members in groups(rows).items():
             if len(members) > 1:
-                runs = {series[r["scenario"]][0].controller.kind: series[r["scenario"]][1]
-                        for r in members}
+                window = series[members[0]["scenario"]][0].analysis
+                runs = {row["label"]: series[row["scenario"]][1] for row in members}
                 plot_comparison(runs, f"{group}: controllers compared",
-                                stage / f"comparison-{group}.png")
+                                stage / f"comparison-{group}.png",
+                                zoom=(window.zoom_start_s, window.zoom_end_s))
         (stage / "comparison.md").write_text(comparison_markdown(rows), encoding="utf-8")
         (stage / "summary.json").write_text(json_text(rows), encoding="utf-8")
     return rows

@@ -24,10 +24,16 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     [plant]
     hysteresis_mode = "switch"  # default "continuous"; optional T_start_degC (default T_room)
 
+    [analysis]                  # optional; defaults derived from the duration (see AnalysisWindow)
+    metrics_start_s = 2.0       # metrics over t >= this
+    zoom_start_s = 24.0         # enlarged window of the comparison figures
+    zoom_end_s = 28.0
+
 Every problem raises :class:`ScenarioError` naming the file, the key and what is wrong.
+A run may have at most :data:`MAX_STEPS` steps.
 """
 import math
-import sys
+from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,25 +41,41 @@ from sma_fmu.parameter_file import load_parameter_set
 from sma_fmu.package_data import shipped_file, shipped_files
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
+from sma_fmu.toml_files import read_toml
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
-
-__all__ = ["ScenarioError", "ControllerSettings", "Scenario", "CONTROLLERS", "PAPER_SET",
-           "load_scenario", "scenario_names", "resolve_scenarios"]
+__all__ = ["ScenarioError", "ControllerSettings", "AnalysisWindow", "Scenario", "CONTROLLERS",
+           "PAPER_SET", "MAX_STEPS", "load_scenario", "default_analysis", "scenario_names",
+           "resolve_scenarios"]
 
 CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")
 PAPER_SET = tuple(f"{profile}-{controller}" for profile in ("load-step", "heavy")
                   for controller in CONTROLLERS)
+MAX_STEPS = 2_000_000  # 33 min at 1 ms; the time series of a run is held in memory
 _SECTIONS = {
-    "scenario": {"description", "stop_time_s", "step_s", "model"},
+    "scenario": {"description", "stop_time_s", "step_s", "model", "group"},
     "reference": None,  # checked by signals.reference_from_table
     "load": None,       # checked by signals.load_from_table
     "controller": {"kind", "Kp_W_per_ohm", "Ki_W_per_ohm_s", "alpha_s", "beta_s", "model_load_kg"},
     "plant": {"hysteresis_mode", "T_start_degC"},
+    "analysis": {"metrics_start_s", "zoom_start_s", "zoom_end_s"},
 }
+
+AnalysisWindow = namedtuple("AnalysisWindow", ["metrics_start_s", "zoom_start_s", "zoom_end_s"])
+AnalysisWindow.__doc__ = """Windows of the results [s]: metrics over t >= metrics_start_s; the
+comparison figures enlarge zoom_start_s ... zoom_end_s."""
+
+
+def default_analysis(stop_time_s):
+    """The default :class:`AnalysisWindow` of a run lasting ``stop_time_s`` [s].
+
+    The paper's 30-s run gives its choices: metrics over t >= 2 s (the start-up transient
+    left out) and an enlarged window of 24-28 s (its Fig. 11). A shorter run scales them:
+    metrics from min(2 s, 10 % of the run), the window ending min(2 s, 10 %) before the end
+    and lasting min(4 s, 40 %).
+    """
+    margin = min(2.0, 0.1 * stop_time_s)
+    zoom_end = stop_time_s - margin
+    return AnalysisWindow(margin, zoom_end - min(4.0, 0.4 * stop_time_s), zoom_end)
 _GAIN_KEYS = {"Kp_W_per_ohm": "Kp", "Ki_W_per_ohm_s": "Ki", "alpha_s": "phase_lag_alpha",
               "beta_s": "beta", "model_load_kg": "model_load"}
 
@@ -100,6 +122,8 @@ class Scenario:
     hysteresis_mode: str
     T_start: float
     parameter_set: object
+    analysis_window: AnalysisWindow = None   # the file's [analysis]; None: from the duration
+    group_name: str = None
 
     @property
     def params(self):
@@ -112,10 +136,21 @@ class Scenario:
         return int(round(self.stop_time_s / self.step_s))
 
     @property
+    def analysis(self):
+        """The :class:`AnalysisWindow`: the file's ``[analysis]``, or the duration's defaults."""
+        return self.analysis_window or default_analysis(self.stop_time_s)
+
+    @property
     def group(self):
-        """Name without the controller suffix: scenarios of one group differ only in controller."""
-        suffix = "-" + self.controller.kind
-        return self.name[:-len(suffix)] if self.name.endswith(suffix) else self.name
+        """The comparison group: ``[scenario] group``, or the name up to ``-<controller kind>``.
+
+        Scenarios of one group share a figure and a ranking (e.g. load-step-pi,
+        load-step-pi+ff-adaptive and load-step-pi+ff-adaptive-minor-loop: "load-step").
+        """
+        if self.group_name:
+            return self.group_name
+        cut = self.name.find("-" + self.controller.kind)
+        return self.name[:cut] if cut > 0 else self.name
 
 
 def _fail(path, message):
@@ -128,11 +163,45 @@ def _number(path, section, table, key, default=None, positive=False):
             _fail(path, f"[{section}] missing key {key}")
         return default
     value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    try:
+        number = float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) \
+            else math.nan
+    except OverflowError:
+        number = math.nan
+    if not math.isfinite(number):
         _fail(path, f"[{section}] {key} must be a finite number, got {value!r}")
-    if positive and not value > 0:
+    if positive and not number > 0:
         _fail(path, f"[{section}] {key} must be > 0, got {value!r}")
-    return float(value)
+    return number
+
+
+def _string(path, section, table, key):
+    value = table.get(key)
+    if value is not None and not isinstance(value, str):
+        _fail(path, f"[{section}] {key} must be a string, got {value!r}")
+    return value
+
+
+def _steps(path, stop, step):
+    ratio = stop / step
+    if not ratio <= MAX_STEPS:
+        _fail(path, f"[scenario] stop_time_s / step_s = {stop!r} / {step!r} = {ratio:.4g} steps; "
+                    f"a run may have at most {MAX_STEPS} steps (raise step_s or shorten the run)")
+    if abs(ratio - round(ratio)) > 1e-9 * ratio:
+        _fail(path, f"[scenario] stop_time_s = {stop!r} is not a whole number of steps of {step!r} s")
+
+
+def _analysis(path, table, stop):
+    defaults = default_analysis(stop)
+    window = AnalysisWindow(*(_number(path, "analysis", table, key, default=getattr(defaults, key))
+                              for key in AnalysisWindow._fields))
+    if not 0.0 <= window.metrics_start_s < stop:
+        _fail(path, f"[analysis] metrics_start_s = {window.metrics_start_s!r} must be in "
+                    f"[0, stop_time_s = {stop!r})")
+    if not 0.0 <= window.zoom_start_s < window.zoom_end_s <= stop:
+        _fail(path, f"[analysis] zoom_start_s = {window.zoom_start_s!r}, zoom_end_s = "
+                    f"{window.zoom_end_s!r}: need 0 <= zoom_start_s < zoom_end_s <= {stop!r}")
+    return window
 
 
 def _controller(path, table, params):
@@ -152,13 +221,7 @@ def _controller(path, table, params):
 def load_scenario(path):
     """Read and validate a scenario file; returns a :class:`Scenario`."""
     path = Path(path)
-    try:
-        with open(path, "rb") as stream:
-            document = tomllib.load(stream)
-    except FileNotFoundError:
-        raise ScenarioError(f"{path}: scenario file not found") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ScenarioError(f"{path}: not valid TOML: {error}") from None
+    document = read_toml(path, ScenarioError, "scenario file")
     for section, table in document.items():
         if section not in _SECTIONS:
             _fail(path, f"unknown section [{section}]; expected {', '.join(_SECTIONS)}")
@@ -174,18 +237,17 @@ def load_scenario(path):
     head = document["scenario"]
     stop = _number(path, "scenario", head, "stop_time_s", positive=True)
     step = _number(path, "scenario", head, "step_s", positive=True)
-    if abs(stop / step - round(stop / step)) > 1e-9 * (stop / step):
-        _fail(path, f"[scenario] stop_time_s = {stop!r} is not a whole number of steps of {step!r} s")
-    model = head.get("model")
+    _steps(path, stop, step)
+    model = _string(path, "scenario", head, "model")
     try:
         parameter_set = load_parameter_set(None if model is None else path.parent / model)
     except ParameterError as error:
-        _fail(path, f"[scenario] model: {error}")
+        _fail(path, f"[scenario] model = {model!r}: {error}")
     signals = {}
     for section, build in (("reference", reference_from_table), ("load", load_from_table)):
         try:
             signals[section] = build(document[section])
-        except ValueError as error:
+        except (ValueError, OverflowError) as error:
             _fail(path, f"[{section}] {error}")
     plant = document.get("plant", {})
     mode = plant.get("hysteresis_mode", "continuous")
@@ -196,7 +258,9 @@ def load_scenario(path):
         name=path.stem, path=path, description=str(head.get("description", "")),
         stop_time_s=stop, step_s=step, reference=signals["reference"], load=signals["load"],
         controller=_controller(path, document["controller"], parameter_set.params),
-        hysteresis_mode=mode, T_start=t_start, parameter_set=parameter_set)
+        hysteresis_mode=mode, T_start=t_start, parameter_set=parameter_set,
+        analysis_window=_analysis(path, document["analysis"], stop) if "analysis" in document else None,
+        group_name=_string(path, "scenario", head, "group"))
 
 
 def scenario_names():

@@ -8,6 +8,7 @@ import math
 from collections import namedtuple
 from dataclasses import dataclass, field
 
+from .constants import BOLTZMANN
 from .lattice import lattice_constants
 from .thermal import thermal_gain, thermal_time_constant
 
@@ -157,10 +158,34 @@ class WireParameters:
             self._fail(f"parameter {key} = {value!r} {_RULE_TEXT[spec.rule]} [{spec.unit}]")
         object.__setattr__(self, spec.name, value)
 
+    def _derived(self, what, unit, keys, compute):
+        """``compute()`` -> value(s) that must be finite and > 0, else ParameterError naming ``keys``."""
+        try:
+            values = compute()
+        except (ZeroDivisionError, OverflowError, ValueError) as error:
+            values, reason = None, f"cannot be computed ({error.args[-1] if error.args else error})"
+        else:
+            numbers = values if isinstance(values, tuple) else (values,)
+            bad = [v for v in numbers if not (math.isfinite(v) and v > 0.0)]
+            reason = f"= {bad[0]!r} {unit} is not a finite number > 0" if bad else None
+        if reason:
+            inputs = ", ".join(f"{SPEC_BY_NAME[k].section}.{k} = {getattr(self, k)!r}" for k in keys)
+            self._fail(f"derived {what} {reason}; it follows from {inputs}")
+        return values
+
     def _derive(self):
-        line_density = self.mass / self.x0
-        lattice = lattice_constants(self.x0, self.x_min, self.diameter, self.theta, line_density)
-        tau_th = thermal_time_constant(self.mass, self.c_p, self.h_c, self.A_s)
+        geometry = ("x0", "x_min", "diameter", "theta", "mass")
+        line_density = self._derived("line density mass/x0", "kg/m", ("mass", "x0"),
+                                     lambda: self.mass / self.x0)
+        lattice = self._derived("lattice (N, x_P, N_l, N_S)", "", geometry, lambda: lattice_constants(
+            self.x0, self.x_min, self.diameter, self.theta, line_density))
+        gain = self._derived("thermal gain K_th = 1/(h_c A_s)", "K/W", ("h_c", "A_s"),
+                             lambda: thermal_gain(self.h_c, self.A_s))
+        tau_th = self._derived("thermal time constant tau_th = m c_p/(h_c A_s)", "s",
+                               ("mass", "c_p", "h_c", "A_s"),
+                               lambda: thermal_time_constant(self.mass, self.c_p, self.h_c, self.A_s))
+        self._derived("domain energy over k_B, nu eps_T/k_B", "K", ("nu", "eps_T"),
+                      lambda: self.nu * self.eps_T / BOLTZMANN)
         return dict(
             lattice=lattice,
             N=lattice.N,
@@ -169,7 +194,7 @@ class WireParameters:
             x_T=self.x_min - 0.5 * (self.l_M + self.l_F),
             x_f=self.l_F - 0.5 * (self.x_min + self.l_M),
             R_MF=0.5 * (self.R_M + self.R_F),
-            K_th=thermal_gain(self.h_c, self.A_s),
+            K_th=gain,
             tau_th=tau_th,
             phase_lag_alpha=tau_th if self.alpha is None else self.alpha,
         )
