@@ -19,6 +19,11 @@ class OutputError(ValueError):
 
 def _writable_parent(path, argument):
     parent = Path(path).absolute().parent
+    for ancestor in (parent, *parent.parents):
+        if ancestor.exists():
+            if not ancestor.is_dir():
+                raise OutputError(f"{argument} {path}: {ancestor} is a file, not a folder")
+            break
     try:
         parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:

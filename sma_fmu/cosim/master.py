@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
-from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths
+from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths, read_description
 from sma_fmu.fmi.instance import FmuError, FmuInstance
 
 __all__ = ["FmuPlant", "FmuCompensator", "run_fmus", "MissingFmuError"]
@@ -21,10 +21,8 @@ class MissingFmuError(FileNotFoundError):
 
 def _model_parameters(fmu_path, params):
     """Start values for every wire parameter the FMU exposes, from ``params``."""
-    from fmpy import read_model_description
-
     values = params.values()
-    return {v.name: values[v.name] for v in read_model_description(str(fmu_path)).modelVariables
+    return {v.name: values[v.name] for v in read_description(fmu_path).modelVariables
             if v.causality == "parameter" and v.name in values}
 
 

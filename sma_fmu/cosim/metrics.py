@@ -14,12 +14,13 @@ def error_metrics(errors, step_size):
     errors = np.asarray(errors, dtype=float)
     if errors.size == 0:
         return {"rmse_ohm": None, "max_abs_ohm": None, "iae_ohm_s": None, "samples": 0}
-    return {
-        "rmse_ohm": float(np.sqrt(np.mean(errors ** 2))),
-        "max_abs_ohm": float(np.max(np.abs(errors))),
-        "iae_ohm_s": float(step_size * np.sum(np.abs(errors))),
-        "samples": int(errors.size),
-    }
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverged run gives inf, reported as such
+        return {
+            "rmse_ohm": float(np.sqrt(np.mean(errors ** 2))),
+            "max_abs_ohm": float(np.max(np.abs(errors))),
+            "iae_ohm_s": float(step_size * np.sum(np.abs(errors))),
+            "samples": int(errors.size),
+        }
 
 
 def scenario_metrics(data, scenario):

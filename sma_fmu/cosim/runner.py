@@ -49,16 +49,10 @@ def result_names(scenarios):
 
 def comparison_labels(scenarios, names):
     """Label of each run in its group's comparison: the controller kind where it is the only
-    run of that kind in the group, otherwise its result name without the group prefix."""
+    run of that kind in the group, otherwise its result name (the scenario's)."""
     kinds = Counter((s.group, s.controller.kind) for s in scenarios)
-    labels = []
-    for scenario, name in zip(scenarios, names):
-        if kinds[scenario.group, scenario.controller.kind] == 1:
-            labels.append(scenario.controller.kind)
-        else:
-            prefix = scenario.group + "-"
-            labels.append(name[len(prefix):] if name.startswith(prefix) else name)
-    return labels
+    return [s.controller.kind if kinds[s.group, s.controller.kind] == 1 else name
+            for s, name in zip(scenarios, names)]
 
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print):

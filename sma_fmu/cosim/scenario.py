@@ -39,6 +39,8 @@ from pathlib import Path
 
 from sma_fmu.parameter_file import load_parameter_set
 from sma_fmu.package_data import shipped_file, shipped_files
+from sma_fmu.runtime.constant_load import branch_constants
+from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
 from sma_fmu.toml_files import read_toml
@@ -191,6 +193,16 @@ def _steps(path, stop, step):
         _fail(path, f"[scenario] stop_time_s = {stop!r} is not a whole number of steps of {step!r} s")
 
 
+def _check_loads(path, load, params):
+    """Every load of the profile must be inside the wire model's range (dH(f) > 0, ...)."""
+    for value in sorted(set(load.values)):
+        for direction in (HEATING, COOLING):
+            try:
+                branch_constants(value, direction, params)
+            except (ValueError, OverflowError) as error:
+                _fail(path, f"[load] values_kg: {value!r} kg: {error}")
+
+
 def _analysis(path, table, stop):
     defaults = default_analysis(stop)
     window = AnalysisWindow(*(_number(path, "analysis", table, key, default=getattr(defaults, key))
@@ -249,6 +261,7 @@ def load_scenario(path):
             signals[section] = build(document[section])
         except (ValueError, OverflowError) as error:
             _fail(path, f"[{section}] {error}")
+    _check_loads(path, signals["load"], parameter_set.params)
     plant = document.get("plant", {})
     mode = plant.get("hysteresis_mode", "continuous")
     if mode not in ("switch", "continuous"):

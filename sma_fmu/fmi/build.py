@@ -27,13 +27,38 @@ from sma_fmu.output_folder import staged_folder
 from sma_fmu.package_data import shipped_file
 from sma_fmu.parameter_file import load_parameter_set
 
-__all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "code_stamp", "build_fmu", "build_fmus",
-           "validate_fmus", "default_fmu_paths"]
+__all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "FmuFileError", "code_stamp", "build_fmu",
+           "build_fmus", "validate_fmus", "default_fmu_paths", "read_description"]
 
 FMU_SCRIPTS = {"SmaActuator": "sma_actuator.py", "SmaFeedforward": "sma_feedforward.py"}
 DEFAULT_FMU_DIR = Path("fmus")
 # shipped package -> suffix of its renamed copy inside an FMU
 _SHIPPED_PACKAGES = {"sma_fmu.runtime": "rt", "sma_fmu.fmi.slave_support": "fmi"}
+
+
+class FmuFileError(ValueError):
+    """A file given as an FMU is missing, not a zip archive, or has no readable model description."""
+
+
+def read_description(path):
+    """fmpy's ModelDescription of the FMU ``path``; an unusable file raises :class:`FmuFileError`."""
+    import zipfile
+
+    from fmpy import read_model_description
+
+    path = Path(path)
+    if path.is_dir():
+        raise FmuFileError(f"{path}: is a folder, not an FMU file")
+    if not path.is_file():
+        raise FmuFileError(f"{path}: FMU file not found")
+    try:
+        return read_model_description(str(path))
+    except zipfile.BadZipFile:
+        raise FmuFileError(f"{path}: not an FMU: not a zip archive (corrupt or truncated?)") from None
+    except KeyError:
+        raise FmuFileError(f"{path}: not an FMU: no modelDescription.xml in the archive") from None
+    except Exception as error:  # fmpy raises bare Exceptions for XML problems
+        raise FmuFileError(f"{path}: not a usable FMU: {error}") from None
 
 
 def _package_sources(package):
@@ -140,12 +165,14 @@ def default_fmu_paths(out_dir=DEFAULT_FMU_DIR):
 
 
 def validate_fmus(paths):
-    """fmpy's validation of each FMU: {path: list of problems} (empty list = valid)."""
+    """fmpy's validation of each FMU: {path: list of problems} (empty list = valid).
+
+    A file that is not an FMU at all (missing, a folder, not a zip archive, no model
+    description) raises :class:`FmuFileError` before anything is validated.
+    """
     from fmpy.validation import validate_fmu
 
-    results = {}
+    paths = [Path(path) for path in paths]
     for path in paths:
-        path = Path(path)
-        results[path] = ([f"{path}: no such file"] if not path.is_file()
-                         else validate_fmu(str(path)))
-    return results
+        read_description(path)
+    return {path: validate_fmu(str(path)) for path in paths}

@@ -10,10 +10,12 @@ import sys
 from pathlib import Path
 from ctypes import POINTER, PyDLL, c_double, c_int, c_size_t, c_uint, c_void_p
 
-from fmpy import extract, read_model_description
+from fmpy import extract
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2CallbackFunctions,
                        fmi2CallbackLoggerTYPE)
+
+from sma_fmu.fmi.build import read_description
 
 __all__ = ["FmuError", "FmuInstance"]
 
@@ -84,7 +86,7 @@ class FmuInstance:
     def __init__(self, path, instance_name, start_values=None, start_time=0.0):
         self.path = str(path)
         self.instance_name = instance_name
-        description = read_model_description(self.path)
+        description = read_description(path)
         self.variables = {v.name: v for v in description.modelVariables}
         self.messages = []
         self._unzipped = extract(self.path)

@@ -56,8 +56,12 @@ class ConstantTemperatureData:
 
 def _rows(path, required):
     path = Path(path)
+    if path.is_dir():
+        raise MeasurementError(f"{path}: is a folder, not a CSV file")
+    number = 1
     try:
-        with open(path, newline="", encoding="utf-8") as stream:
+        # utf-8-sig: a byte-order mark (as spreadsheet programs write) is not part of the header
+        with open(path, newline="", encoding="utf-8-sig") as stream:
             reader = csv.reader(stream)
             header = next(reader, None)
             if header is None:
@@ -67,14 +71,21 @@ def _rows(path, required):
             missing = [name for name in required if name not in header]
             if missing:
                 raise MeasurementError(f"{path}: line 1: missing column(s) {', '.join(missing)}; "
-                                       f"found {', '.join(header)}")
+                                       f"found {', '.join(map(repr, header))}")
             columns = {name: header.index(name) for name in header}
-            rows = [(number, row) for number, row in enumerate(reader, start=2)
-                    if any(cell.strip() for cell in row)]
+            rows = []
+            for number, row in enumerate(reader, start=2):
+                if any(cell.strip() for cell in row):
+                    rows.append((number, row))
     except FileNotFoundError:
         raise MeasurementError(f"{path}: file not found") from None
     except UnicodeDecodeError as error:
-        raise MeasurementError(f"{path}: not a UTF-8 text file ({error.reason})") from None
+        raise MeasurementError(f"{path}: not a UTF-8 text file (byte {error.start}: {error.reason}); "
+                               f"save it as UTF-8 CSV") from None
+    except csv.Error as error:
+        raise MeasurementError(f"{path}: line {number + 1}: not readable as CSV: {error}") from None
+    except OSError as error:
+        raise MeasurementError(f"{path}: cannot read the file: {error.strerror or error}") from None
     if not rows:
         raise MeasurementError(f"{path}: no data rows after the header")
     return path, columns, rows

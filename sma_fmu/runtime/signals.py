@@ -6,8 +6,10 @@ Built from the ``[reference]`` and ``[load]`` tables of a scenario file. Problem
 import bisect
 import math
 
-__all__ = ["REFERENCE_KINDS", "ReferenceSignal", "LoadProfile", "reference_from_table",
+__all__ = ["REFERENCE_KINDS", "MAX_REFERENCE_OHM", "ReferenceSignal", "LoadProfile", "reference_from_table",
            "load_from_table"]
+
+MAX_REFERENCE_OHM = 1e6  # a wire's resistance is ohms to kilo-ohms; beyond this is a typo
 
 # kind -> (required keys, optional keys with defaults)
 REFERENCE_KINDS = {
@@ -48,21 +50,27 @@ class ReferenceSignal:
         s = self.settings
         if kind == "table":
             self._times, self._values = s["times_s"], s["values_ohm"]
-        lowest = self._lowest()
+        lowest, highest = self.bounds()
         if not lowest > 0.0:
             raise ValueError(f"the reference must stay > 0 ohm, but reaches {lowest!r} ohm")
+        if not highest <= MAX_REFERENCE_OHM:
+            raise ValueError(f"the reference must stay <= {MAX_REFERENCE_OHM:g} ohm, "
+                             f"but reaches {highest!r} ohm")
 
-    def _lowest(self):
+    def bounds(self):
+        """(lowest, highest) value of R_ref over all time [ohm]."""
         s = self.settings
         if self.kind == "constant":
-            return s["value_ohm"]
-        if self.kind == "step":
-            return min(s["initial_ohm"], s["final_ohm"])
-        if self.kind == "ramp":
-            return min(s["start_ohm"], s["end_ohm"])
-        if self.kind in ("sine", "cosine"):
-            return s["offset_ohm"] - abs(s["amplitude_ohm"])
-        return min(self._values)
+            values = [s["value_ohm"]]
+        elif self.kind == "step":
+            values = [s["initial_ohm"], s["final_ohm"]]
+        elif self.kind == "ramp":
+            values = [s["start_ohm"], s["end_ohm"]]
+        elif self.kind in ("sine", "cosine"):
+            values = [s["offset_ohm"] - abs(s["amplitude_ohm"]), s["offset_ohm"] + abs(s["amplitude_ohm"])]
+        else:
+            values = self._values
+        return min(values), max(values)
 
     def value(self, t):
         """R_ref [ohm] at time ``t`` [s]."""
