@@ -11,7 +11,8 @@ EXPERIMENTS = ("constant-load", "constant-temperature")
 def _fit(args):
     from sma_fmu.identification.runner import format_report, run_fit
     out = args.out or Path("results") / f"fit-{args.experiment}"
-    report = run_fit(args.experiment, args.files, out, args.model)
+    report = run_fit(args.experiment, args.files, out, args.model,
+                     progress=lambda text: print(text, flush=True))
     print(format_report(report))
     print(f"written: {out}/identified.toml, report.json, figures")
     return 0

@@ -20,27 +20,33 @@ __all__ = ["EXPERIMENTS", "run_fit", "format_report"]
 EXPERIMENTS = ("constant-load", "constant-temperature")
 
 
-def _fit(experiment, files, base):
+def _fit(experiment, files, base, progress):
     """(FitResult, report, {figure name: PNG bytes}) of one experiment."""
     if experiment == "constant-load":
         data = read_constant_load(files)
+        progress(f"fitting {len(fit_constant_load.FITTED)} parameters to "
+                 f"{data.resistance.size} points ...")
         result, report = fit_constant_load.fit_constant_load(data, base)
+        progress("drawing the figures ...")
         sensed, _, _ = fit_constant_load.sensing_comparison(result.params, data)
         return result, report, constant_load_figures(result.params, data, sensed)
     experiments = [read_constant_temperature(f) for f in files]
+    progress(f"fitting {len(fit_constant_temperature.FITTED)} parameters to "
+             f"{sum(e.load.size for e in experiments)} points ...")
     result, report = fit_constant_temperature.fit_constant_temperature(experiments, base)
+    progress("drawing the figures ...")
     model = fit_constant_temperature.model_resistance(result.params, experiments)
     return result, report, constant_temperature_figures(result.params, experiments, model)
 
 
-def run_fit(experiment, files, out_dir, model=None):
+def run_fit(experiment, files, out_dir, model=None, progress=lambda text: None):
     """Identify from ``files``; write identified.toml, report.json and figures; return report."""
     if experiment not in EXPERIMENTS:
         raise ValueError(f"experiment must be one of {', '.join(EXPERIMENTS)}, got {experiment!r}")
     if not files:
         raise ValueError("no measurement file given")
     base_set = load_parameter_set(model)
-    result, report, figures = _fit(experiment, [Path(f) for f in files], base_set.params)
+    result, report, figures = _fit(experiment, [Path(f) for f in files], base_set.params, progress)
     fitted = ", ".join(p.name for p in result.parameters)
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     report["base_parameter_file"] = str(base_set.path)
