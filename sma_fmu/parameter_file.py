@@ -20,12 +20,14 @@ from pathlib import Path
 from sma_fmu.package_data import default_parameter_file
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
 from sma_fmu.toml_files import read_toml
+from sma_fmu.wire_geometry import DERIVABLE, GEOMETRY_INPUTS, complete_from_geometry
 
 __all__ = ["ParameterSet", "load_parameter_set", "load_parameters", "parse_parameter_document",
            "parameter_file_text", "write_parameter_file", "ParameterError"]
 
 _ENTRY_FIELDS = {"value", "unit", "meaning"}
-_SECTIONS = {spec.section for spec in PARAMETER_SPECS}
+_FILE_SPECS = PARAMETER_SPECS + GEOMETRY_INPUTS  # what a file may hold
+_SECTIONS = {spec.section for spec in _FILE_SPECS}
 
 
 @dataclass(frozen=True)
@@ -37,6 +39,7 @@ class ParameterSet:
     description: str
     meanings: dict = field(default_factory=dict)
     path: Path = None
+    derived: dict = field(default_factory=dict)  # {name: how it was derived} (wire_geometry)
 
     def as_json(self):
         """JSON-ready dict {name, description, parameters: {key: {value, unit, meaning}}}."""
@@ -62,7 +65,7 @@ def parse_parameter_document(document, source):
                              f"expected {', '.join(sorted(_SECTIONS | {'wire'}))}")
     values, meanings = {}, {}
     specs_by_section = {}
-    for spec in PARAMETER_SPECS:
+    for spec in _FILE_SPECS:
         specs_by_section.setdefault(spec.section, {})[spec.name] = spec
     for section, entries in document.items():
         if section == "wire":
@@ -75,12 +78,14 @@ def parse_parameter_document(document, source):
                 raise ParameterError(f"{source}: unknown parameter {section}.{key}; expected one "
                                      f"of {', '.join(specs_by_section[section])}")
             values[key], meanings[key] = _parse_entry(entry, spec, source)
-    missing = [f"{s.section}.{s.name}" for s in PARAMETER_SPECS if s.required and s.name not in values]
+    missing = [f"{s.section}.{s.name}" for s in PARAMETER_SPECS
+               if s.required and s.name not in values and s.name not in DERIVABLE]
     if missing:
         raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
+    values, derived = complete_from_geometry(values, source)
     params = WireParameters.from_values(values, source=str(source))
     return ParameterSet(params, str(wire.get("name", Path(str(source)).stem)),
-                        str(wire.get("description", "")), meanings)
+                        str(wire.get("description", "")), meanings, derived=derived)
 
 
 def _parse_entry(entry, spec, source):
@@ -109,7 +114,8 @@ def load_parameter_set(path=None):
     path = Path(path) if path is not None else default_parameter_file()
     document = read_toml(path, ParameterError, "parameter file")
     parsed = parse_parameter_document(document, path)
-    return ParameterSet(parsed.params, parsed.name, parsed.description, parsed.meanings, path)
+    return ParameterSet(parsed.params, parsed.name, parsed.description, parsed.meanings, path,
+                        parsed.derived)
 
 
 def load_parameters(path=None):

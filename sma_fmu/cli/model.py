@@ -1,10 +1,12 @@
-"""Model commands: lattice, resistance, sense, constant-length (``name = value unit`` or JSON)."""
+"""Model commands: lattice, wire, resistance, sense, constant-length (``name = value unit`` or JSON)."""
 import json
+import math
 
 from sma_fmu.parameter_file import load_parameter_set
 from sma_fmu.runtime.checks import direction_name
 from sma_fmu.runtime.constant_length import load_temperature_slope
 from sma_fmu.runtime.constant_load import constant_load_fractions
+from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.phases import length_of, resistance_of
 from sma_fmu.runtime.sensing import sense_temperature
 
@@ -26,7 +28,31 @@ def _report(rows, as_json):
 def _lattice(args, parameter_set):
     lattice = parameter_set.params.lattice
     return [("N", lattice.N, ""), ("x_P", lattice.x_P, "m"), ("N_l", lattice.N_l, ""),
-            ("N_S", lattice.N_S, "")]
+            ("N_S", lattice.N_S, "")] + _derived_notes(parameter_set)
+
+
+def _derived_notes(parameter_set):
+    """Rows saying which file values were derived from the geometry (none for a full file)."""
+    return [(f"derived {name}", how, "") for name, how in parameter_set.derived.items()]
+
+
+def _wire(args, parameter_set):
+    params = parameter_set.params
+    rows = [("name", parameter_set.name, ""), ("file", str(parameter_set.path), "")]
+    for spec in PARAMETER_SPECS:
+        value = getattr(params, spec.name)
+        if value is not None:
+            unit = "" if spec.unit == "1" else spec.unit
+            rows.append((f"{spec.section}.{spec.name}", value, unit))
+    rows += _derived_notes(parameter_set)
+    rows += [("K_th", params.K_th, "K/W"), ("tau_th", params.tau_th, "s"),
+             ("alpha (phase-lag lead time)", params.phase_lag_alpha, "s"),
+             ("surface pi d x0", math.pi * params.diameter * params.x0, "m2"),
+             ("line density mass/x0", params.line_density, "kg/m"),
+             ("R fully hot, no load", params.R_P, "ohm"), ("R fully cold", params.R_MF, "ohm"),
+             ("note", f"T_room = {params.T_room:g} degC is the ambient of the paper's tests; "
+                      f"set thermal.T_room to yours", "")]
+    return rows
 
 
 def _resistance(args, parameter_set):
@@ -70,6 +96,11 @@ def register(commands):
     lattice = commands.add_parser("lattice", parents=[common],
                                   help="lattice constants N, x_P, N_l, N_S")
     lattice.set_defaults(handler=_handler(_lattice))
+
+    wire = commands.add_parser("wire", parents=[common],
+                               help="the wire's parameters, what was derived from its geometry, "
+                                    "and the constants that follow")
+    wire.set_defaults(handler=_handler(_wire))
 
     resistance = commands.add_parser("resistance", parents=[common],
                                      help="resistance, fractions and length at T, load, direction")

@@ -71,7 +71,7 @@ def _rows(path, required):
             missing = [name for name in required if name not in header]
             if missing:
                 raise MeasurementError(f"{path}: line 1: missing column(s) {', '.join(missing)}; "
-                                       f"found {', '.join(map(repr, header))}")
+                                       f"found {', '.join(header)}")
             columns = {name: header.index(name) for name in header}
             rows = []
             for number, row in enumerate(reader, start=2):
