@@ -1,63 +1,151 @@
-"""Figures like the paper's Figs. 10-11, drawn with matplotlib.
+"""Figures of runs: one per scenario (like the paper's Fig. 10) and one per comparison (Fig. 11).
 
 Drawn on :class:`matplotlib.figure.Figure` objects, not through pyplot: no screen is
-needed, and importing this module leaves the process's matplotlib backend alone.
+needed, and importing this module leaves the process's matplotlib backend alone. Every
+panel has a legend; the load changes and the start of the metrics window are marked on
+every panel that shows the whole run.
 """
+import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["plot_run", "plot_comparison"]
+__all__ = ["plot_run", "plot_comparison", "rolling_rms"]
 
 _COLOURS = {"pi": "tab:red", "pi+ff-fixed": "tab:orange", "pi+ff-adaptive": "tab:green"}
+_EXTRA_COLOURS = ("tab:blue", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
+
+
+def _colours(labels):
+    """A colour per run label: the paper's three controllers keep theirs."""
+    extra = iter(_EXTRA_COLOURS * (1 + len(labels) // len(_EXTRA_COLOURS)))
+    return {label: _COLOURS.get(label) or next(extra) for label in labels}
+
+
+def _load_changes(data):
+    """[(time [s], new load [kg])] where the load steps."""
+    load = data["load"]
+    steps = np.nonzero(np.diff(load) != 0.0)[0] + 1
+    return [(float(data["t"][i]), float(load[i])) for i in steps]
+
+
+def _mark(axis, data, metrics_start, label=False):
+    """Grey out the samples before the metrics window and draw a line at each load change."""
+    if metrics_start > 0.0:
+        axis.axvspan(data["t"][0], metrics_start, color="0.85", alpha=0.6, lw=0,
+                     label="outside the metrics window" if label else None)
+    for index, (time, load) in enumerate(_load_changes(data)):
+        axis.axvline(time, color="0.35", ls=":", lw=1.0,
+                     label="load change" if label and index == 0 else None)
+        if label:
+            axis.annotate(f"{load:g} kg", (time, 1.0), xycoords=("data", "axes fraction"),
+                          xytext=(3, -12), textcoords="offset points", fontsize=8, color="0.3")
 
 
 def plot_run(data, scenario, path):
-    """Power and load on top, R_ref and R below (paper Fig. 10); saved as PNG at ``path``."""
-    figure = Figure(figsize=(10, 6.5))
-    top, bottom = figure.subplots(2, 1, sharex=True)
+    """Resistance, temperature, power (total, feedforward, feedback), load and stroke; PNG at ``path``."""
+    figure = Figure(figsize=(10, 10))
+    axes = figure.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2, 2, 1.4]})
     t = data["t"]
-    top.plot(t[:-1], data["P"][:-1], color="black", lw=0.8, label="P (input power)")
-    top.set_ylabel("power P [W]")
-    load_axis = top.twinx()
-    load_axis.step(t, data["load"], where="post", color="tab:blue", ls="--", label="load")
-    load_axis.set_ylabel("load [kg]", color="tab:blue")
-    load_axis.set_ylim(0, max(0.3, 1.1 * float(data["load"].max())))
-    bottom.plot(t, data["R_ref"], color="black", ls="--", lw=0.9, label="R_ref")
-    bottom.plot(t, data["R"], color="tab:red", lw=0.9, label="R")
-    bottom.set_xlabel("time t [s]")
-    bottom.set_ylabel("resistance [ohm]")
-    bottom.legend(loc="upper right")
-    top.set_title(f"{scenario.name}: {scenario.controller.kind}, {scenario.hysteresis_mode} hysteresis")
-    for axis in (top, bottom):
+    start = scenario.analysis.metrics_start_s
+    resistance, temperature, power, load = axes
+    resistance.plot(t, data["R_ref"], color="black", ls="--", lw=0.9, label="R_ref")
+    resistance.plot(t, data["R"], color="tab:red", lw=0.9, label="R")
+    resistance.set_ylabel("resistance [ohm]")
+    temperature.plot(t, data["T"], color="tab:red", lw=0.9, label="T (wire)")
+    if scenario.controller.feedforward:
+        temperature.plot(t, data["T_ref"], color="black", ls="--", lw=0.9,
+                         label="T_ref (inverse model)")
+    temperature.axhline(scenario.params.T_room, color="tab:blue", lw=0.8, ls="-.", label="T_room")
+    temperature.set_ylabel("temperature [degC]")
+    power.plot(t[:-1], data["P"][:-1], color="black", lw=0.9, label="P applied")
+    if scenario.controller.feedforward:
+        power.plot(t[:-1], data["P_ff"][:-1], color="tab:blue", lw=0.8, label="P_ff (feedforward)")
+    power.plot(t[:-1], data["P_fb"][:-1], color="tab:orange", lw=0.8, label="P_fb (PI feedback)")
+    power.axhline(0.0, color="0.5", lw=0.6)
+    power.set_ylabel("power [W]")
+    load.step(t, data["load"], where="post", color="tab:blue", label="load")
+    load.set_ylabel("load [kg]")
+    load.set_ylim(0.0, max(0.3, 1.15 * float(data["load"].max())))
+    stroke = load.twinx()
+    stroke.plot(t, 1e3 * data["stroke"], color="tab:green", lw=0.9, label="stroke x_0 - x")
+    stroke.set_ylabel("stroke [mm]")
+    load.set_xlabel("time t [s]")
+    for index, axis in enumerate(axes):
+        _mark(axis, data, start, label=index == 0)
         axis.grid(alpha=0.3)
+    for axis in (resistance, temperature, power):
+        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0)
+    handles = load.get_legend_handles_labels()[0] + stroke.get_legend_handles_labels()[0]
+    load.legend(handles, [h.get_label() for h in handles], loc="upper left",
+                bbox_to_anchor=(1.08, 1.0), fontsize=8, borderaxespad=0)
+    resistance.set_title(f"{scenario.name}: {scenario.controller.kind}, "
+                         f"{scenario.hysteresis_mode} hysteresis")
     figure.tight_layout()
     figure.savefig(path, dpi=110)
 
 
-def plot_comparison(runs, title, path, zoom=(24.0, 28.0)):
-    """Overlay controllers: R over the run, a zoomed window (paper Fig. 11) and the error.
+def rolling_rms(values, window):
+    """Root mean square of ``values`` over a centred window of ``window`` samples (same length)."""
+    window = max(1, min(int(window), len(values)))
+    squares = np.concatenate([[0.0], np.cumsum(np.square(values))])
+    half = window // 2
+    index = np.arange(len(values))
+    low = np.clip(index - half, 0, len(values))
+    high = np.clip(index - half + window, 0, len(values))
+    return np.sqrt((squares[high] - squares[low]) / np.maximum(high - low, 1))
 
-    ``runs`` maps controller kind -> time-series array of the same scenario group.
+
+def _reference_period(scenario):
+    """Period of a periodic reference [s], or a twentieth of the run for the others."""
+    settings = scenario.reference.settings
+    frequency = settings.get("frequency_hz", 0.0) if scenario.reference.kind in ("sine", "cosine") else 0.0
+    return 1.0 / frequency if frequency > 0.0 else scenario.stop_time_s / 20.0
+
+
+def plot_comparison(runs, scenario, title, path):
+    """Overlay runs of one group: the whole run, an enlarged window, and the error.
+
+    ``runs`` maps a label (controller kind or scenario name) to the time series of runs of
+    one group; ``scenario`` (any of them) gives the windows and the reference period. Panels:
+    R over the whole run; R and the error R - R_ref in the enlarged window (the paper's
+    Fig. 11); the RMS error over one reference period, over the whole run.
     """
-    figure = Figure(figsize=(10, 9))
-    axes = figure.subplots(3, 1)
-    first = next(iter(runs.values()))
+    labels = list(runs)
+    colours = _colours(labels)
+    first = runs[labels[0]]
     t = first["t"]
-    zoomed = (t >= zoom[0]) & (t <= zoom[1])
-    for axis, mask in ((axes[0], slice(None)), (axes[1], zoomed)):
-        axis.plot(t[mask], first["R_ref"][mask], color="black", ls="--", lw=1.0, label="R_ref")
-    for kind, data in runs.items():
-        colour = _COLOURS.get(kind)
-        axes[0].plot(t, data["R"], color=colour, lw=0.8, label=kind)
-        axes[1].plot(t[zoomed], data["R"][zoomed], color=colour, lw=1.2, label=kind)
-        axes[2].plot(t, data["R"] - data["R_ref"], color=colour, lw=0.8, label=kind)
-    axes[0].set_title(title)
-    axes[0].set_ylabel("resistance [ohm]")
-    axes[1].set_ylabel("resistance [ohm]")
-    axes[1].set_title(f"enlarged: {zoom[0]:g} s to {zoom[1]:g} s")
-    axes[2].set_ylabel("error R - R_ref [ohm]")
-    axes[2].set_xlabel("time t [s]")
-    for axis in axes:
+    window = scenario.analysis
+    zoom = (t >= window.zoom_start_s) & (t <= window.zoom_end_s)
+    figure = Figure(figsize=(12, 10))
+    grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
+    overview = figure.add_subplot(grid[0, :])
+    zoomed = figure.add_subplot(grid[1, 0])
+    zoomed_error = figure.add_subplot(grid[1, 1], sharex=zoomed)
+    rms = figure.add_subplot(grid[2, :], sharex=overview)
+    overview.plot(t, first["R_ref"], color="black", ls="--", lw=0.8, label="R_ref")
+    zoomed.plot(t[zoom], first["R_ref"][zoom], color="black", ls="--", lw=1.1, label="R_ref")
+    samples = max(1, int(round(_reference_period(scenario) / scenario.step_s)))
+    for label, data in runs.items():
+        colour, error = colours[label], data["R"] - data["R_ref"]
+        overview.plot(t, data["R"], color=colour, lw=0.6, label=label)
+        zoomed.plot(t[zoom], data["R"][zoom], color=colour, lw=1.2, label=label)
+        zoomed_error.plot(t[zoom], error[zoom], color=colour, lw=1.2, label=label)
+        rms.plot(t, rolling_rms(error, samples), color=colour, lw=1.2, label=label)
+    overview.set(ylabel="resistance [ohm]", title=f"{title}: whole run")
+    zoomed.set(ylabel="resistance [ohm]", xlabel="time t [s]",
+               title=f"enlarged: {window.zoom_start_s:g} s to {window.zoom_end_s:g} s")
+    zoomed_error.set(ylabel="error R - R_ref [ohm]", xlabel="time t [s]", title="error, enlarged")
+    zoomed_error.axhline(0.0, color="0.5", lw=0.6)
+    rms.set(ylabel="RMS error [ohm]", xlabel="time t [s]",
+            title=f"RMS of R - R_ref over {samples * scenario.step_s:g} s (one reference period)")
+    for index, axis in enumerate((overview, rms)):
+        _mark(axis, first, window.metrics_start_s, label=index == 0)
+    overview.axvspan(window.zoom_start_s, window.zoom_end_s, color="tab:blue", alpha=0.08, lw=0,
+                     label="enlarged below")
+    for axis in (overview, rms):
+        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0)
+    for axis in (zoomed, zoomed_error):
+        axis.legend(loc="best", fontsize=7, framealpha=0.7)
+    for axis in (overview, zoomed, zoomed_error, rms):
         axis.grid(alpha=0.3)
-        axis.legend(loc="upper right", fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=110)

@@ -85,11 +85,9 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
             series[name] = (scenario, result.data)
         for group, members in groups(rows).items():
             if len(members) > 1:
-                window = series[members[0]["scenario"]][0].analysis
                 runs = {row["label"]: series[row["scenario"]][1] for row in members}
-                plot_comparison(runs, f"{group}: controllers compared",
-                                stage / f"comparison-{group}.png",
-                                zoom=(window.zoom_start_s, window.zoom_end_s))
+                plot_comparison(runs, series[members[0]["scenario"]][0],
+                                f"{group}: controllers compared", stage / f"comparison-{group}.png")
         (stage / "comparison.md").write_text(comparison_markdown(rows), encoding="utf-8")
         (stage / "summary.json").write_text(json_text(rows), encoding="utf-8")
     return rows
