@@ -4,7 +4,7 @@ Not a speed benchmark: it prints the table of docs/systems.md, the RMSE of R - R
 (t >= 2 s) per scenario for the library path (Gauss-Seidel and Jacobi) and for each host
 (libcosim and Ecos run the SSP, fmpy and libcosim the container FMU), and the largest
 deviation of a host run from the library run of its coupling. It builds the FMUs into a
-temporary folder. A 30 s scenario takes 15-60 s in an SSP host (about 50 min in all).
+temporary folder. A 30 s scenario takes 10-40 s per host (about 10 minutes in all).
 
     python benchmarks/hosts.py [SCENARIO...] [--stop-time S] [--json FILE]
 """
