@@ -19,6 +19,7 @@ from pathlib import Path
 
 from sma_fmu.systems.c_host import run_c_host
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
+from sma_fmu.systems.toolbox_log import toolbox_messages
 
 __all__ = ["CheckResult", "SHORT_RUN_STEPS", "check_file", "check_files", "format_result"]
 
@@ -58,30 +59,14 @@ def _fmpy_validation(path):
     return ("ok", "no problems") if not problems else ("FAIL", "; ".join(problems))
 
 
-class _Errors(logging.Handler):
-    def __init__(self):
-        super().__init__(level=logging.ERROR)
-        self.messages = []
-
-    def emit(self, record):
-        self.messages.append(record.getMessage())
-
-
 def _toolbox_checker(path):
     from fmu_manipulation_toolbox.checker import get_checkers
     from fmu_manipulation_toolbox.operations import FMU
 
-    errors, logger = _Errors(), logging.getLogger("fmu_manipulation_toolbox")
-    logger.addHandler(errors)
-    propagate, logger.propagate = logger.propagate, False
-    try:
-        with FMU(str(path)) as fmu:
-            for checker in get_checkers():
-                fmu.apply_operation(checker())
-    finally:
-        logger.removeHandler(errors)
-        logger.propagate = propagate
-    return ("ok", "compliant") if not errors.messages else ("FAIL", "; ".join(errors.messages))
+    with toolbox_messages(logging.ERROR) as errors, FMU(str(path)) as fmu:
+        for checker in get_checkers():
+            fmu.apply_operation(checker())
+    return ("ok", "compliant") if not errors else ("FAIL", "; ".join(errors))
 
 
 def _fmu_step(path):

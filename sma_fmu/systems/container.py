@@ -9,7 +9,6 @@ values as start values. The container has no inputs; its outputs are :data:`OUTP
 the units of the embedded FMUs (added to the builder's modelDescription.xml, which has none).
 """
 import io
-import logging
 import shutil
 import tempfile
 import xml.etree.ElementTree as ET
@@ -20,6 +19,7 @@ from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
 from sma_fmu.output_folder import OutputError, write_file
 from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.toolbox_log import toolbox_messages
 
 __all__ = ["OUTPUTS", "container_outputs", "build_container", "export_container"]
 
@@ -50,17 +50,6 @@ def _text(value):
         raise ValueError(f"start value {text!r} contains white space, which an FMU container "
                          "cannot carry")
     return text
-
-
-class _BuilderLog(logging.Handler):
-    """Keeps the builder's warnings and errors (it logs problems rather than raising)."""
-
-    def __init__(self):
-        super().__init__(level=logging.WARNING)
-        self.messages = []
-
-    def emit(self, record):
-        self.messages.append(record.getMessage())
 
 
 # what the builder says about this loop by design: the PI and the plant form a loop (the
@@ -135,11 +124,10 @@ def build_container(system, out, step_size=None, argument="--out"):
 
     scenario = system.scenario
     step_size = scenario.step_s if step_size is None else step_size
-    log, logger = _BuilderLog(), logging.getLogger("fmu_manipulation_toolbox")
-    logger.addHandler(log)
-    propagate, logger.propagate = logger.propagate, False
+    expected = _EXPECTED if scenario.controller.feedforward else _EXPECTED_WITHOUT_COMPENSATOR
     try:
-        with tempfile.TemporaryDirectory(prefix="sma_fmu_container_") as folder:
+        with toolbox_messages() as messages, \
+                tempfile.TemporaryDirectory(prefix="sma_fmu_container_") as folder:
             for component in system.components:
                 shutil.copy(component.fmu, folder)
             container = FMUContainer(_identifier(scenario.name), folder, fmi_version=2)
@@ -147,18 +135,13 @@ def build_container(system, out, step_size=None, argument="--out"):
             _configure(container, system)
             built = Path(folder) / "container.fmu"
             container.make_fmu(built.name, step_size=step_size, sequential=True)
-            expected = (_EXPECTED if scenario.controller.feedforward
-                        else _EXPECTED_WITHOUT_COMPENSATOR)
-            unexpected = [m for m in log.messages if not m.startswith(expected)]
+            unexpected = [m for m in messages if not m.startswith(expected)]
             if unexpected or not built.is_file():
                 raise ValueError(f"{out}: the container builder reports: "
                                  f"{'; '.join(unexpected) or 'no file written'}")
             write_file(out, _with_units(built.read_bytes(), _units(system)), argument)
     except FMUContainerError as error:
         raise ValueError(f"{out}: cannot build the container: {error}") from None
-    finally:
-        logger.removeHandler(log)
-        logger.propagate = propagate
     return Path(out)
 
 
