@@ -8,7 +8,7 @@ from fmpy import read_model_description
 
 from sma_fmu import load_parameter_set
 from sma_fmu.cli import main
-from sma_fmu.fmi.build import build_fmu, code_stamp, validate_fmus
+from sma_fmu.fmi.build import FMU_SCRIPTS, build_fmu, code_stamp, validate_fmus
 from sma_fmu.parameter_file import write_parameter_file
 from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
 
@@ -115,7 +115,7 @@ def test_cli_build_and_validate(tmp_path, capsys):
     assert "SmaActuator: " in capsys.readouterr().out
     assert main(["validate", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert out.count("valid (fmpy: no problems)") == 2
+    assert out.count("valid (fmpy: no problems)") == len(FMU_SCRIPTS) == 4
 
 
 def test_cli_validate_fails_on_a_broken_fmu(tmp_path, fmus, capsys):

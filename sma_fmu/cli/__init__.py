@@ -1,19 +1,20 @@
 """Command line ``sma-fmu``: thin wrappers; each flag maps onto one API argument.
 
-One module per group of commands (model, fmus, cosim, identification, bench, examples);
+One module per group of commands (model, fmus, cosim, export, check, identification, bench,
+examples);
 each has ``register(commands)``. Every failure is one line ``sma-fmu: error: ...`` on stderr
-with exit status 2 (``validate`` exits 1 when an FMU has problems); no traceback, ever.
+with exit status 2 (``validate`` and ``check`` exit 1 when a file fails); no traceback, ever.
 """
 import sys
 
 from sma_fmu import __version__
 
-from . import bench, cosim, examples, fmus, identification, model
+from . import bench, check, cosim, examples, export, fmus, identification, model
 from .arguments import Parser, fail
 
 __all__ = ["main", "build_parser", "COMMAND_GROUPS"]
 
-COMMAND_GROUPS = (model, fmus, cosim, identification, bench, examples)
+COMMAND_GROUPS = (model, fmus, cosim, export, check, identification, bench, examples)
 
 
 def build_parser():

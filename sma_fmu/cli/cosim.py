@@ -22,8 +22,9 @@ def register(commands):
                      help="a .toml file, the name of a shipped scenario, or 'paper'")
     run.add_argument("--all", action="store_true", help="every shipped scenario")
     run.add_argument("--out", type=Path, default=Path("results"), metavar="DIR", help="output folder")
-    run.add_argument("--path", choices=("fmu", "library"), default="fmu",
-                     help="fmu: the FMUs under fmpy; library: the steppers directly")
+    run.add_argument("--path", choices=("fmu", "library", "ssp", "container"), default="fmu",
+                     help="fmu: the FMUs under fmpy; library: the steppers directly; ssp: the "
+                          "SSP package in libcosim (Jacobi); container: the one-FMU loop in libcosim")
     run.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR",
                      help="folder of the built FMUs")
     run.set_defaults(handler=_run)

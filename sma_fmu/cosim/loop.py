@@ -5,6 +5,13 @@ are FMUs under fmpy) and the library path (here, the runtime steppers directly).
 step k = 0 ... n-1 (t_k = k h): read R_k; e_k = R_k - R_ref(t_k); the compensator takes
 R_ref(t_k), f(t_k) -> u_ff,k; the PI gives u_k = max(0, u_ff,k + Kp e_k + Ki I_k); the plant
 steps t_k -> t_k+1 with u_k and f(t_k) held. Sample n records R_n and T_n only.
+
+That is Gauss-Seidel coupling (``coupling="gauss-seidel"``, the default): each block sees
+the outputs computed before it in the same step. SSP hosts (libcosim, Ecos) couple by
+Jacobi (``coupling="jacobi"``): all blocks step together, each with the outputs the others
+had at t_k, so the PI gets u_ff,k-1 and the plant gets u_k-1 (at k = 0: the outputs after
+initialization, u_ff of the first sample and the PI's output before its first step).
+The signals R_ref(t_k), f(t_k) and R_k reach the blocks alike in both.
 """
 import math
 import time
@@ -16,14 +23,15 @@ from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper
 
-__all__ = ["COLUMNS", "PLANT_OUTPUTS", "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator",
-           "run_library"]
+__all__ = ["COLUMNS", "PLANT_OUTPUTS", "COUPLINGS", "LoopResult", "run_loop", "LibraryPlant",
+           "LibraryCompensator", "run_library"]
 
 COLUMNS = (("t", "s"), ("R_ref", "ohm"), ("R", "ohm"), ("T", "degC"), ("T_ref", "degC"),
            ("x", "m"), ("stroke", "m"), ("xi_P", ""), ("xi_M", ""), ("xi_F", ""),
            ("P_ff", "W"), ("P_fb", "W"), ("P", "W"), ("load", "kg"), ("saturated", ""))
 _DTYPE = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
 PLANT_OUTPUTS = ("R", "T", "x", "xi_P", "xi_M", "xi_F", "P")  # what a loop plant returns
+COUPLINGS = ("gauss-seidel", "jacobi")
 
 
 @dataclass
@@ -63,6 +71,10 @@ class LibraryCompensator:
         self.stepper = FeedforwardStepper(scenario.params, c.alpha, c.beta, c.model_load,
                                           c.adapt_to_load)
 
+    def initial(self, reference, load):
+        """(P_ff [W], T_ref [degC], saturated) before the first step (what a Jacobi host passes on)."""
+        return self.stepper.initial_outputs(reference, load)
+
     def step(self, time_s, reference, load, step_size):
         """(P_ff [W], T_ref [degC], saturated) for the sample at ``time_s``."""
         return self.stepper.step(reference, load, step_size)
@@ -71,15 +83,20 @@ class LibraryCompensator:
         """Nothing to release."""
 
 
-def run_loop(scenario, plant, compensator=None):
+def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel"):
     """Close the loop over ``scenario``; returns the structured time-series array.
 
     ``plant`` has ``outputs()`` and ``step(t, power, load, h)`` returning the
     :data:`PLANT_OUTPUTS` (R, T, x, xi_P, xi_M, xi_F, applied power P); ``compensator``
     (None for the "pi" controller) has ``step(t, R_ref, load, h)`` returning
-    (P_ff, T_ref, saturated). Row k holds the samples at t_k and the powers applied over
-    [t_k, t_k+1); the stroke is the contraction x_0 - x_k [m] (positive: the wire shortened).
+    (P_ff, T_ref, saturated), and for Jacobi ``initial(R_ref, load)``. ``coupling`` is one
+    of :data:`COUPLINGS`. Row k holds the samples at t_k, the compensator's and the PI's
+    outputs of step k and the power the plant applied over [t_k, t_k+1); the stroke is the
+    contraction x_0 - x_k [m] (positive: the wire shortened).
     """
+    if coupling not in COUPLINGS:
+        raise ValueError(f"coupling must be one of {', '.join(COUPLINGS)}, got {coupling!r}")
+    jacobi = coupling == "jacobi"
     h, n = scenario.step_s, scenario.steps
     times = [k * h for k in range(n + 1)]
     references = [scenario.reference.value(t) for t in times]
@@ -87,31 +104,45 @@ def run_loop(scenario, plant, compensator=None):
     gains = scenario.controller
     pi = PIController(gains.Kp, gains.Ki)
     nan = math.nan
+    no_compensator = (0.0, nan, False)
     rows = []
     resistance, temperature, length, xi_p, xi_m, xi_f, _ = plant.outputs()
     start_length = length
+    if jacobi:  # what the blocks show after initialization: a Jacobi host passes it on at k = 0
+        held_ff = (no_compensator if compensator is None
+                   else compensator.initial(references[0], loads[0]))
+        held_power = pi.output(resistance - references[0], held_ff[0])[0]
     for k in range(n):
         time_s, reference, load = times[k], references[k], loads[k]
         error = resistance - reference
         if compensator is None:
-            p_ff, t_ref, saturated = 0.0, nan, False
+            compensated = no_compensator
         else:
-            p_ff, t_ref, saturated = compensator.step(time_s, reference, load, h)
-        power, feedback = pi.step(error, p_ff, h)
+            compensated = compensator.step(time_s, reference, load, h)
+        p_ff, t_ref, saturated = compensated
+        if jacobi:  # the PI and the plant get what their sources had at t_k
+            power, feedback = pi.step(error, held_ff[0], h)
+            plant_power, held_ff, held_power = held_power, compensated, power
+        else:
+            power, feedback = pi.step(error, p_ff, h)
+            plant_power = power
         sample = (time_s, reference, resistance, temperature, t_ref, length, start_length - length,
                   xi_p, xi_m, xi_f, p_ff, feedback)
         resistance, temperature, length, xi_p, xi_m, xi_f, applied = plant.step(
-            time_s, power, load, h)
+            time_s, plant_power, load, h)
         rows.append(sample + (applied, load, saturated))
     rows.append((times[n], references[n], resistance, temperature, nan, length,
                  start_length - length, xi_p, xi_m, xi_f, nan, nan, nan, loads[n], False))
     return np.array(rows, dtype=_DTYPE)
 
 
-def run_library(scenario):
-    """Run ``scenario`` on the library steppers (no FMUs); returns a :class:`LoopResult`."""
+def run_library(scenario, coupling="gauss-seidel"):
+    """Run ``scenario`` on the library steppers (no FMUs); returns a :class:`LoopResult`.
+
+    ``coupling``: one of :data:`COUPLINGS`; "jacobi" gives what an SSP host computes.
+    """
     start = time.perf_counter()
     plant = LibraryPlant(scenario)
     compensator = LibraryCompensator(scenario) if scenario.controller.feedforward else None
-    data = run_loop(scenario, plant, compensator)
+    data = run_loop(scenario, plant, compensator, coupling)
     return LoopResult(scenario, data, "library", time.perf_counter() - start)

@@ -11,15 +11,14 @@ from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
 from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths, read_description
 from sma_fmu.fmi.instance import FmuError, FmuInstance
 
-__all__ = ["FmuPlant", "FmuCompensator", "run_fmus", "MissingFmuError"]
-
+__all__ = ["FmuPlant", "FmuCompensator", "run_fmus", "MissingFmuError", "model_parameter_values"]
 
 
 class MissingFmuError(FileNotFoundError):
     """A needed FMU has not been built."""
 
 
-def _model_parameters(fmu_path, params):
+def model_parameter_values(fmu_path, params):
     """Start values for every wire parameter the FMU exposes, from ``params``."""
     values = params.values()
     return {v.name: values[v.name] for v in read_description(fmu_path).modelVariables
@@ -30,7 +29,7 @@ class FmuPlant:
     """The SmaActuator FMU as a loop plant."""
 
     def __init__(self, scenario, fmu_path, instance_name="plant"):
-        start = _model_parameters(fmu_path, scenario.params)
+        start = model_parameter_values(fmu_path, scenario.params)
         start.update(T_start=scenario.T_start, hysteresis_mode=scenario.hysteresis_mode,
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
@@ -57,7 +56,7 @@ class FmuCompensator:
 
     def __init__(self, scenario, fmu_path, instance_name="feedforward"):
         c = scenario.controller
-        start = _model_parameters(fmu_path, scenario.params)
+        start = model_parameter_values(fmu_path, scenario.params)
         start.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
                      adapt_to_load=c.adapt_to_load, R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))

@@ -21,11 +21,13 @@ from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.build import DEFAULT_FMU_DIR
 from sma_fmu.json_output import json_text
 from sma_fmu.output_folder import staged_folder
+from sma_fmu.systems.runs import run_container, run_ssp
 
 __all__ = ["PATHS", "run_scenarios", "timed_run", "write_timeseries", "result_names",
            "comparison_labels"]
 
-PATHS = {"fmu": run_fmus, "library": lambda scenario, fmu_dir: run_library(scenario)}
+PATHS = {"fmu": run_fmus, "library": lambda scenario, fmu_dir: run_library(scenario),
+         "ssp": run_ssp, "container": run_container}
 
 
 def write_timeseries(data, path):
@@ -56,7 +58,7 @@ def comparison_labels(scenarios, names):
 
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print):
-    """Run scenario files through ``path`` ("fmu" or "library"); write results; return rows.
+    """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
     a failed run leaves ``out_dir`` as it was.

@@ -5,7 +5,9 @@ Each FMU ships, in resources/:
 - a copy of ``sma_fmu/runtime`` (the physics, standard library only) renamed
   ``<script>_rt_<stamp>``, and a copy of ``sma_fmu/fmi/slave_support`` (the FMI glue, which
   needs pythonfmu) renamed ``<script>_fmi_<stamp>``, with their imports rewritten to match;
-- ``parameters.json``: the wire parameter file used at build time.
+- ``parameters.json``: the wire parameter file used at build time;
+- SmaScenarioSignals only: ``signals.json``, its default signals (those of the shipped
+  scenario :data:`DEFAULT_SIGNALS_SCENARIO`).
 
 ``<stamp>`` is a hash of all shipped code. pythonfmu FMUs loaded into one process share
 ``sys.modules``: with these names an FMU never runs another FMU type's modules, another
@@ -27,11 +29,15 @@ from sma_fmu.output_folder import staged_folder
 from sma_fmu.package_data import shipped_file
 from sma_fmu.parameter_file import load_parameter_set
 
-__all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "FmuFileError", "code_stamp", "build_fmu",
-           "build_fmus", "validate_fmus", "default_fmu_paths", "read_description"]
+__all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "DEFAULT_SIGNALS_SCENARIO", "FmuFileError",
+           "code_stamp", "build_fmu", "build_fmus", "validate_fmus", "default_fmu_paths",
+           "read_description"]
 
-FMU_SCRIPTS = {"SmaActuator": "sma_actuator.py", "SmaFeedforward": "sma_feedforward.py"}
+FMU_SCRIPTS = {"SmaActuator": "sma_actuator.py", "SmaFeedforward": "sma_feedforward.py",
+               "SmaPiController": "sma_pi_controller.py",
+               "SmaScenarioSignals": "sma_scenario_signals.py"}
 DEFAULT_FMU_DIR = Path("fmus")
+DEFAULT_SIGNALS_SCENARIO = "load-step-pi+ff-adaptive"  # the paper's Fig. 10 signals
 # shipped package -> suffix of its renamed copy inside an FMU
 _SHIPPED_PACKAGES = {"sma_fmu.runtime": "rt", "sma_fmu.fmi.slave_support": "fmi"}
 
@@ -91,6 +97,21 @@ def _renamer(stem, stamp):
     return names, lambda text: pattern.sub(lambda match: names[match.group(0)], text)
 
 
+def _default_signals(stage):
+    """Write SmaScenarioSignals' ``signals.json``; returns [its path]."""
+    from sma_fmu.cosim.scenario import load_scenario  # cosim imports this module
+
+    scenario = load_scenario(shipped_file("scenarios", f"{DEFAULT_SIGNALS_SCENARIO}.toml"))
+    path = stage / "signals.json"
+    path.write_text(json.dumps({"scenario": scenario.name, "reference": scenario.reference.as_table(),
+                                "load": scenario.load.as_table()}, indent=2), encoding="utf-8")
+    return [path]
+
+
+# model name -> function(stage folder) writing more files for its resources/
+_EXTRA_RESOURCES = {"SmaScenarioSignals": _default_signals}
+
+
 def _stage(script_name, stage, parameter_set, stamp):
     """Write the renamed packages, the rewritten slave script and parameters.json into ``stage``."""
     stem = Path(script_name).stem
@@ -126,6 +147,8 @@ def _build_into(model_name, folder, parameter_set, stamp):
 
     with tempfile.TemporaryDirectory(prefix="sma_fmu_stage_") as stage:
         script, project_files = _stage(FMU_SCRIPTS[model_name], Path(stage), parameter_set, stamp)
+        if model_name in _EXTRA_RESOURCES:
+            project_files += _EXTRA_RESOURCES[model_name](Path(stage))
         try:
             return Path(FmuBuilder.build_FMU(
                 script, dest=folder / f"{model_name}.fmu", project_files=project_files,

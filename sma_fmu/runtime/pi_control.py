@@ -5,8 +5,11 @@
     I_(k+1) = I_k + h e_k, except while clamped (u_raw < 0) with e_k <= 0, where I stays.
 
 The integrator is forward Euler: python-control's sample_system(Kp + Ki/s, h, 'zoh').
+The library loop calls :meth:`PIController.step` with e_k; the SmaPiController FMU calls
+:meth:`PIController.sample`, which checks its inputs first, and shows :meth:`PIController.output`
+before its first step.
 """
-from .checks import require_nonnegative
+from .checks import fast_finite, fast_positive, require_finite, require_nonnegative
 
 __all__ = ["PIController"]
 
@@ -19,16 +22,47 @@ class PIController:
         self.Ki = require_nonnegative("Ki", Ki)
         self.integral = 0.0   # I_k [ohm.s]
 
+    def output(self, error, feedforward):
+        """(power u_k [W], feedback part Kp e + Ki I [W]) with the present integral; no change.
+
+        ``error`` e_k [ohm], ``feedforward`` u_ff,k [W].
+        """
+        feedback = self.Kp * error + self.Ki * self.integral
+        raw = feedforward + feedback
+        return (0.0 if raw < 0.0 else raw), feedback
+
     def step(self, error, feedforward, step_size):
         """Return (power u_k [W], feedback part Kp e + Ki I [W]) and advance the integrator.
 
         ``error`` e_k [ohm], ``feedforward`` u_ff,k [W], ``step_size`` h [s].
         """
-        feedback = self.Kp * error + self.Ki * self.integral
-        raw = feedforward + feedback
-        if raw < 0.0:
-            if error > 0.0:
-                self.integral += step_size * error
-            return 0.0, feedback
-        self.integral += step_size * error
-        return raw, feedback
+        power, feedback = self.output(error, feedforward)
+        clamped = feedforward + feedback < 0.0
+        if not clamped or error > 0.0:
+            self.integral += step_size * error
+        return power, feedback
+
+    def sample(self, resistance, reference, feedforward, step_size):
+        """:meth:`step` for R [ohm], R_ref [ohm], u_ff [W] and h [s], each checked first.
+
+        Non-finite inputs or a step <= 0 raise ``ValueError`` naming the input; the state
+        is then unchanged.
+        """
+        resistance = fast_finite("R", resistance)
+        reference = fast_finite("R_ref", reference)
+        feedforward = fast_finite("P_ff", feedforward)
+        step_size = fast_positive("step_size", step_size)
+        return self.step(resistance - reference, feedforward, step_size)
+
+    def preview(self, resistance, reference, feedforward):
+        """:meth:`output` for R [ohm], R_ref [ohm] and u_ff [W], each checked first."""
+        error = require_finite("R", resistance) - require_finite("R_ref", reference)
+        return self.output(error, require_finite("P_ff", feedforward))
+
+    def state(self):
+        """JSON-ready hidden state (the integral I_k [ohm.s])."""
+        return {"integral": self.integral}
+
+    def restore(self, state):
+        """Restore a state saved by :meth:`state`."""
+        self.integral = float(state["integral"])

@@ -89,6 +89,10 @@ class ReferenceSignal:
             return s["offset_ohm"] + s["amplitude_ohm"] * wave(angle)
         return _interpolate(self._times, self._values, t)
 
+    def as_table(self):
+        """The scenario file's ``[reference]`` table of this signal (kind and settings)."""
+        return {"kind": self.kind, **self.settings}
+
 
 def _interpolate(times, values, t):
     if t <= times[0]:
@@ -116,6 +120,10 @@ class LoadProfile:
         ends = self.times[1:] + [math.inf]
         return [(start, min(end, stop_time), value)
                 for start, end, value in zip(self.times, ends, self.values) if start < stop_time]
+
+    def as_table(self):
+        """The scenario file's ``[load]`` table of this profile."""
+        return {"times_s": list(self.times), "values_kg": list(self.values)}
 
 
 def reference_from_table(table):

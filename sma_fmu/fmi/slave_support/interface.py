@@ -31,6 +31,7 @@ class SlaveInterface:
         self.units = {}
         self.exposed = []
         self.initialization_error = None
+        self._preview = None  # recomputes the outputs until exitInitializationMode
         self._reals = {}     # value reference -> attribute name, Real variables
         self._booleans = {}  # value reference -> attribute name, Boolean variables
         # pythonfmu's generic accessors check every variable's type on every call; these
@@ -55,6 +56,8 @@ class SlaveInterface:
             self.units[variable.name] = unit
 
     def _get_real(self, references):
+        if self._preview is not None:
+            self._preview()
         slave, names = self.slave, self._reals
         return [float(getattr(slave, names[vr])) for vr in references]
 
@@ -64,6 +67,8 @@ class SlaveInterface:
             setattr(slave, names[vr], value)
 
     def _get_boolean(self, references):
+        if self._preview is not None:
+            self._preview()
         slave, names = self.slave, self._booleans
         return [bool(getattr(slave, names[vr])) for vr in references]
 
@@ -125,6 +130,22 @@ class SlaveInterface:
         """Add units, output dependencies and InitialUnknowns to pythonfmu's description."""
         return decorate_model_description(root, self.units)
 
+    def preview_outputs(self, start, publish, invalid_outputs):
+        """Until exitInitializationMode, compute the outputs afresh whenever they are read.
+
+        Hosts read outputs in Initialization Mode (libcosim and Ecos do, to pass start values
+        along connections), so they must follow the inputs and parameters set so far:
+        ``publish(start()[1])``, or ``publish(invalid_outputs)`` while ``start`` raises (the
+        error is logged at exitInitializationMode).
+        """
+        def preview():
+            try:
+                outputs = start()[1]
+            except Exception:  # noqa: BLE001 - reported by initialize()
+                outputs = invalid_outputs
+            publish(outputs)
+        self._preview = preview
+
     def initialize(self, start, invalid_outputs):
         """Run ``start()`` -> (stepper, outputs) at exitInitializationMode; never raise.
 
@@ -132,6 +153,7 @@ class SlaveInterface:
         free the instance. Invalid parameters are instead logged as fmi2Error, the outputs
         become ``invalid_outputs`` (NaN) and every doStep is discarded with the reason.
         """
+        self._preview = None
         try:
             stepper, outputs = start()
         except ValueError as error:

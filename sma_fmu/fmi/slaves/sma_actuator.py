@@ -6,7 +6,8 @@ versions loaded into one process never share a module.
 
 Semantics: doStep(t, h) holds P_in and load over the step (P_in <= 0 is applied as 0 W);
 the outputs are then the state at t + h with the held load (no direct feedthrough). After initialization the
-outputs reflect T_start and the load set during initialization. Invalid parameters are
+outputs reflect T_start and the load set during initialization (in Initialization Mode
+they follow them as they are set). Invalid parameters are
 logged as fmi2Error at exitInitializationMode; the outputs are then NaN and every
 doStep is discarded (pythonfmu would turn an exception there into fmi2Fatal).
 """
@@ -49,6 +50,7 @@ class SmaActuator(Fmi2Slave):
         fmi.model_parameters()
         self.stepper = None
         self._publish(PlantStepper(fmi.defaults, self.T_start, self.hysteresis_mode, self.load).outputs)
+        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
 
     def _publish(self, outputs):
         self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.P, self.heating = outputs

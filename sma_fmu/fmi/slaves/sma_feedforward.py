@@ -6,7 +6,8 @@ temperature-sensing inverse of the wire model followed by the phase-lag filter.
 Semantics: a sampled block. doStep(t_k, h) samples R_ref and load as set before the
 call and its outputs then hold u_ff,k for that step; step it before the plant
 (Gauss-Seidel) so u_ff,k reaches the plant's step k without delay. After
-initialization the outputs are those of the first sample (filter in steady state).
+initialization the outputs are those of the first sample (filter in steady state); in
+Initialization Mode they follow R_ref, load and the parameters as they are set.
 Invalid parameters are logged as fmi2Error at exitInitializationMode; the outputs are
 then NaN and every doStep is discarded.
 """
@@ -48,6 +49,7 @@ class SmaFeedforward(Fmi2Slave):
         fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin"))
         self.stepper = None
         self._publish(FeedforwardStepper(fmi.defaults).initial_outputs(self.R_ref, self.load))
+        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
 
     def _start(self):
         stepper = FeedforwardStepper(self.interface.wire_parameters(),

@@ -1,0 +1,58 @@
+"""Export commands: the closed loop for system-level tools (SSP package, container FMU)."""
+from pathlib import Path
+
+from sma_fmu.fmi.build import DEFAULT_FMU_DIR
+
+__all__ = ["register"]
+
+
+def _ssp(args):
+    from sma_fmu.cosim.scenario import resolve_scenarios
+    from sma_fmu.systems.ssp import export_ssp
+
+    for path in export_ssp(resolve_scenarios(args.scenarios, everything=args.all), args.out,
+                           args.fmus):
+        print(path)
+    return 0
+
+
+def _container(args):
+    from sma_fmu.cosim.scenario import resolve_scenarios
+    from sma_fmu.systems.container import export_container
+
+    paths = resolve_scenarios([args.scenario])
+    if len(paths) != 1:
+        raise ValueError(f"SCENARIO {args.scenario!r}: names {len(paths)} scenarios; a container "
+                         "holds one (export each into its own file)")
+    print(export_container(paths[0], args.out, args.fmus))
+    return 0
+
+
+def register(commands):
+    """Add ``export ssp`` and ``export container`` to the ``commands`` subparsers."""
+    export = commands.add_parser("export", help="the closed loop for system tools: SSP, container FMU")
+    kinds = export.add_subparsers(dest="kind", required=True, metavar="KIND")
+
+    ssp = kinds.add_parser(
+        "ssp", help="SSP 1.0 package(s): signals -> compensator -> PI -> plant, with the "
+                    "scenario's parameters",
+        description="One .ssp per scenario: --out FILE.ssp for one scenario, else --out is a "
+                    "folder that gets NAME.ssp for each.")
+    ssp.add_argument("scenarios", nargs="*", metavar="SCENARIO",
+                     help="a .toml file, the name of a shipped scenario, or 'paper'")
+    ssp.add_argument("--all", action="store_true", help="every shipped scenario")
+    ssp.add_argument("--out", type=Path, required=True, metavar="FILE.ssp|DIR",
+                     help="the .ssp file (one scenario) or a folder")
+    ssp.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR",
+                     help="folder of the built FMUs (sma-fmu build)")
+    ssp.set_defaults(handler=_ssp)
+
+    container = kinds.add_parser(
+        "container", help="the whole closed loop of one scenario as one FMI 2.0 FMU")
+    container.add_argument("scenario", metavar="SCENARIO",
+                           help="a .toml file or the name of a shipped scenario")
+    container.add_argument("--out", type=Path, required=True, metavar="FILE.fmu",
+                           help="the container FMU to write")
+    container.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR",
+                           help="folder of the built FMUs (sma-fmu build)")
+    container.set_defaults(handler=_container)

@@ -1,0 +1,74 @@
+"""SmaPiController: the loop's PI block (anti-windup, power clamp at 0 W) as an FMI 2.0 CS FMU.
+
+A thin adapter over ``sma_fmu.runtime.pi_control.PIController``, the PI block of the
+library loop.
+
+Semantics: a sampled block, like SmaFeedforward. doStep(t_k, h) samples R, R_ref and P_ff
+as set before the call; its outputs then hold u_k = max(0, P_ff + Kp e_k + Ki I_k) with
+e_k = R - R_ref for that step, and the integrator advances. Before the first step (also
+in Initialization Mode) the outputs are those the first step will give: the present
+inputs with I = 0. Non-finite inputs discard the step. Invalid gains are logged as
+fmi2Error at exitInitializationMode; the outputs are then NaN and every doStep is discarded.
+"""
+from pythonfmu import Fmi2Slave
+from pythonfmu.default_experiment import DefaultExperiment
+
+from sma_fmu.fmi.slave_support.interface import SlaveInterface
+from sma_fmu.runtime.pi_control import PIController
+
+INVALID_OUTPUTS = (float("nan"), float("nan"))
+
+
+class SmaPiController(Fmi2Slave):
+
+    author = "sma-fmu"
+    description = "PI resistance controller of the SMA wire: anti-windup, power clamped at 0 W"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.interface = fmi = SlaveInterface(self)
+        defaults = fmi.defaults
+        fmi.input("R", defaults.R_P, "ohm", "measured wire resistance")
+        fmi.input("R_ref", defaults.R_P, "ohm", "reference resistance; error e = R - R_ref")
+        fmi.input("P_ff", 0.0, "W", "feedforward power u_ff (0 W without a compensator)")
+        fmi.output("P", "W", "power command u = max(0, P_ff + Kp e + Ki I) for this step")
+        fmi.output("P_fb", "W", "feedback part Kp e + Ki I (before the clamp)")
+        fmi.model_parameters(sections=(), extra=("Kp", "Ki"))
+        self.stepper = None
+        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
+
+    def _start(self):
+        params = self.interface.wire_parameters()
+        stepper = PIController(params.Kp, params.Ki)
+        return stepper, stepper.preview(self.R, self.R_ref, self.P_ff)
+
+    def _publish(self, outputs):
+        self.P, self.P_fb = outputs
+
+    def exit_initialization_mode(self):
+        self.stepper, outputs = self.interface.initialize(self._start, INVALID_OUTPUTS)
+        self._publish(outputs)
+
+    def do_step(self, current_time, step_size):
+        if self.stepper is None:
+            return self.interface.not_initialized(current_time)
+        try:
+            self._publish(self.stepper.sample(self.R, self.R_ref, self.P_ff, step_size))
+        except Exception as error:  # an exception here would reach the host as fmi2Fatal
+            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
+        return True
+
+    def to_xml(self, model_options=dict()):
+        return self.interface.decorate(super().to_xml(model_options))
+
+    def _get_fmu_state(self):
+        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
+
+    def _set_fmu_state(self, state):
+        variables, stepper_state = self.interface.split_state(state)
+        super()._set_fmu_state(variables)
+        if stepper_state is not None:
+            if self.stepper is None:
+                self.stepper = self._start()[0]
+            self.stepper.restore(stepper_state)

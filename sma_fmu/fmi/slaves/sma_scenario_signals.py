@@ -1,0 +1,89 @@
+"""SmaScenarioSignals: a scenario's reference R_ref(t) and load f(t) as an FMI 2.0 CS FMU.
+
+A thin adapter over ``sma_fmu.runtime.scenario_signals.SignalSource``, which evaluates the
+signals of ``sma_fmu.runtime.signals``, the code that scenario files use.
+
+Parameters: ``reference`` and ``load_profile``, String parameters holding a scenario's
+``[reference]`` and ``[load]`` tables as JSON objects (FMI 2.0 has no arrays); their
+defaults, from ``resources/signals.json``, are the paper's load-step scenario.
+Semantics: a source. After initialization the outputs are the signals at the start
+time; after doStep(t, h) they are the signals at t + h. Invalid tables are logged as
+fmi2Error at exitInitializationMode, naming the parameter and the key; the outputs are
+then NaN and every doStep is discarded.
+"""
+import json
+import os
+
+from pythonfmu import Fmi2Slave
+from pythonfmu.default_experiment import DefaultExperiment
+
+from sma_fmu.fmi.slave_support.interface import SlaveInterface
+from sma_fmu.runtime.scenario_signals import SignalSource, signals_from_text, table_text
+
+INVALID_OUTPUTS = (float("nan"), float("nan"))
+DEFAULTS_FILE = "signals.json"
+
+
+class SmaScenarioSignals(Fmi2Slave):
+
+    author = "sma-fmu"
+    description = "Scenario signals of the SMA wire loop: reference resistance R_ref(t) and load f(t)"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.interface = fmi = SlaveInterface(self)
+        with open(os.path.join(self.resources, DEFAULTS_FILE), encoding="utf-8") as stream:
+            defaults = json.load(stream)
+        fmi.output("R_ref", "ohm", "reference resistance R_ref(t) at the communication point")
+        fmi.output("load", "kg", "hung mass f(t) at the communication point")
+        fmi.string_parameter(
+            "reference", table_text(defaults["reference"]),
+            "R_ref(t): a scenario's [reference] table as a JSON object, e.g. "
+            '{"kind":"constant","value_ohm":40.0}; kinds constant, step, ramp, sine, cosine, table')
+        fmi.string_parameter(
+            "load_profile", table_text(defaults["load"]),
+            "piecewise-constant load: a scenario's [load] table as a JSON object, "
+            '{"times_s":[0.0,...],"values_kg":[...]}; values_kg[i] from times_s[i] on')
+        self.start_time = 0.0
+        self.stepper = None
+        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
+
+    def _start(self):
+        reference, load = signals_from_text(self.reference, self.load_profile)
+        stepper = SignalSource(reference, load, self.start_time)
+        return stepper, stepper.outputs
+
+    def _publish(self, outputs):
+        self.R_ref, self.load = outputs
+
+    def setup_experiment(self, start_time, stop_time, tolerance):
+        self.start_time = start_time
+
+    def exit_initialization_mode(self):
+        self.stepper, outputs = self.interface.initialize(self._start, INVALID_OUTPUTS)
+        self._publish(outputs)
+
+    def do_step(self, current_time, step_size):
+        if self.stepper is None:
+            return self.interface.not_initialized(current_time)
+        try:
+            self._publish(self.stepper.step(current_time, step_size))
+        except Exception as error:  # an exception here would reach the host as fmi2Fatal
+            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
+        return True
+
+    def to_xml(self, model_options=dict()):
+        return self.interface.decorate(super().to_xml(model_options))
+
+    def _get_fmu_state(self):
+        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
+
+    def _set_fmu_state(self, state):
+        variables, stepper_state = self.interface.split_state(state)
+        super()._set_fmu_state(variables)
+        if stepper_state is not None:
+            if self.stepper is None:
+                self.stepper = self._start()[0]
+            self.stepper.restore(stepper_state)
+            self._publish(self.stepper.outputs)

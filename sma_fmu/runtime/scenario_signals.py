@@ -1,0 +1,92 @@
+"""A scenario's signals as a co-simulation source, and their text form for FMI String parameters.
+
+FMI 2.0 has no array parameters, so the SmaScenarioSignals FMU takes a scenario's
+``[reference]`` and ``[load]`` tables as two String parameters, each holding its table as
+a JSON object with the scenario file's keys (units in the key names)::
+
+    reference    = {"kind":"cosine","offset_ohm":41.85,"amplitude_ohm":6.05,"frequency_hz":0.5}
+    load_profile = {"times_s":[0.0,10.0,20.0],"values_kg":[0.0032,0.05,0.15]}
+
+The same functions check them as check scenario files (:mod:`.signals`), so a table that
+a scenario file accepts works in the FMU, and the error messages are the same.
+"""
+import json
+from collections import namedtuple
+
+from .checks import fast_finite, fast_positive, require_finite
+from .signals import load_from_table, reference_from_table
+
+__all__ = ["SignalOutputs", "SignalSource", "table_text", "signals_from_text"]
+
+SignalOutputs = namedtuple("SignalOutputs", ["R_ref", "load"])
+SignalOutputs.__doc__ = "Reference resistance R_ref [ohm] and load [kg] at one time."
+
+
+def table_text(table):
+    """A signal table as compact JSON: no spaces, because FMU containers split start values at spaces."""
+    return json.dumps(table, separators=(",", ":"), allow_nan=False)
+
+
+def _table(name, text):
+    if not isinstance(text, str):
+        raise ValueError(f"{name} must be a JSON object in a string, got {text!r}")
+    try:
+        table = json.loads(text)
+    except (ValueError, RecursionError) as error:
+        raise ValueError(f"{name} is not valid JSON ({error}): {text!r}") from None
+    if not isinstance(table, dict):
+        raise ValueError(f"{name} must be a JSON object, got {text!r}")
+    return table
+
+
+def signals_from_text(reference_text, load_text):
+    """(ReferenceSignal, LoadProfile) from the two JSON texts; ``ValueError`` names the parameter."""
+    signals = []
+    for name, text, build in (("reference", reference_text, reference_from_table),
+                              ("load_profile", load_text, load_from_table)):
+        try:
+            signals.append(build(_table(name, text)))
+        except ValueError as error:
+            message = str(error)
+            raise ValueError(message if message.startswith(name) else f"{name}: {message}") from None
+    return tuple(signals)
+
+
+class SignalSource:
+    """R_ref(t) [ohm] and the load f(t) [kg] at the communication points of a co-simulation.
+
+    Parameters
+    ----------
+    reference : ReferenceSignal
+    load : LoadProfile
+    start_time : float
+        Start time [s]; the outputs before the first step are those at this time.
+
+    After :meth:`step` (t, h) the outputs are those at t + h: a plot of them against the
+    communication points shows R_ref(t) and f(t) exactly.
+    """
+
+    def __init__(self, reference, load, start_time=0.0):
+        self.reference = reference
+        self.load = load
+        self.time = require_finite("start time", start_time)
+        self.outputs = self._sample(self.time)
+
+    def _sample(self, time_s):
+        return SignalOutputs(self.reference.value(time_s), self.load.value(time_s))
+
+    def step(self, current_time, step_size):
+        """Advance from ``current_time`` [s] by ``step_size`` [s]; returns the outputs at the end."""
+        end = fast_finite("current time", current_time) + fast_positive("step_size", step_size)
+        self.outputs = self._sample(fast_finite("current time + step_size", end))
+        self.time = end
+        return self.outputs
+
+    def state(self):
+        """JSON-ready hidden state (the time of the outputs [s])."""
+        return {"time": self.time}
+
+    def restore(self, state):
+        """Restore a state saved by :meth:`state`."""
+        self.time = float(state["time"])
+        self.outputs = self._sample(self.time)

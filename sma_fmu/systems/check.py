@@ -1,0 +1,183 @@
+"""Compliance checks of FMUs, SSP packages and container FMUs (``sma-fmu check``).
+
+Per FMU (a container is an FMU; the FMUs inside an SSP are checked one by one):
+- ``fmpy validation``: fmpy's check of modelDescription.xml (schema and rules);
+- ``FMI checker``: fmu-manipulation-toolbox's checkers (FMI XSD and the standard's rules);
+- ``C host (libcosim)``: a short run in sma-fmu's C host (:mod:`.c_host`), all outputs finite;
+- ``state round trip``: save the state, step, restore, step again: the same outputs, bit
+  for bit (serialized and read back when the FMU can); "n/a" when it does not declare it.
+Per SSP also ``SSD schema``: SystemStructure.ssd against the SSP 1.0 schemas (fmpy's
+copy), and the C-host run is of the whole system, with its parameter bindings.
+Each check gives a :class:`CheckResult`; an exception inside a check is its failure.
+"""
+import logging
+import math
+import tempfile
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from sma_fmu.systems.c_host import run_c_host
+from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
+from sma_fmu.systems.toolbox_log import toolbox_messages
+
+__all__ = ["CheckResult", "SHORT_RUN_STEPS", "check_file", "check_files", "format_result"]
+
+SHORT_RUN_STEPS = 100   # steps of the C-host run
+STATE_STEPS = 20        # steps before and after saving the state
+_DEFAULT_STEP_S = 1e-3  # when the file names no step size
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """One line of the report: ``status`` "ok", "FAIL" or "n/a"."""
+
+    file: str
+    check: str
+    status: str
+    detail: str
+
+
+def format_result(result):
+    """``STATUS  FILE: CHECK: DETAIL`` (one line)."""
+    detail = " ".join(result.detail.split())
+    return f"{result.status:<5} {result.file}: {result.check}: {detail}"
+
+
+def _run(file, check, function):
+    try:
+        status, detail = function()
+    except Exception as error:  # noqa: BLE001 - a check that raises has failed
+        status, detail = "FAIL", f"{type(error).__name__}: {error}"
+    return CheckResult(str(file), check, status, detail)
+
+
+def _fmpy_validation(path):
+    from fmpy.validation import validate_fmu
+
+    problems = validate_fmu(str(path))
+    return ("ok", "no problems") if not problems else ("FAIL", "; ".join(problems))
+
+
+def _toolbox_checker(path):
+    from fmu_manipulation_toolbox.checker import get_checkers
+    from fmu_manipulation_toolbox.operations import FMU
+
+    with toolbox_messages(logging.ERROR) as errors, FMU(str(path)) as fmu:
+        for checker in get_checkers():
+            fmu.apply_operation(checker())
+    return ("ok", "compliant") if not errors else ("FAIL", "; ".join(errors))
+
+
+def _fmu_step(path):
+    from fmpy import read_model_description
+
+    experiment = read_model_description(str(path)).defaultExperiment
+    step = experiment.stepSize if experiment is not None and experiment.stepSize else None
+    return float(step) if step else _DEFAULT_STEP_S
+
+
+def _short_run(kind, path, step_size):
+    values = run_c_host(kind, path, step_size, SHORT_RUN_STEPS)
+    if not values:
+        return "FAIL", "the host reported no outputs"
+    bad = [f"{name} = {value!r}" for name, value in values.items() if not math.isfinite(value)]
+    if bad:
+        return "FAIL", f"non-finite outputs after {SHORT_RUN_STEPS} steps: {', '.join(bad)}"
+    return "ok", f"{SHORT_RUN_STEPS} steps of {step_size:g} s, {len(values)} outputs finite"
+
+
+def _state_round_trip(path):
+    from fmpy import read_model_description
+
+    from sma_fmu.fmi.instance import FmuInstance
+
+    description = read_model_description(str(path))
+    cs = description.coSimulation
+    if cs is None or not cs.canGetAndSetFMUstate:
+        return "n/a", "the FMU does not declare canGetAndSetFMUstate"
+    step = _fmu_step(path)
+    outputs = tuple(v.name for v in description.modelVariables
+                    if v.type == "Real" and v.causality == "output")
+    with FmuInstance(path, "state_check") as fmu:
+        def run(first):
+            values = []
+            for k in range(first, first + STATE_STEPS):
+                fmu.step(k * step, step)
+                values.append(repr(fmu.get_real(outputs)))
+            return values
+
+        run(0)
+        state = fmu.get_state()
+        if cs.canSerializeFMUstate:
+            saved, state = state, fmu.deserialize_state(fmu.serialize_state(state))
+            fmu.free_state(saved)
+        before = run(STATE_STEPS)
+        fmu.set_state(state)
+        after = run(STATE_STEPS)
+        fmu.free_state(state)
+    how = "serialized, " if cs.canSerializeFMUstate else ""
+    return (("ok", f"{how}{STATE_STEPS} steps repeated bit for bit") if before == after
+            else ("FAIL", f"{STATE_STEPS} steps after restoring the state differ from the first run"))
+
+
+def _fmu_checks(path, label, c_host=True):
+    results = [_run(label, "fmpy validation", lambda: _fmpy_validation(path)),
+               _run(label, "FMI checker", lambda: _toolbox_checker(path))]
+    if c_host:
+        results.append(_run(label, "C host (libcosim)",
+                            lambda: _short_run("fmu", path, _fmu_step(path))))
+    results.append(_run(label, "state round trip", lambda: _state_round_trip(path)))
+    return results
+
+
+def _ssd_schema(path):
+    from fmpy.ssp.ssd import read_ssd
+
+    ssd = read_ssd(str(path))
+    return "ok", f"SSP {ssd.version}, system {ssd.system.name!r}, schema valid"
+
+
+def _ssp_step(path):
+    import xml.etree.ElementTree as ET
+
+    with zipfile.ZipFile(path) as archive:
+        root = ET.fromstring(archive.read(SSD_NAME))
+    algorithm = root.find(f".//{{{NAMESPACES['osp']}}}FixedStepAlgorithm")
+    return float(algorithm.get("baseStepSize")) if algorithm is not None else _DEFAULT_STEP_S
+
+
+def _ssp_checks(path):
+    results = [_run(path, "SSD schema", lambda: _ssd_schema(path)),
+               _run(path, "C host (libcosim)", lambda: _short_run("ssp", path, _ssp_step(path)))]
+    with tempfile.TemporaryDirectory(prefix="sma_fmu_check_") as folder, \
+            zipfile.ZipFile(path) as archive:
+        for name in sorted(n for n in archive.namelist() if n.lower().endswith(".fmu")):
+            fmu = Path(archive.extract(name, folder))
+            results += _fmu_checks(fmu, f"{path}[{name}]", c_host=False)
+    return results
+
+
+def check_file(path):
+    """The :class:`CheckResult` list of one FMU, container FMU or SSP package."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{path}: no such file")
+    if not zipfile.is_zipfile(path):
+        return [CheckResult(str(path), "archive", "FAIL", "not a zip archive (an FMU or SSP is one)")]
+    if path.suffix.lower() == ".ssp":
+        return _ssp_checks(path)
+    return _fmu_checks(path, str(path))
+
+
+def check_files(paths, report=print):
+    """Check every file, ``report`` each line as it comes; returns True when none failed."""
+    missing = [str(path) for path in paths if not Path(path).is_file()]
+    if missing:
+        raise ValueError(f"{missing[0]}: no such file")
+    passed = True
+    for path in paths:
+        for result in check_file(path):
+            report(format_result(result))
+            passed = passed and result.status != "FAIL"
+    return passed

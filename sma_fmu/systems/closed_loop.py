@@ -1,0 +1,106 @@
+"""One scenario's closed loop as a system of FMUs: components, parameter values, connections.
+
+The SSP package (:mod:`.ssp`) and the container FMU (:mod:`.container`) are both written
+from this one description, so they wire and parameterise the loop alike::
+
+    signals.R_ref --> compensator.R_ref, pi.R_ref        signals.load --> compensator.load, plant.load
+    compensator.P_ff --> pi.P_ff     pi.P --> plant.P_in     plant.R --> pi.R
+
+The "pi" controller has no compensator (the PI's P_ff input then keeps its start, 0 W).
+Each component's parameter values are the scenario's: every wire parameter its FMU
+exposes (from the scenario's parameter file), the controller's gains and filter, the
+plant's start temperature and hysteresis mode, and the signals as JSON tables.
+"""
+from dataclasses import dataclass
+
+from sma_fmu.cosim.master import MissingFmuError, model_parameter_values
+from sma_fmu.fmi.build import default_fmu_paths
+from sma_fmu.runtime.scenario_signals import table_text
+
+__all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "STEP_ORDER"]
+
+# Gauss-Seidel order of a sequential host: the sampled blocks in data-flow order, then the
+# blocks whose outputs hold at the end of their step (plant: the state at t + h; signals:
+# their values at t + h), so every block of step k sees R_k, R_ref(t_k), f(t_k) and the
+# u_ff,k and u_k just computed, as in the library loop
+STEP_ORDER = ("compensator", "pi", "plant", "signals")
+
+
+@dataclass(frozen=True)
+class Component:
+    """One FMU instance: ``name`` in the system, FMU ``model`` name, its ``fmu`` file and
+    ``parameters`` (name -> float, bool or str)."""
+
+    name: str
+    model: str
+    fmu: object
+    parameters: dict
+
+
+@dataclass(frozen=True)
+class Connection:
+    """``source``.``output`` feeds ``target``.``input`` (component and variable names)."""
+
+    source: str
+    output: str
+    target: str
+    input: str
+
+
+@dataclass(frozen=True)
+class LoopSystem:
+    """The closed loop of ``scenario``: components in data-flow order and their connections."""
+
+    scenario: object
+    components: tuple
+    connections: tuple
+
+    def component(self, name):
+        """The component called ``name``."""
+        for component in self.components:
+            if component.name == name:
+                return component
+        raise KeyError(name)
+
+    def in_step_order(self):
+        """The components in the Gauss-Seidel order :data:`STEP_ORDER`."""
+        return sorted(self.components, key=lambda component: STEP_ORDER.index(component.name))
+
+
+def _fmu_files(scenario, fmu_dir):
+    paths = default_fmu_paths(fmu_dir)
+    needed = ["SmaScenarioSignals", "SmaPiController", "SmaActuator"]
+    needed += ["SmaFeedforward"] if scenario.controller.feedforward else []
+    for name in needed:
+        if not paths[name].is_file():
+            raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "
+                                  f"sma-fmu build --out {fmu_dir}")
+    return paths
+
+
+def closed_loop(scenario, fmu_dir):
+    """The :class:`LoopSystem` of ``scenario`` with the FMUs built in ``fmu_dir``."""
+    paths = _fmu_files(scenario, fmu_dir)
+    c = scenario.controller
+    components = [Component("signals", "SmaScenarioSignals", paths["SmaScenarioSignals"], {
+        "reference": table_text(scenario.reference.as_table()),
+        "load_profile": table_text(scenario.load.as_table())})]
+    connections = [Connection("signals", "R_ref", "pi", "R_ref"),
+                   Connection("pi", "P", "plant", "P_in"),
+                   Connection("signals", "load", "plant", "load"),
+                   Connection("plant", "R", "pi", "R")]
+    if c.feedforward:
+        parameters = model_parameter_values(paths["SmaFeedforward"], scenario.params)
+        parameters.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
+                          adapt_to_load=c.adapt_to_load)
+        components.append(Component("compensator", "SmaFeedforward", paths["SmaFeedforward"],
+                                    parameters))
+        connections[1:1] = [Connection("signals", "R_ref", "compensator", "R_ref"),
+                            Connection("signals", "load", "compensator", "load"),
+                            Connection("compensator", "P_ff", "pi", "P_ff")]
+    components.append(Component("pi", "SmaPiController", paths["SmaPiController"],
+                                {"Kp": c.Kp, "Ki": c.Ki}))
+    parameters = model_parameter_values(paths["SmaActuator"], scenario.params)
+    parameters.update(T_start=scenario.T_start, hysteresis_mode=scenario.hysteresis_mode)
+    components.append(Component("plant", "SmaActuator", paths["SmaActuator"], parameters))
+    return LoopSystem(scenario, tuple(components), tuple(connections))

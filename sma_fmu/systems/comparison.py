@@ -1,0 +1,74 @@
+"""Each host's run of a scenario against the library loop of the host's coupling.
+
+:func:`compare_hosts` runs a scenario on the library path (Gauss-Seidel and Jacobi) and
+in the hosts of :data:`~.runs.HOSTS`, and reports per run the RMSE of R - R_ref (the
+metric of :mod:`sma_fmu.cosim.metrics`) and the largest deviation of any time-series
+column from the library run of the same coupling. :func:`rmse_table` formats the rows
+(``benchmarks/hosts.py`` prints it for the paper scenarios; docs/systems.md shows it).
+"""
+import math
+
+import numpy as np
+
+from sma_fmu.cosim.loop import COLUMNS, COUPLINGS, run_library
+from sma_fmu.cosim.metrics import scenario_metrics
+from sma_fmu.systems.runs import HOSTS, run_host
+
+__all__ = ["deviation", "compare_hosts", "rmse_table"]
+
+
+def deviation(data, reference):
+    """Largest |difference| over every numeric column of two time-series arrays (nan = nan)."""
+    largest = 0.0
+    for name, _ in COLUMNS:
+        a, b = data[name].astype(float), reference[name].astype(float)
+        same_nan = np.isnan(a) & np.isnan(b)
+        if np.any(np.isnan(a) != np.isnan(b)):
+            return math.inf
+        if np.any(~same_nan):
+            largest = max(largest, float(np.max(np.abs(a[~same_nan] - b[~same_nan]))))
+    return largest
+
+
+def _rmse(data, scenario):
+    return scenario_metrics(data, scenario)["overall"]["rmse_ohm"]
+
+
+def compare_hosts(scenario, fmu_dir, hosts=tuple(HOSTS), artifacts=None):
+    """Rows {scenario, run, coupling, rmse_ohm, deviation, wall_time_s} for ``scenario``.
+
+    ``artifacts``: optional {"ssp": path, "container": path} already written for the
+    scenario (otherwise each host run builds its own). ``deviation`` is the largest
+    difference from the library run of the same coupling (0 for the library rows).
+    """
+    artifacts = artifacts or {}
+    library = {coupling: run_library(scenario, coupling) for coupling in COUPLINGS}
+    rows = [{"scenario": scenario.name, "run": "library", "coupling": coupling,
+             "rmse_ohm": _rmse(result.data, scenario), "deviation": 0.0,
+             "wall_time_s": result.wall_time_s}
+            for coupling, result in library.items()]
+    for host in hosts:
+        kind, coupling, _ = HOSTS[host]
+        result = run_host(host, scenario, fmu_dir, artifacts.get(kind))
+        rows.append({"scenario": scenario.name, "run": f"{host} ({kind})", "coupling": coupling,
+                     "rmse_ohm": _rmse(result.data, scenario),
+                     "deviation": deviation(result.data, library[coupling].data),
+                     "wall_time_s": result.wall_time_s})
+    return rows
+
+
+def rmse_table(rows):
+    """Markdown: one line per scenario, one column per run (RMSE [ohm], coupling in the head)."""
+    runs = list(dict.fromkeys((row["run"], row["coupling"]) for row in rows))
+    scenarios = list(dict.fromkeys(row["scenario"] for row in rows))
+    value = {(row["scenario"], row["run"], row["coupling"]): row for row in rows}
+    lines = ["| scenario | " + " | ".join(f"{run}, {coupling}" for run, coupling in runs) + " |",
+             "|---|" + "---:|" * len(runs)]
+    for name in scenarios:
+        cells = [f"{value[(name, *run)]['rmse_ohm']:.3f}" if (name, *run) in value else ""
+                 for run in runs]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    worst = max((row["deviation"] for row in rows), default=0.0)
+    lines += ["", f"Largest deviation of a host run from the library run of its coupling, over "
+                  f"all time-series columns: {worst:.2g}"]
+    return "\n".join(lines)

@@ -1,0 +1,158 @@
+"""The closed loop of one scenario as a single FMI 2.0 co-simulation FMU (an FMU container).
+
+Built with fmu-manipulation-toolbox's container builder in sequential mode: inside each
+doStep the embedded FMUs step one after another in :data:`~.closed_loop.STEP_ORDER`
+(compensator, PI, plant, signals), each with the outputs just computed by the ones before
+it (Gauss-Seidel), so the container computes exactly what the library loop computes.
+Every embedded FMU is named as in the SSP, and its parameters are set to the scenario's
+values as start values. The container has no inputs; its outputs are :data:`OUTPUTS`, with
+the units of the embedded FMUs (added to the builder's modelDescription.xml, which has none).
+"""
+import io
+import shutil
+import tempfile
+import xml.etree.ElementTree as ET
+import zipfile
+from pathlib import Path
+
+from sma_fmu.cosim.scenario import load_scenario
+from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
+from sma_fmu.output_folder import OutputError, write_file
+from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.toolbox_log import toolbox_messages
+
+__all__ = ["OUTPUTS", "container_outputs", "build_container", "export_container"]
+
+# container output -> (component, variable): what the time-series CSV needs
+OUTPUTS = {
+    "R": ("plant", "R"), "R_ref": ("signals", "R_ref"), "P": ("plant", "P"), "T": ("plant", "T"),
+    "load": ("signals", "load"), "x": ("plant", "x"), "xi_P": ("plant", "xi_P"),
+    "xi_M": ("plant", "xi_M"), "xi_F": ("plant", "xi_F"), "P_fb": ("pi", "P_fb"),
+    "P_ff": ("compensator", "P_ff"), "T_ref": ("compensator", "T_ref"),
+    "saturated": ("compensator", "saturated"),
+}
+
+
+def container_outputs(system):
+    """The :data:`OUTPUTS` that ``system`` has (the "pi" controller has no compensator)."""
+    names = {component.name for component in system.components}
+    return {name: source for name, source in OUTPUTS.items() if source[0] in names}
+
+
+def _text(value):
+    """A start value as the builder wants it (a string without spaces)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)
+    text = str(value)
+    if any(character.isspace() for character in text):
+        raise ValueError(f"start value {text!r} contains white space, which an FMU container "
+                         "cannot carry")
+    return text
+
+
+# what the builder says about this loop by design: the PI and the plant form a loop (the
+# PI is initialized before the plant's R reaches it; its first step then reads R_0), and
+# the step order puts the signals after the blocks that read them (see STEP_ORDER)
+_EXPECTED = ("Loop of links through the embedded FMU 'pi'",
+             "Sequential mode: the order of the configuration does not match")
+# ... and without a compensator the PI's P_ff keeps its start value, 0 W
+_EXPECTED_WITHOUT_COMPENSATOR = _EXPECTED + ("Input 'Port pi/P_ff' is not connected",)
+
+
+def _configure(container, system):
+    for component in system.in_step_order():  # the sequential mode steps in this order
+        container.get_fmu(Path(component.fmu).name, name=component.name)
+    for connection in system.connections:
+        container.add_link(connection.source, connection.output, connection.target, connection.input)
+    for exposed, (component, variable) in container_outputs(system).items():
+        container.add_output(component, variable, exposed)
+    for component in system.components:
+        for name, value in component.parameters.items():
+            container.add_start_value(component.name, name, _text(value))
+    container.drop_port("plant", "heating")
+    container.add_implicit_rule(auto_input=False, auto_output=False, auto_link=False)
+
+
+def _units(system):
+    """{container output: unit} from the embedded FMUs' model descriptions."""
+    from fmpy import read_model_description
+
+    units = {}
+    for exposed, (name, variable) in container_outputs(system).items():
+        fmu = system.component(name).fmu
+        declared = {v.name: v.unit for v in read_model_description(str(fmu)).modelVariables}
+        if declared.get(variable):
+            units[exposed] = declared[variable]
+    return units
+
+
+def _with_units(archive, units):
+    """The container FMU ``archive`` (bytes) with UnitDefinitions and a unit on each output."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(archive)) as source, \
+            zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as target:
+        for item in source.infolist():
+            data = source.read(item.filename)
+            if item.filename == "modelDescription.xml":
+                root = ET.fromstring(data)
+                for variable in root.iter("ScalarVariable"):
+                    real = variable.find("Real")
+                    if real is not None and variable.get("name") in units:
+                        real.set("unit", units[variable.get("name")])
+                definitions = ET.Element("UnitDefinitions")
+                for name in sorted(set(units.values())):
+                    unit = ET.SubElement(definitions, "Unit", name=name)
+                    ET.SubElement(unit, "BaseUnit", {key: str(value)
+                                                     for key, value in UNIT_DEFINITIONS[name].items()})
+                root.insert(list(root).index(root.find("CoSimulation")) + 1, definitions)
+                data = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+            target.writestr(item, data)
+    return buffer.getvalue()
+
+
+def build_container(system, out, step_size=None, argument="--out"):
+    """Write the container FMU of ``system`` (a :class:`~.closed_loop.LoopSystem`) to ``out``.
+
+    ``step_size`` [s]: the internal step (default: the scenario's). Returns ``out``.
+    Anything the builder reports beyond what this loop makes it say (``_EXPECTED``) is an
+    error.
+    """
+    from fmu_manipulation_toolbox.container import FMUContainer
+    from fmu_manipulation_toolbox.container.errors import FMUContainerError
+
+    scenario = system.scenario
+    step_size = scenario.step_s if step_size is None else step_size
+    expected = _EXPECTED if scenario.controller.feedforward else _EXPECTED_WITHOUT_COMPENSATOR
+    try:
+        with toolbox_messages() as messages, \
+                tempfile.TemporaryDirectory(prefix="sma_fmu_container_") as folder:
+            for component in system.components:
+                shutil.copy(component.fmu, folder)
+            container = FMUContainer(_identifier(scenario.name), folder, fmi_version=2)
+            container.start_time, container.stop_time = 0.0, scenario.stop_time_s
+            _configure(container, system)
+            built = Path(folder) / "container.fmu"
+            container.make_fmu(built.name, step_size=step_size, sequential=True)
+            unexpected = [m for m in messages if not m.startswith(expected)]
+            if unexpected or not built.is_file():
+                raise ValueError(f"{out}: the container builder reports: "
+                                 f"{'; '.join(unexpected) or 'no file written'}")
+            write_file(out, _with_units(built.read_bytes(), _units(system)), argument)
+    except FMUContainerError as error:
+        raise ValueError(f"{out}: cannot build the container: {error}") from None
+    return Path(out)
+
+
+def _identifier(name):
+    """A C identifier for the container's modelIdentifier, from a scenario name."""
+    text = "".join(character if character.isalnum() else "_" for character in name)
+    return text if text[:1].isalpha() else f"sma_{text}"
+
+
+def export_container(scenario_path, out, fmu_dir):
+    """Write the container FMU of one scenario file to ``out`` (a .fmu file); returns ``out``."""
+    if Path(out).suffix.lower() != ".fmu":
+        raise OutputError(f"--out {out}: a container is one FMU file; name it NAME.fmu")
+    return build_container(closed_loop(load_scenario(scenario_path), fmu_dir), out)

@@ -1,0 +1,214 @@
+"""Run the SSP packages and the container FMU in third-party hosts; results as loop time series.
+
+- :func:`run_ssp_libcosim`: libcosim (Open Simulation Platform) through libcosimpy;
+- :func:`run_ssp_ecos`: Ecos through ecospy (its library needs libtbb, from the ``tbb`` wheel);
+- :func:`run_container_fmpy`, :func:`run_container_libcosim`: the container FMU alone.
+
+Each returns the samples at the communication points t_0 ... t_n (t_0: after
+initialization) as {column of :data:`~sma_fmu.cosim.loop.COLUMNS`: array};
+:func:`loop_series` turns them into the loop's time-series array, row k holding the
+values at t_k and the outputs of step k, as the library loop does.
+"""
+import math
+
+import numpy as np
+
+from sma_fmu.cosim.loop import COLUMNS
+from sma_fmu.systems.container import OUTPUTS
+from sma_fmu.systems.ssp import PARAMETER_SET
+
+__all__ = ["HostError", "STATE_COLUMNS", "STEP_COLUMNS", "loop_series", "run_ssp_libcosim",
+           "run_ssp_ecos", "run_container_fmpy", "run_container_libcosim", "load_tbb"]
+
+# columns whose value at t_k is the sample of row k (states and signals) ...
+STATE_COLUMNS = ("R_ref", "R", "T", "x", "xi_P", "xi_M", "xi_F", "load")
+# ... and columns whose row k is the block's output after step k (what acts over [t_k, t_k+1))
+STEP_COLUMNS = ("P", "P_fb", "P_ff", "T_ref", "saturated")
+# without a compensator the loop's rows hold u_ff = 0 W, T_ref = nan, not saturated
+_NO_COMPENSATOR = {"P_ff": 0.0, "T_ref": math.nan, "saturated": False}
+
+
+class HostError(RuntimeError):
+    """A host failed to load or to run a system; the message names the host and the file."""
+
+
+def loop_series(scenario, samples, steps):
+    """The loop's time-series array from host ``samples`` ({column: n + 1 values}).
+
+    Columns the system lacks (the compensator's, for the "pi" controller) get the values
+    the library loop writes; the last row has no step outputs (nan), as there.
+    """
+    dtype = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
+    data = np.zeros(steps + 1, dtype=dtype)
+    data["t"] = np.arange(steps + 1) * scenario.step_s
+    for name in STATE_COLUMNS:
+        data[name] = samples[name]
+    for name in STEP_COLUMNS:
+        if name in samples:
+            data[name][:-1] = np.asarray(samples[name])[1:]
+        else:
+            data[name][:-1] = _NO_COMPENSATOR[name]
+        data[name][-1] = False if name == "saturated" else math.nan
+    data["stroke"] = data["x"][0] - data["x"]
+    return data
+
+
+def _ssp_sources():
+    """{column: (component, variable)} observed in an SSP (as the container exposes them)."""
+    return dict(OUTPUTS)
+
+
+# --------------------------------------------------------------------------- libcosim
+def _libcosim_run(execution, observed, steps, what):
+    """Step a libcosim execution; returns {column: n + 1 samples} of ``observed`` variables.
+
+    ``observed`` maps columns to (slave name, variable name); Reals are recorded by a
+    time-series observer (which keeps the sample after initialization), Booleans by
+    reading the last values after each step.
+    """
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimObserver import CosimObserver
+
+    series = CosimObserver.create_time_series(buffer_size=steps + 1)
+    last = CosimObserver.create_last_value()
+    execution.add_observer(series)
+    execution.add_observer(last)
+    slaves = {info.name.decode(): info.index for info in execution.slave_infos()}
+    variables = {(name, v.name.decode()): v for name, index in slaves.items()
+                 for v in execution.slave_variables(index)}
+    reals, booleans = {}, {}
+    for column, key in observed.items():
+        if key not in variables:
+            if column in _NO_COMPENSATOR:  # the "pi" controller has no compensator
+                continue
+            raise HostError(f"libcosim: {what} has no variable {key[0]}.{key[1]}")
+        variable = variables[key]
+        if variable.type == CosimVariableType.BOOLEAN.value:
+            booleans[column] = (slaves[key[0]], variable.reference)
+        else:
+            reals[column] = (slaves[key[0]], variable.reference)
+            series.start_time_series(slaves[key[0]], variable.reference, CosimVariableType.REAL)
+    flags = {column: [False] for column in booleans}
+    for k in range(steps):
+        if not execution.step():
+            raise HostError(f"libcosim: {what}: step {k} (t = {k} steps) failed; see its log")
+        for column, (index, reference) in booleans.items():
+            flags[column].append(bool(last.last_boolean_values(index, [reference])[0]))
+    samples = {column: _libcosim_samples(series, index, reference, steps)
+               for column, (index, reference) in reals.items()}
+    samples.update({column: np.array(values) for column, values in flags.items()})
+    return samples
+
+
+def _libcosim_samples(series, index, reference, steps):
+    # libcosimpy counts a sample of step number 0 as missing: read step 0 on its own
+    first = series.time_series_real_samples(index, reference, from_step=0, sample_count=2)[2]
+    rest = series.time_series_real_samples(index, reference, from_step=1, sample_count=steps)[2]
+    values = np.array(first[:1] + list(rest))
+    if values.size != steps + 1:
+        raise HostError(f"libcosim recorded {values.size} samples, expected {steps + 1}")
+    return values
+
+
+def _quiet_libcosim():
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+
+    log_output_level(CosimLogLevel.WARNING)
+
+
+def run_ssp_libcosim(ssp_path, steps):
+    """Run an SSP of :mod:`.ssp` for ``steps`` steps in libcosim; returns {column: samples}.
+
+    The step size comes from the SSD's OSP annotation. libcosim couples by Jacobi.
+    """
+    from libcosimpy.CosimExecution import CosimExecution
+
+    _quiet_libcosim()
+    try:
+        execution = CosimExecution.from_ssp_file(str(ssp_path))
+    except AssertionError:
+        raise HostError(f"libcosim cannot load {ssp_path}; see its log") from None
+    return _libcosim_run(execution, _ssp_sources(), steps, str(ssp_path))
+
+
+def run_container_libcosim(fmu_path, step_size, steps):
+    """Run the container FMU alone in libcosim, ``steps`` steps of ``step_size`` [s]."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    _quiet_libcosim()
+    execution = CosimExecution.from_step_size(step_size=int(round(step_size * 1e9)))
+    slave = CosimLocalSlave(fmu_path=str(fmu_path), instance_name="loop")
+    if execution.add_local_slave(local_slave=slave) < 0:
+        raise HostError(f"libcosim cannot load {fmu_path}; see its log")
+    observed = {column: ("loop", column) for column in OUTPUTS}
+    return _libcosim_run(execution, observed, steps, str(fmu_path))
+
+
+# ------------------------------------------------------------------------------- Ecos
+def load_tbb():
+    """Load libtbb.so.12 from the ``tbb`` wheel (Ecos's library needs it) before ecospy."""
+    import ctypes
+    from importlib.metadata import PackageNotFoundError, files
+
+    try:
+        candidates = [f.locate() for f in files("tbb") or () if f.name == "libtbb.so.12"]
+    except PackageNotFoundError:
+        candidates = []
+    for path in candidates:
+        ctypes.CDLL(str(path), mode=ctypes.RTLD_GLOBAL)
+        return path
+    raise HostError("Ecos needs libtbb.so.12: pip install tbb (or install Debian's libtbb12)")
+
+
+def run_ssp_ecos(ssp_path, step_size, steps):
+    """Run an SSP of :mod:`.ssp` in Ecos, ``steps`` steps of ``step_size`` [s] (Jacobi)."""
+    load_tbb()
+    from ecospy import EcosLib, EcosSimulation
+
+    EcosLib.set_log_level("warn")
+    samples = {column: [] for column in OUTPUTS}
+    try:
+        with EcosSimulation(ssp_path=str(ssp_path), step_size=step_size) as simulation:
+            simulation.init(parameter_set=PARAMETER_SET)  # without the name Ecos binds nothing
+            readers = _ecos_readers(simulation)
+            for k in range(steps + 1):
+                if k:
+                    simulation.step()
+                for column, read in readers.items():
+                    samples[column].append(read())
+            simulation.terminate()
+    except Exception as error:  # ecospy raises bare Exception with Ecos's message
+        if isinstance(error, HostError):
+            raise
+        raise HostError(f"Ecos: {ssp_path}: {error}") from None
+    return {column: np.array(values) for column, values in samples.items() if values}
+
+
+def _ecos_readers(simulation):
+    readers = {}
+    for column, (component, variable) in OUTPUTS.items():
+        name = f"{component}::{variable}"
+        read = simulation.get_bool if column == "saturated" else simulation.get_real
+        try:
+            read(name)
+        except Exception:  # noqa: BLE001 - ecospy raises bare Exception
+            if column in _NO_COMPENSATOR:  # the "pi" controller has no compensator
+                continue
+            raise
+        readers[column] = (lambda read=read, name=name: read(name))
+    return readers
+
+
+# ------------------------------------------------------------------------------ fmpy
+def run_container_fmpy(fmu_path, step_size, steps):
+    """Run the container FMU in fmpy's ``simulate_fmu``; returns {column: samples}."""
+    from fmpy import read_model_description, simulate_fmu
+
+    names = [v.name for v in read_model_description(str(fmu_path)).modelVariables
+             if v.causality == "output"]
+    result = simulate_fmu(str(fmu_path), stop_time=steps * step_size, step_size=step_size,
+                          output_interval=step_size, output=names)
+    if result.size != steps + 1:
+        raise HostError(f"fmpy: {fmu_path}: the run stopped after {result.size - 1} of {steps} steps")
+    return {name: result[name] for name in names if name in OUTPUTS}

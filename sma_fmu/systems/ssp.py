@@ -1,0 +1,181 @@
+"""SSP 1.0 packages of a scenario's closed loop: SystemStructure.ssd + the FMUs under resources/.
+
+The SSD follows what the hosts need (see docs/systems.md):
+- the literal prefixes ``ssd:``, ``ssc:``, ``ssv:`` (libcosim and Ecos match prefixes);
+- a connector, with its type and unit, for every connection end, and no unconnected inputs
+  (fmpy's resolver breaks on them);
+- one ParameterBinding per component, inline, in a parameter set named :data:`PARAMETER_SET`
+  (libcosim applies only the first binding of a component; Ecos applies a set only when
+  its name is given to ``init``);
+- a DefaultExperiment with the OSP annotation of the step size (libcosim reads it).
+"""
+import io
+import zipfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from sma_fmu.cosim.scenario import load_scenario
+from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
+from sma_fmu.output_folder import OutputError, staged_folder, write_file
+from sma_fmu.systems.closed_loop import closed_loop
+
+__all__ = ["PARAMETER_SET", "SSD_NAME", "NAMESPACES", "ssd_document", "ssp_bytes", "write_ssp",
+           "ssp_targets", "export_ssp"]
+
+PARAMETER_SET = "initial"
+SSD_NAME = "SystemStructure.ssd"
+NAMESPACES = {
+    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+    "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
+}
+_FMU_MIME = "application/x-fmu-sharedlibrary"
+
+for _prefix, _uri in NAMESPACES.items():
+    ET.register_namespace(_prefix, _uri)
+
+
+def _tag(name):
+    prefix, local = name.split(":")
+    return f"{{{NAMESPACES[prefix]}}}{local}"
+
+
+def _add(parent, tag, **attributes):
+    return ET.SubElement(parent, _tag(tag), {k: v for k, v in attributes.items() if v is not None})
+
+
+def _text(value, kind):
+    """A value as the SSP attribute text for an FMU variable of type ``kind``."""
+    if kind == "Boolean":
+        return "true" if value else "false"
+    if kind == "Real":
+        return repr(float(value))
+    if kind == "Integer":
+        return str(int(value))
+    return str(value)
+
+
+def _variables(fmu):
+    from fmpy import read_model_description
+
+    return {v.name: v for v in read_model_description(str(fmu)).modelVariables}
+
+
+def _connectors(system):
+    """{component: {variable: kind}} of every connection end."""
+    ends = {}
+    for c in system.connections:
+        ends.setdefault(c.source, {})[c.output] = "output"
+        ends.setdefault(c.target, {})[c.input] = "input"
+    return ends
+
+
+def _component(elements, component, variables, connectors, units):
+    node = _add(elements, "ssd:Component", name=component.name, type=_FMU_MIME,
+                source=f"resources/{component.model}.fmu")
+    if connectors:
+        group = _add(node, "ssd:Connectors")
+        for name, kind in connectors.items():
+            variable = variables[name]
+            connector = _add(group, "ssd:Connector", name=name, kind=kind)
+            _add(connector, f"ssc:{variable.type}", unit=variable.unit)
+            if variable.unit:
+                units.add(variable.unit)
+    if component.parameters:
+        binding = _add(_add(node, "ssd:ParameterBindings"), "ssd:ParameterBinding")
+        values = _add(binding, "ssd:ParameterValues")
+        parameters = _add(_add(values, "ssv:ParameterSet", version="1.0", name=PARAMETER_SET),
+                          "ssv:Parameters")
+        for name, value in component.parameters.items():
+            if name not in variables:
+                raise ValueError(f"{component.fmu}: has no variable {name!r} to bind")
+            variable = variables[name]
+            entry = _add(parameters, "ssv:Parameter", name=name)
+            unit = variable.unit if variable.type == "Real" else None
+            _add(entry, f"ssv:{variable.type}", value=_text(value, variable.type), unit=unit)
+            if unit:
+                units.add(unit)
+
+
+def ssd_document(system):
+    """SystemStructure.ssd of ``system`` (a :class:`~.closed_loop.LoopSystem`) as bytes."""
+    scenario = system.scenario
+    root = ET.Element(_tag("ssd:SystemStructureDescription"), version="1.0", name=scenario.name)
+    top = _add(root, "ssd:System", name=scenario.name,
+               description=scenario.description or None)
+    elements = _add(top, "ssd:Elements")
+    ends, units = _connectors(system), set()
+    for component in system.components:
+        _component(elements, component, _variables(component.fmu),
+                   ends.get(component.name, {}), units)
+    connections = _add(top, "ssd:Connections")
+    for c in system.connections:
+        _add(connections, "ssd:Connection", startElement=c.source, startConnector=c.output,
+             endElement=c.target, endConnector=c.input)
+    unit_group = _add(root, "ssd:Units")
+    for name in sorted(units):
+        unit = _add(unit_group, "ssc:Unit", name=name)
+        _add(unit, "ssc:BaseUnit", **{k: str(v) for k, v in UNIT_DEFINITIONS[name].items()})
+    experiment = _add(root, "ssd:DefaultExperiment", startTime="0.0",
+                      stopTime=repr(scenario.stop_time_s))
+    annotation = _add(_add(experiment, "ssd:Annotations"), "ssc:Annotation",
+                      type="com.opensimulationplatform")
+    _add(_add(annotation, "osp:Algorithm"), "osp:FixedStepAlgorithm",
+         baseStepSize=repr(scenario.step_s))
+    ET.indent(root)
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def ssp_bytes(system):
+    """The .ssp archive of ``system``: SystemStructure.ssd at the root, FMUs under resources/."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr(SSD_NAME, ssd_document(system))
+        for component in system.components:
+            archive.write(component.fmu, f"resources/{component.model}.fmu")
+    return buffer.getvalue()
+
+
+def write_ssp(system, path, argument="--out"):
+    """Write the .ssp of ``system`` to ``path`` (through a temporary file); returns ``path``."""
+    write_file(path, ssp_bytes(system), argument)
+    return Path(path)
+
+
+def ssp_targets(names, out):
+    """{scenario name: .ssp path}: ``out`` is the file for one scenario, else a folder.
+
+    One scenario with ``out`` ending in ``.ssp`` writes that file; otherwise ``out`` is a
+    folder that gets ``NAME.ssp`` per scenario.
+    """
+    out = Path(out)
+    if out.suffix.lower() == ".ssp":
+        if len(names) > 1:
+            raise OutputError(f"--out {out}: {len(names)} scenarios need a folder, not one .ssp file")
+        return {names[0]: out}
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"--out {out}: exists and is not a folder")
+    return {name: out / f"{name}.ssp" for name in names}
+
+
+def export_ssp(scenario_paths, out, fmu_dir):
+    """Write one .ssp per scenario file (see :func:`ssp_targets`); returns the paths written.
+
+    Every scenario and FMU is checked before anything is written; a failure leaves ``out``
+    as it was.
+    """
+    scenarios = [load_scenario(path) for path in scenario_paths]
+    names = [scenario.name for scenario in scenarios]
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise ValueError(f"two scenario files are both named {repeated[0]!r}; each .ssp is "
+                         "named after its scenario")
+    targets = ssp_targets(names, out)
+    systems = [closed_loop(scenario, fmu_dir) for scenario in scenarios]
+    if len(systems) == 1 and Path(out).suffix.lower() == ".ssp":
+        return [write_ssp(systems[0], out)]
+    with staged_folder(out) as stage:
+        for system in systems:
+            write_ssp(system, stage / f"{system.scenario.name}.ssp")
+    return list(targets.values())
