@@ -13,6 +13,13 @@ from pathlib import Path
 __all__ = ["OutputError", "staged_folder", "write_file"]
 
 
+def _umask():
+    """The process's file-creation mask (read by setting it, then restoring it)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 class OutputError(ValueError):
     """An output path cannot be used; the message names the argument and the path."""
 
@@ -49,6 +56,7 @@ def staged_folder(out, argument="--out"):
     except OSError as error:
         raise OutputError(f"{argument} {out}: cannot write in {parent}: "
                           f"{error.strerror or error}") from None
+    stage.chmod(0o777 & ~_umask())  # mkdtemp makes it private (0700); results are for sharing
     try:
         yield stage
         _commit(stage, out, argument)
@@ -85,6 +93,7 @@ def write_file(path, data, argument="--out"):
     try:
         with os.fdopen(handle, "wb") as stream:
             stream.write(data.encode("utf-8") if isinstance(data, str) else data)
+        os.chmod(temporary, 0o666 & ~_umask())  # mkstemp makes it private (0600)
         os.replace(temporary, path)
     except BaseException:
         with contextlib.suppress(OSError):

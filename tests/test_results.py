@@ -105,3 +105,19 @@ def test_importing_the_library_leaves_the_matplotlib_backend_alone():
             "print(matplotlib.get_backend())\n")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "svg"
+
+
+def test_outputs_get_the_usual_permissions(tmp_path):
+    """Staged outputs are not left private (mkdtemp/mkstemp make 0700/0600)."""
+    import os
+    import stat
+    from sma_fmu.output_folder import staged_folder, write_file
+    mask = os.umask(0o022)
+    try:
+        with staged_folder(tmp_path / "out") as folder:
+            (folder / "a.txt").write_text("a")
+        write_file(tmp_path / "b.csv", "b")
+    finally:
+        os.umask(mask)
+    assert stat.S_IMODE((tmp_path / "out").stat().st_mode) == 0o755
+    assert stat.S_IMODE((tmp_path / "b.csv").stat().st_mode) == 0o644
