@@ -59,13 +59,17 @@ def _sources():
             if entry.name.endswith((".c", ".h"))}
 
 
-def compile_front():
-    """Compile the front once per process and compiler; returns a :class:`FrontBuild`."""
+def compile_front(libpython=None):
+    """Compile the front once per process and compiler; returns a :class:`FrontBuild`.
+
+    ``libpython`` is the (path, soname) the front tries when the host has no Python;
+    default :func:`libpython_path` (the Python running the build).
+    """
     if not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
         return FrontBuild(problem=f"the native front is built for Linux x86-64 only (this is {sys.platform})")
     compiler = shlex.split(os.environ.get("CC") or "cc")
     sources = _sources()
-    library_path, soname = libpython_path()
+    library_path, soname = libpython_path() if libpython is None else libpython
     digest = hashlib.sha256(b"".join(name.encode() + data for name, data in sorted(sources.items())))
     key = (tuple(compiler), digest.hexdigest(), library_path, soname)
     if key not in _compiled:

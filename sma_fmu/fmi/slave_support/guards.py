@@ -171,8 +171,8 @@ class CallGuard:
 
     def do_step(self, current_time, step_size):
         function = "fmi2DoStep"
-        if self.state is not STEP_COMPLETE:
-            return self.allowed(function)
+        if self.state is not STEP_COMPLETE and not self.allowed(function):
+            return False
         if not (-_INF < current_time < _INF and 0.0 < step_size < _INF):
             return self.refuse(function, f"currentCommunicationPoint = {current_time!r} s and "
                                          f"communicationStepSize = {step_size!r} s must be finite, "

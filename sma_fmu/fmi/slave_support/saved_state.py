@@ -149,7 +149,8 @@ class SavedStates:
             return f"the model could not take it back ({type(error).__name__}: {error})"
         if saved_again != state.get(_STEPPER):
             return "the hidden model state is corrupt (the model does not save it back unchanged)"
-        guard.state, guard.time = meta["state"], meta["time"]
+        guard.state = STATES[STATES.index(meta["state"])]  # the constant (compared with `is`)
+        guard.time = meta["time"]
         guard.start_time, guard.stop_time = meta["start_time"], meta["stop_time"]
         guard.outputs_current = bool(meta.get("outputs_current"))
         guard.initial_error = meta.get("initial_error")
