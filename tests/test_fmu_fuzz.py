@@ -9,8 +9,10 @@ off here; with loggingOn false too). Each case ends with fmi2FreeInstance.
 About 200 cases in CI (100 per FMU, derandomized so CI is repeatable); set
 SMA_FMU_FUZZ_EXAMPLES=N for N random cases per FMU.
 """
+import json
 import math
 import os
+import zlib
 
 import pytest
 from fmpy import read_model_description
@@ -74,7 +76,20 @@ def actions(by_type):
         st.tuples(st.just("deserialize"), st.integers(0, 3),
                   st.one_of(st.just(None), st.binary(max_size=64))),
         st.tuples(st.sampled_from(["boolstatus", "realstatus"]), st.integers(-1, 4)),
+        st.tuples(st.just("corrupt"), st.integers(0, 3), st.integers(0, 99), st.booleans(),
+                  st.one_of(reals, strings.filter(lambda v: not isinstance(v, bytes)), st.booleans())),
     )
+
+
+def _corrupted(saved, index, inner, value):
+    """A saved state with one entry (or one entry of the hidden state) replaced, well framed."""
+    document = json.loads(saved[20:])
+    target = document.get("__stepper__") if inner and isinstance(document.get("__stepper__"), dict) else document
+    if target:
+        target[sorted(target)[index % len(target)]] = value
+    payload = json.dumps(document).encode()
+    return (b"SMAF" + (1).to_bytes(4, "little") + len(payload).to_bytes(8, "little")
+            + zlib.crc32(payload).to_bytes(4, "little") + payload)
 
 
 def _command(action, run):
@@ -89,6 +104,9 @@ def _command(action, run):
         return f"step 0 {time!r} {action[2]!r}"
     if kind == "setup":
         return f"setup 0 {action[1]!r} {'-' if action[2] is None else repr(action[2])}"
+    if kind == "corrupt":
+        data = _corrupted(run["saved"], *action[2:]) if run["saved"] else b""
+        return f"deserialize 0 {action[1]} {data.hex() or '_'}"
     if kind == "deserialize":
         data = run["saved"] if action[2] is None else action[2]
         return f"deserialize 0 {action[1]} {data.hex() or '_'}"

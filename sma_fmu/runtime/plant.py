@@ -14,8 +14,8 @@ for that one step, so the FMU can warn once per excursion.
 import math
 from collections import namedtuple
 
-from .checks import (fast_finite, fast_nonnegative, fast_positive, require_mode,
-                     require_nonnegative)
+from .checks import (direction_sign, fast_finite, fast_nonnegative, fast_positive,
+                     require_finite, require_mode, require_nonnegative)
 from .constant_load import BranchCache, branch_fractions, require_temperature
 from .constants import COOLING, HEATING
 from .minor_loops import Reversal, minor_branch_fractions
@@ -144,12 +144,18 @@ class PlantStepper:
         }
 
     def restore(self, state):
-        """Restore a state saved by :meth:`state` and re-evaluate the outputs."""
-        self.temperature = state["temperature"]
-        self.direction = state["direction"]
-        self.reversal = None if state["reversal"] is None else Reversal(*state["reversal"])
-        self.load = state["load"]
-        self.xi_MF = state["xi_MF"]
-        self.xi_P = state["xi_P"]
-        self.power = state.get("power", 0.0)
+        """Restore a state saved by :meth:`state` and re-evaluate the outputs.
+
+        A value of the wrong kind raises ``ValueError`` (``KeyError`` if one is missing).
+        """
+        reversal = state["reversal"]
+        if reversal is not None:
+            if not isinstance(reversal, (list, tuple)) or len(reversal) != 2:
+                raise ValueError(f"reversal must be None or [T, xi_MF], got {reversal!r}")
+            reversal = Reversal(*(require_finite("reversal", v) for v in reversal))
+        values = [require_finite(key, state[key]) for key in ("temperature", "load", "xi_MF", "xi_P")]
+        self.direction = direction_sign(state["direction"])
+        self.temperature, self.load, self.xi_MF, self.xi_P = values
+        self.reversal = reversal
+        self.power = require_finite("power", state.get("power", 0.0))
         self.outputs = self._evaluate(self._branches.get(self.load, self.direction))

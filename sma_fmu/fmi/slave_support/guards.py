@@ -83,6 +83,11 @@ class CallGuard:
         self.log(status, function, text)
         return False
 
+    def internal(self, function, error, result=None):
+        """An unexpected exception: logged as fmi2Error (never passed on); returns ``result``."""
+        self.refuse(function, f"internal error, the call did nothing: {type(error).__name__}: {error}")
+        return result
+
     def allowed(self, function, family=None):
         """True if ``function`` may be called now, else log fmi2Error and return False."""
         if self.state in ALLOWED[family or function]:
@@ -98,7 +103,10 @@ class CallGuard:
         values = self._real_outputs(self.slave)
         if not isinstance(values, tuple):
             values = (values,)
-        return all(map(math.isfinite, values))
+        try:
+            return all(map(math.isfinite, values))
+        except TypeError:  # not even a number
+            return False
 
     def _run_initialization(self):
         """The model's exitInitializationMode computation; returns an error text or None."""
@@ -170,6 +178,12 @@ class CallGuard:
                 self.refuse("fmi2Terminate", f"{type(error).__name__}: {error}")
 
     def do_step(self, current_time, step_size):
+        try:
+            return self._do_step(current_time, step_size)
+        except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
+            return self.internal("fmi2DoStep", error, False)
+
+    def _do_step(self, current_time, step_size):
         function = "fmi2DoStep"
         if self.state is not STEP_COMPLETE and not self.allowed(function):
             return False
@@ -211,6 +225,12 @@ class CallGuard:
     # ---- variables ---------------------------------------------------------------------------
     def _get(self, function, kind, references, convert, missing):
         """Values of ``references`` of type ``kind``; refused calls log fmi2Error."""
+        try:
+            return self._values(function, kind, references, convert, missing)
+        except Exception as error:  # noqa: BLE001
+            return self.internal(function, error, [missing] * len(references))
+
+    def _values(self, function, kind, references, convert, missing):
         if not self.describing:
             if self.state not in ALLOWED["fmi2Get"]:
                 self.allowed(function, "fmi2Get")
@@ -232,6 +252,12 @@ class CallGuard:
 
     def _set(self, function, kind, references, values, check):
         """Set ``references`` of type ``kind`` to ``values``; all or nothing."""
+        try:
+            self._assign(function, kind, references, values, check)
+        except Exception as error:  # noqa: BLE001
+            self.internal(function, error)
+
+    def _assign(self, function, kind, references, values, check):
         if self.state not in ALLOWED["fmi2Set"]:
             return self.allowed(function, "fmi2Set")
         settable = self.interface.settable(kind, self.state)

@@ -129,6 +129,12 @@ class SavedStates:
 
     def set(self, state):
         """Restore ``state`` (pythonfmu's fmi2SetFMUstate callback); all or nothing, never raises."""
+        try:
+            self._set(state)
+        except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
+            self.guard.internal("fmi2SetFMUstate", error)
+
+    def _set(self, state):
         guard, function = self.guard, "fmi2SetFMUstate"
         problem = self._problem(state)
         if problem is None:
