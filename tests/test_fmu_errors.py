@@ -145,3 +145,30 @@ def test_log_messages_stay_with_their_instance(fmus):
     finally:
         second.close()
         first.close()
+
+
+def test_leaving_the_validity_range_warns_once_per_excursion(fmus, params):
+    """100 W for 1 s (far above T_max), 3 s off (back below), 1 s on: two warnings."""
+    with FmuInstance(fmus["SmaActuator"], "hot", {"load": 0.05}) as fmu:
+        temperatures, warned_at = [], []
+        for k in range(5000):
+            fmu.set_real(("P_in", "load"), (0.0 if 1000 <= k < 4000 else 100.0, 0.05))
+            seen = len(fmu.messages)
+            fmu.step(k * STEP, STEP)                      # fmi2Warning does not raise
+            temperatures.append(fmu.get_real(("T",))[0])
+            warned_at += [k for status, _ in fmu.messages[seen:] if status == "warning"]
+        warnings = [text for status, text in fmu.messages if status == "warning"]
+    assert max(temperatures) > params.T_max > temperatures[3999]
+    assert len(warnings) == 2 and f"validity.T_max = {params.T_max:g} degC" in warnings[0]
+    assert temperatures[warned_at[0] - 1] <= params.T_max < temperatures[warned_at[0]]
+    assert warned_at[1] > 4000
+
+
+def test_tiny_and_huge_steps_keep_the_outputs_finite(fmus):
+    with FmuInstance(fmus["SmaFeedforward"], "tiny", {"R_ref": 42.0, "load": 0.05}) as fmu:
+        time = 0.0
+        for step in (1e-3, 1e-310, 5e-324, 1e-3, 1e300):
+            fmu.set_real(("R_ref", "load"), (41.0, 0.05))
+            fmu.step(time, step)
+            time += step
+            assert all(math.isfinite(v) for v in fmu.get_real(("P_ff", "T_ref")))
