@@ -1,29 +1,18 @@
-"""Driving tests/c_host/fmi_host.c: a plain C FMI host process, one command per line.
+"""Driving sma_fmu/fmi/hosts/fmi_host.c: a plain C FMI host process, one command per line.
 
 The host runs without libpython linked and without LD_PRELOAD, so what it shows is what
 any C tool (fmusim, the FMI Library, libcosim) sees. A crash of the FMU is a crash of this
 process, which the tests see as its exit status.
 """
 import os
-import shutil
 import subprocess
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-HERE = Path(__file__).parent
-SOURCE = HERE / "c_host" / "fmi_host.c"
+from sma_fmu.fmi.hosts import compile_host
+
 OK, WARNING, DISCARD, ERROR, FATAL = range(5)
-
-
-def compile_host(folder):
-    """Compile fmi_host.c into ``folder``; returns the executable's path."""
-    compiler = shutil.which(os.environ.get("CC") or "cc") or shutil.which("gcc")
-    assert compiler, "a C compiler is needed to build the test host"
-    exe = Path(folder) / "fmi_host"
-    subprocess.run([compiler, "-std=c11", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
-                    str(SOURCE), "-ldl"], check=True)
-    return exe
 
 
 def unpack(fmu, folder):

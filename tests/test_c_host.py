@@ -1,8 +1,8 @@
 """The FMUs in hosts that are not Python, with no environment variable set (no LD_PRELOAD).
 
 - libcosim (Open Simulation Platform, from the libcosimpy wheel) driven from a C program
-  (tests/c_host/cosim_run.c): it loads the FMU through the FMI Library;
-- a plain dlopen C host (tests/c_host/fmi_host.c), as fmusim does;
+  (sma_fmu/fmi/hosts/cosim_run.c): it loads the FMU through the FMI Library;
+- a plain dlopen C host (sma_fmu/fmi/hosts/fmi_host.c), as fmusim does;
 - fmpy under Debian's statically linked /usr/bin/python3 (the front must use that
   process's Python, not load a second libpython).
 The results equal the library steppers'. Without the native front (no C compiler at build
@@ -22,10 +22,9 @@ from fmpy import read_model_description
 from fmi_host import ERROR, OK, WARNING, FmiHost, text, unpack
 from sma_fmu.fmi.build import build_fmu
 from sma_fmu.fmi.front import NativeFrontWarning, compile_front
+from sma_fmu.fmi.hosts import compile_cosim_run
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
-
-HERE = Path(__file__).parent
 
 libcosimpy = pytest.importorskip("libcosimpy", reason="libcosimpy (test extra) provides libcosimc")
 
@@ -38,12 +37,8 @@ def _clean_env(**extra):
 
 @pytest.fixture(scope="module")
 def cosim_run(tmp_path_factory):
-    compiler = shutil.which("gcc") or shutil.which("cc")
-    assert compiler, "a C compiler is needed to build the C host"
-    lib_dir = Path(libcosimpy.__file__).parent / "libcosimc"
-    exe = tmp_path_factory.mktemp("c_host") / "cosim_run"
-    subprocess.run([compiler, "-O1", "-Wall", "-Werror", "-o", str(exe), str(HERE / "c_host" / "cosim_run.c"),
-                    f"-L{lib_dir}", "-lcosimc", f"-Wl,-rpath,{lib_dir}"], check=True)
+    exe = compile_cosim_run(tmp_path_factory.mktemp("c_host"))
+    assert exe is not None, "libcosimpy and a C compiler are needed to build the libcosim host"
     return exe
 
 
