@@ -97,6 +97,22 @@ typedef struct {
     FrontState* states; /* the states this instance handed out and that are not freed */
 } Instance;
 
+/* ---- forwarding (fmi2_exports.c) and saved states (fmi2_states.c) ----------------------- */
+fmi2Status refuse(Instance* in, fmi2Status status, const char* function, const char* why);
+fmi2Status finish(Instance* in, fmi2Status status); /* the backend's status, or worse if logged */
+FrontState* find_state(Instance* in, fmi2FMUstate state);
+void drop_state(Instance* in, FrontState* state);
+
+/* Every forwarded call starts with this: refuse after fmi2Fatal, keep the thread's Python
+ * thread state, and reset the worst status the slave logged. */
+#define ENTER(name)                                                                             \
+    Instance* in = (Instance*)c;                                                                \
+    if (!in) return fmi2Error;                                                                  \
+    if (in->dead) return refuse(in, fmi2Fatal, "fmi2" #name, "refused: an earlier call returned " \
+                                "fmi2Fatal; only fmi2FreeInstance is possible");                \
+    keep_thread_state();                                                                        \
+    in->logged_status = fmi2OK
+
 /* ---- logging (host_log.c) ---------------------------------------------------------------- */
 void host_log(const Instance* in, fmi2Status status, const char* category, const char* message);
 void host_logf(const Instance* in, fmi2Status status, const char* format, ...)
