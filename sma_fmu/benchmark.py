@@ -13,6 +13,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from sma_fmu.benchmark_c_hosts import C_HOST_STEPS, c_host_step_costs
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.fmi.build import build_fmus
 from sma_fmu.fmi.instance import FmuInstance
@@ -30,6 +31,7 @@ TARGETS = {  # issue 6, on a 2-core machine
     "feedforward_step_us": 15.0,               # SmaFeedforward set + doStep + get
     "library_real_time_factor": 150.0,         # per scenario
     "identification_s": 2.0,                   # the 4-load constant-load fit
+    "c_host_vs_fmpy": 2.0,                     # issue 10: SmaActuator step in a C host / fmpy master
 }
 _TRIVIAL_SLAVE = '''
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
@@ -186,6 +188,8 @@ def run_benchmarks(out_dir, runs=5, progress=print):
         fmu_paths["Trivial (baseline)"] = _build_trivial(folder)
         progress(f"FMU step costs ({runs} runs) ...")
         steps = fmu_step_costs(fmu_paths, runs)
+        progress(f"SmaActuator in C hosts ({runs} runs of {C_HOST_STEPS} steps per host) ...")
+        c_hosts = c_host_step_costs(fmu_paths["SmaActuator"], runs, folder)
         machine = {"python": platform.python_version(), "system": platform.platform(),
                    "python_loop_ns_per_iteration": python_loop_ns()}
         progress(f"closed loops, load-step 30 s ({runs} runs per controller and path) ...")
@@ -194,7 +198,7 @@ def run_benchmarks(out_dir, runs=5, progress=print):
         throughput = library_throughput()
         progress("identification ...")
         results = {
-            "machine": machine, "runs": runs, "fmu_step": steps,
+            "machine": machine, "runs": runs, "fmu_step": steps, "c_host_step": c_hosts,
             "closed_loop_load_step_30s": loops, "library_throughput": throughput,
             "identification_4_loads_s": identification_time(runs), "targets": TARGETS,
         }
@@ -219,7 +223,9 @@ def format_table(results):
     trivial = results["fmu_step"]["Trivial (baseline)"]["set_doStep_get_us"]
     ff = results["fmu_step"]["SmaFeedforward"]["set_doStep_get_us"]
     lines += [f"SmaFeedforward step: {ff:.2f} us = {ff / trivial:.2f} x trivial FMU; "
-              f"{_verdict(ff, TARGETS['feedforward_step_us'])} us", "",
+              f"{_verdict(ff, TARGETS['feedforward_step_us'])} us", ""]
+    lines += _c_host_lines(results)
+    lines += ["",
               "load-step, 30 s at 1 ms          wall [s]   x real time   (min ... max of runs)"]
     for name, row in results["closed_loop_load_step_30s"].items():
         lines.append(f"{name:<32}{row['wall_s']:>9.3f}{row['real_time_factor']:>13.1f}"
@@ -236,6 +242,20 @@ def format_table(results):
               f"identification, 4 loads, 808 points: {results['identification_4_loads_s']:.3f} s: "
               f"{_verdict(results['identification_4_loads_s'], TARGETS['identification_s'])} s"]
     return "\n".join(lines)
+
+
+def _c_host_lines(results):
+    """The C-host table and its verdict against the fmpy master."""
+    lines = ["SmaActuator in C hosts [us per step]                 mean     p50     p99   p99.9"]
+    for name, cost in results["c_host_step"].items():
+        lines.append(f"{name:<50}{cost['mean_us']:>8.2f}{cost['p50_us']:>8.2f}{cost['p99_us']:>8.2f}"
+                     f"{cost['p99_9_us']:>8.1f}")
+    after = results["c_host_step"]["plain C host, front (after)"]["mean_us"]
+    fmpy = results["fmu_step"]["SmaActuator"]["set_doStep_get_us"]
+    ratio = after / fmpy
+    lines.append(f"plain C host (front) {after:.2f} us = {ratio:.2f} x the fmpy master's {fmpy:.2f} us: "
+                 f"{_verdict(ratio, TARGETS['c_host_vs_fmpy'])}")
+    return lines
 
 
 def main(out_dir="results/benchmark", runs=5):

@@ -9,10 +9,13 @@ def test_benchmark_runs_and_reports_every_section(tmp_path, capsys):
     out = capsys.readouterr().out
     for text in ("FMU per step", "Trivial (baseline)", "load-step, 30 s at 1 ms",
                  "pi+ff-adaptive (fmu)", "pi+ff-adaptive (library)", "library batch",
-                 "identification, 4 loads", "target"):
+                 "identification, 4 loads", "target", "SmaActuator in C hosts",
+                 "plain C host, front (after)", "libcosim step, front (after)"):
         assert text in out
     results = json.loads((tmp_path / "benchmark.json").read_text())
     assert set(results["fmu_step"]) == {"SmaActuator", "SmaFeedforward", "Trivial (baseline)"}
     assert len(results["closed_loop_load_step_30s"]) == 6
     assert all(row["wall_s"] > 0 for row in results["closed_loop_load_step_30s"].values())
     assert results["identification_4_loads_s"] > 0
+    c_hosts = results["c_host_step"]
+    assert len(c_hosts) == 5 and all(0 < row["p50_us"] <= row["p99_9_us"] for row in c_hosts.values())

@@ -1,52 +1,53 @@
-"""The FMUs in a C host: libcosim (Open Simulation Platform) driven from a C program.
+"""The FMUs in hosts that are not Python, with no environment variable set (no LD_PRELOAD).
 
-The host process is not Python: libcosim loads the FMU with the FMI Library; pythonfmu's
-binary needs libpython preloaded (LD_PRELOAD), as the README explains.
+- libcosim (Open Simulation Platform, from the libcosimpy wheel) driven from a C program
+  (sma_fmu/fmi/hosts/cosim_run.c): it loads the FMU through the FMI Library;
+- a plain dlopen C host (sma_fmu/fmi/hosts/fmi_host.c), as fmusim does;
+- fmpy under Debian's statically linked /usr/bin/python3 (the front must use that
+  process's Python, not load a second libpython).
+The results equal the library steppers'. Without the native front (no C compiler at build
+time) the FMU's binary is pythonfmu's own, which does not load in a C host.
 """
 import os
 import re
 import shutil
 import subprocess
-import sysconfig
+import warnings
+import zipfile
 from pathlib import Path
 
 import pytest
 from fmpy import read_model_description
 
+from fmi_host import ERROR, OK, WARNING, FmiHost, text, unpack
+from sma_fmu.fmi.build import build_fmu
+from sma_fmu.fmi.front import NativeFrontWarning, compile_front
+from sma_fmu.fmi.hosts import compile_cosim_run
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
-
-HERE = Path(__file__).parent
 
 libcosimpy = pytest.importorskip("libcosimpy", reason="libcosimpy (test extra) provides libcosimc")
 
 
-def _libpython():
-    name = sysconfig.get_config_var("INSTSONAME") or sysconfig.get_config_var("LDLIBRARY")
-    return Path(sysconfig.get_config_var("LIBDIR")) / name
+def _clean_env(**extra):
+    env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
+    env.update(extra)
+    return env
 
 
 @pytest.fixture(scope="module")
 def cosim_run(tmp_path_factory):
-    assert shutil.which("gcc"), "gcc is needed to build the C host"
-    lib_dir = Path(libcosimpy.__file__).parent / "libcosimc"
-    exe = tmp_path_factory.mktemp("c_host") / "cosim_run"
-    subprocess.run(["gcc", "-O1", "-Wall", "-Werror", "-o", str(exe), str(HERE / "c_host" / "cosim_run.c"),
-                    f"-L{lib_dir}", "-lcosimc", f"-Wl,-rpath,{lib_dir}"], check=True)
+    exe = compile_cosim_run(tmp_path_factory.mktemp("c_host"))
+    assert exe is not None, "libcosimpy and a C compiler are needed to build the libcosim host"
     return exe
 
 
-def _run(exe, fmu, step, steps, assignments, outputs, preload=True):
+def _run(exe, fmu, step, steps, assignments, outputs, env=None):
     refs = {v.name: v.valueReference for v in read_model_description(str(fmu)).modelVariables}
-    env = dict(os.environ)
-    if preload:
-        env["LD_PRELOAD"] = str(_libpython())
-    else:
-        env.pop("LD_PRELOAD", None)
     args = [str(exe), str(fmu), repr(step), str(steps)]
     args += [f"{refs[name]}={value!r}" for name, value in assignments.items()]
     args += ["--"] + [str(refs[name]) for name in outputs]
-    result = subprocess.run(args, capture_output=True, text=True, env=env, timeout=120)
+    result = subprocess.run(args, capture_output=True, text=True, env=env or _clean_env(), timeout=120)
     values = {}
     names = {ref: name for name, ref in refs.items()}
     for line in result.stdout.splitlines():  # libcosim also logs to stdout
@@ -56,10 +57,10 @@ def _run(exe, fmu, step, steps, assignments, outputs, preload=True):
     return result, values
 
 
-def test_plant_fmu_runs_in_libcosim(cosim_run, fmus, params):
+def test_plant_fmu_runs_in_libcosim_without_ld_preload(cosim_run, fmus, params):
     result, values = _run(cosim_run, fmus["SmaActuator"], 1e-3, 5000,
                           {"P_in": 2.6, "load": 0.05}, ["R", "T", "xi_F"])
-    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     library = PlantStepper(params, load=0.05)
     for _ in range(5000):
         out = library.step(2.6, 0.05, 1e-3)
@@ -70,10 +71,10 @@ def test_plant_fmu_runs_in_libcosim(cosim_run, fmus, params):
     assert out.R < 48.0  # the run went into the transformation
 
 
-def test_feedforward_fmu_runs_in_libcosim(cosim_run, fmus, params):
+def test_feedforward_fmu_runs_in_libcosim_without_ld_preload(cosim_run, fmus, params):
     result, values = _run(cosim_run, fmus["SmaFeedforward"], 1e-3, 500,
                           {"R_ref": 42.0, "load": 0.15}, ["P_ff", "T_ref"])
-    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     library = FeedforwardStepper(params)
     for _ in range(500):
         out = library.step(42.0, 0.15, 1e-3)
@@ -81,7 +82,160 @@ def test_feedforward_fmu_runs_in_libcosim(cosim_run, fmus, params):
     assert values["P_ff"] == pytest.approx(out.P_ff, abs=1e-9)
 
 
-def test_without_preloaded_libpython_the_fmu_binary_cannot_load(cosim_run, fmus):
-    result, values = _run(cosim_run, fmus["SmaActuator"], 1e-3, 10, {}, ["R"], preload=False)
+def _start(host, name="plant", uri="ok", logging=0):
+    reply = host.call(f"instantiate 0 {text(name)} {uri} ok {logging}")
+    if reply.status == OK:
+        for line in ("setup 0 0 -", "enter 0", "exit 0"):
+            assert host.call(line).status == OK
+    return reply
+
+
+def test_plain_c_host_equals_the_library(fmi_host_exe, unpacked, params):
+    library = PlantStepper(params, load=0.05)
+    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+        assert _start(host).status == OK
+        for k in range(2000):
+            assert host.call(f"setreal 0 2 0 {1.4!r} 1 {0.05!r}").status == OK
+            assert host.call(f"step 0 {k * 1e-3!r} {1e-3!r}").status == OK
+            out = library.step(1.4, 0.05, 1e-3)
+        values = host.call("getreal 0 2 2 3").values
+        assert host.close() == 0
+    assert [float(v) for v in values] == [out.R, out.T]
+
+
+@pytest.mark.parametrize("uri", ["ok", "one", "localhost", "plain", "pct"])
+def test_resource_uris_that_name_the_folder_work(fmi_host_exe, unpacked, uri):
+    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+        reply = _start(host, uri=uri)
+        assert reply.status == OK
+        assert host.call("step 0 0 0.001").status == OK
+        assert bool(reply.logged(WARNING)) == (uri == "plain")  # a path is not a URI: warned
+
+
+@pytest.mark.parametrize("uri", ["empty", "null", "missing", "http", "relative", text("file:///%zz")])
+def test_unusable_resource_uris_give_null_and_a_message(fmi_host_exe, unpacked, uri):
+    with FmiHost(fmi_host_exe, unpacked["SmaFeedforward"]) as host:
+        reply = host.call(f"instantiate 0 {text('ff')} {uri} ok 0")
+        assert reply.status == ERROR  # the host prints 3 for a NULL instance
+        assert any("fmuResourceLocation" in m or "resource folder" in m for m in reply.logged(ERROR))
+        assert _start(host).status == OK  # the process is fine: the next instance works
+        assert host.close() == 0
+
+
+def test_format_characters_are_logged_literally(fmi_host_exe, unpacked):
+    """'%' in an instance name or a String parameter reaches a printf-style logger as text."""
+    mode_ref = {v.name: v.valueReference for v in read_model_description(
+        str(unpacked["SmaActuator"] / "modelDescription.xml")).modelVariables}["hysteresis_mode"]
+    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+        assert host.call(f"instantiate 0 {text('valve 50%s%n')} ok ok 1").status == OK
+        assert host.call("setup 0 0 -").status == OK
+        assert host.call(f"setstring 0 1 {mode_ref} {text('%s%s%n%x')}").status == OK
+        assert host.call("enter 0").status == OK
+        reply = host.call("exit 0")
+        assert reply.status == ERROR
+        assert any("'valve 50%s%n'" in m and "got '%s%s%n%x'" in m for m in reply.logged(ERROR))
+        assert host.close() == 0
+
+
+def test_errors_are_logged_with_logging_off_unless_switched_off(fmi_host_exe, unpacked):
+    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+        assert _start(host, logging=0).status == OK
+        reply = host.call("setreal 0 1 2 1.0")             # R is an output
+        assert reply.status == ERROR and "R (value reference 2)" in reply.logged(ERROR)[0]
+        assert host.call("debuglog 0 0 0").status == OK     # everything off, errors too
+        reply = host.call("setreal 0 1 2 1.0")
+        assert reply.status == ERROR and not reply.logs
+        assert host.call(f"debuglog 0 1 1 {text('logStatusError')}").status == OK
+        assert host.call("setreal 0 1 2 1.0").logged(ERROR)
+
+
+def test_a_discarded_step_can_be_retried_and_a_repeated_one_terminates(fmi_host_exe, unpacked):
+    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+        assert _start(host).status == OK
+        assert host.call("step 0 0 0.001").status == OK
+        assert host.call("setreal 0 1 0 nan").status == OK
+        reply = host.call("step 0 0.001 0.001")
+        assert reply.status == 2 and "P_in must be finite, got nan" in reply.logged(2)[0]
+        assert host.call("boolstatus 0 3").values == ["0"]         # fmi2Terminated: no
+        assert float(host.call("realstatus 0 2").values[0]) == 0.001  # last successful time
+        assert host.call("setreal 0 1 0 1.0").status == OK           # the master fixes P_in
+        assert host.call("step 0 0.001 0.001").status == OK
+        assert host.call("setreal 0 1 0 nan").status == OK
+        assert host.call("step 0 0.002 0.001").status == 2
+        assert host.call("step 0 0.002 0.001").status == 2             # retried unchanged
+        assert host.call("boolstatus 0 3").values == ["1"]
+
+
+def test_states_in_a_c_host(fmi_host_exe, unpacked):
+    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+        assert _start(host).status == OK
+        assert host.call("setreal 0 2 0 2.0 1 0.05").status == OK
+        assert host.call("step 0 0 0.5").status == OK
+        assert host.call("getstate 0 0").status == OK
+        saved = host.call("serialize 0 0")
+        assert saved.status == OK
+        before = host.call("getreal 0 1 3").values
+        assert host.call("step 0 0.5 0.5").status == OK
+        corrupted = bytearray(bytes.fromhex(saved.values[0]))
+        corrupted[len(corrupted) // 2] ^= 0x55
+        for data in (corrupted.hex(), b"garbage".hex(), "_"):
+            reply = host.call(f"deserialize 0 1 {data}")
+            assert reply.status == ERROR and "not a state serialized by this FMU" in reply.logged(ERROR)[0]
+        assert host.call("setstate 0 3").status == ERROR             # never saved: refused
+        assert host.call(f"deserialize 0 1 {saved.values[0]}").status == OK
+        assert host.call("setstate 0 1").status == OK
+        assert host.call("getreal 0 1 3").values == before
+        assert host.call("freestate 0 1").status == OK
+        assert host.call("setstate 0 1").status == ERROR             # freed: refused
+        assert host.call("step 0 0.5 0.5").status == OK
+        assert host.close() == 0
+
+
+def test_missing_libpython_gives_null_and_says_what_to_set(fmi_host_exe, fmus, tmp_path):
+    front = compile_front(libpython=("", "libpython9.99.so.1.0"))
+    assert front.library is not None, front.problem
+    folder = unpack(fmus["SmaActuator"], tmp_path / "unpacked")
+    (folder / "binaries/linux64/SmaActuator.so").write_bytes(front.library)  # pythonfmu's stays
+    with FmiHost(fmi_host_exe, folder) as host:
+        reply = host.call(f"instantiate 0 {text('p')} ok ok 0")
+        assert reply.status == ERROR
+        message = " ".join(reply.logged(ERROR))
+        assert "libpython9.99.so.1.0" in message and "SMA_FMU_LIBPYTHON" in message
+        assert "LD_PRELOAD" in message
+
+
+def test_without_a_compiler_the_build_keeps_pythonfmus_binary_and_says_so(
+        fmi_host_exe, tmp_path, monkeypatch, cosim_run):
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        path = build_fmu("SmaActuator", tmp_path / "out")
+    assert any(issubclass(w.category, NativeFrontWarning) and "no-such-compiler" in str(w.message)
+               and "LD_PRELOAD" in str(w.message) for w in caught)
+    names = zipfile.ZipFile(path).namelist()
+    assert "binaries/linux64/SmaActuator.so" in names
+    assert not any(n.endswith("_pythonfmu.so") for n in names)
+    result, values = _run(cosim_run, path, 1e-3, 10, {}, ["R"])  # pythonfmu alone: needs libpython
     assert result.returncode != 0 and not values
-    assert "undefined symbol" in result.stdout + result.stderr  # libcosim logs to stdout
+    assert "undefined symbol" in result.stdout + result.stderr
+
+
+def test_fmpy_in_debians_static_python_uses_that_python(fmus, tmp_path):
+    """The front must not load a second libpython into a process that has Python built in."""
+    python = Path("/usr/bin/python3")
+    assert python.is_file(), "Debian's python3 is part of the test machine"
+    import fmpy
+    script = tmp_path / "run.py"
+    script.write_text(
+        "import sys\nfrom fmpy import simulate_fmu\n"
+        "r = simulate_fmu(sys.argv[1], stop_time=1.0, step_size=1e-3, output_interval=1e-3,"
+        " start_values={'P_in': 2.0, 'load': 0.05}, output=['T'])\n"
+        "maps = open('/proc/self/maps').read()\n"
+        "print(sorted({l.split()[-1] for l in maps.splitlines() if 'libpython' in l}), r['T'][-1])\n")
+    site = str(Path(fmpy.__file__).parent.parent)
+    result = subprocess.run([str(python), str(script), str(fmus["SmaActuator"])], capture_output=True,
+                            text=True, env=_clean_env(PYTHONPATH=site), timeout=120)
+    assert result.returncode == 0, result.stderr[-2000:]
+    libraries, temperature = result.stdout.strip().rsplit(" ", 1)
+    assert libraries == "[]"  # no libpython mapped: the executable's own Python ran the FMU
+    assert 20.0 < float(temperature) < 60.0

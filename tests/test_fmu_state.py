@@ -63,7 +63,7 @@ def test_restored_minor_loop_memory_matters(fmus):
     name, start, inputs, outputs = CASES["plant-continuous"]
     with FmuInstance(fmus[name], "memory", start) as fmu:
         _run(fmu, inputs, outputs, 0, SAVE_AT)
-        saved = json.loads(fmu.serialize_state(fmu.get_state()))
+        saved = json.loads(fmu.serialize_state(fmu.get_state())[20:])  # after the front's header
     stepper = saved["__stepper__"]
     assert stepper["reversal"] is not None and len(stepper["reversal"]) == 2
     assert stepper["direction"] in (1, -1)

@@ -1,4 +1,6 @@
 """FMU commands: build, validate."""
+import sys
+import warnings
 from pathlib import Path
 
 from sma_fmu.fmi import build as fmu_build
@@ -7,7 +9,11 @@ __all__ = ["register"]
 
 
 def _build(args):
-    paths = fmu_build.build_fmus(args.out, args.model)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        paths = fmu_build.build_fmus(args.out, args.model)
+    for warning in caught:
+        print(f"sma-fmu: warning: {warning.message}", file=sys.stderr)
     for name, path in paths.items():
         print(f"{name}: {path}")
     return 0

@@ -100,8 +100,8 @@ class FmuInstance:
         self._callbacks.freeMemory = defaultCallbacks.freeMemory
         # No fmpy.logging.addLoggerProxy: it keeps ONE logger in a C global, so messages of
         # every instance would reach the last instance's logger, and a freed logger would be
-        # called later (heap corruption). pythonfmu passes the finished message as the
-        # format argument without varargs, so a plain per-instance callback receives it whole.
+        # called later (heap corruption). The FMUs pass the finished message as the format,
+        # '%' doubled, without varargs, so a plain per-instance callback receives it whole.
         self._ports = {}
         self._reported = 0  # messages before this index are in an earlier FmuError already
         # the library fmpy loaded, called without releasing the GIL: pythonfmu's C++ takes it
@@ -127,17 +127,23 @@ class FmuInstance:
             if start_values:
                 self.set(start_values)
             seen = len(self.messages)
-            self._call("fmi2ExitInitializationMode", self._fmu.exitInitializationMode)
+            try:
+                self._call("fmi2ExitInitializationMode", self._fmu.exitInitializationMode)
+                failed = 0
+            except FmuError as error:
+                failed = error.status
             errors = [text for status, text in self.messages[seen:] if status in ("error", "fatal")]
-            if errors:
-                raise FmuError(f"{instance_name}: initialization failed: {'; '.join(errors)}", 3)
+            if failed or errors:  # (without the native front a refusal is only logged)
+                raise FmuError(f"{instance_name}: initialization failed: {'; '.join(errors)}",
+                               failed or 3)
         except BaseException:
             self.close()
             raise
 
     def _log(self, environment, instance_name, status, category, message):
+        # FMI passes a printf format; ours carry no arguments and write a '%' as "%%"
         self.messages.append((_STATUS[status] if 0 <= status < len(_STATUS) else str(status),
-                              message.decode("utf-8", "replace")))
+                              message.decode("utf-8", "replace").replace("%%", "%")))
 
     def _call(self, name, function, *args, **kwargs):
         """Call one of fmpy's wrappers; a failure becomes :class:`FmuError`."""

@@ -55,6 +55,7 @@ PARAMETER_SPECS = (
     ParameterSpec("beta", "control", "s", "positive", True),
     ParameterSpec("Kp", "control", "W/ohm", "nonnegative", True),
     ParameterSpec("Ki", "control", "W/(ohm.s)", "nonnegative", True),
+    ParameterSpec("T_max", "validity", "degC", "finite", True),
 )
 
 SPEC_BY_NAME = {spec.name: spec for spec in PARAMETER_SPECS}
@@ -121,6 +122,7 @@ class WireParameters:
     beta: float
     Kp: float
     Ki: float
+    T_max: float
     alpha: float = None
     source: str = field(default="<parameters>", compare=False, repr=False)
 
@@ -210,6 +212,9 @@ class WireParameters:
                 "the F phase must be the longest")
         if not self.T_room > -273.15:
             self._fail(f"parameter thermal.T_room = {self.T_room!r} degC is below absolute zero")
+        if not self.T_max > self.T_room:
+            self._fail(f"parameter validity.T_max = {self.T_max!r} degC must exceed "
+                       f"thermal.T_room = {self.T_room!r} degC")
 
     def values(self):
         """Parameter values by name (only the schema's entries; alpha omitted when not given)."""

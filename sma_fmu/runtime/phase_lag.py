@@ -9,14 +9,15 @@ from .checks import require_nonnegative, require_positive
 
 __all__ = ["tustin_coefficients", "PhaseLagFilter"]
 
+_INF = float("inf")
+
 
 def tustin_coefficients(alpha, beta, step_size):
     """(b0, b1, a1) of Cpl(s) for lead time ``alpha`` [s], lag time ``beta`` [s], step [s]."""
-    c = 2.0 / step_size
-    denominator = beta * c + 1.0
-    return ((alpha * c + 1.0) / denominator,
-            (1.0 - alpha * c) / denominator,
-            (1.0 - beta * c) / denominator)
+    # the formulas above multiplied through by h/2: finite for every step, however small
+    half = 0.5 * step_size
+    denominator = beta + half
+    return (alpha + half) / denominator, (half - alpha) / denominator, (half - beta) / denominator
 
 
 class PhaseLagFilter:
@@ -36,9 +37,12 @@ class PhaseLagFilter:
             self._coefficients = tustin_coefficients(self.alpha, self.beta, step_size)
             self._step_size = step_size
         b0, b1, a1 = self._coefficients
-        if self.previous_input is None:
-            self.previous_input = self.previous_output = value
-        output = b0 * value + b1 * self.previous_input - a1 * self.previous_output
+        first = self.previous_input is None  # steady state at the first input
+        output = (b0 * value + b1 * (value if first else self.previous_input)
+                  - a1 * (value if first else self.previous_output))
+        if not -_INF < output < _INF:
+            raise ValueError(f"phase-lag filter output {output!r} W is not finite (alpha = "
+                             f"{self.alpha!r} s, beta = {self.beta!r} s, step {step_size!r} s)")
         self.previous_input = value
         self.previous_output = output
         return output

@@ -6,12 +6,16 @@ The direction is sgn(T+ - T) (unchanged when T+ = T). In mode "continuous" (the
 default) a reversal found in a step stores (T_k, xi_MF_k) and the minor branch of
 section 6 follows; in mode "switch" (the paper's) the fractions follow the major branch
 of that direction. A power of 0 W or less is applied as 0 W (the paper's rule), so a
-compensator output wired straight to the plant is valid; non-finite power is rejected.
+compensator output wired straight to the plant is valid; non-finite power is rejected,
+and so is a finite power so large that the temperature would leave the floating-point
+range. Leaving the validity range (T above ``validity.T_max``) sets :attr:`PlantStepper.warning`
+for that one step, so the FMU can warn once per excursion.
 """
+import math
 from collections import namedtuple
 
-from .checks import (fast_finite, fast_nonnegative, fast_positive, require_mode,
-                     require_nonnegative)
+from .checks import (direction_sign, fast_finite, fast_nonnegative, fast_positive,
+                     require_finite, require_mode, require_nonnegative)
 from .constant_load import BranchCache, branch_fractions, require_temperature
 from .constants import COOLING, HEATING
 from .minor_loops import Reversal, minor_branch_fractions
@@ -43,7 +47,8 @@ class PlantStepper:
     load : float
         Load during initialization [kg]; the initial outputs reflect it.
 
-    The wire starts heating, on the major branch.
+    The wire starts heating, on the major branch. ``warning`` is a message for the one
+    step (or the start) in which the temperature rises above ``params.T_max``, else None.
     """
 
     def __init__(self, params, T_start=None, mode="continuous", load=0.0):
@@ -61,6 +66,15 @@ class PlantStepper:
         constants = self._branches.get(self.load, HEATING)
         self.xi_MF, self.xi_P = branch_fractions(self.temperature, constants)
         self.outputs = self._evaluate(constants)
+        self.warning = None
+        self._check_validity(-math.inf)
+
+    def _check_validity(self, before):
+        """Set :attr:`warning` when the temperature crosses ``T_max`` upwards."""
+        limit = self.params.T_max
+        if self.temperature > limit >= before:
+            self.warning = (f"T = {self.temperature:.6g} degC rose above validity.T_max = {limit:g} "
+                            "degC: outside the range the model's parameters describe")
 
     def step(self, power, load, step_size):
         """Advance one step of ``step_size`` [s] with ``power`` [W] and ``load`` [kg] held.
@@ -78,6 +92,9 @@ class PlantStepper:
             self._decay = (step_size, step_decay(step_size, params.tau_th))
         before = self.temperature
         after = thermal_step(before, power, params.T_room, params.K_th, self._decay[1])
+        if not -math.inf < after < math.inf:
+            raise ValueError(f"P_in = {power!r} W over {step_size!r} s would take the wire "
+                             "temperature out of the floating-point range")
         direction = HEATING if after > before else (COOLING if after < before else self.direction)
         constants = self._branches.get(load, direction)
         reversal = self.reversal
@@ -94,6 +111,9 @@ class PlantStepper:
             after, direction, reversal, load, power)
         self.xi_MF, self.xi_P = xi_mf, xi_p
         self.outputs = self._evaluate(constants)
+        self.warning = None
+        if after > params.T_max:
+            self._check_validity(before)
         return self.outputs
 
     def _evaluate(self, constants):
@@ -124,12 +144,18 @@ class PlantStepper:
         }
 
     def restore(self, state):
-        """Restore a state saved by :meth:`state` and re-evaluate the outputs."""
-        self.temperature = state["temperature"]
-        self.direction = state["direction"]
-        self.reversal = None if state["reversal"] is None else Reversal(*state["reversal"])
-        self.load = state["load"]
-        self.xi_MF = state["xi_MF"]
-        self.xi_P = state["xi_P"]
-        self.power = state.get("power", 0.0)
+        """Restore a state saved by :meth:`state` and re-evaluate the outputs.
+
+        A value of the wrong kind raises ``ValueError`` (``KeyError`` if one is missing).
+        """
+        reversal = state["reversal"]
+        if reversal is not None:
+            if not isinstance(reversal, (list, tuple)) or len(reversal) != 2:
+                raise ValueError(f"reversal must be None or [T, xi_MF], got {reversal!r}")
+            reversal = Reversal(*(require_finite("reversal", v) for v in reversal))
+        values = [require_finite(key, state[key]) for key in ("temperature", "load", "xi_MF", "xi_P")]
+        self.direction = direction_sign(state["direction"])
+        self.temperature, self.load, self.xi_MF, self.xi_P = values
+        self.reversal = reversal
+        self.power = require_finite("power", state.get("power", 0.0))
         self.outputs = self._evaluate(self._branches.get(self.load, self.direction))

@@ -6,14 +6,21 @@ pythonfmu FMU ships pythonfmu in its resources/. The library path never imports 
 The build writes the wire's parameter set to ``resources/parameters.json``; a slave
 exposes some of those parameters as FMI parameters (start values from that file) and
 takes the rest from the file as they are.
+
+Creating a :class:`SlaveInterface` also puts a :class:`~.guards.CallGuard` over the
+slave's pythonfmu callbacks: the FMI state machine, checked arguments and saved states,
+and no exception ever reaching pythonfmu (which would make it fmi2Fatal).
 """
 import json
 import os
 
-from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Variability, Real, String
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
+from sma_fmu.fmi.slave_support.guards import CallGuard
+from sma_fmu.fmi.slave_support.lifecycle import setting_refusal
 from sma_fmu.fmi.slave_support.model_description import decorate_model_description
+from sma_fmu.fmi.slave_support.saved_state import state_from_bytes, state_to_bytes
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, WireParameters
 
 __all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
@@ -21,6 +28,7 @@ __all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
 PARAMETERS_FILE = "parameters.json"
 MODEL_SECTIONS = ("geometry", "phases", "hysteresis", "constant_load", "thermal")
 _STATE_KEY = "__stepper__"
+_KIND_OF = ((Real, "Real"), (Boolean, "Boolean"), (String, "String"), (Integer, "Integer"))
 
 
 class SlaveInterface:
@@ -31,13 +39,15 @@ class SlaveInterface:
         self.units = {}
         self.exposed = []
         self.initialization_error = None
-        self._preview = None  # recomputes the outputs until exitInitializationMode
-        self._reals = {}     # value reference -> attribute name, Real variables
-        self._booleans = {}  # value reference -> attribute name, Boolean variables
-        # pythonfmu's generic accessors check every variable's type on every call; these
-        # table lookups do the same job in about half the time (they run at every step)
-        slave.get_real, slave.set_real, slave.get_boolean = (
-            self._get_real, self._set_real, self._get_boolean)
+        # value reference -> (name, kind, causality, variability); table lookups replace
+        # pythonfmu's generic accessors (they run at every step)
+        self._variables = {}
+        self._tables = {}
+        self.guard = CallGuard(slave, self)
+        # pythonfmu calls the state byte conversions on the class: make them never raise
+        cls = type(slave)
+        cls._fmu_state_to_bytes = staticmethod(state_to_bytes)
+        cls._fmu_state_from_bytes = staticmethod(state_from_bytes)
         with open(os.path.join(slave.resources, PARAMETERS_FILE), encoding="utf-8") as stream:
             self.parameter_file = json.load(stream)
         entries = self.parameter_file["parameters"]
@@ -48,29 +58,61 @@ class SlaveInterface:
     def _declare(self, variable, start, unit):
         setattr(self.slave, variable.name, start)
         self.slave.register_variable(variable)
-        if isinstance(variable, Real):
-            self._reals[variable.value_reference] = variable.name
-        elif isinstance(variable, Boolean):
-            self._booleans[variable.value_reference] = variable.name
+        kind = next(name for cls, name in _KIND_OF if isinstance(variable, cls))
+        self._variables[variable.value_reference] = (
+            variable.name, kind, variable.causality.name, variable.variability.name)
+        self._tables.clear()
         if unit is not None:
             self.units[variable.name] = unit
 
-    def _get_real(self, references):
-        if self._preview is not None:
-            self._preview()
-        slave, names = self.slave, self._reals
-        return [float(getattr(slave, names[vr])) for vr in references]
+    # ---- variable tables (used by the guard) ----------------------------------------------
+    def _table(self, key, build):
+        table = self._tables.get(key)
+        if table is None:
+            table = self._tables[key] = build()
+        return table
 
-    def _set_real(self, references, values):
-        slave, names = self.slave, self._reals
-        for vr, value in zip(references, values):
-            setattr(slave, names[vr], value)
+    def names(self, kind):
+        """{value reference: attribute name} of the variables of type ``kind`` ("Real", ...)."""
+        return self._table(kind, lambda: {vr: v[0] for vr, v in self._variables.items() if v[1] == kind})
 
-    def _get_boolean(self, references):
-        if self._preview is not None:
-            self._preview()
-        slave, names = self.slave, self._booleans
-        return [bool(getattr(slave, names[vr])) for vr in references]
+    def settable(self, kind, state):
+        """{value reference: name} of the ``kind`` variables that may be set in ``state``."""
+        return self._table((kind, state), lambda: {
+            vr: v[0] for vr, v in self._variables.items()
+            if v[1] == kind and setting_refusal(v[2], v[3], state) is None})
+
+    def setting_refusal(self, kind, reference, state, rule):
+        """Why value reference ``reference`` cannot be set as a ``kind`` in ``state``."""
+        variable = self._variables.get(reference)
+        if variable is None or variable[1] != kind:
+            return self.describe_reference(kind, reference & 0xFFFFFFFF)
+        return f"{variable[0]} (value reference {reference}) cannot be set: " \
+               f"{rule(variable[2], variable[3], state)}"
+
+    def describe_reference(self, kind, reference):
+        """Text for a value reference that is not a variable of type ``kind``."""
+        variable = self._variables.get(reference)
+        if variable is None:
+            return f"value reference {reference} is not a variable of {self.slave.modelName}"
+        return f"value reference {reference} is {variable[1]} variable {variable[0]}, not a {kind}"
+
+    def variable_kinds(self):
+        """{name: kind} of every variable (what a saved state must hold)."""
+        return {v[0]: v[1] for v in self._variables.values()}
+
+    def real_output_names(self):
+        """Names of the Real outputs (which must stay finite)."""
+        return [v[0] for v in self._variables.values() if v[1] == "Real" and v[2] == "output"]
+
+    def log(self, message, status=Fmi2Status.ok):
+        """Log ``message`` for the host, naming the model and instance.
+
+        Every '%' is doubled: a host that uses the message as a printf format (pythonfmu
+        passes it so, when no front is built) prints it literally; the front undoes it.
+        """
+        text = f"{self.slave.modelName} '{self.slave.instance_name}': {message}"
+        self.slave.log(text.replace("%", "%%"), status)
 
     def parameter(self, name, start, unit, description, kind=Real):
         """A fixed parameter ``name`` with ``start`` value, ``unit`` and ``description``."""
@@ -131,50 +173,44 @@ class SlaveInterface:
         return decorate_model_description(root, self.units)
 
     def preview_outputs(self, start, publish, invalid_outputs):
-        """Until exitInitializationMode, compute the outputs afresh whenever they are read.
+        """Outputs that follow what is set in Initialization Mode (kept for the slaves' API).
 
-        Hosts read outputs in Initialization Mode (libcosim and Ecos do, to pass start values
-        along connections), so they must follow the inputs and parameters set so far:
-        ``publish(start()[1])``, or ``publish(invalid_outputs)`` while ``start`` raises (the
-        error is logged at exitInitializationMode).
+        The guard does this for every slave: until exitInitializationMode it recomputes the
+        outputs by running the slave's ``exit_initialization_mode`` whenever they are read
+        after a set, and refuses the read (fmi2Error, with the reason) while that fails.
         """
-        def preview():
-            try:
-                outputs = start()[1]
-            except Exception:  # noqa: BLE001 - reported by initialize()
-                outputs = invalid_outputs
-            publish(outputs)
-        self._preview = preview
 
     def initialize(self, start, invalid_outputs):
-        """Run ``start()`` -> (stepper, outputs) at exitInitializationMode; never raise.
+        """Run ``start()`` -> (stepper, outputs) for exitInitializationMode; never raise.
 
-        pythonfmu turns an exception here into fmi2Fatal, after which a host may not even
-        free the instance. Invalid parameters are instead logged as fmi2Error, the outputs
-        become ``invalid_outputs`` (NaN) and every doStep is discarded with the reason.
+        pythonfmu turns an exception here into fmi2Fatal. Invalid parameters instead set
+        :attr:`initialization_error` and give ``invalid_outputs``; the guard then refuses
+        fmi2ExitInitializationMode with fmi2Error naming the reason, and the instance stays
+        in Initialization Mode, where the host may correct the parameters.
         """
-        self._preview = None
         try:
             stepper, outputs = start()
-        except ValueError as error:
-            self.initialization_error = str(error)
-            self.report("initialization failed (every doStep will be discarded)", error)
+        except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
+            self.initialization_error = (str(error) if isinstance(error, ValueError)
+                                         else f"{type(error).__name__}: {error}")
             return None, invalid_outputs
         self.initialization_error = None
         return stepper, outputs
 
     def not_initialized(self, current_time):
-        """Discard a doStep of an instance without a valid initialization; returns False."""
+        """Discard a doStep of an instance without a valid initialization; returns False.
+
+        (The guard refuses such a doStep before the slave sees it; kept for slaves that ask.)
+        """
         reason = self.initialization_error or "exitInitializationMode was not called"
         return self.report(f"step at t = {current_time!r} s discarded", f"not initialized: {reason}")
 
     def report(self, where, error):
-        """Log ``error`` as an fmi2Error message naming the instance and ``where``; return False.
+        """Log a rejected step: ``error`` with status fmi2Discard, naming ``where``; return False.
 
-        The FMU then answers fmi2Discard instead of letting an exception become fmi2Fatal.
+        The FMU answers fmi2Discard; the step changed nothing and may be retried.
         """
-        self.slave.log(f"{self.slave.modelName} '{self.slave.instance_name}' {where}: {error}",
-                       Fmi2Status.error)
+        self.log(f"{where}: {error}", Fmi2Status.discard)
         return False
 
     @staticmethod

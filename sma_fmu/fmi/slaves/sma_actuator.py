@@ -47,7 +47,7 @@ class SmaActuator(Fmi2Slave):
         fmi.string_parameter("hysteresis_mode", "continuous",
                              "'continuous' (minor loops; holds a set-point) or 'switch' "
                              "(paper: branch follows sgn dT/dt; limit-cycles at a set-point)")
-        fmi.model_parameters()
+        fmi.model_parameters(extra=("T_max",))
         self.stepper = None
         self._publish(PlantStepper(fmi.defaults, self.T_start, self.hysteresis_mode, self.load).outputs)
         fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
@@ -82,8 +82,8 @@ class SmaActuator(Fmi2Slave):
     def _set_fmu_state(self, state):
         variables, stepper_state = self.interface.split_state(state)
         super()._set_fmu_state(variables)
-        if stepper_state is not None:
-            if self.stepper is None:
-                self.stepper = self._start()[0]
+        # a new stepper with the restored parameters, then its hidden state
+        self.stepper = None if stepper_state is None else self._start()[0]
+        if self.stepper is not None:
             self.stepper.restore(stepper_state)
             self._publish(self.stepper.outputs)

@@ -81,7 +81,7 @@ class SmaFeedforward(Fmi2Slave):
     def _set_fmu_state(self, state):
         variables, stepper_state = self.interface.split_state(state)
         super()._set_fmu_state(variables)
-        if stepper_state is not None:
-            if self.stepper is None:
-                self.stepper = self._start()[0]
+        # a new stepper with the restored parameters, then its hidden state
+        self.stepper = None if stepper_state is None else self._start()[0]
+        if self.stepper is not None:
             self.stepper.restore(stepper_state)

@@ -5,15 +5,19 @@
  *
  * usage: cosim_run FMU STEP_S STEPS VR=VALUE... -- OUT_VR...
  *   sets each input/parameter VR to VALUE before initialization, runs STEPS fixed steps
- *   of STEP_S seconds, then prints "VR=value" (%.17g) for each OUT_VR.
+ *   of STEP_S seconds, then prints "VR=value" (%.17g) for each OUT_VR. With
+ *   COSIM_RUN_TIMING=1 it steps one step at a time and also prints
+ *   "timing P50_US P99_US P999_US TOTAL_S" (each step's wall time, first step excluded).
  * Exit status 1 with libcosim's message on stderr on any failure.
  */
+#define _POSIX_C_SOURCE 199309L
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 typedef int64_t cosim_time_point;
 typedef int64_t cosim_duration;
@@ -37,6 +41,39 @@ int cosim_observer_slave_get_real(cosim_observer* observer, cosim_slave_index sl
                                   const cosim_value_reference variables[], size_t nv,
                                   double values[]);
 int cosim_execution_destroy(cosim_execution* execution);
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+static int by_value(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+/* Steps one at a time, timing each; prints the percentiles. */
+static int timed_steps(cosim_execution* execution, long steps)
+{
+    if (cosim_execution_step(execution, 1) != 0) return -1; /* the first step initializes */
+    double* cost = malloc(sizeof(double) * (size_t)steps);
+    double start = now();
+    for (long i = 1; i < steps; ++i) {
+        double before = now();
+        if (cosim_execution_step(execution, 1) != 0) { free(cost); return -1; }
+        cost[i - 1] = now() - before;
+    }
+    double total = now() - start;
+    long n = steps - 1;
+    qsort(cost, (size_t)n, sizeof(double), by_value);
+    printf("timing %.3f %.3f %.3f %.6f\n", 1e6 * cost[n / 2], 1e6 * cost[(long)(n * 0.99)],
+           1e6 * cost[(long)(n * 0.999)], total);
+    free(cost);
+    return 0;
+}
 
 static int fail(const char* what)
 {
@@ -73,7 +110,12 @@ int main(int argc, char** argv)
     cosim_observer* observer = cosim_last_value_observer_create();
     if (!observer || cosim_execution_add_observer(execution, observer) != 0)
         return fail("cosim_execution_add_observer");
-    if (cosim_execution_step(execution, (size_t)steps) != 0) return fail("cosim_execution_step");
+    const char* timing = getenv("COSIM_RUN_TIMING");
+    if (timing && *timing == '1' && steps > 1) {
+        if (timed_steps(execution, steps) != 0) return fail("cosim_execution_step");
+    } else if (cosim_execution_step(execution, (size_t)steps) != 0) {
+        return fail("cosim_execution_step");
+    }
 
     for (++arg; arg < argc; ++arg) {
         cosim_value_reference vr = (cosim_value_reference)strtoul(argv[arg], NULL, 10);

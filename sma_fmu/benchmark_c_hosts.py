@@ -1,0 +1,106 @@
+"""What a SmaActuator step costs in C hosts, before and after the native front.
+
+Each host runs 30,000 steps of 1 ms (P_in = 2.6 W, load = 0.05 kg) and times every step:
+- the plain ``dlopen`` C host (``sma_fmu/fmi/hosts/fmi_host.c``): set P_in + doStep + get T;
+- libcosim (``hosts/cosim_run.c``, if libcosimpy is installed): one ``cosim_execution_step``
+  (libcosim sets, steps and reads the FMU's variables itself).
+"Before" is pythonfmu's own binary with libpython in LD_PRELOAD (what the FMUs were);
+"after" is the front, which also keeps one Python thread state per host thread; the front
+without that keeper (SMA_FMU_NO_TSTATE=1) shows what the keeper alone is worth.
+"""
+import os
+import shutil
+import statistics
+import subprocess
+import zipfile
+from pathlib import Path
+
+from sma_fmu.fmi.front import libpython_path
+from sma_fmu.fmi.hosts import compile_cosim_run, compile_host
+
+__all__ = ["C_HOST_STEPS", "c_host_step_costs"]
+
+C_HOST_STEPS = 30_000
+_STEP = 1e-3
+
+
+def _without_front(fmu, destination):
+    """A copy of ``fmu`` whose binary is pythonfmu's own again (the FMUs before the front)."""
+    with zipfile.ZipFile(fmu) as source, zipfile.ZipFile(destination, "w", zipfile.ZIP_DEFLATED) as target:
+        names = source.namelist()
+        for item in source.infolist():
+            if item.filename.endswith("_pythonfmu.so"):
+                continue
+            backend = item.filename.replace(".so", "_pythonfmu.so")
+            data = source.read(backend if backend in names else item.filename)
+            target.writestr(item, data)
+    return destination
+
+
+def _references(fmu):
+    from sma_fmu.fmi.build import read_description
+    return {v.name: v.valueReference for v in read_description(fmu).modelVariables}
+
+
+def _environment(extra):
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON", "SMA_FMU_NO_TSTATE")}
+    env.update(extra)
+    return env
+
+
+def _plain_host(exe, folder, refs, env):
+    """(mean, p50, p99, p99.9) [us] of set + doStep + get in fmi_host."""
+    commands = "\n".join([
+        f"instantiate 0 {b'bench'.hex()} ok ok 0", "setup 0 0 -", "enter 0",
+        f"setreal 0 1 {refs['load']} 0.05", "exit 0",
+        f"bench 0 {C_HOST_STEPS} {_STEP} {refs['P_in']} 2.6 {refs['T']} 0", "end", ""])
+    result = subprocess.run([str(exe), str(folder)], input=commands, capture_output=True, text=True,
+                            env=_environment(env), timeout=600, check=True)
+    words = [line.split() for line in result.stdout.splitlines() if line.startswith("= ")][-1]
+    if words[1] != "0":
+        raise RuntimeError(f"the C host's bench failed: {result.stdout[-500:]}")
+    p50, p99, p999, total = map(float, words[3:7])
+    return total / C_HOST_STEPS * 1e6, p50, p99, p999
+
+
+def _libcosim(exe, fmu, refs, env):
+    """(mean, p50, p99, p99.9) [us] of one libcosim step."""
+    result = subprocess.run(
+        [str(exe), str(fmu), repr(_STEP), str(C_HOST_STEPS), f"{refs['P_in']}=2.6",
+         f"{refs['load']}=0.05", "--", str(refs["T"])], capture_output=True, text=True,
+        env=_environment({**env, "COSIM_RUN_TIMING": "1"}), timeout=600)
+    timing = [line.split() for line in result.stdout.splitlines() if line.startswith("timing ")]
+    if result.returncode != 0 or not timing:
+        raise RuntimeError(f"libcosim run failed: {(result.stdout + result.stderr)[-500:]}")
+    p50, p99, p999, total = map(float, timing[-1][1:])
+    return total / (C_HOST_STEPS - 1) * 1e6, p50, p99, p999
+
+
+def c_host_step_costs(fmu, runs, folder):
+    """{host and configuration: {mean_us, p50_us, p99_us, p99_9_us}} (medians of ``runs``)."""
+    folder = Path(folder)
+    refs = _references(fmu)
+    before = _without_front(fmu, folder / "SmaActuator-pythonfmu.fmu")
+    unpacked = {}
+    for name, path in (("front", fmu), ("pythonfmu", before)):
+        unpacked[name] = folder / f"unpacked-{name}"
+        shutil.unpack_archive(str(path), str(unpacked[name]), "zip")
+    preload = {"LD_PRELOAD": libpython_path()[0]}
+    host = compile_host(folder)
+    cases = {
+        "plain C host, pythonfmu + LD_PRELOAD (before)": lambda: _plain_host(host, unpacked["pythonfmu"], refs, preload),
+        "plain C host, front without thread-state keeper": lambda: _plain_host(
+            host, unpacked["front"], refs, {"SMA_FMU_NO_TSTATE": "1"}),
+        "plain C host, front (after)": lambda: _plain_host(host, unpacked["front"], refs, {}),
+    }
+    cosim = compile_cosim_run(folder)
+    if cosim is not None:
+        cases["libcosim step, pythonfmu + LD_PRELOAD (before)"] = lambda: _libcosim(cosim, before, refs, preload)
+        cases["libcosim step, front (after)"] = lambda: _libcosim(cosim, fmu, refs, {})
+    results = {}
+    for name, measure in cases.items():
+        samples = list(zip(*(measure() for _ in range(runs))))
+        results[name] = {key: round(statistics.median(values), 3) for key, values in
+                         zip(("mean_us", "p50_us", "p99_us", "p99_9_us"), samples)}
+    return results

@@ -1,0 +1,310 @@
+/*
+ * fmi_host.c - a plain C FMI 2.0 co-simulation host for the tests: no libpython linked,
+ * no LD_PRELOAD. It dlopens DIR/binaries/linux64/<modelIdentifier>.so like fmusim does
+ * and runs FMI calls read from stdin, one command per line, so the tests (and the fuzz
+ * suite) can drive any call sequence in a real non-Python process.
+ *
+ * usage: fmi_host DIR   then commands on stdin; strings are hex-encoded, "-" is NULL:
+ *   instantiate S NAME URI GUID LOGGING   URI: ok|one|localhost|plain|empty|null|missing|
+ *                                         http|relative|pct or hex text; GUID: ok|wrong|null
+ *   free S | setup S T0 STOP(or -) | enter S | exit S | terminate S | reset S
+ *   setreal S N VR V ... | getreal S N VR ... | setbool S N VR B ... | getbool S N VR ...
+ *   setint S N VR I ... | getint S N VR ... | setstring S N VR TEXT ... | getstring S N VR ...
+ *   step S T H | getstate S K | setstate S K | freestate S K | serialize S K
+ *   deserialize S K BYTES | boolstatus S KIND | realstatus S KIND | debuglog S ON N CAT ...
+ *   bench S STEPS H VR_IN VALUE VR_OUT T0 (set + doStep + get from T0; p50/p99/p99.9 in us)
+ * Each command prints its log lines ("log STATUS CATEGORY TEXT", text hex-encoded) and then
+ * one result line "= STATUS [values]". The logger formats the message like fmusim, the FMI
+ * Library and fmpy's log proxy do: as a printf format (which a '%' must not break).
+ */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef void* Component;
+typedef struct {
+    void (*logger)(void*, const char*, int, const char*, const char*, ...);
+    void* (*allocate)(size_t, size_t);
+    void (*release)(void*);
+    void* step_finished;
+    void* environment;
+} Callbacks;
+
+#define SLOTS 8
+#define MAXN 64
+static struct {
+    Component (*Instantiate)(const char*, int, const char*, const char*, const Callbacks*, int, int);
+    void (*FreeInstance)(Component);
+    int (*SetupExperiment)(Component, int, double, double, int, double);
+    int (*EnterInitializationMode)(Component), (*ExitInitializationMode)(Component);
+    int (*Terminate)(Component), (*Reset)(Component);
+    int (*SetReal)(Component, const unsigned*, size_t, const double*);
+    int (*GetReal)(Component, const unsigned*, size_t, double*);
+    int (*SetInteger)(Component, const unsigned*, size_t, const int*);
+    int (*GetInteger)(Component, const unsigned*, size_t, int*);
+    int (*SetBoolean)(Component, const unsigned*, size_t, const int*);
+    int (*GetBoolean)(Component, const unsigned*, size_t, int*);
+    int (*SetString)(Component, const unsigned*, size_t, const char* const*);
+    int (*GetString)(Component, const unsigned*, size_t, const char**);
+    int (*DoStep)(Component, double, double, int);
+    int (*GetFMUstate)(Component, void**), (*SetFMUstate)(Component, void*);
+    int (*FreeFMUstate)(Component, void**);
+    int (*SerializedFMUstateSize)(Component, void*, size_t*);
+    int (*SerializeFMUstate)(Component, void*, char*, size_t);
+    int (*DeSerializeFMUstate)(Component, const char*, size_t, void**);
+    int (*GetBooleanStatus)(Component, int, int*), (*GetRealStatus)(Component, int, double*);
+    int (*SetDebugLogging)(Component, int, size_t, const char* const*);
+} F;
+
+static char dir[PATH_MAX], guid[256], model[256];
+static Component slot[SLOTS];
+static void* states[SLOTS][4];
+
+static void print_hex(const char* text, size_t n)
+{
+    if (!text) { fputs("-", stdout); return; }
+    if (n == 0) { fputs("_", stdout); return; }
+    for (size_t i = 0; i < n; ++i) printf("%02x", (unsigned char)text[i]);
+}
+
+static void logger(void* env, const char* name, int status, const char* category, const char* message, ...)
+{
+    (void)env; (void)name;
+    char text[8192];
+    va_list args;
+    va_start(args, message);
+    vsnprintf(text, sizeof text, message, args); /* the message is a printf format (FMI 2.0) */
+    va_end(args);
+    printf("log %d %s ", status, category && *category ? category : "-");
+    print_hex(text, strlen(text));
+    putchar('\n');
+}
+
+/* hex text -> malloc'd bytes (NUL-terminated); "-" -> NULL, "_" -> "". */
+static char* unhex(const char* hex, size_t* length)
+{
+    if (!strcmp(hex, "-")) { if (length) *length = 0; return NULL; }
+    size_t n = strcmp(hex, "_") ? strlen(hex) / 2 : 0;
+    char* out = calloc(n + 1, 1);
+    for (size_t i = 0; i < n; ++i) sscanf(hex + 2 * i, "%2hhx", (unsigned char*)&out[i]);
+    if (length) *length = n;
+    return out;
+}
+
+static const char* resource_uri(const char* mode)
+{
+    static char uri[PATH_MAX + 64];
+    char absolute[PATH_MAX];
+    if (!realpath(dir, absolute)) return NULL;
+    if (!strcmp(mode, "ok")) snprintf(uri, sizeof uri, "file://%s/resources", absolute);
+    else if (!strcmp(mode, "one")) snprintf(uri, sizeof uri, "file:%s/resources", absolute);
+    else if (!strcmp(mode, "localhost")) snprintf(uri, sizeof uri, "file://localhost%s/resources", absolute);
+    else if (!strcmp(mode, "plain")) snprintf(uri, sizeof uri, "%s/resources", absolute);
+    else if (!strcmp(mode, "pct")) snprintf(uri, sizeof uri, "file://%s/re%%73ources", absolute);
+    else if (!strcmp(mode, "empty")) uri[0] = '\0';
+    else if (!strcmp(mode, "null")) return NULL;
+    else if (!strcmp(mode, "missing")) snprintf(uri, sizeof uri, "file://%s/nonexistent", absolute);
+    else if (!strcmp(mode, "http")) snprintf(uri, sizeof uri, "http://example.com%s/resources", absolute);
+    else if (!strcmp(mode, "relative")) snprintf(uri, sizeof uri, "file:resources");
+    else { char* text = unhex(mode, NULL); snprintf(uri, sizeof uri, "%s", text ? text : ""); free(text); }
+    return uri;
+}
+
+static void read_model_description(void)
+{
+    char path[PATH_MAX + 32];
+    snprintf(path, sizeof path, "%s/modelDescription.xml", dir);
+    FILE* file = fopen(path, "r");
+    if (!file) { perror(path); exit(2); }
+    static char xml[1 << 17];
+    xml[fread(xml, 1, sizeof xml - 1, file)] = '\0';
+    fclose(file);
+    char* g = strstr(xml, " guid=\"");
+    char* m = strstr(xml, "modelIdentifier=\"");
+    if (!g || !m) { fprintf(stderr, "no guid or modelIdentifier\n"); exit(2); }
+    sscanf(g + 7, "%255[^\"]", guid);
+    sscanf(m + 17, "%255[^\"]", model);
+}
+
+static void load(void)
+{
+    char path[PATH_MAX + 300];
+    snprintf(path, sizeof path, "%s/binaries/linux64/%s.so", dir, model);
+    void* library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!library) { fprintf(stderr, "fmi_host: dlopen: %s\n", dlerror()); exit(3); }
+#define SYM(n) if (!(*(void**)&F.n = dlsym(library, "fmi2" #n))) { fprintf(stderr, "no fmi2" #n "\n"); exit(3); }
+    SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
+    SYM(ExitInitializationMode) SYM(Terminate) SYM(Reset) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
+    SYM(GetInteger) SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(GetString) SYM(DoStep)
+    SYM(GetFMUstate) SYM(SetFMUstate) SYM(FreeFMUstate) SYM(SerializedFMUstateSize)
+    SYM(SerializeFMUstate) SYM(DeSerializeFMUstate) SYM(GetBooleanStatus) SYM(GetRealStatus)
+    SYM(SetDebugLogging)
+#undef SYM
+}
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+static int by_value(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+static void bench(Component c, long steps, double h, unsigned in, double value, unsigned out, double t)
+{
+    double* cost = malloc(sizeof(double) * (size_t)steps), result = 0.0;
+    int status = 0;
+    double start = now();
+    for (long i = 0; i < steps && status <= 1; ++i) {
+        double before = now();
+        status = F.SetReal(c, &in, 1, &value);
+        if (status <= 1) status = F.DoStep(c, t, h, 1);
+        if (status <= 1) status = F.GetReal(c, &out, 1, &result);
+        cost[i] = now() - before;
+        t += h;
+    }
+    double total = now() - start;
+    qsort(cost, (size_t)steps, sizeof(double), by_value);
+    printf("= %d %.17g %.3f %.3f %.3f %.6f\n", status, result, 1e6 * cost[steps / 2],
+           1e6 * cost[(long)(steps * 0.99)], 1e6 * cost[(long)(steps * 0.999)], total);
+    free(cost);
+}
+
+int main(int argc, char** argv)
+{
+    if (argc != 2) { fprintf(stderr, "usage: fmi_host DIR < commands\n"); return 2; }
+    snprintf(dir, sizeof dir, "%s", argv[1]);
+    read_model_description();
+    load();
+    Callbacks callbacks = {logger, calloc, free, NULL, NULL};
+    static char line[1 << 20];
+    while (fgets(line, sizeof line, stdin)) {
+        char* word[4 * MAXN + 8];
+        int n = 0;
+        for (char* p = strtok(line, " \n"); p && n < 4 * MAXN + 8; p = strtok(NULL, " \n")) word[n++] = p;
+        if (n == 0) continue;
+        const char* command = word[0];
+        if (!strcmp(command, "end")) break;
+        int s = n > 1 ? atoi(word[1]) % SLOTS : 0;
+        Component c = slot[s];
+        unsigned vr[MAXN];
+        int count = n > 2 ? atoi(word[2]) : 0;
+        if (count < 0 || count > MAXN) count = 0;
+        int status = -1;
+        if (!strcmp(command, "instantiate") && n == 6) {
+            char* name = unhex(word[2], NULL);
+            const char* id = !strcmp(word[4], "ok") ? guid : !strcmp(word[4], "wrong") ? "{00000000-0}" : NULL;
+            slot[s] = F.Instantiate(name, 1, id, resource_uri(word[3]), &callbacks, 0, atoi(word[5]));
+            free(name);
+            printf("= %d\n", slot[s] ? 0 : 3);
+            fflush(stdout);
+            continue;
+        }
+        if (!c) { printf("= -2\n"); fflush(stdout); continue; } /* no instance in this slot */
+        if (!strcmp(command, "free")) { F.FreeInstance(c); slot[s] = NULL; memset(states[s], 0, sizeof states[s]); status = 0; }
+        else if (!strcmp(command, "setup") && n == 4)
+            status = F.SetupExperiment(c, 0, 0.0, strtod(word[2], NULL), strcmp(word[3], "-") != 0,
+                                       strtod(word[3], NULL));
+        else if (!strcmp(command, "enter")) status = F.EnterInitializationMode(c);
+        else if (!strcmp(command, "exit")) status = F.ExitInitializationMode(c);
+        else if (!strcmp(command, "terminate")) status = F.Terminate(c);
+        else if (!strcmp(command, "reset")) status = F.Reset(c);
+        else if (!strcmp(command, "step") && n == 4) status = F.DoStep(c, strtod(word[2], NULL), strtod(word[3], NULL), 1);
+        else if (!strncmp(command, "set", 3) && n >= 3 + 2 * count && strcmp(command, "setstate") && strcmp(command, "setup")) {
+            double reals[MAXN];
+            int ints[MAXN];
+            char* texts[MAXN];
+            for (int i = 0; i < count; ++i) {
+                vr[i] = (unsigned)strtoul(word[3 + 2 * i], NULL, 10);
+                const char* v = word[4 + 2 * i];
+                reals[i] = strtod(v, NULL);
+                ints[i] = (int)strtol(v, NULL, 10);
+                texts[i] = !strcmp(command, "setstring") ? unhex(v, NULL) : NULL;
+            }
+            if (!strcmp(command, "setreal")) status = F.SetReal(c, vr, (size_t)count, reals);
+            else if (!strcmp(command, "setint")) status = F.SetInteger(c, vr, (size_t)count, ints);
+            else if (!strcmp(command, "setbool")) status = F.SetBoolean(c, vr, (size_t)count, ints);
+            else if (!strcmp(command, "setstring")) status = F.SetString(c, vr, (size_t)count, (const char* const*)texts);
+            for (int i = 0; i < count; ++i) free(texts[i]);
+        } else if (!strncmp(command, "get", 3) && strcmp(command, "getstate") && n >= 3 + count) {
+            double reals[MAXN];
+            int ints[MAXN];
+            const char* texts[MAXN] = {0};
+            for (int i = 0; i < count; ++i) vr[i] = (unsigned)strtoul(word[3 + i], NULL, 10);
+            if (!strcmp(command, "getreal")) status = F.GetReal(c, vr, (size_t)count, reals);
+            else if (!strcmp(command, "getint")) status = F.GetInteger(c, vr, (size_t)count, ints);
+            else if (!strcmp(command, "getbool")) status = F.GetBoolean(c, vr, (size_t)count, ints);
+            else if (!strcmp(command, "getstring")) status = F.GetString(c, vr, (size_t)count, texts);
+            printf("= %d", status);
+            for (int i = 0; i < count && status >= 0; ++i) {
+                if (!strcmp(command, "getreal")) printf(" %.17g", reals[i]);
+                else if (!strcmp(command, "getstring")) { putchar(' '); print_hex(texts[i], texts[i] ? strlen(texts[i]) : 0); }
+                else printf(" %d", ints[i]);
+            }
+            putchar('\n');
+            fflush(stdout);
+            continue;
+        } else if (n >= 3 && strstr(command, "state")) {
+            int k = atoi(word[2]) & 3;
+            if (!strcmp(command, "getstate")) status = F.GetFMUstate(c, &states[s][k]);
+            else if (!strcmp(command, "setstate")) status = F.SetFMUstate(c, states[s][k]);
+            else if (!strcmp(command, "freestate")) status = F.FreeFMUstate(c, &states[s][k]);
+        } else if (!strcmp(command, "serialize") && n == 3) {
+            int k = atoi(word[2]) & 3;
+            size_t size = 0;
+            status = F.SerializedFMUstateSize(c, states[s][k], &size);
+            char* bytes = status <= 1 ? malloc(size + 1) : NULL;
+            if (bytes) status = F.SerializeFMUstate(c, states[s][k], bytes, size);
+            printf("= %d ", status);
+            print_hex(bytes, status <= 1 ? size : 0);
+            putchar('\n');
+            free(bytes);
+            fflush(stdout);
+            continue;
+        } else if (!strcmp(command, "deserialize") && n == 4) {
+            size_t size = 0;
+            char* bytes = unhex(word[3], &size);
+            status = F.DeSerializeFMUstate(c, bytes ? bytes : "", size, &states[s][atoi(word[2]) & 3]);
+            free(bytes);
+        } else if (!strcmp(command, "boolstatus") && n == 3) {
+            int value = -1;
+            status = F.GetBooleanStatus(c, atoi(word[2]), &value);
+            printf("= %d %d\n", status, value);
+            fflush(stdout);
+            continue;
+        } else if (!strcmp(command, "realstatus") && n == 3) {
+            double value = -1;
+            status = F.GetRealStatus(c, atoi(word[2]), &value);
+            printf("= %d %.17g\n", status, value);
+            fflush(stdout);
+            continue;
+        } else if (!strcmp(command, "debuglog") && n >= 4) {
+            int k = atoi(word[3]) > 0 && atoi(word[3]) <= MAXN ? atoi(word[3]) : 0;
+            char* categories[MAXN];
+            for (int i = 0; i < k && 4 + i < n; ++i) categories[i] = unhex(word[4 + i], NULL);
+            status = F.SetDebugLogging(c, atoi(word[2]), (size_t)k, (const char* const*)categories);
+            for (int i = 0; i < k && 4 + i < n; ++i) free(categories[i]);
+        } else if (!strcmp(command, "bench") && n == 8 && atol(word[2]) > 0) {
+            bench(c, atol(word[2]), strtod(word[3], NULL), (unsigned)atoi(word[4]), strtod(word[5], NULL),
+                  (unsigned)atoi(word[6]), strtod(word[7], NULL));
+            fflush(stdout);
+            continue;
+        }
+        printf("= %d\n", status);
+        fflush(stdout);
+    }
+    for (int s = 0; s < SLOTS; ++s)
+        if (slot[s]) F.FreeInstance(slot[s]);
+    printf("bye\n");
+    return 0;
+}
