@@ -40,6 +40,13 @@ def mixed_fractions_of_resistance(resistance, constants, params):
     return (resistance - r_hot) / span, (r_cold - resistance) / span
 
 
+def _clamped(xi_mf, total, delta):
+    """(xi_MF, xi_P, True) moved to the nearer end of [delta, total - delta] (one is outside)."""
+    if not xi_mf >= delta:  # also NaN
+        return delta, total - delta, True
+    return total - delta, delta, True
+
+
 def temperature_of_fractions(xi_mf, xi_p, constants, margin):
     """Invert a major branch: (xi_MF, xi_P) [1] -> :class:`SensedTemperature`.
 
@@ -47,10 +54,8 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin):
     """
     delta = margin * constants.M
     saturated = False
-    if not xi_mf >= delta:
-        xi_mf, xi_p, saturated = delta, constants.M - delta, True
-    elif not xi_p >= delta:
-        xi_mf, xi_p, saturated = constants.M - delta, delta, True
+    if not (xi_mf >= delta and xi_p >= delta):
+        xi_mf, xi_p, saturated = _clamped(xi_mf, constants.M, delta)
     exponent = math.log(xi_p / xi_mf)
     inverse_kelvin = constants.inv_centre_K - exponent / constants.energy_over_kB
     if not inverse_kelvin > 0.0:
@@ -75,10 +80,8 @@ def temperature_on_branch(xi_mf, xi_p, constants, direction, reversal, margin):
         return temperature_of_fractions(xi_mf, xi_p, constants, margin)
     delta = margin * constants.M
     clamped = False
-    if not xi_mf >= delta:
-        xi_mf, xi_p, clamped = delta, constants.M - delta, True
-    elif not xi_p >= delta:
-        xi_mf, xi_p, clamped = constants.M - delta, delta, True
+    if not (xi_mf >= delta and xi_p >= delta):
+        xi_mf, xi_p, clamped = _clamped(xi_mf, constants.M, delta)
     major = major_equivalent(xi_mf, xi_p, constants, direction, reversal)
     if major is None:
         return _new_tuple(SensedTemperature, (reversal.temperature, True))
