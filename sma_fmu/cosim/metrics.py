@@ -13,7 +13,7 @@ import numpy as np
 
 from sma_fmu.runtime.reachable_band import reachable_band
 
-__all__ = ["error_metrics", "unreachable_samples", "unreachable_intervals",
+__all__ = ["error_metrics", "band_edges", "unreachable_samples", "unreachable_intervals",
            "reachability_warning", "scenario_metrics"]
 
 _LISTED_INTERVALS = 4  # a warning names at most this many intervals, then counts the rest
@@ -33,17 +33,26 @@ def error_metrics(errors, step_size):
         }
 
 
-def unreachable_samples(references, loads, params):
-    """Boolean arrays (below, above): R_ref [ohm] at or below R_hot(f), at or above R_cold(f).
+def band_edges(loads, params):
+    """Arrays (R_hot, R_cold) [ohm] of the reachable band at each load [kg] of ``loads``.
 
-    ``references`` and ``loads`` [kg] are arrays of samples; the band is computed once per
-    distinct load (loads are piecewise constant).
+    The band is computed once per distinct load (loads are piecewise constant).
     """
-    references, loads = np.asarray(references, dtype=float), np.asarray(loads, dtype=float)
-    hot, cold = np.empty_like(references), np.empty_like(references)
+    loads = np.asarray(loads, dtype=float)
+    hot, cold = np.empty_like(loads), np.empty_like(loads)
     for load in np.unique(loads):
         band = reachable_band(float(load), params)
         hot[loads == load], cold[loads == load] = band.hot, band.cold
+    return hot, cold
+
+
+def unreachable_samples(references, loads, params):
+    """Boolean arrays (below, above): R_ref [ohm] at or below R_hot(f), at or above R_cold(f).
+
+    ``references`` and ``loads`` [kg] are arrays of samples.
+    """
+    references = np.asarray(references, dtype=float)
+    hot, cold = band_edges(loads, params)
     return references <= hot, references >= cold
 
 
