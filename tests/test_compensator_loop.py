@@ -66,6 +66,30 @@ def test_minor_loop_controller_fmu_path_equals_library_path(fmus):
     assert np.max(np.abs(major["T_ref"][:-1] - library["T_ref"][:-1])) > 1.0  # another inverse
 
 
+def test_minor_loop_option_reaches_the_system_tools(fmus, tmp_path):
+    """The SSP binds inverse = minor-loop, and a host run matches the library loop."""
+    import dataclasses
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    from sma_fmu.systems.closed_loop import closed_loop
+    from sma_fmu.systems.comparison import compare_hosts
+    from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME, write_ssp
+
+    scenario = dataclasses.replace(_scenario("load-step-continuous-pi+ff-adaptive-minor-loop"),
+                                   stop_time_s=2.2)
+    fmu_dir = fmus["SmaActuator"].parent
+    path = write_ssp(closed_loop(scenario, fmu_dir), tmp_path / "minor.ssp")
+    with zipfile.ZipFile(path) as archive:
+        root = ET.fromstring(archive.read(SSD_NAME))
+    bound = {(c.get("name"), p.get("name")): p[0].get("value")
+             for c in root.iter(f"{{{NAMESPACES['ssd']}}}Component")
+             for p in c.iter(f"{{{NAMESPACES['ssv']}}}Parameter")}
+    assert bound[("compensator", "inverse")] == "minor-loop"
+    rows = compare_hosts(scenario, fmu_dir, hosts=("fmpy",))
+    assert rows[-1]["run"] == "fmpy (container)" and rows[-1]["deviation"] <= 1e-9
+
+
 def test_feedforward_fmu_state_keeps_the_minor_loop_memory(fmus):
     start = {"inverse": "minor-loop", "R_ref": 45.0, "load": 0.05}
     references = [41.85 + 6.05 * math.cos(math.pi * k * 1e-3) for k in range(3000)]
@@ -124,15 +148,23 @@ def test_metrics_report_the_unreachable_part_of_the_run(tmp_path, params):
 
 
 def test_runner_warns_once_per_run_in_the_log_and_metrics(tmp_path):
+    wide = _wide(tmp_path)
+    short = tmp_path / "short-wide.toml"
+    short.write_text(wide.read_text().replace("stop_time_s = 30.0", "stop_time_s = 5.0"))
     messages = []
-    paths = [_wide(tmp_path), shipped_file("scenarios", "load-step-continuous-pi+ff-adaptive-minor-loop.toml")]
-    rows = run_scenarios(paths, tmp_path / "out", path="library", progress=messages.append)
+    run_scenarios([short], tmp_path / "out", path="library", progress=messages.append)
     warnings = [m for m in messages if m.startswith("warning:")]
     assert len(warnings) == 1
-    assert warnings[0].startswith("warning: wide: R_ref leaves the band the wire can reach")
-    assert "between t = 0 s and 30 s" in warnings[0] and "0.847-1.153 s (below R_hot)" in warnings[0]
-    written = json.loads((tmp_path / "out" / "wide" / "metrics.json").read_text())
-    assert written["warnings"] == [warnings[0][len("warning: wide: "):]]
-    paper = rows[1]["metrics"]
-    assert paper["unreachable_fraction"] == 0.0 and paper["warnings"] == []
-    assert paper["reachable"] == paper["overall"] and paper["inverse"] == "minor-loop"
+    assert warnings[0].startswith("warning: short-wide: R_ref leaves the band the wire can reach")
+    assert "interval(s) between t = 0 s and 5 s" in warnings[0]
+    assert "0.847-1.153 s (below R_hot)" in warnings[0] and "and 2 more" in warnings[0]
+    written = json.loads((tmp_path / "out" / "short-wide" / "metrics.json").read_text())
+    assert written["warnings"] == [warnings[0][len("warning: short-wide: "):]]
+
+
+def test_paper_reference_stays_reachable():
+    scenario = _scenario("load-step-continuous-pi+ff-adaptive-minor-loop")
+    metrics = scenario_metrics(run_library(scenario).data, scenario)
+    assert metrics["unreachable_fraction"] == 0.0 and metrics["warnings"] == []
+    assert metrics["unreachable_intervals_s"] == [] and metrics["saturated_fraction"] == 0.0
+    assert metrics["reachable"] == metrics["overall"] and metrics["inverse"] == "minor-loop"
