@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from sma_fmu.analysis.inverse_tracker import track
+from sma_fmu.analysis.inverse_tracker import OneStepInverse, track
 from sma_fmu.analysis.switch_dp import _WindowMin, cell_lower_bound
 from sma_fmu.analysis.tracking_bound import saturation_bound, tracking_bound
 from sma_fmu.analysis.tracking_problem import TemperatureGrid, TrackingProblem
@@ -133,6 +133,39 @@ def test_grid_passive_step_lands_at_most_one_cell_down(switch_bound):
     passive = np.array([thermal_step(t, 0.0, params.T_room, params.K_th, problem.decay)
                         for t in nodes])
     assert np.all(passive[1:] > nodes[:-1]) and np.all(passive[1:] - nodes[:-1] < 1e-8)
+
+
+def test_power_to_inverts_the_runtime_thermal_step(switch_bound):
+    problem = TrackingProblem.from_scenario(switch_bound[0])
+    params = problem.params
+    for start, target in ((10.0, 70.0), (80.0, 79.99), (55.5, 55.5), (90.0, 20.0)):
+        power = problem.power_to(start, target)
+        assert thermal_step(start, power, params.T_room, params.K_th, problem.decay) == \
+            pytest.approx(target, abs=1e-10)
+    assert problem.power_to(90.0, 20.0) < 0.0 < problem.power_to(10.0, 70.0)
+
+
+@pytest.mark.parametrize("mode,offset", [("switch", -1.0), ("switch", -0.05), ("continuous", -1.0),
+                                         ("continuous", -0.05), ("continuous", 0.02)])
+def test_one_step_inverse_lands_on_the_target(switch_bound, mode, offset):
+    """From a state inside the transformation reached with two reversals, one step to R + offset.
+
+    (In mode "switch" a small rise needs the cooling branch, far away: the one-step inverse
+    is greedy there, which is why the switch-mode benchmark is the dynamic program.)
+    """
+    problem = TrackingProblem.from_scenario(switch_bound[0], mode=mode)
+    inverse = OneStepInverse(problem)
+    for power in [3.5] * 1500 + [0.0] * 100 + [3.0] * 100:  # heat, cool a little, heat again
+        inverse.plant.step(power, 0.05, problem.step_s)
+    before = inverse.plant.outputs.R
+    assert 36.0 < before < 47.0 and (mode == "switch" or inverse.plant.reversal is not None)
+    target = before + offset
+    power = inverse.power_for(target, 0.05)
+    after = inverse.plant.step(power, 0.05, problem.step_s).R
+    if offset < 0.0 or power > 0.0:  # heating is always feasible (no cap)
+        assert power > 0.0 and after == pytest.approx(target, abs=1e-9)
+    else:  # cooling faster than passive is not: 0 W comes closest
+        assert abs(after - target) < abs(before - target)
 
 
 def test_window_minimum_matches_brute_force():

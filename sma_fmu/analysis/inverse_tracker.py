@@ -7,6 +7,9 @@ step allows it: the temperature comes from inverting the branch the plant will f
 branch from the present state after a reversal; the major branch in mode "switch"), and
 the power from the thermal step, clamped into [0, P_max].
 
+It is greedy: in mode "switch", where a small rise of R needs the far cooling branch,
+it does poorly (the dynamic program of :mod:`.switch_dp` is the benchmark there).
+
 Optionally it prefers passive cooling: P = 0 whenever R after a passive step lies within
 ``tolerance`` [ohm] of the target. In mode "continuous" this turns the power into a
 sawtooth at the step rate that ratchets xi_MF down at a moderate temperature (the minor
@@ -50,17 +53,14 @@ class OneStepInverse:
 
     def power_for(self, reference, load):
         """Power [W] in [0, P_max] for the next step (``load`` [kg] held) towards ``reference`` [ohm]."""
-        params, plant = self.problem.params, self.plant
-        now = plant.temperature
-        passive = params.T_room + self.problem.decay * (now - params.T_room)
+        now = self.plant.temperature
         heating = self._temperature_towards(reference, load, HEATING)
         if heating > now:
             aim = heating
         else:
             cooling = self._temperature_towards(reference, load, COOLING)
             aim = cooling if cooling < now else now
-        power = (aim - passive) / self.problem.heating_gain
-        return min(self.cap, max(0.0, power))
+        return min(self.cap, max(0.0, self.problem.power_to(now, aim)))
 
     def passive_resistance(self, load):
         """R [ohm] after a step at 0 W with ``load`` [kg] held; the plant is left unchanged."""

@@ -91,9 +91,8 @@ def cell_lower_bound(problem, grid, power_cap=None):
         charges[load] = (
             np.stack([np.append(_resistances(high_t[:-1], load, d, params), hot) for d in _ROWS]),
             np.stack([_resistances(low_t, load, d, params) for d in _ROWS]))
-    reach = (problem.params.T_room + problem.decay * (high_t - params.T_room)
-             + problem.heating_gain * cap)
-    can_heat = low_t < params.T_room + params.K_th * cap
+    reach = problem.after_step(high_t, cap)
+    can_heat = problem.after_step(low_t, cap) > low_t  # P_max can still raise T there
     cells = np.arange(size)
     heat = _WindowMin(cells, np.where(can_heat, grid.cell_of(reach), -1), size)
     values = np.zeros((2, size))
@@ -120,9 +119,9 @@ class _NodeProgram:
         self.problem, self.nodes = problem, grid.nodes
         count = len(self.nodes)
         self.start = count
-        self.can_hold = np.append((self.nodes - params.T_room) / params.K_th <= cap,
-                                  (problem.T_start - params.T_room) / params.K_th <= cap)
-        reach = params.T_room + problem.decay * (self.nodes - params.T_room) + problem.heating_gain * cap
+        self.can_hold = np.append(problem.power_to(self.nodes, self.nodes) <= cap,
+                                  problem.power_to(problem.T_start, problem.T_start) <= cap)
+        reach = problem.after_step(self.nodes, cap)
         self.heat = _WindowMin(np.arange(1, count + 1),
                                np.searchsorted(self.nodes, reach, side="right") - 1, count)
         self.costs = {}
@@ -202,8 +201,7 @@ def replay_path(problem, temperatures, rows, power_cap=None):
     its temperature and the plant is on it, the aim is the plant's temperature moved by
     1e-9 K in the held direction (rows[k + 1]), so the plant keeps that direction.
     """
-    params, cap = problem.params, np.inf if power_cap is None else power_cap
-    plant, decay, gain = problem.plant(), problem.decay, problem.heating_gain
+    cap, plant = np.inf if power_cap is None else power_cap, problem.plant()
     powers = np.empty(problem.steps)
     resistances = np.empty(problem.steps + 1)
     resistances[0] = plant.outputs.R
@@ -211,8 +209,7 @@ def replay_path(problem, temperatures, rows, power_cap=None):
         aim = temperatures[k + 1]
         if aim == temperatures[k] and abs(plant.temperature - aim) < 1e-6:
             aim = plant.temperature + (1e-9 if rows[k + 1] == 0 else -1e-9)
-        needed = (aim - params.T_room - decay * (plant.temperature - params.T_room)) / gain
-        powers[k] = min(cap, max(0.0, needed))
+        powers[k] = min(cap, max(0.0, problem.power_to(plant.temperature, aim)))
         resistances[k + 1] = plant.step(float(powers[k]), float(problem.step_loads[k]),
                                         problem.step_s).R
     return powers, resistances

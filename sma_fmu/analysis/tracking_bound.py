@@ -26,7 +26,6 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from sma_fmu.cosim.metrics import band_edges
-from sma_fmu.runtime.thermal import thermal_step
 
 from .inverse_tracker import track
 from .switch_dp import cell_lower_bound, node_path, replay_path
@@ -95,10 +94,9 @@ def saturation_bound(problem):
 
 def reversal_rate(problem, powers):
     """Direction changes of the temperature per second [1/s] under ``powers`` [W], metric window."""
-    params, decay = problem.params, problem.decay
     temperatures = [problem.T_start]
     for power in powers.tolist():
-        temperatures.append(thermal_step(temperatures[-1], power, params.T_room, params.K_th, decay))
+        temperatures.append(problem.after_step(temperatures[-1], power))
     signs = np.sign(np.diff(temperatures))[problem.weights[1:] > 0]
     signs = signs[signs != 0]
     return float(np.count_nonzero(np.diff(signs))) / (np.sum(problem.weights[1:]) * problem.step_s)

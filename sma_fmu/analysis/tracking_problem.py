@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sma_fmu.runtime.plant import PlantStepper
-from sma_fmu.runtime.thermal import step_decay
+from sma_fmu.runtime.thermal import step_decay, thermal_step
 
 __all__ = ["TrackingProblem", "TemperatureGrid"]
 
@@ -71,6 +71,21 @@ class TrackingProblem:
         """G = K_th (1 - a) [K/W]: the temperature one step adds per watt held."""
         return self.params.K_th * (1.0 - self.decay)
 
+    def after_step(self, temperature, power):
+        """Temperature [degC] one step after ``temperature`` [degC] at ``power`` [W] (arrays too).
+
+        The runtime's exact thermal step (:func:`~sma_fmu.runtime.thermal.thermal_step`).
+        """
+        params = self.params
+        return thermal_step(temperature, power, params.T_room, params.K_th, self.decay)
+
+    def power_to(self, temperature, target):
+        """Power [W] that takes ``temperature`` to ``target`` [degC] in one step (may be < 0).
+
+        The inverse of :meth:`after_step`, which is linear in the power.
+        """
+        return (target - self.after_step(temperature, 0.0)) / self.heating_gain
+
     def rmse(self, squared_sum):
         """RMSE [ohm] from a weighted sum of squared errors [ohm^2]."""
         return math.sqrt(max(float(squared_sum), 0.0) / self.weights.sum())
@@ -111,12 +126,16 @@ class TemperatureGrid:
     count: int
 
     @classmethod
-    def for_problem(cls, problem, low=30.0, high=135.0):
-        """A grid from ``low`` to at least ``high`` [degC] for the problem's wire and step."""
+    def for_problem(cls, problem, low=20.0, high=125.0):
+        """A grid from T_room + ``low`` to at least T_room + ``high`` [K above room].
+
+        The defaults give 30-135 degC for the reference wire (10 degC room): below, the
+        wire is fully cold; above, fully hot (the top cell holds both ends' rest anyway).
+        """
         params = problem.params
         delta = problem.step_s / params.tau_th * (1.0 + 1e-9)
-        offset = low - params.T_room
-        count = int(math.ceil(math.log((high - params.T_room) / offset) / delta))
+        offset = low
+        count = int(math.ceil(math.log(high / offset) / delta))
         return cls(params.T_room, min(params.T_room, problem.T_start), offset, delta, count)
 
     @property
