@@ -69,7 +69,7 @@ class LibraryCompensator:
     def __init__(self, scenario):
         c = scenario.controller
         self.stepper = FeedforwardStepper(scenario.params, c.alpha, c.beta, c.model_load,
-                                          c.adapt_to_load)
+                                          c.adapt_to_load, c.inverse)
 
     def initial(self, reference, load):
         """(P_ff [W], T_ref [degC], saturated) before the first step (what a Jacobi host passes on)."""

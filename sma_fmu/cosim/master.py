@@ -58,7 +58,8 @@ class FmuCompensator:
         c = scenario.controller
         start = model_parameter_values(fmu_path, scenario.params)
         start.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
-                     adapt_to_load=c.adapt_to_load, R_ref=scenario.reference.value(0.0),
+                     adapt_to_load=c.adapt_to_load, inverse=c.inverse,
+                     R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
         self._inputs = self.fmu.port(("R_ref", "load"))

@@ -79,6 +79,8 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
             write_timeseries(result.data, folder / "timeseries.csv")
             metrics = scenario_metrics(result.data, scenario)
             metrics.update(path=path, wall_time_s=result.wall_time_s)
+            for warning in metrics["warnings"]:
+                progress(f"warning: {scenario.name}: {warning}")
             (folder / "metrics.json").write_text(json_text(metrics), encoding="utf-8")
             plot_run(result.data, scenario, folder / "figure.png")
             rows.append({"scenario": name, "label": label, "group": scenario.group,

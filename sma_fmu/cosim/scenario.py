@@ -21,6 +21,8 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     [controller]                # pi | pi+ff-fixed | pi+ff-adaptive
     kind = "pi+ff-adaptive"     # optional, default from the parameter file's [control]:
                                 # Kp_W_per_ohm, Ki_W_per_ohm_s, alpha_s, beta_s, model_load_kg
+    # inverse = "minor-loop"    # compensator's inverse: "major" (default, the paper's) or
+                                # "minor-loop" (the plant's continuous-mode branches)
     [plant]
     hysteresis_mode = "switch"  # default "continuous"; optional T_start_degC (default T_room)
 
@@ -41,6 +43,7 @@ from sma_fmu.parameter_file import load_parameter_set
 from sma_fmu.package_data import shipped_file, shipped_files
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
+from sma_fmu.runtime.feedforward import INVERSES
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
 from sma_fmu.toml_files import read_toml
@@ -57,7 +60,8 @@ _SECTIONS = {
     "scenario": {"description", "stop_time_s", "step_s", "model", "group"},
     "reference": None,  # checked by signals.reference_from_table
     "load": None,       # checked by signals.load_from_table
-    "controller": {"kind", "Kp_W_per_ohm", "Ki_W_per_ohm_s", "alpha_s", "beta_s", "model_load_kg"},
+    "controller": {"kind", "Kp_W_per_ohm", "Ki_W_per_ohm_s", "alpha_s", "beta_s", "model_load_kg",
+                   "inverse"},
     "plant": {"hysteresis_mode", "T_start_degC"},
     "analysis": {"metrics_start_s", "zoom_start_s", "zoom_end_s"},
 }
@@ -89,7 +93,8 @@ class ScenarioError(ValueError):
 @dataclass(frozen=True)
 class ControllerSettings:
     """Controller of a scenario: kind and gains (Kp [W/ohm], Ki [W/(ohm.s)], alpha, beta [s],
-    model_load [kg] of the fixed compensator)."""
+    model_load [kg] of the fixed compensator) and the compensator's inverse ("major" or
+    "minor-loop", see :class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`)."""
 
     kind: str
     Kp: float
@@ -97,6 +102,7 @@ class ControllerSettings:
     alpha: float
     beta: float
     model_load: float
+    inverse: str = "major"
 
     @property
     def feedforward(self):
@@ -226,8 +232,14 @@ def _controller(path, table, params):
         if value < 0 or (key == "beta_s" and value == 0):
             _fail(path, f"[controller] {key} must be {'> 0' if key == 'beta_s' else '>= 0'}, got {value!r}")
         values[attribute] = value
+    inverse = table.get("inverse", "major")
+    if inverse not in INVERSES:
+        _fail(path, f"[controller] inverse must be one of {', '.join(INVERSES)}, got {inverse!r}")
+    if inverse != "major" and kind == "pi":
+        _fail(path, f"[controller] inverse = {inverse!r} needs a feedforward controller "
+                    f"(kind pi+ff-fixed or pi+ff-adaptive), got kind 'pi'")
     return ControllerSettings(kind, values["Kp"], values["Ki"], values["phase_lag_alpha"],
-                              values["beta"], values["model_load"])
+                              values["beta"], values["model_load"], inverse)
 
 
 def load_scenario(path):

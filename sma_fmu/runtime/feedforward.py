@@ -1,21 +1,39 @@
 """Stateful feedforward compensator: temperature-sensing inverse + phase-lag filter (spec section 10).
 
-    R_ref, f -> T_ref = sense(R_ref, f, d_ref) -> v = (T_ref - T_room)/K_th -> u_ff = Cpl(s) v
+    R_ref, f -> T_ref = inverse(R_ref, f, d_ref) -> v = (T_ref - T_room)/K_th -> u_ff = Cpl(s) v
 
 d_ref comes from successive reference samples: a falling R_ref means heating (+1), a
 rising one cooling (-1), an equal one keeps the last; the first sample is heating.
-The inverse always uses the major branches, as the paper's compensator does. With
-``adapt_to_load`` the measured load enters the inverse; otherwise the fixed ``model_load``.
+With ``adapt_to_load`` the measured load enters the inverse; otherwise the fixed ``model_load``.
+
+Two inverses (``inverse``):
+
+- ``"major"`` (default, the paper's): the major branch of d_ref (section 5).
+- ``"minor-loop"``: the branch the plant's continuous mode (section 6) is on. The
+  compensator keeps its own reversal memory: when d_ref changes at sample k, the reversal
+  point is the state it assumed at sample k-1, (T_ref,k-1, xi_MF,k-1), where xi_MF,k-1 is
+  the fraction of R_ref(t_k-1) at the load then (or, where that sample was clamped, the
+  fraction of its branch at the clamped T_ref,k-1). The minor branch leaving it is
+  inverted in closed form (:func:`~.sensing.temperature_on_branch`). After a load change
+  the branch is re-evaluated with the new load, as the plant does. Before the first
+  reversal it is the major heating branch, where the plant starts.
+
+In both, a reference outside what the branch can reach at the present load gives the
+temperature of the nearest reachable edge (xi_MF clamped to delta or M - delta of the
+section 5 clamp) and ``saturated`` = True.
 """
 from collections import namedtuple
 
 from .checks import fast_nonnegative, fast_positive, require_nonnegative, require_positive
-from .constant_load import BranchCache
+from .constant_load import BranchCache, branch_fractions
 from .constants import COOLING, HEATING
+from .minor_loops import Reversal, minor_branch_fractions
 from .phase_lag import PhaseLagFilter
-from .sensing import mixed_fractions_of_resistance, temperature_of_fractions
+from .sensing import mixed_fractions_of_resistance, temperature_on_branch
 
-__all__ = ["FeedforwardOutputs", "FeedforwardStepper"]
+__all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStepper"]
+
+INVERSES = ("major", "minor-loop")
 
 FeedforwardOutputs = namedtuple("FeedforwardOutputs", ["P_ff", "T_ref", "saturated"])
 _new_tuple = tuple.__new__  # builds the namedtuple in C (see plant.py)
@@ -23,8 +41,16 @@ FeedforwardOutputs.__doc__ = """Compensator outputs for one reference sample.
 
 P_ff : feedforward power u_ff [W] (may be negative; the loop clamps the sum at 0 W);
 T_ref : temperature the inverse model assigns to R_ref [degC];
-saturated : True when R_ref lies outside the transformation (T_ref is clamped).
+saturated : True when R_ref is outside what the inverted branch reaches at the present
+load (T_ref is then the temperature of the nearest reachable edge).
 """
+
+
+def require_inverse(inverse):
+    """Return ``inverse`` if it is one of :data:`INVERSES`, else raise ``ValueError``."""
+    if isinstance(inverse, str) and inverse in INVERSES:
+        return inverse
+    raise ValueError(f"inverse must be one of {', '.join(INVERSES)}, got {inverse!r}")
 
 
 class FeedforwardStepper:
@@ -39,9 +65,13 @@ class FeedforwardStepper:
         Load assumed by the inverse when not adapting [kg]; default from ``params``.
     adapt_to_load : bool
         True: the inverse uses the measured load ("adaptive"); False: ``model_load``.
+    inverse : "major" | "minor-loop"
+        Invert the major branches (the paper's) or the minor branches of the plant's
+        continuous mode, with a reversal memory taken from d_ref (see the module docstring).
     """
 
-    def __init__(self, params, alpha=None, beta=None, model_load=None, adapt_to_load=True):
+    def __init__(self, params, alpha=None, beta=None, model_load=None, adapt_to_load=True,
+                 inverse="major"):
         self.params = params
         self.filter = PhaseLagFilter(
             params.phase_lag_alpha if alpha is None else alpha,
@@ -49,16 +79,29 @@ class FeedforwardStepper:
         self.model_load = require_nonnegative(
             "model_load", params.model_load if model_load is None else model_load)
         self.adapt_to_load = bool(adapt_to_load)
+        self.inverse = require_inverse(inverse)
+        self._minor_loops = self.inverse == "minor-loop"
         self.direction = HEATING
         self.previous_reference = None
+        self.reversal = None              # minor-loop memory: Reversal(T_r [degC], xi_r [1])
+        self.previous_temperature = None  # T_ref,k-1 [degC] (minor-loop inverse only)
+        self.previous_fraction = None     # xi_MF,k-1 [1] the compensator assumed
         self._branches = BranchCache(params)
 
     def _invert(self, reference, load, direction):
+        """(SensedTemperature, v [W], reversal, xi_MF assumed) for one sample; no state change."""
         params = self.params
         constants = self._branches.get(load if self.adapt_to_load else self.model_load, direction)
         xi_mf, xi_p = mixed_fractions_of_resistance(reference, constants, params)
-        sensed = temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin)
-        return sensed, (sensed.temperature - params.T_room) / params.K_th
+        reversal = self.reversal
+        if self._minor_loops and direction != self.direction and self.previous_temperature is not None:
+            reversal = Reversal(self.previous_temperature, self.previous_fraction)
+        sensed = temperature_on_branch(xi_mf, xi_p, constants, direction, reversal,
+                                       params.saturation_margin)
+        if sensed.saturated and self._minor_loops:  # the state assumed is on the branch's edge
+            xi_mf = (branch_fractions(sensed.temperature, constants)[0] if reversal is None else
+                     minor_branch_fractions(sensed.temperature, constants, direction, reversal)[0])
+        return sensed, (sensed.temperature - params.T_room) / params.K_th, reversal, xi_mf
 
     def _direction_for(self, reference):
         previous = self.previous_reference
@@ -75,7 +118,7 @@ class FeedforwardStepper:
             raise RuntimeError("initial_outputs is only defined before the first step")
         reference = require_positive("R_ref", reference)
         load = require_nonnegative("load", load)
-        sensed, power = self._invert(reference, load, self._direction_for(reference))
+        sensed, power, _, _ = self._invert(reference, load, self._direction_for(reference))
         return FeedforwardOutputs(power, sensed.temperature, sensed.saturated)
 
     def step(self, reference, load, step_size):
@@ -87,19 +130,29 @@ class FeedforwardStepper:
         load = fast_nonnegative("load", load)
         step_size = fast_positive("step_size", step_size)
         direction = self._direction_for(reference)
-        sensed, power = self._invert(reference, load, direction)
+        sensed, power, reversal, fraction = self._invert(reference, load, direction)
         output = self.filter.step(power, step_size)
         self.direction = direction
         self.previous_reference = reference
+        self.reversal = reversal
+        self.previous_temperature = sensed.temperature
+        self.previous_fraction = fraction
         return _new_tuple(FeedforwardOutputs, (output, sensed.temperature, sensed.saturated))
 
     def state(self):
-        """JSON-ready hidden state (reference direction, last reference, filter memory)."""
+        """JSON-ready hidden state (direction, last reference, minor-loop memory, filter)."""
         return {"direction": self.direction, "previous_reference": self.previous_reference,
+                "reversal": None if self.reversal is None else list(self.reversal),
+                "previous_temperature": self.previous_temperature,
+                "previous_fraction": self.previous_fraction,
                 "filter": self.filter.state()}
 
     def restore(self, state):
         """Restore a state saved by :meth:`state`."""
         self.direction = state["direction"]
         self.previous_reference = state["previous_reference"]
+        reversal = state.get("reversal")
+        self.reversal = None if reversal is None else Reversal(*reversal)
+        self.previous_temperature = state.get("previous_temperature")
+        self.previous_fraction = state.get("previous_fraction")
         self.filter.restore(state["filter"])

@@ -92,7 +92,7 @@ def closed_loop(scenario, fmu_dir):
     if c.feedforward:
         parameters = model_parameter_values(paths["SmaFeedforward"], scenario.params)
         parameters.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
-                          adapt_to_load=c.adapt_to_load)
+                          adapt_to_load=c.adapt_to_load, inverse=c.inverse)
         components.append(Component("compensator", "SmaFeedforward", paths["SmaFeedforward"],
                                     parameters))
         connections[1:1] = [Connection("signals", "R_ref", "compensator", "R_ref"),

@@ -46,6 +46,9 @@ class SmaFeedforward(Fmi2Slave):
         fmi.boolean_output("saturated", "true when R_ref is outside the transformation (T_ref clamped)")
         fmi.boolean_parameter("adapt_to_load", True,
                               "true: the inverse uses the measured load; false: model_load")
+        fmi.string_parameter("inverse", "major",
+                             "'major' (the paper's: major branches) or 'minor-loop' (the plant's "
+                             "continuous-mode minor branches, reversals taken from R_ref)")
         fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin"))
         self.stepper = None
         self._publish(FeedforwardStepper(fmi.defaults).initial_outputs(self.R_ref, self.load))
@@ -53,7 +56,7 @@ class SmaFeedforward(Fmi2Slave):
 
     def _start(self):
         stepper = FeedforwardStepper(self.interface.wire_parameters(),
-                                     adapt_to_load=self.adapt_to_load)
+                                     adapt_to_load=self.adapt_to_load, inverse=self.inverse)
         return stepper, stepper.initial_outputs(self.R_ref, self.load)
 
     def _publish(self, outputs):

@@ -1,0 +1,135 @@
+"""How well can any controller track a scenario's reference? A lower bound and benchmarks.
+
+For a scenario (reference, loads, hysteresis mode, wire) and powers 0 <= P <= P_max:
+
+- **saturation bound** (any mode): where R_ref lies outside the band the wire can reach
+  at the load (:func:`~sma_fmu.runtime.reachable_band.reachable_band`), no controller gets
+  closer than the band's edge. Rigorous; 0 when the reference stays inside the band.
+- **lower bound**: mode "switch": the cell dynamic program of :mod:`.switch_dp`, rigorous
+  for the model as implemented (with the thermal limit: cooling is passive). Mode
+  "continuous": the saturation bound only. Relaxations of the hysteresis to the major
+  loop give 0 there for the paper's reference (at one temperature the band between the
+  major branches covers it), so this module does not pretend to more.
+- **benchmarks**: power sequences replayed through the runtime plant, so each RMSE is
+  reachable: mode "switch": the node program's path; mode "continuous": the one-step
+  inverse of :mod:`.inverse_tracker` with a few passive-cooling tolerances.
+
+The optimum lies between the lower bound and the best benchmark; their difference says
+how tight the bound is. Each benchmark also reports its peak power and how often the
+temperature reverses: the best continuous-mode benchmarks chatter at the step rate, which
+no real driver and wire would follow, so the best one with at most
+:data:`SMOOTH_REVERSALS_PER_S` reversals per second is reported as well. Units: ohm, W, s.
+"""
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from sma_fmu.cosim.metrics import band_edges
+
+from .inverse_tracker import track
+from .switch_dp import cell_lower_bound, node_path, replay_path
+from .tracking_problem import TemperatureGrid, TrackingProblem
+
+__all__ = ["Benchmark", "TrackingBound", "TOLERANCES", "SMOOTH_REVERSALS_PER_S",
+           "saturation_bound", "reversal_rate", "tracking_bound"]
+
+TOLERANCES = (0.0, 0.01, 0.02, 0.03)  # ohm: passive-cooling tolerances of the continuous benchmark
+SMOOTH_REVERSALS_PER_S = 10.0         # 1/s: a benchmark reversing at most this often does not chatter
+
+
+@dataclass(frozen=True)
+class Benchmark:
+    """A power sequence replayed through the plant: its RMSE [ohm], peak power [W] and
+    temperature reversals per second [1/s], both over the metric window."""
+
+    method: str
+    rmse_ohm: float
+    peak_W: float
+    reversals_per_s: float
+
+
+@dataclass(frozen=True)
+class TrackingBound:
+    """The bound of one scenario (RMSE over the metric window, in ohm).
+
+    lower_bound_ohm <= the best RMSE any controller reaches <= min of the benchmarks.
+    """
+
+    scenario: str
+    hysteresis_mode: str
+    power_cap_W: object
+    saturation_bound_ohm: float
+    lower_bound_ohm: float
+    lower_bound_method: str
+    benchmarks: tuple
+    seconds: float
+
+    @property
+    def achievable(self):
+        """The best :class:`Benchmark`."""
+        return min(self.benchmarks, key=lambda b: b.rmse_ohm)
+
+    @property
+    def smooth(self):
+        """The best benchmark with at most SMOOTH_REVERSALS_PER_S reversals per second, or None."""
+        smooth = [b for b in self.benchmarks if b.reversals_per_s <= SMOOTH_REVERSALS_PER_S]
+        return min(smooth, key=lambda b: b.rmse_ohm) if smooth else None
+
+    def as_dict(self):
+        """JSON-ready fields, with the best and the best smooth benchmark."""
+        fields = asdict(self)
+        fields["achievable"] = asdict(self.achievable)
+        fields["smooth"] = None if self.smooth is None else asdict(self.smooth)
+        return fields
+
+
+def saturation_bound(problem):
+    """RMSE [ohm] forced by R_ref leaving the reachable band: its distance to the band's edge."""
+    hot, cold = band_edges(problem.sample_loads, problem.params)
+    references = problem.references
+    distance = np.maximum(hot - references, 0.0) + np.maximum(references - cold, 0.0)
+    return problem.rmse(np.sum(problem.weights * distance ** 2))
+
+
+def reversal_rate(problem, powers):
+    """Direction changes of the temperature per second [1/s] under ``powers`` [W], metric window."""
+    temperatures = [problem.T_start]
+    for power in powers.tolist():
+        temperatures.append(problem.after_step(temperatures[-1], power))
+    signs = np.sign(np.diff(temperatures))[problem.weights[1:] > 0]
+    signs = signs[signs != 0]
+    return float(np.count_nonzero(np.diff(signs))) / (np.sum(problem.weights[1:]) * problem.step_s)
+
+
+def _benchmark(problem, method, powers, resistances):
+    return Benchmark(method, problem.rmse_of(resistances),
+                     float(powers[problem.weights[:-1] > 0].max()), reversal_rate(problem, powers))
+
+
+def tracking_bound(scenario, power_cap=None, mode=None):
+    """:class:`TrackingBound` of a :class:`~sma_fmu.cosim.scenario.Scenario`.
+
+    ``power_cap`` P_max [W] (None: no upper limit); ``mode`` overrides the hysteresis mode.
+    """
+    start = time.perf_counter()
+    problem = TrackingProblem.from_scenario(scenario, mode)
+    saturation = saturation_bound(problem)
+    if problem.mode == "switch":
+        grid = TemperatureGrid.for_problem(problem)
+        lower = max(saturation, cell_lower_bound(problem, grid, power_cap))
+        lower_method = f"cell dynamic program, {grid.count} temperature nodes, exact passive cooling"
+        _, temperatures, rows = node_path(problem, grid, power_cap)
+        powers, resistances = replay_path(problem, temperatures, rows, power_cap)
+        benchmarks = (_benchmark(problem, "node dynamic program's path", powers, resistances),)
+    else:
+        lower, lower_method = saturation, "saturation (reachable band) only"
+        benchmarks = tuple(
+            _benchmark(problem, "one-step inverse of the plant" + (
+                f", 0 W where a passive step lands within {tolerance:g} ohm" if tolerance else ""),
+                *track(problem, tolerance, power_cap))
+            for tolerance in TOLERANCES)
+    return TrackingBound(
+        scenario=scenario.name, hysteresis_mode=problem.mode, power_cap_W=power_cap,
+        saturation_bound_ohm=saturation, lower_bound_ohm=lower, lower_bound_method=lower_method,
+        benchmarks=benchmarks, seconds=time.perf_counter() - start)
