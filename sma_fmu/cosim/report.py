@@ -24,12 +24,12 @@ def groups(rows):
 
 def summary_table(rows):
     """Plain-text table of runs (one dict per run with metrics and timing)."""
-    lines = [f"{'scenario':<44}{'controller':<16}{'mode':<12}{'RMSE':>8}{'max|e|':>8}"
+    lines = [f"{'scenario':<48}{'controller':<16}{'mode':<12}{'RMSE':>8}{'max|e|':>8}"
              f"{'IAE':>8}{'wall s':>8}{'x real':>8}",
-             f"{'':<72}{'[ohm]':>8}{'[ohm]':>8}{'[ohm.s]':>8}"]
+             f"{'':<76}{'[ohm]':>8}{'[ohm]':>8}{'[ohm.s]':>8}"]
     for row in rows:
         m = row["metrics"]["overall"]
-        lines.append(f"{row['scenario']:<44}{row['metrics']['controller']:<16}"
+        lines.append(f"{row['scenario']:<48}{row['metrics']['controller']:<16}"
                      f"{row['metrics']['hysteresis_mode']:<12}{_number(m['rmse_ohm'], '>8.3f'):>8}"
                      f"{_number(m['max_abs_ohm'], '>8.3f'):>8}{_number(m['iae_ohm_s'], '>8.2f'):>8}"
                      f"{row['wall_time_s']:>8.2f}{row['real_time_factor']:>8.0f}")
