@@ -12,10 +12,13 @@ import pandas as pd
 import pytest
 
 from sma_fmu.cli import main
+from sma_fmu.cosim.loop import run_library
+from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.package_data import shipped_file
-from sma_fmu.studies import StudyError
+from sma_fmu.studies import StudyError, template
 from sma_fmu.studies.design import monte_carlo_draws
-from sma_fmu.studies.spec import load_spec
+from sma_fmu.studies.spec import StudyRunSpec, load_spec
+from sma_fmu.studies.tasks import run_task
 from sma_fmu.studies.sweep import run_sweep
 
 GRID = """
@@ -213,3 +216,17 @@ def test_cli_error_is_one_line_and_writes_nothing(tmp_path, capsys):
     error = capsys.readouterr().err
     assert error.count("\n") == 1 and error.startswith("sma-fmu: error:") and "bad.toml" in error
     assert not (tmp_path / "out").exists()
+
+
+def test_a_task_runs_what_the_batch_engine_lacks_on_the_library_path():
+    base = template("load-step-pi+ff-adaptive")
+    overrides = [{"scenario.stop_time_s": 3.0, "controller.inverse": inverse}
+                 for inverse in ("major", "minor-loop")]
+    rows = run_task([base], [StudyRunSpec(i, 0, o) for i, o in enumerate(overrides)])
+    assert [row["path"] for row in rows] == ["batch", "library"]
+    assert [row["status"] for row in rows] == ["ok", "ok"]
+    for row, changes in zip(rows, overrides):
+        item = base.scenario(changes)
+        expected = scenario_metrics(run_library(item).data, item)["overall"]["rmse_ohm"]
+        assert row["rmse_ohm"] == pytest.approx(expected, rel=1e-12)
+    assert rows[0]["rmse_ohm"] != rows[1]["rmse_ohm"]      # the minor-loop inverse differs

@@ -143,7 +143,8 @@ class BatchInputs:
 
     def unreachable(self, start, stop):
         """(below, above), (c, N) each: R_ref(t_k) <= R_hot(f_k), R_ref(t_k) >= R_cold(f_k)."""
-        segments = np.broadcast_to(self.segments(start, stop), (stop - start, self.size))
+        rows = stop - start if self.changes_within(start, stop) else 1   # else one row broadcasts
+        segments = np.broadcast_to(self.segments(start, start + rows), (rows, self.size))
         columns = np.arange(self.size)
         reference = self.references(start, stop)
         return (reference <= self.band_hot[segments, columns],

@@ -102,10 +102,11 @@ class MetricsAccumulator:
         stop = start + errors.shape[0]
         below, above = self.inputs.unreachable(start, stop)
         outside = below | above
+        anywhere = bool(outside.any())         # usually not: then reachable = overall here
         for group in self.groups:
             runs = group["runs"]
             group["overall"].add(start, errors, runs)
-            group["reachable"].add(start, errors, runs, keep=~outside)
+            group["reachable"].add(start, errors, runs, keep=~outside if anywhere else None)
             for part in group["segments"]:
                 part.add(start, errors, runs)
             first, last = group["window"]
@@ -114,9 +115,11 @@ class MetricsAccumulator:
                 rows = slice(low - start, high - start)
                 self.saturated[runs] += np.count_nonzero(saturated[rows][:, runs], axis=0)
                 self.clamped[runs] += np.count_nonzero(power[rows][:, runs] == 0.0, axis=0)
-                self.unreachable[runs] += np.count_nonzero(outside[rows][:, runs], axis=0)
+                if anywhere:
+                    self.unreachable[runs] += np.count_nonzero(outside[rows][:, runs], axis=0)
         for side, mask in zip(_SIDES, (below, above)):
-            self._track(side, start, mask)
+            if anywhere or self._inside[side].any():
+                self._track(side, start, mask)
 
     def _track(self, side, start, mask):
         """Runs of consecutive unreachable samples, as unreachable_intervals finds them."""
