@@ -23,7 +23,7 @@ from sma_fmu.output_folder import staged_folder
 from sma_fmu.package_data import shipped_file
 from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario, resolve_scenarios
 
-__all__ = ["TARGETS", "run_benchmarks", "format_table", "main"]
+__all__ = ["TARGETS", "run_benchmarks", "run_batch_benchmark", "format_table", "main"]
 
 STEP = 1e-3
 TARGETS = {  # issue 6, on a 2-core machine
@@ -178,8 +178,19 @@ def _build_trivial(folder):
     return Path(FmuBuilder.build_FMU(script, dest=Path(folder) / "Trivial.fmu"))
 
 
+def run_batch_benchmark(out_dir, quick=False, progress=print):
+    """Only the batch engine's section (``sma-fmu bench --only batch``); written as JSON too."""
+    from sma_fmu.studies.batch_benchmark import batch_throughput
+    options = dict(sizes=(1, 100, 1000), scalar_runs=4) if quick else {}
+    results = {"runs": 1, "batch_engine": batch_throughput(progress=progress, **options)}
+    with staged_folder(out_dir) as stage:
+        (stage / "benchmark.json").write_text(json_text(results), encoding="utf-8")
+    return results
+
+
 def run_benchmarks(out_dir, runs=5, progress=print):
     """Run every benchmark; returns the results (also written to out_dir/benchmark.json)."""
+    from sma_fmu.studies.batch_benchmark import batch_throughput
     if runs < 1:
         raise ValueError(f"runs must be >= 1, got {runs!r}")
     with staged_folder(out_dir) as stage, tempfile.TemporaryDirectory() as folder:
@@ -201,6 +212,9 @@ def run_benchmarks(out_dir, runs=5, progress=print):
             "machine": machine, "runs": runs, "fmu_step": steps, "c_host_step": c_hosts,
             "closed_loop_load_step_30s": loops, "library_throughput": throughput,
             "identification_4_loads_s": identification_time(runs), "targets": TARGETS,
+            # --runs 1 or 2 is a smoke run: 1 s batch runs, where the setup weighs more
+            "batch_engine": batch_throughput(stop_time_s=5.0 if runs >= 3 else 1.0,
+                                             progress=progress),
         }
         (stage / "benchmark.json").write_text(json_text(results), encoding="utf-8")
     return results
@@ -213,6 +227,9 @@ def _verdict(value, target, larger_is_better=False):
 
 def format_table(results):
     """The results as plain-text tables, with each target's verdict."""
+    from sma_fmu.studies.batch_benchmark import format_batch
+    if "fmu_step" not in results:                  # --only batch
+        return "\n".join(format_batch(results["batch_engine"]))
     lines = [f"sma-fmu benchmark (median of {results['runs']} runs; Python "
              f"{results['machine']['python']}; plain Python loop "
              f"{results['machine']['python_loop_ns_per_iteration']} ns/iteration)", "",
@@ -240,7 +257,8 @@ def format_table(results):
               f"library batch ({throughput['scenarios']} scenarios): "
               + ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in throughput.items() if k != "scenarios"),
               f"identification, 4 loads, 808 points: {results['identification_4_loads_s']:.3f} s: "
-              f"{_verdict(results['identification_4_loads_s'], TARGETS['identification_s'])} s"]
+              f"{_verdict(results['identification_4_loads_s'], TARGETS['identification_s'])} s",
+              ""] + format_batch(results["batch_engine"])
     return "\n".join(lines)
 
 
@@ -258,9 +276,11 @@ def _c_host_lines(results):
     return lines
 
 
-def main(out_dir="results/benchmark", runs=5):
-    """Run, print the table, write JSON; returns 0."""
-    results = run_benchmarks(out_dir, runs, progress=lambda text: print(text, flush=True))
+def main(out_dir="results/benchmark", runs=5, only=None, quick=False):
+    """Run (everything, or ``only="batch"``), print the table, write JSON; returns 0."""
+    say = lambda text: print(text, flush=True)  # noqa: E731
+    results = (run_batch_benchmark(out_dir, quick, say) if only == "batch"
+               else run_benchmarks(out_dir, runs, progress=say))
     print(format_table(results))
     print(f"written: {Path(out_dir) / 'benchmark.json'}")
     return 0

@@ -1,7 +1,7 @@
 """Command line ``sma-fmu``: thin wrappers; each flag maps onto one API argument.
 
 One module per group of commands (model, fmus, cosim, analysis, export, check,
-identification, bench, examples);
+identification, studies, bench, examples);
 each has ``register(commands)``. Every failure is one line ``sma-fmu: error: ...`` on stderr
 with exit status 2 (``validate`` and ``check`` exit 1 when a file fails); no traceback, ever.
 """
@@ -9,12 +9,14 @@ import sys
 
 from sma_fmu import __version__
 
-from . import analysis, bench, check, cosim, examples, export, fmus, identification, model
+from . import (analysis, bench, check, cosim, examples, export, fmus, identification, model,
+               studies)
 from .arguments import Parser, fail
 
 __all__ = ["main", "build_parser", "COMMAND_GROUPS"]
 
-COMMAND_GROUPS = (model, fmus, cosim, analysis, export, check, identification, bench, examples)
+COMMAND_GROUPS = (model, fmus, cosim, analysis, export, check, identification, studies, bench,
+                  examples)
 
 
 def build_parser():

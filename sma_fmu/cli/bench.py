@@ -8,7 +8,7 @@ __all__ = ["register"]
 
 def _bench(args):
     from sma_fmu.benchmark import main as bench_main
-    return bench_main(args.out, args.runs)
+    return bench_main(args.out, args.runs, args.only, args.quick)
 
 
 def register(commands):
@@ -17,4 +17,8 @@ def register(commands):
     bench.add_argument("--out", type=Path, default=Path("results/benchmark"), metavar="DIR",
                        help="output folder")
     bench.add_argument("--runs", type=positive_integer, default=5, help="repetitions per measurement")
+    bench.add_argument("--only", choices=("batch",),
+                       help="only this section (batch: the batch engine's throughput table)")
+    bench.add_argument("--quick", action="store_true",
+                       help="with --only batch: N up to 1,000 only (a quick look)")
     bench.set_defaults(handler=_bench)

@@ -23,13 +23,14 @@ from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper
 
-__all__ = ["COLUMNS", "PLANT_OUTPUTS", "COUPLINGS", "LoopResult", "run_loop", "LibraryPlant",
-           "LibraryCompensator", "run_library"]
+__all__ = ["COLUMNS", "COLUMN_NAMES", "TIMESERIES_DTYPE", "PLANT_OUTPUTS", "COUPLINGS",
+           "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator", "run_library"]
 
 COLUMNS = (("t", "s"), ("R_ref", "ohm"), ("R", "ohm"), ("T", "degC"), ("T_ref", "degC"),
            ("x", "m"), ("stroke", "m"), ("xi_P", ""), ("xi_M", ""), ("xi_F", ""),
            ("P_ff", "W"), ("P_fb", "W"), ("P", "W"), ("load", "kg"), ("saturated", ""))
-_DTYPE = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
+COLUMN_NAMES = tuple(f"{name}_{unit}" if unit else name for name, unit in COLUMNS)  # CSV header
+TIMESERIES_DTYPE = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
 PLANT_OUTPUTS = ("R", "T", "x", "xi_P", "xi_M", "xi_F", "P")  # what a loop plant returns
 COUPLINGS = ("gauss-seidel", "jacobi")
 
@@ -68,8 +69,8 @@ class LibraryCompensator:
 
     def __init__(self, scenario):
         c = scenario.controller
-        self.stepper = FeedforwardStepper(scenario.params, c.alpha, c.beta, c.model_load,
-                                          c.adapt_to_load, c.inverse)
+        self.stepper = FeedforwardStepper(scenario.compensator_params, c.alpha, c.beta,
+                                          c.model_load, c.adapt_to_load, c.inverse)
 
     def initial(self, reference, load):
         """(P_ff [W], T_ref [degC], saturated) before the first step (what a Jacobi host passes on)."""
@@ -133,7 +134,7 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel"):
         rows.append(sample + (applied, load, saturated))
     rows.append((times[n], references[n], resistance, temperature, nan, length,
                  start_length - length, xi_p, xi_m, xi_f, nan, nan, nan, loads[n], False))
-    return np.array(rows, dtype=_DTYPE)
+    return np.array(rows, dtype=TIMESERIES_DTYPE)
 
 
 def run_library(scenario, coupling="gauss-seidel"):

@@ -56,7 +56,7 @@ class FmuCompensator:
 
     def __init__(self, scenario, fmu_path, instance_name="feedforward"):
         c = scenario.controller
-        start = model_parameter_values(fmu_path, scenario.params)
+        start = model_parameter_values(fmu_path, scenario.compensator_params)
         start.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
                      adapt_to_load=c.adapt_to_load, inverse=c.inverse,
                      R_ref=scenario.reference.value(0.0),

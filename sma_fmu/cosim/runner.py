@@ -12,7 +12,7 @@ from collections import Counter
 
 import numpy as np
 
-from sma_fmu.cosim.loop import COLUMNS, run_library
+from sma_fmu.cosim.loop import COLUMN_NAMES, COLUMNS, run_library
 from sma_fmu.cosim.master import run_fmus
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.plots import plot_comparison, plot_run
@@ -32,7 +32,7 @@ PATHS = {"fmu": run_fmus, "library": lambda scenario, fmu_dir: run_library(scena
 
 def write_timeseries(data, path):
     """CSV with a header of names and units (``t_s,R_ref_ohm,...``), time first."""
-    header = ",".join(f"{name}_{unit}" if unit else name for name, unit in COLUMNS)
+    header = ",".join(COLUMN_NAMES)
     table = np.column_stack([data[name].astype(float) for name, _ in COLUMNS])
     np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.10g")
 

@@ -49,7 +49,8 @@ from sma_fmu.runtime.signals import load_from_table, reference_from_table
 from sma_fmu.toml_files import read_toml
 
 __all__ = ["ScenarioError", "ControllerSettings", "AnalysisWindow", "Scenario", "CONTROLLERS",
-           "PAPER_SET", "MAX_STEPS", "load_scenario", "default_analysis", "scenario_names",
+           "PAPER_SET", "MAX_STEPS", "load_scenario", "read_scenario_document",
+           "scenario_from_document", "check_sections", "default_analysis", "scenario_names",
            "resolve_scenarios"]
 
 CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")
@@ -132,11 +133,19 @@ class Scenario:
     parameter_set: object
     analysis_window: AnalysisWindow = None   # the file's [analysis]; None: from the duration
     group_name: str = None
+    compensator_parameter_set: object = None   # the compensator's model; None: the wire's
 
     @property
     def params(self):
         """The wire's WireParameters."""
         return self.parameter_set.params
+
+    @property
+    def compensator_params(self):
+        """The WireParameters of the compensator's inverse model: the wire's, unless a study
+        gives the model other values than the wire (``compensator_parameter_set``)."""
+        chosen = self.compensator_parameter_set or self.parameter_set
+        return chosen.params
 
     @property
     def steps(self):
@@ -242,31 +251,52 @@ def _controller(path, table, params):
                               values["beta"], values["model_load"], inverse)
 
 
+def check_sections(path, document, sections, required, error=ScenarioError):
+    """Raise ``error`` for a section or key not in ``sections`` (name -> allowed keys, or None
+    for any) and for a missing ``required`` section, naming ``path``."""
+    for section, table in document.items():
+        if section not in sections:
+            raise error(f"{path}: unknown section [{section}]; expected {', '.join(sections)}")
+        if not isinstance(table, dict):
+            raise error(f"{path}: [{section}] must be a table")
+        allowed = sections[section]
+        if allowed is not None and set(table) - allowed:
+            raise error(f"{path}: [{section}] unknown key(s) "
+                        f"{', '.join(sorted(set(table) - allowed))}; "
+                        f"expected {', '.join(sorted(allowed))}")
+    for section in required:
+        if section not in document:
+            raise error(f"{path}: missing section [{section}]")
+
+
+def read_scenario_document(path):
+    """The parsed TOML document of a scenario file (not yet validated)."""
+    return read_toml(Path(path), ScenarioError, "scenario file")
+
+
 def load_scenario(path):
     """Read and validate a scenario file; returns a :class:`Scenario`."""
+    return scenario_from_document(read_scenario_document(path), Path(path))
+
+
+def scenario_from_document(document, path, parameter_set=None):
+    """Validate a parsed scenario ``document``; ``path`` names it in errors and locates ``model``.
+
+    ``parameter_set`` replaces the parameter file the document names (the study API uses
+    it for changed wire parameters); the controller's defaults then come from it.
+    """
     path = Path(path)
-    document = read_toml(path, ScenarioError, "scenario file")
-    for section, table in document.items():
-        if section not in _SECTIONS:
-            _fail(path, f"unknown section [{section}]; expected {', '.join(_SECTIONS)}")
-        if not isinstance(table, dict):
-            _fail(path, f"[{section}] must be a table")
-        allowed = _SECTIONS[section]
-        if allowed is not None and set(table) - allowed:
-            _fail(path, f"[{section}] unknown key(s) {', '.join(sorted(set(table) - allowed))}; "
-                        f"expected {', '.join(sorted(allowed))}")
-    for section in ("scenario", "reference", "load", "controller"):
-        if section not in document:
-            _fail(path, f"missing section [{section}]")
+    check_sections(path, document, _SECTIONS, ("scenario", "reference", "load", "controller"))
     head = document["scenario"]
     stop = _number(path, "scenario", head, "stop_time_s", positive=True)
     step = _number(path, "scenario", head, "step_s", positive=True)
     _steps(path, stop, step)
     model = _string(path, "scenario", head, "model")
-    try:
-        parameter_set = load_parameter_set(None if model is None else path.parent / model)
-    except ParameterError as error:
-        _fail(path, f"[scenario] model = {model!r}: {error}")
+    if parameter_set is None:
+        try:
+            parameter_set = load_parameter_set(None if model is None else path.parent / model)
+        except ParameterError as error:
+            _fail(path, f"[scenario] model = {model!r}: {error}")
     signals = {}
     for section, build in (("reference", reference_from_table), ("load", load_from_table)):
         try:

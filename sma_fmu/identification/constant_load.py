@@ -174,6 +174,7 @@ def fit_constant_load(data, base):
         "files": [str(f) for f in data.files],
         "points": int(data.resistance.size),
         "parameters": result.table(),
+        "covariance": result.covariance_table(),
         "fixed_from_base": {"eps_T": base.eps_T},
         "mape_percent": float(errors.mean()),
         "max_abs_error_ohm": float(np.max(np.abs(result.residuals))),

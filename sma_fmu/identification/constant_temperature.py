@@ -91,6 +91,7 @@ def fit_constant_temperature(experiments, base):
         "files": [str(e.path) for e in experiments],
         "points": int(measured.size),
         "parameters": result.table(),
+        "covariance": result.covariance_table(),
         "critical_load_kg": params.eps_f * params.N / (STANDARD_GRAVITY * params.x_f),
         "mape_percent": float(percentage_errors(model, measured).mean()),
         "max_abs_error_ohm": float(np.max(np.abs(result.residuals))),

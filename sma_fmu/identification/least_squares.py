@@ -33,6 +33,7 @@ class FitResult:
     values: np.ndarray
     std_errors: np.ndarray
     ci95: np.ndarray             # shape (n, 2)
+    covariance: np.ndarray       # shape (n, n), physical units, order of ``parameters``
     residuals: np.ndarray        # model - data at the solution
     cost: float
     evaluations: int
@@ -50,6 +51,15 @@ class FitResult:
                             "ci95": [float(low), float(high)],
                             "at_bound": bool(min(value - p.lower, p.upper - value) < 1e-9 * span)}
         return rows
+
+    def covariance_table(self):
+        """{"parameters": names, "matrix": rows} of the estimates' covariance (JSON-ready).
+
+        ``matrix[i][j]`` = cov(p_i, p_j) in the product of the two parameters' units;
+        its diagonal is the square of the standard errors.
+        """
+        return {"parameters": [p.name for p in self.parameters],
+                "matrix": [[float(v) for v in row] for row in self.covariance]}
 
 
 def fit_parameters(residuals_of, base, parameters, max_evaluations=2000):
@@ -83,6 +93,7 @@ def fit_parameters(residuals_of, base, parameters, max_evaluations=2000):
     return FitResult(
         params=base.replace(**dict(zip(names, values.tolist()))), parameters=list(parameters),
         values=values, std_errors=std_errors, ci95=np.column_stack([values - half, values + half]),
+        covariance=covariance,
         residuals=solution.fun, cost=float(solution.cost), evaluations=int(solution.nfev),
         converged=bool(solution.status > 0), message=str(solution.message), seconds=seconds)
 

@@ -90,7 +90,7 @@ def closed_loop(scenario, fmu_dir):
                    Connection("signals", "load", "plant", "load"),
                    Connection("plant", "R", "pi", "R")]
     if c.feedforward:
-        parameters = model_parameter_values(paths["SmaFeedforward"], scenario.params)
+        parameters = model_parameter_values(paths["SmaFeedforward"], scenario.compensator_params)
         parameters.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
                           adapt_to_load=c.adapt_to_load, inverse=c.inverse)
         components.append(Component("compensator", "SmaFeedforward", paths["SmaFeedforward"],

@@ -1,0 +1,64 @@
+"""Study commands: sweep (a study spec on Dask) and tune (PI and compensator gains)."""
+from pathlib import Path
+
+from .arguments import positive_integer
+
+__all__ = ["register"]
+
+
+def _sweep(args):
+    from sma_fmu.studies.sweep import run_sweep
+    out = args.out or Path("results") / f"sweep-{Path(args.spec).stem}"
+    summary = run_sweep(args.spec, out, args.scheduler, args.workers, progress=not args.quiet)
+    status = summary["status"]
+    print(f"{summary['runs']} runs: {status['ok']} ok, {status['failed']} failed, "
+          f"{status['error']} task errors")
+    for name, entry in summary["scenarios"].items():
+        stats = entry["rmse_ohm"]
+        if stats:
+            print(f"{name}: RMSE {stats['mean']:.4f} ohm mean, {stats['p05']:.4f} ... "
+                  f"{stats['p95']:.4f} (5-95 %), best {entry['best']['rmse_ohm']:.4f} ohm "
+                  f"(run {entry['best']['run_id']})")
+    print(f"written: {out}/results.parquet, results.csv, summary.md, summary.json, figures/")
+    return 0
+
+
+def _tune(args):
+    from sma_fmu.cosim.scenario import resolve_scenarios
+    from sma_fmu.studies.tuning import run_tuning
+    paths = resolve_scenarios(args.scenarios, everything=args.all)
+    out = args.out or Path("results") / "tune"
+    run_tuning(paths, out, seed=args.seed, generations=args.generations,
+               population=args.population, stop_time_s=args.stop_time)
+    print(f"written: {out}/report.md, report.json, NAME/controller.toml")
+    return 0
+
+
+def register(commands):
+    """Add ``sweep`` and ``tune`` to the ``commands`` subparsers."""
+    sweep = commands.add_parser("sweep", help="run a study spec (grid, random, LHS, Monte "
+                                              "Carlo) on Dask; results table, summary, figures")
+    sweep.add_argument("spec", metavar="SPEC.toml", help="study spec (see docs/studies.md)")
+    sweep.add_argument("--scheduler", metavar="ADDRESS",
+                       help="address of a running Dask scheduler (default: a local cluster)")
+    sweep.add_argument("--workers", type=positive_integer, metavar="N",
+                       help="worker processes of the local cluster (default: one per core)")
+    sweep.add_argument("--out", type=Path, metavar="DIR",
+                       help="output folder (default: results/sweep-SPEC); rerun to resume")
+    sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.set_defaults(handler=_sweep)
+
+    tune = commands.add_parser("tune", help="optimise Kp, Ki (and alpha, beta with "
+                                            "feedforward) for RMSE; [controller] snippets")
+    tune.add_argument("scenarios", nargs="*", metavar="SCENARIO",
+                      help="a .toml file, the name of a shipped scenario, or 'paper'")
+    tune.add_argument("--all", action="store_true", help="every shipped scenario")
+    tune.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: results/tune)")
+    tune.add_argument("--seed", type=int, default=1, help="seed of differential evolution")
+    tune.add_argument("--generations", type=positive_integer, default=30,
+                      help="most generations of differential evolution")
+    tune.add_argument("--population", type=positive_integer, default=12,
+                      help="population size per tuned parameter (scipy's popsize)")
+    tune.add_argument("--stop-time", type=float, metavar="S",
+                      help="tune over the first S seconds (default: the scenario's duration)")
+    tune.set_defaults(handler=_tune)

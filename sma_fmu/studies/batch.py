@@ -1,0 +1,259 @@
+"""The batch engine: N closed loops of spec section 11, advanced in lock-step with numpy.
+
+Runs that share the step and the duration (different gains, filters, loads, references,
+wire parameters, hysteresis modes and controllers) go through one loop whose every
+quantity is an array of N. Per step k, as :func:`sma_fmu.cosim.loop.run_loop` does it:
+e_k = R_k - R_ref(t_k); u_k = max(0, u_ff,k + Kp e_k + Ki I_k), with the integrator held
+while clamped with e_k <= 0; the plants step with u_k and f(t_k) held. The results equal
+the scalar library path's to rounding (tests/test_batch.py: <= 1e-10 on every column).
+
+Two ways to record: ``"timeseries"`` keeps every run's full series (the rows of
+:data:`~sma_fmu.cosim.loop.COLUMNS`; for a few runs), ``"metrics"`` keeps only the metrics,
+accumulated per chunk of steps, so memory does not grow with the duration.
+
+Options the engine does not implement raise :class:`BatchUnsupported` (see
+:func:`unsupported_reason`); a run that fails in the batch (the compensator's inverse
+diverges, a load beyond the model's range, a non-finite power) is run again on the scalar
+path, so its outcome, and its error message, are exactly the scalar path's.
+"""
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from sma_fmu.cosim.loop import TIMESERIES_DTYPE, run_library
+from sma_fmu.cosim.metrics import scenario_metrics
+from sma_fmu.cosim.scenario import CONTROLLERS, Scenario
+from sma_fmu.runtime.checks import HYSTERESIS_MODES
+from sma_fmu.studies.batch_feedforward import BatchFeedforward
+from sma_fmu.studies.batch_inputs import BatchInputs
+from sma_fmu.studies.batch_metrics import MetricsAccumulator
+from sma_fmu.studies.batch_plant import BatchPlant
+
+__all__ = ["BatchUnsupported", "BatchRun", "RECORDS", "unsupported_reason", "run_batch",
+           "chunk_steps", "chunk_bounds"]
+
+RECORDS = ("timeseries", "metrics")
+CHUNK_ELEMENTS = 65536      # steps x runs per chunk of precomputed signals and errors
+_KNOWN_SCENARIO_FIELDS = {f.name for f in dataclasses.fields(Scenario)}
+_KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load"}
+# Controller options added later whose value here means "what the batch engine computes"
+# (the compensator inverts the major branches, as the paper's does).
+_MAJOR_BRANCH_VALUES = {None, "major", "major-branch", "major-branches"}
+
+
+class BatchUnsupported(ValueError):
+    """A scenario uses an option the batch engine does not implement; run it on the library path."""
+
+
+@dataclasses.dataclass
+class BatchRun:
+    """Outcome of one run of a batch.
+
+    ``data``: the time series (record "timeseries", else None); ``metrics``: the
+    :func:`~sma_fmu.cosim.metrics.scenario_metrics` record (None when the run failed);
+    ``error``: the failure's message (None when it succeeded); ``path``: "batch", or
+    "library" when the run failed in the batch and was run again on the scalar path.
+    """
+
+    scenario: object
+    data: object
+    metrics: object
+    error: object
+    path: str
+
+
+def unsupported_reason(scenario):
+    """Why the batch engine cannot run ``scenario`` (a sentence), or None when it can."""
+    if not isinstance(scenario, Scenario):
+        return f"{scenario!r} is not a Scenario"
+    extra = {f.name for f in dataclasses.fields(scenario)} - _KNOWN_SCENARIO_FIELDS
+    if extra:
+        return f"scenario option(s) {', '.join(sorted(extra))} are not implemented in the batch engine"
+    controller = scenario.controller
+    for field in dataclasses.fields(controller):
+        if field.name not in _KNOWN_CONTROLLER_FIELDS:
+            value = getattr(controller, field.name)
+            if value not in _MAJOR_BRANCH_VALUES:
+                return (f"{scenario.name}: controller option {field.name} = {value!r} is not "
+                        f"implemented in the batch engine")
+    if controller.kind not in CONTROLLERS:
+        return f"{scenario.name}: controller kind {controller.kind!r} is not implemented"
+    if scenario.hysteresis_mode not in HYSTERESIS_MODES:
+        return f"{scenario.name}: hysteresis mode {scenario.hysteresis_mode!r} is not implemented"
+    return None
+
+
+def chunk_steps(runs, steps):
+    """Steps per chunk: about :data:`CHUNK_ELEMENTS` steps x runs, at least 16, at most n + 1."""
+    return max(16, min(steps + 1, CHUNK_ELEMENTS // max(runs, 1)))
+
+
+def chunk_bounds(steps, rows, change_steps, most_changes=64):
+    """[(start, stop)] of chunks of ``rows`` steps; a load step starts a chunk when few are."""
+    bounds = set(range(0, steps, rows))
+    if len(change_steps) <= most_changes:
+        bounds.update(k for k in change_steps if k < steps)
+    edges = sorted(bounds) + [steps]
+    return list(zip(edges[:-1], edges[1:]))
+
+
+def _check(scenarios, record):
+    if record not in RECORDS:
+        raise ValueError(f"record must be one of {', '.join(RECORDS)}, got {record!r}")
+    if not scenarios:
+        raise ValueError("run_batch needs at least one scenario")
+    for scenario in scenarios:
+        reason = unsupported_reason(scenario)
+        if reason:
+            raise BatchUnsupported(reason)
+
+
+class _Series:
+    """Full time series of every run (record "timeseries"): one (n + 1, N) array per column."""
+
+    def __init__(self, inputs):
+        shape = (inputs.steps + 1, inputs.size)
+        self.columns = {name: np.full(shape, np.nan) for name in
+                        ("R", "T", "x", "xi_P", "xi_M", "xi_F", "P_ff", "P_fb", "P", "T_ref")}
+        self.saturated = np.zeros(shape, dtype=bool)
+        self.inputs = inputs
+
+    def sample(self, k, plant):
+        c = self.columns
+        c["R"][k], c["T"][k], c["x"][k] = plant.R, plant.temperature, plant.length()
+        c["xi_P"][k], c["xi_M"][k], c["xi_F"][k] = plant.xi_P, plant.xi_M, plant.xi_F
+
+    def controls(self, start, feedforward, feedback, power):
+        rows = slice(start, start + power.shape[0])
+        c = self.columns
+        c["P_ff"][rows], c["T_ref"][rows], c["P_fb"][rows], c["P"][rows] = (
+            feedforward.P_ff, feedforward.T_ref, feedback, power)
+        self.saturated[rows] = feedforward.saturated
+
+    def data(self, run):
+        inputs, c = self.inputs, self.columns
+        n = inputs.steps
+        data = np.zeros(n + 1, dtype=TIMESERIES_DTYPE)
+        data["t"] = inputs.times
+        data["R_ref"] = np.broadcast_to(inputs.references(0, n + 1), (n + 1, inputs.size))[:, run]
+        data["load"] = inputs.load_rows(0, n + 1)[:, run]
+        for name, values in c.items():
+            data[name] = values[:, run]
+        data["stroke"] = c["x"][0, run] - c["x"][:, run]
+        data["saturated"] = self.saturated[:, run]
+        data["saturated"][n] = False
+        return data
+
+
+def _loop(scenarios, inputs, record):
+    """Close the N loops; returns (series or None, metrics accumulator or None, {run: reason})."""
+    plant = BatchPlant(inputs, scenarios)
+    feedforward = BatchFeedforward(inputs, scenarios)
+    size, n, h = inputs.size, inputs.steps, inputs.step_s
+    Kp = np.array([s.controller.Kp for s in scenarios])
+    Ki = np.array([s.controller.Ki for s in scenarios])
+    integral = np.zeros(size)
+    series = _Series(inputs) if record == "timeseries" else None
+    totals = MetricsAccumulator(inputs, scenarios) if record == "metrics" else None
+    failed = dict(inputs.failures)
+    rows = chunk_steps(size, n)
+    work, raw, mask = np.empty(size), np.empty(size), np.empty(size)
+    integrate, positive = np.empty(size, dtype=bool), np.empty(size, dtype=bool)
+    zero, step = np.zeros(size), np.full(size, h)
+    changes = set(inputs.change_steps)
+    subtract, multiply, add, maximum = np.subtract, np.multiply, np.add, np.maximum
+    greater_equal, greater, logical_or, copyto = (np.greater_equal, np.greater, np.logical_or,
+                                                  np.copyto)
+    for start, stop in chunk_bounds(n, rows, inputs.change_steps):
+        references = inputs.references(start, stop + 1)
+        compensator = feedforward.chunk(start, stop)
+        for run, message in compensator.diverged.items():
+            failed.setdefault(run, message)
+        errors = np.empty((stop - start + 1, size))
+        feedback = np.empty((stop - start, size))
+        power = np.empty((stop - start + 1, size))
+        power[-1] = np.nan
+        P_ff = compensator.P_ff
+        for j in range(stop - start):
+            k = start + j
+            if k in changes:
+                plant.set_segments(inputs.segment_row(k), inputs.segment_row(k - 1))
+            if series is not None:
+                series.sample(k, plant)
+            e, fb, u = errors[j], feedback[j], power[j]
+            subtract(plant.R, references[j], e)
+            multiply(Kp, e, fb)                        # PIController.step
+            multiply(Ki, integral, work)
+            add(fb, work, fb)
+            add(P_ff[j], fb, raw)
+            maximum(raw, zero, out=u)                  # the clamp; the plant applies u <= 0 as 0
+            greater_equal(raw, zero, integrate)        # held while raw < 0 and e <= 0
+            greater(e, zero, positive)
+            logical_or(integrate, positive, integrate)
+            copyto(mask, integrate)
+            multiply(step, e, work)
+            multiply(work, mask, work)                 # I + (h e) * 1 = I + h e; * 0 adds 0
+            add(integral, work, integral)
+            plant.step(u)
+        np.subtract(plant.R, references[-1], out=errors[-1])   # e_stop, counted by the next chunk
+        if series is not None:
+            series.controls(start, compensator, feedback, power[:-1])
+        finite = np.isfinite(power[:-1]).all(axis=0)
+        for run in np.flatnonzero(~finite):
+            failed.setdefault(int(run), "P_in must be finite")
+        if totals is not None:
+            last = stop == n
+            totals.add(start, errors if last else errors[:-1], power if last else power[:-1],
+                       compensator.saturated if not last else np.vstack(
+                           [compensator.saturated, np.zeros((1, size), dtype=bool)]))
+    if series is not None:
+        series.sample(n, plant)
+    return series, totals, failed
+
+
+def run_batch(scenarios, record="metrics"):
+    """Run ``scenarios`` (same step and duration) as one batch; returns a list of :class:`BatchRun`.
+
+    ``record``: "metrics" (default; no time series kept) or "timeseries".
+    Raises :class:`BatchUnsupported` when a scenario uses an option the engine lacks.
+    """
+    scenarios = list(scenarios)
+    _check(scenarios, record)
+    # feedforward runs first: the compensators then work on column slices
+    order = sorted(range(len(scenarios)), key=lambda i: not scenarios[i].controller.feedforward)
+    ordered = [scenarios[i] for i in order]
+    inputs = BatchInputs(ordered)
+    with np.errstate(all="ignore"):
+        series, totals, failed = _loop(ordered, inputs, record)
+    results = [None] * len(scenarios)
+    for position, (run, scenario) in enumerate(zip(order, ordered)):
+        if position in failed:
+            results[run] = _scalar_run(scenario, record)
+            continue
+        data = series.data(position) if series is not None else None
+        metrics = scenario_metrics(data, scenario) if data is not None else totals.metrics(position)
+        results[run] = BatchRun(scenario, data, metrics, None, "batch")
+    return results
+
+
+def _scalar_run(scenario, record):
+    """A run that failed in the batch, run again on the scalar library path."""
+    try:
+        result = run_library(scenario)
+    except ValueError as error:
+        return BatchRun(scenario, None, None, str(error), "library")
+    metrics = scenario_metrics(result.data, scenario)
+    return BatchRun(scenario, result.data if record == "timeseries" else None, metrics, None,
+                    "library")
+
+
+def throughput(scenarios, repeats=1):
+    """Closed-loop steps per second of one batch of ``scenarios`` (record "metrics")."""
+    best = math.inf
+    for _ in range(repeats):
+        began = time.perf_counter()
+        run_batch(scenarios, "metrics")
+        best = min(best, time.perf_counter() - began)
+    return len(scenarios) * scenarios[0].steps / best

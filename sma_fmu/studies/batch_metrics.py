@@ -1,0 +1,171 @@
+"""Tracking metrics of a batch, accumulated chunk by chunk: no run's time series is kept.
+
+The same record as :func:`sma_fmu.cosim.metrics.scenario_metrics`: the windows are built
+with its predicates on t_k = k h, then turned into index ranges; the reachable band comes
+from :func:`~sma_fmu.runtime.reachable_band.reachable_band` per run and load segment; the
+warning from :func:`~sma_fmu.cosim.metrics.reachability_warning`. Sums run over chunks
+instead of a stored series, so they agree to rounding (tests/test_batch.py binds the two).
+"""
+import math
+
+import numpy as np
+
+from sma_fmu.cosim.metrics import reachability_warning
+
+__all__ = ["MetricsAccumulator"]
+
+_SIDES = ("below R_hot", "above R_cold")
+
+
+def _index_range(mask):
+    """[first, stop) of a contiguous boolean mask (t_k is increasing, so windows are ranges)."""
+    where = np.flatnonzero(mask)
+    if where.size == 0:
+        return 0, 0
+    if where[-1] - where[0] + 1 != where.size:
+        raise AssertionError("a metrics window is not contiguous")
+    return int(where[0]), int(where[-1]) + 1
+
+
+class _Totals:
+    """Sum of e^2, sum of |e|, max |e| and count per run over rows [first, stop) where
+    ``keep`` (a (rows, N) mask, or None for all) holds."""
+
+    def __init__(self, first, stop, size):
+        self.first, self.stop = first, stop
+        self.squares, self.absolute = np.zeros(size), np.zeros(size)
+        self.largest, self.count = np.zeros(size), np.zeros(size, dtype=np.int64)
+
+    def add(self, start, errors, columns, keep=None):
+        low, high = max(self.first, start), min(self.stop, start + errors.shape[0])
+        if low >= high:
+            return
+        rows = slice(low - start, high - start)
+        part = np.abs(errors[rows][:, columns])
+        if keep is not None:
+            chosen = keep[rows][:, columns]
+            part = np.where(chosen, part, 0.0)
+            self.count[columns] += np.count_nonzero(chosen, axis=0)
+        else:
+            self.count[columns] += high - low
+        self.squares[columns] += np.sum(part * part, axis=0)
+        self.absolute[columns] += np.sum(part, axis=0)
+        self.largest[columns] = np.maximum(self.largest[columns], np.max(part, axis=0))
+
+    def metrics(self, run, step_s):
+        count = int(self.count[run])
+        if count == 0:
+            return {"rmse_ohm": None, "max_abs_ohm": None, "iae_ohm_s": None, "samples": 0}
+        return {"rmse_ohm": math.sqrt(float(self.squares[run]) / count),
+                "max_abs_ohm": float(self.largest[run]),
+                "iae_ohm_s": float(step_s * self.absolute[run]), "samples": count}
+
+
+class MetricsAccumulator:
+    """Metrics of every run of a batch from chunks of e_k = R_k - R_ref(t_k), P_k and flags.
+
+    ``inputs`` is the batch's :class:`~sma_fmu.studies.batch_inputs.BatchInputs`;
+    ``scenarios`` give the load segments and the metrics window.
+    """
+
+    def __init__(self, inputs, scenarios):
+        self.scenarios, self.inputs, self.step_s = scenarios, inputs, inputs.step_s
+        t, size = inputs.times, inputs.size
+        self.groups, self._group_of = [], {}
+        keys = {}
+        for run, scenario in enumerate(scenarios):
+            start = scenario.analysis.metrics_start_s
+            key = (start, tuple((a, b) for a, b, _ in scenario.load.segments(scenario.stop_time_s)))
+            keys.setdefault(key, []).append(run)
+        for (metrics_start, segments), runs in keys.items():
+            window = t >= metrics_start - 1e-9 * inputs.step_s
+            stop_time = scenarios[runs[0]].stop_time_s
+            parts = []
+            for start, end in segments:
+                last = end >= stop_time
+                inside = window & (t >= start - 1e-9) & ((t <= end + 1e-9) if last else
+                                                        (t < end - 1e-9))
+                parts.append(_Totals(*_index_range(inside), size))
+            window = _index_range(window)
+            self._group_of.update((run, len(self.groups)) for run in runs)
+            self.groups.append({"runs": np.array(runs), "window": window, "segments": parts,
+                                "overall": _Totals(*window, size),
+                                "reachable": _Totals(*window, size)})
+        self.saturated, self.clamped = np.zeros(size), np.zeros(size)
+        self.unreachable = np.zeros(size)
+        self._inside = {side: np.zeros(size, dtype=bool) for side in _SIDES}   # carried over
+        self._opened = {side: {} for side in _SIDES}
+        self.intervals = [[] for _ in range(size)]
+
+    def add(self, start, errors, power, saturated):
+        """Rows k = start ... of e [ohm], applied power P [W] (nan at k = n) and flags, (c, N)."""
+        stop = start + errors.shape[0]
+        below, above = self.inputs.unreachable(start, stop)
+        outside = below | above
+        anywhere = bool(outside.any())         # usually not: then reachable = overall here
+        for group in self.groups:
+            runs = group["runs"]
+            group["overall"].add(start, errors, runs)
+            group["reachable"].add(start, errors, runs, keep=~outside if anywhere else None)
+            for part in group["segments"]:
+                part.add(start, errors, runs)
+            first, last = group["window"]
+            low, high = max(first, start), min(last, stop)
+            if low < high:
+                rows = slice(low - start, high - start)
+                self.saturated[runs] += np.count_nonzero(saturated[rows][:, runs], axis=0)
+                self.clamped[runs] += np.count_nonzero(power[rows][:, runs] == 0.0, axis=0)
+                if anywhere:
+                    self.unreachable[runs] += np.count_nonzero(outside[rows][:, runs], axis=0)
+        for side, mask in zip(_SIDES, (below, above)):
+            if anywhere or self._inside[side].any():
+                self._track(side, start, mask)
+
+    def _track(self, side, start, mask):
+        """Runs of consecutive unreachable samples, as unreachable_intervals finds them."""
+        rows = np.vstack([self._inside[side], mask]).astype(np.int8)
+        change = np.diff(rows, axis=0)
+        times = self.inputs.times
+        opened = self._opened[side]
+        for row, run in zip(*np.nonzero(change)):
+            k = start + int(row)
+            if change[row, run] > 0:
+                opened[int(run)] = k
+            else:
+                self.intervals[run].append([float(times[opened.pop(int(run))]),
+                                            float(times[k - 1]), side])
+        self._inside[side] = mask[-1].copy()
+
+    def metrics(self, run):
+        """The :func:`~sma_fmu.cosim.metrics.scenario_metrics` record of run ``run``."""
+        scenario = self.scenarios[run]
+        group = self.groups[self._group_of[run]]
+        count = group["window"][1] - group["window"][0]
+        intervals = list(self.intervals[run])
+        for side in _SIDES:                     # still open at the last sample
+            if run in self._opened[side]:
+                intervals.append([float(self.inputs.times[self._opened[side][run]]),
+                                  float(self.inputs.times[-1]), side])
+        intervals.sort()
+        fraction = float(self.unreachable[run] / count) if count else math.nan
+        warning = reachability_warning(intervals, fraction)
+        start = scenario.analysis.metrics_start_s
+        return {
+            "scenario": scenario.name,
+            "controller": scenario.controller.kind,
+            "inverse": scenario.controller.inverse if scenario.controller.feedforward else None,
+            "hysteresis_mode": scenario.hysteresis_mode,
+            "window": f"t >= {start:g} s",
+            "metrics_start_s": start,
+            "overall": group["overall"].metrics(run, self.step_s),
+            "segments": [{"start_s": a, "end_s": b, "load_kg": load,
+                          **part.metrics(run, self.step_s)}
+                         for part, (a, b, load) in
+                         zip(group["segments"], scenario.load.segments(scenario.stop_time_s))],
+            "saturated_fraction": float(self.saturated[run] / count) if count else math.nan,
+            "clamped_fraction": float(self.clamped[run] / (count - 1)) if count > 1 else None,
+            "unreachable_fraction": fraction,
+            "reachable": group["reachable"].metrics(run, self.step_s),
+            "unreachable_intervals_s": intervals,
+            "warnings": [] if warning is None else [warning],
+        }

@@ -1,0 +1,137 @@
+"""``sma-fmu sweep``: run a study spec on Dask distributed, streaming results to disk.
+
+The runs are split into tasks (:func:`~sma_fmu.studies.tasks.run_task`) and sent to a
+Dask cluster: a ``LocalCluster`` of worker processes by default, or an existing cluster
+with ``scheduler`` (its workers need sma-fmu installed). Each finished task's rows are
+written at once to ``OUT/runs/part-*.parquet`` (through a temporary file and a rename),
+so memory holds no more than the tasks in flight, and an interrupted sweep keeps what it
+finished. Running the same spec into the same folder again resumes: runs already in a
+part (succeeded or failed) are not run again; runs of a task that itself failed (status
+"error", e.g. a worker died) are. ``OUT/study.json`` records the spec's fingerprint; a
+different spec into the same folder is refused. At the end, :mod:`~sma_fmu.studies.results`
+writes the table, the summary and the figures.
+"""
+import contextlib
+import io
+import json
+import logging
+import math
+import os
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from sma_fmu.json_output import json_text
+from sma_fmu.output_folder import write_file
+from sma_fmu.studies.overrides import StudyError
+from sma_fmu.studies.results import write_results
+from sma_fmu.studies.spec import load_spec
+from sma_fmu.studies.tasks import run_task
+
+__all__ = ["PARTS", "run_sweep", "finished_runs", "dask_client", "task_size"]
+
+PARTS = "runs"
+MOST_RUNS_PER_TASK = 1000
+
+
+@contextlib.contextmanager
+def dask_client(scheduler=None, workers=None):
+    """A ``dask.distributed.Client``: of ``scheduler`` (an address), or of a new LocalCluster
+    with ``workers`` single-threaded worker processes (default: one per core)."""
+    from dask.distributed import Client, LocalCluster
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="20s")
+        except (OSError, TimeoutError) as error:
+            raise StudyError(f"--scheduler {scheduler}: cannot connect ({error})") from None
+        with client:
+            yield client
+        return
+    count = workers or os.cpu_count() or 1
+    with LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
+                      dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
+            Client(cluster) as client:
+        yield client
+
+
+def task_size(remaining, workers, requested=None):
+    """Runs per task: ``requested``, or an even split over twice the workers, at most 1000."""
+    if requested:
+        return requested
+    return max(1, min(MOST_RUNS_PER_TASK, math.ceil(remaining / (2 * max(workers, 1)))))
+
+
+def finished_runs(out):
+    """{run_id: status} of the runs already written to ``out``/runs (an error is not final)."""
+    done = {}
+    for part in sorted((Path(out) / PARTS).glob("part-*.parquet")):
+        table = pd.read_parquet(part, columns=["run_id", "status"])
+        for run_id, status in zip(table["run_id"].tolist(), table["status"].tolist()):
+            if status != "error" or run_id not in done:
+                done[run_id] = status
+    return {run_id: status for run_id, status in done.items() if status != "error"}
+
+
+def _check_folder(out, spec):
+    """Create ``out`` for ``spec``, or check that it holds a sweep of the same spec."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise StudyError(f"--out {out}: exists and is not a folder")
+    marker = out / "study.json"
+    fingerprint = spec.fingerprint()
+    if marker.is_file():
+        recorded = json.loads(marker.read_text(encoding="utf-8")).get("fingerprint")
+        if recorded != fingerprint:
+            raise StudyError(f"--out {out}: holds the results of another study spec "
+                             f"(study.json); give another --out, or remove that folder")
+        return
+    (out / PARTS).mkdir(parents=True, exist_ok=True)
+    write_file(marker, json_text({"spec": str(spec.path), "fingerprint": fingerprint,
+                                  "runs": len(spec.runs())}))
+
+
+def _write_part(out, rows):
+    buffer = io.BytesIO()
+    pd.DataFrame(rows).to_parquet(buffer, index=False)
+    first = min(row["run_id"] for row in rows)
+    status = "error" if all(row["status"] == "error" for row in rows) else "part"
+    name = f"part-{first:08d}-{len(rows):05d}{'-error' if status == 'error' else ''}.parquet"
+    write_file(Path(out) / PARTS / name, buffer.getvalue())
+
+
+def _error_rows(spec, runs, reason):
+    return [{"run_id": r.run_id, "scenario": spec.templates[r.base].name, "point": r.point,
+             "draw": r.draw, "status": "error", "error": reason, **r.overrides} for r in runs]
+
+
+def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True):
+    """Run the study spec at ``spec_path`` into folder ``out``; returns the summary dict."""
+    from dask.distributed import as_completed
+    from tqdm import tqdm
+
+    spec = load_spec(spec_path)
+    runs = spec.runs()
+    _check_folder(out, spec)
+    done = finished_runs(out)
+    todo = [run for run in runs if run.run_id not in done]
+    if todo:
+        with dask_client(scheduler, workers) as client:
+            count = len(client.scheduler_info().get("workers", {})) or 1
+            size = task_size(len(todo), count, spec.runs_per_task)
+            chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
+            futures = {client.submit(run_task, spec.templates, chunk, pure=False): chunk
+                       for chunk in chunks}
+            with tqdm(total=len(runs), initial=len(runs) - len(todo), unit="run",
+                      disable=not progress, file=sys.stderr, desc="sweep") as bar:
+                for future in as_completed(futures):
+                    chunk = futures.pop(future)
+                    try:
+                        rows = future.result()
+                    except Exception as error:  # noqa: BLE001 - recorded, retried on resume
+                        rows = _error_rows(spec, chunk, f"task failed: {type(error).__name__}: "
+                                                        f"{error}")
+                    _write_part(out, rows)
+                    bar.update(len(chunk))
+                    future.release()
+    return write_results(spec, out)

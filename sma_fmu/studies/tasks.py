@@ -1,0 +1,61 @@
+"""One Dask task of a sweep: build its runs' scenarios, run them, return one row per run.
+
+Runs that share the step and duration and use only what the batch engine implements go
+through :func:`~sma_fmu.studies.batch.run_batch` (metrics only, no time series kept); the
+others run one by one on the scalar library path. A run that cannot be built or fails is
+a row with ``status = "failed"`` and the reason in ``error``, never dropped.
+"""
+from sma_fmu.cosim.loop import run_library
+from sma_fmu.cosim.metrics import scenario_metrics
+from sma_fmu.studies.batch import run_batch, unsupported_reason
+from sma_fmu.studies.overrides import StudyError
+from sma_fmu.studies.runs import metrics_record
+
+__all__ = ["STATUSES", "run_task"]
+
+STATUSES = ("ok", "failed", "error")   # error: the task itself failed (retried on resume)
+
+
+def _row(run, template):
+    row = {"run_id": run.run_id, "scenario": template.name, "point": run.point,
+           "draw": run.draw, "status": "ok", "error": None, "path": None,
+           "controller": None, "hysteresis_mode": None}
+    row.update(run.overrides)
+    return row
+
+
+def _finish(row, scenario, metrics, path, error=None):
+    row.update(controller=scenario.controller.kind, hysteresis_mode=scenario.hysteresis_mode,
+               path=path)
+    if error is not None:
+        row.update(status="failed", error=error)
+    else:
+        row.update(metrics_record(metrics))
+    return row
+
+
+def run_task(templates, runs):
+    """Rows (dicts) of ``runs`` (:class:`~sma_fmu.studies.spec.StudyRunSpec`), in order."""
+    rows, batches, single = {}, {}, []
+    for run in runs:
+        row = rows[run.run_id] = _row(run, templates[run.base])
+        try:
+            scenario = templates[run.base].scenario(run.overrides)
+        except StudyError as error:
+            row.update(status="failed", error=str(error))
+            continue
+        if unsupported_reason(scenario) is None:
+            batches.setdefault((scenario.step_s, scenario.steps), []).append((row, scenario))
+        else:
+            single.append((row, scenario))
+    for members in batches.values():
+        for (row, scenario), outcome in zip(members, run_batch([s for _, s in members])):
+            _finish(row, scenario, outcome.metrics, outcome.path, outcome.error)
+    for row, scenario in single:
+        try:
+            result = run_library(scenario)
+        except ValueError as error:
+            _finish(row, scenario, None, "library", str(error))
+            continue
+        _finish(row, scenario, scenario_metrics(result.data, scenario), "library")
+    return [rows[run.run_id] for run in runs]
