@@ -7,6 +7,7 @@
 #include <limits.h>
 #include <pthread.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "front.h"
@@ -17,6 +18,23 @@ char load_info[1024] = "";
 
 static pthread_mutex_t load_mutex = PTHREAD_MUTEX_INITIALIZER;
 static int load_state = 0; /* 0 not tried, 1 loaded, -1 failed */
+
+/*
+ * pythonfmu 0.7.0 releases its PyState twice at process exit: the destructor of its static
+ * std::shared_ptr runs among the exit handlers, then its library destructor
+ * (onLibraryUnload) assigns nullptr to that destroyed shared_ptr and releases the freed
+ * block again (valgrind: invalid read in finalizePythonInterpreter; now and then glibc
+ * aborts with "corrupted double-linked list"). Exit handlers run last-registered first, so
+ * this one, registered after pythonfmu's binary is loaded, runs before pythonfmu's static
+ * destructor: it empties the shared_ptr through pythonfmu's own finalizePythonInterpreter,
+ * and both later steps then find it empty.
+ */
+static void (*finalize_python)(void);
+
+static void finalize_backend_at_exit(void)
+{
+    if (finalize_python) finalize_python();
+}
 
 /* <directory of this library>/<its name without .so>_pythonfmu.so into path, or 0. */
 static int backend_path(char* path, size_t size)
@@ -64,6 +82,8 @@ int load_backend(void)
         }
         BACKEND_FUNCTIONS(LOOKUP)
 #undef LOOKUP
+        *(void**)(&finalize_python) = dlsym(handle, "finalizePythonInterpreter");
+        if (finalize_python) atexit(finalize_backend_at_exit);
         load_state = 1;
     }
 done:;
