@@ -76,3 +76,17 @@ def test_run_many_groups_by_duration_and_keeps_the_order():
     assert flat["rmse_ohm"] == results[1].metrics["overall"]["rmse_ohm"]
     with pytest.raises(StudyError, match="path must be one of"):
         run_many(items, path="gpu")
+
+
+def test_scenario_model_override_loads_that_parameter_file(tmp_path):
+    """An override of scenario.model is not ignored: the plant and the compensator use that file."""
+    from sma_fmu.package_data import shipped_file
+    from sma_fmu.studies import scenario as study_scenario
+    text = shipped_file("models", "reference_wire.toml").read_text().replace(
+        "a_h = { value = 68.0", "a_h = { value = 71.0")
+    (tmp_path / "wire.toml").write_text(text)
+    changed = study_scenario("heavy-pi", {"scenario.model": str(tmp_path / "wire.toml")})
+    assert changed.params.a_h == 71.0
+    assert changed.compensator_params.a_h == 71.0
+    with pytest.raises(StudyError, match="nowhere.toml: parameter file not found"):
+        study_scenario("heavy-pi", {"scenario.model": str(tmp_path / "nowhere.toml")})

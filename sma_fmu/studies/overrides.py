@@ -26,6 +26,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.scenario import (Scenario, ScenarioError, read_scenario_document,
                                     resolve_scenarios, scenario_from_document)
+from sma_fmu.parameter_file import load_parameter_set
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError
 
 __all__ = ["StudyError", "SECTIONS", "ScenarioTemplate", "template", "with_overrides"]
@@ -94,6 +95,16 @@ def _split(overrides):
     return tables, wire, model
 
 
+def _parameter_set(base, model):
+    """The scenario's parameter set: the template's, or the file an override of
+    ``scenario.model`` names (relative to the scenario file, like the key in a file)."""
+    if model is None:
+        return base.parameter_set
+    if not isinstance(model, (str, Path)):
+        raise ScenarioError(f"{base.path}: [scenario] model must be a path, got {model!r}")
+    return load_parameter_set(base.path.parent / model)
+
+
 def with_overrides(base, overrides):
     """The :class:`Scenario` of ``base`` (a :class:`ScenarioTemplate`) with ``overrides``."""
     tables, wire, model = _split(overrides)
@@ -106,8 +117,8 @@ def with_overrides(base, overrides):
         document["reference"] = {}
     for section, values in tables.items():
         document.setdefault(section, {}).update(values)
-    nominal = base.parameter_set
     try:
+        nominal = _parameter_set(base, tables.get("scenario", {}).get("model"))
         plant = replace(nominal, params=nominal.params.replace(**wire)) if wire else nominal
         scenario = scenario_from_document(document, base.path, plant)
         if wire or model:
