@@ -10,7 +10,6 @@ import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from sma_fmu.fmi.hosts import compile_host
 
 OK, WARNING, DISCARD, ERROR, FATAL = range(5)
 

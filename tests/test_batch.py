@@ -3,7 +3,6 @@
 The sets (sma_fmu.studies.random_set, also the benchmark's) mix every controller in both
 hysteresis modes with random gains, filters, loads, references, wire and model parameters.
 """
-import dataclasses
 import itertools
 
 import numpy as np

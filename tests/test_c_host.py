@@ -10,7 +10,6 @@ time) the FMU's binary is pythonfmu's own, which does not load in a C host.
 """
 import os
 import re
-import shutil
 import subprocess
 import warnings
 import zipfile

@@ -1,12 +1,10 @@
 """The built FMUs: fmpy validation, declared interface, shipped code, CLI build/validate."""
 import ast
-import shutil
 import zipfile
 
 import pytest
 from fmpy import read_model_description
 
-from sma_fmu import load_parameter_set
 from sma_fmu.cli import main
 from sma_fmu.fmi.build import FMU_SCRIPTS, build_fmu, code_stamp, validate_fmus
 from sma_fmu.parameter_file import write_parameter_file

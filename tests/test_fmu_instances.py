@@ -22,7 +22,7 @@ def test_two_plants_with_different_loads_side_by_side(fmus, params):
             for key, fmu in instances.items():
                 fmu.set_real(("P_in", "load"), (plant_power(k), loads[key]))
                 fmu.step(k * STEP, STEP)
-                out = libraries[key].step(plant_power(k), loads[key], STEP)
+                libraries[key].step(plant_power(k), loads[key], STEP)
             feedforward.set_real(("R_ref", "load"), (reference(k), 0.25))
             feedforward.step(k * STEP, STEP)
             ff_out = ff_library.step(reference(k), 0.25, STEP)

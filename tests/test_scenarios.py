@@ -1,5 +1,4 @@
 """Scenario files: the shipped set, signals, and malformed files rejected naming file and key."""
-import math
 
 import pytest
 

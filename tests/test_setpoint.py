@@ -6,7 +6,6 @@ Continuous mode (the default of the library, the FMUs and scenarios) settles wit
 why it is not the default.
 """
 import numpy as np
-import pytest
 
 from sma_fmu.cosim.master import run_fmus
 from sma_fmu.cosim.scenario import load_scenario

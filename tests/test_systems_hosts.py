@@ -2,8 +2,8 @@
 
 The SSP package runs in libcosim (libcosimpy) and in Ecos (ecospy), which couple by
 Jacobi; the container FMU runs in fmpy and in libcosim, sequential inside (Gauss-Seidel);
-both run in sma-fmu's C host, a C program on libcosim's C API (with libpython preloaded
-today). Each run must match the library loop of its coupling to 1e-9 in every
+both run in sma-fmu's C host, a C program on libcosim's C API (nothing preloaded: the
+FMUs load libpython themselves). Each run must match the library loop of its coupling to 1e-9 in every
 time-series column. The scenarios are shortened to 2.2 s (RMSE from 2 s on), with a load
 step at 0.6 s.
 """
@@ -143,7 +143,7 @@ def test_fmpy_simulate_ssp_cannot_run_the_loop(adaptive, fmu_dir):
 
 
 def test_container_and_ssp_run_in_the_c_host(adaptive):
-    """A C program on libcosim's C API, LD_PRELOAD of libpython (until the FMUs load it)."""
+    """A C program on libcosim's C API, with nothing preloaded (the FMUs load libpython)."""
     scenario, artifacts = adaptive
     n = scenario.steps
     last = {coupling: run_library(scenario, coupling).data[-1] for coupling in ("gauss-seidel", "jacobi")}

@@ -5,7 +5,6 @@ identification, studies, bench, examples);
 each has ``register(commands)``. Every failure is one line ``sma-fmu: error: ...`` on stderr
 with exit status 2 (``validate`` and ``check`` exit 1 when a file fails); no traceback, ever.
 """
-import sys
 
 from sma_fmu import __version__
 

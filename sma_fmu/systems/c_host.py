@@ -5,10 +5,9 @@ Library, in a process that is not Python. The program (``c_host/cosim_host.c``) 
 with the system C compiler (``$CC``, else ``cc``) against the libcosimc of the libcosimpy
 wheel, once per source and library, into a cache folder.
 
-pythonfmu's binary does not link libpython, so :func:`host_environment` preloads this
-Python's libpython (LD_PRELOAD). **Where this changes**: once the FMUs carry a native front
-library that loads libpython themselves (issue 10), :func:`host_environment` returns the
-environment unchanged and the C host needs nothing preloaded.
+The FMUs carry a native front library that loads libpython itself (docs/fmus.md), so the
+host process needs nothing preloaded: :func:`host_environment` removes LD_PRELOAD, and the
+runs show what any C tool sees.
 """
 import hashlib
 import importlib.util
@@ -16,12 +15,11 @@ import os
 import re
 import shutil
 import subprocess
-import sysconfig
 import tempfile
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["CHostError", "libpython", "host_environment", "build_c_host", "run_c_host"]
+__all__ = ["CHostError", "host_environment", "build_c_host", "run_c_host"]
 
 _SOURCE = ("c_host", "cosim_host.c")
 _OUTPUT_LINE = re.compile(r"([^=\s]+)=(\S+)")
@@ -31,20 +29,11 @@ class CHostError(RuntimeError):
     """The C host could not be built or failed to run; the message says why."""
 
 
-def libpython():
-    """Path of this Python's shared libpython (what a C host must preload today)."""
-    name = sysconfig.get_config_var("INSTSONAME") or sysconfig.get_config_var("LDLIBRARY")
-    return Path(sysconfig.get_config_var("LIBDIR")) / name
-
-
 def host_environment(environment=None):
-    """The environment for a C host process: ``environment`` (default os.environ) + LD_PRELOAD."""
+    """The environment for a C host process: ``environment`` (default os.environ) without
+    LD_PRELOAD: the FMUs load libpython themselves."""
     environment = dict(os.environ if environment is None else environment)
-    preload = str(libpython())
-    if not Path(preload).is_file():
-        raise CHostError(f"{preload}: this Python has no shared libpython, which pythonfmu FMUs "
-                         "need in a C host (build Python with --enable-shared)")
-    environment["LD_PRELOAD"] = preload
+    environment.pop("LD_PRELOAD", None)
     return environment
 
 
