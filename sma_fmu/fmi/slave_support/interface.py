@@ -172,14 +172,6 @@ class SlaveInterface:
         """Add units, output dependencies and InitialUnknowns to pythonfmu's description."""
         return decorate_model_description(root, self.units)
 
-    def preview_outputs(self, start, publish, invalid_outputs):
-        """Outputs that follow what is set in Initialization Mode (kept for the slaves' API).
-
-        The guard does this for every slave: until exitInitializationMode it recomputes the
-        outputs by running the slave's ``exit_initialization_mode`` whenever they are read
-        after a set, and refuses the read (fmi2Error, with the reason) while that fails.
-        """
-
     def initialize(self, start, invalid_outputs):
         """Run ``start()`` -> (stepper, outputs) for exitInitializationMode; never raise.
 

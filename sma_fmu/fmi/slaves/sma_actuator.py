@@ -11,10 +11,10 @@ they follow them as they are set). Invalid parameters are
 logged as fmi2Error at exitInitializationMode; the outputs are then NaN and every
 doStep is discarded (pythonfmu would turn an exception there into fmi2Fatal).
 """
-from pythonfmu import Fmi2Slave
 from pythonfmu.default_experiment import DefaultExperiment
 
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
+from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.plant import PlantStepper
 
 OUTPUTS = (
@@ -29,8 +29,9 @@ OUTPUTS = (
 INVALID_OUTPUTS = (float("nan"),) * len(OUTPUTS) + (False,)
 
 
-class SmaActuator(Fmi2Slave):
+class SmaActuator(StepperSlave):
 
+    INVALID_OUTPUTS = INVALID_OUTPUTS
     author = "sma-fmu"
     description = "SMA wire actuator: Joule heating, first-order thermal model, resistance hysteresis under load"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
@@ -50,7 +51,6 @@ class SmaActuator(Fmi2Slave):
         fmi.model_parameters(extra=("T_max",))
         self.stepper = None
         self._publish(PlantStepper(fmi.defaults, self.T_start, self.hysteresis_mode, self.load).outputs)
-        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
 
     def _publish(self, outputs):
         self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.P, self.heating = outputs
@@ -60,30 +60,5 @@ class SmaActuator(Fmi2Slave):
                                self.hysteresis_mode, self.load)
         return stepper, stepper.outputs
 
-    def exit_initialization_mode(self):
-        self.stepper, outputs = self.interface.initialize(self._start, INVALID_OUTPUTS)
-        self._publish(outputs)
-
-    def do_step(self, current_time, step_size):
-        if self.stepper is None:
-            return self.interface.not_initialized(current_time)
-        try:
-            self._publish(self.stepper.step(self.P_in, self.load, step_size))
-        except Exception as error:  # an exception here would reach the host as fmi2Fatal
-            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
-        return True
-
-    def to_xml(self, model_options=dict()):
-        return self.interface.decorate(super().to_xml(model_options))
-
-    def _get_fmu_state(self):
-        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
-
-    def _set_fmu_state(self, state):
-        variables, stepper_state = self.interface.split_state(state)
-        super()._set_fmu_state(variables)
-        # a new stepper with the restored parameters, then its hidden state
-        self.stepper = None if stepper_state is None else self._start()[0]
-        if self.stepper is not None:
-            self.stepper.restore(stepper_state)
-            self._publish(self.stepper.outputs)
+    def _advance(self, current_time, step_size):
+        return self.stepper.step(self.P_in, self.load, step_size)

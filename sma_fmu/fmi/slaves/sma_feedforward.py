@@ -11,13 +11,13 @@ Initialization Mode they follow R_ref, load and the parameters as they are set.
 Invalid parameters are logged as fmi2Error at exitInitializationMode; the outputs are
 then NaN and every doStep is discarded.
 """
-from pythonfmu import Fmi2Slave
 from pythonfmu.default_experiment import DefaultExperiment
 
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
+from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 
 INVALID_OUTPUTS = (float("nan"), float("nan"), False)
 
@@ -29,8 +29,9 @@ def _mid_transformation_resistance(params):
             + 0.5 * constants.M * (params.R_MF - params.R_P))
 
 
-class SmaFeedforward(Fmi2Slave):
+class SmaFeedforward(StepperSlave):
 
+    INVALID_OUTPUTS = INVALID_OUTPUTS
     author = "sma-fmu"
     description = "SMA feedforward compensator: temperature-sensing inverse model + phase-lag filter"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
@@ -52,7 +53,6 @@ class SmaFeedforward(Fmi2Slave):
         fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin"))
         self.stepper = None
         self._publish(FeedforwardStepper(fmi.defaults).initial_outputs(self.R_ref, self.load))
-        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
 
     def _start(self):
         stepper = FeedforwardStepper(self.interface.wire_parameters(),
@@ -62,29 +62,5 @@ class SmaFeedforward(Fmi2Slave):
     def _publish(self, outputs):
         self.P_ff, self.T_ref, self.saturated = outputs
 
-    def exit_initialization_mode(self):
-        self.stepper, outputs = self.interface.initialize(self._start, INVALID_OUTPUTS)
-        self._publish(outputs)
-
-    def do_step(self, current_time, step_size):
-        if self.stepper is None:
-            return self.interface.not_initialized(current_time)
-        try:
-            self._publish(self.stepper.step(self.R_ref, self.load, step_size))
-        except Exception as error:  # an exception here would reach the host as fmi2Fatal
-            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
-        return True
-
-    def to_xml(self, model_options=dict()):
-        return self.interface.decorate(super().to_xml(model_options))
-
-    def _get_fmu_state(self):
-        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
-
-    def _set_fmu_state(self, state):
-        variables, stepper_state = self.interface.split_state(state)
-        super()._set_fmu_state(variables)
-        # a new stepper with the restored parameters, then its hidden state
-        self.stepper = None if stepper_state is None else self._start()[0]
-        if self.stepper is not None:
-            self.stepper.restore(stepper_state)
+    def _advance(self, current_time, step_size):
+        return self.stepper.step(self.R_ref, self.load, step_size)

@@ -10,17 +10,18 @@ in Initialization Mode) the outputs are those the first step will give: the pres
 inputs with I = 0. Non-finite inputs discard the step. Invalid gains are logged as
 fmi2Error at exitInitializationMode; the outputs are then NaN and every doStep is discarded.
 """
-from pythonfmu import Fmi2Slave
 from pythonfmu.default_experiment import DefaultExperiment
 
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
+from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.pi_control import PIController
 
 INVALID_OUTPUTS = (float("nan"), float("nan"))
 
 
-class SmaPiController(Fmi2Slave):
+class SmaPiController(StepperSlave):
 
+    INVALID_OUTPUTS = INVALID_OUTPUTS
     author = "sma-fmu"
     description = "PI resistance controller of the SMA wire: anti-windup, power clamped at 0 W"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
@@ -36,7 +37,6 @@ class SmaPiController(Fmi2Slave):
         fmi.output("P_fb", "W", "feedback part Kp e + Ki I (before the clamp)")
         fmi.model_parameters(sections=(), extra=("Kp", "Ki"))
         self.stepper = None
-        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
 
     def _start(self):
         params = self.interface.wire_parameters()
@@ -46,29 +46,5 @@ class SmaPiController(Fmi2Slave):
     def _publish(self, outputs):
         self.P, self.P_fb = outputs
 
-    def exit_initialization_mode(self):
-        self.stepper, outputs = self.interface.initialize(self._start, INVALID_OUTPUTS)
-        self._publish(outputs)
-
-    def do_step(self, current_time, step_size):
-        if self.stepper is None:
-            return self.interface.not_initialized(current_time)
-        try:
-            self._publish(self.stepper.sample(self.R, self.R_ref, self.P_ff, step_size))
-        except Exception as error:  # an exception here would reach the host as fmi2Fatal
-            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
-        return True
-
-    def to_xml(self, model_options=dict()):
-        return self.interface.decorate(super().to_xml(model_options))
-
-    def _get_fmu_state(self):
-        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
-
-    def _set_fmu_state(self, state):
-        variables, stepper_state = self.interface.split_state(state)
-        super()._set_fmu_state(variables)
-        if stepper_state is not None:
-            if self.stepper is None:
-                self.stepper = self._start()[0]
-            self.stepper.restore(stepper_state)
+    def _advance(self, current_time, step_size):
+        return self.stepper.sample(self.R, self.R_ref, self.P_ff, step_size)

@@ -14,18 +14,19 @@ then NaN and every doStep is discarded.
 import json
 import os
 
-from pythonfmu import Fmi2Slave
 from pythonfmu.default_experiment import DefaultExperiment
 
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
+from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.scenario_signals import SignalSource, signals_from_text, table_text
 
 INVALID_OUTPUTS = (float("nan"), float("nan"))
 DEFAULTS_FILE = "signals.json"
 
 
-class SmaScenarioSignals(Fmi2Slave):
+class SmaScenarioSignals(StepperSlave):
 
+    INVALID_OUTPUTS = INVALID_OUTPUTS
     author = "sma-fmu"
     description = "Scenario signals of the SMA wire loop: reference resistance R_ref(t) and load f(t)"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
@@ -47,7 +48,6 @@ class SmaScenarioSignals(Fmi2Slave):
             '{"times_s":[0.0,...],"values_kg":[...]}; values_kg[i] from times_s[i] on')
         self.start_time = 0.0
         self.stepper = None
-        fmi.preview_outputs(self._start, self._publish, INVALID_OUTPUTS)
 
     def _start(self):
         reference, load = signals_from_text(self.reference, self.load_profile)
@@ -60,30 +60,5 @@ class SmaScenarioSignals(Fmi2Slave):
     def setup_experiment(self, start_time, stop_time, tolerance):
         self.start_time = start_time
 
-    def exit_initialization_mode(self):
-        self.stepper, outputs = self.interface.initialize(self._start, INVALID_OUTPUTS)
-        self._publish(outputs)
-
-    def do_step(self, current_time, step_size):
-        if self.stepper is None:
-            return self.interface.not_initialized(current_time)
-        try:
-            self._publish(self.stepper.step(current_time, step_size))
-        except Exception as error:  # an exception here would reach the host as fmi2Fatal
-            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
-        return True
-
-    def to_xml(self, model_options=dict()):
-        return self.interface.decorate(super().to_xml(model_options))
-
-    def _get_fmu_state(self):
-        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
-
-    def _set_fmu_state(self, state):
-        variables, stepper_state = self.interface.split_state(state)
-        super()._set_fmu_state(variables)
-        if stepper_state is not None:
-            if self.stepper is None:
-                self.stepper = self._start()[0]
-            self.stepper.restore(stepper_state)
-            self._publish(self.stepper.outputs)
+    def _advance(self, current_time, step_size):
+        return self.stepper.step(current_time, step_size)

@@ -1,0 +1,53 @@
+"""The base class of sma-fmu's slaves: a runtime stepper behind pythonfmu's callbacks.
+
+A slave subclasses :class:`StepperSlave`, declares its variables through its
+:class:`~.interface.SlaveInterface` in ``__init__``, and provides three methods:
+
+- ``_start()`` -> (stepper, outputs): a new stepper from the present parameters and inputs,
+  and the outputs after initialization;
+- ``_advance(current_time, step_size)`` -> outputs: one step of the stepper from the inputs;
+- ``_publish(outputs)``: copy outputs into the output variables;
+
+and the class attribute ``INVALID_OUTPUTS`` (the outputs while the parameters are invalid).
+Initialization, guarded steps, the model description's additions and the saved state (the
+pythonfmu variables plus the stepper's hidden state) are the same for every slave, here.
+"""
+from pythonfmu import Fmi2Slave
+
+__all__ = ["StepperSlave"]
+
+
+class StepperSlave(Fmi2Slave):
+    """pythonfmu slave over a runtime stepper (see the module docstring)."""
+
+    INVALID_OUTPUTS = ()
+
+    def exit_initialization_mode(self):
+        self.stepper, outputs = self.interface.initialize(self._start, self.INVALID_OUTPUTS)
+        self._publish(outputs)
+
+    def do_step(self, current_time, step_size):
+        if self.stepper is None:
+            return self.interface.not_initialized(current_time)
+        try:
+            self._publish(self._advance(current_time, step_size))
+        except Exception as error:  # an exception here would reach the host as fmi2Fatal
+            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
+        return True
+
+    def to_xml(self, model_options=None):
+        return self.interface.decorate(super().to_xml({} if model_options is None else model_options))
+
+    def _get_fmu_state(self):
+        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
+
+    def _set_fmu_state(self, state):
+        variables, stepper_state = self.interface.split_state(state)
+        super()._set_fmu_state(variables)
+        # a new stepper with the restored parameters, then its hidden state
+        self.stepper = None if stepper_state is None else self._start()[0]
+        if self.stepper is not None:
+            self.stepper.restore(stepper_state)
+            outputs = getattr(self.stepper, "outputs", None)
+            if outputs is not None:  # steppers that hold their outputs (the others' are variables)
+                self._publish(outputs)
