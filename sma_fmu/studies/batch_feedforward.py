@@ -1,17 +1,20 @@
 """N feedforward compensators (:class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`) at once.
 
 The compensator is open loop: its output at step k depends only on R_ref(t_k), f(t_k) and
-its own filter memory, never on the plant. So the inverse of :mod:`~sma_fmu.runtime.sensing`
-(major branch of the reference direction, at the measured or the fixed model load, with
-the saturation clamp) is computed for a whole chunk of steps in a few numpy calls, once
-per distinct compensator (runs that differ only in gains or filter share it), and only
-the phase-lag filter (Tustin, started in steady state) runs step by step, per run. The
-operations are those of the scalar code, in its order; tests/test_batch.py binds the two.
+its own memory (d_ref, the minor-loop reversal, the filter), never on the plant. So the
+inverse of :mod:`~sma_fmu.runtime.sensing` (major branch of the reference direction, at the
+measured or the fixed model load, with the saturation clamp; for ``inverse = "minor-loop"``
+the minor branch after the compensator's last reversal, :mod:`.batch_minor_loops`) is
+computed for a whole chunk of steps in a few numpy calls, once per distinct compensator
+(runs that differ only in gains or filter share it), and only the phase-lag filter
+(Tustin, started in steady state) runs step by step, per run. The operations are those of
+the scalar code, in its order; tests/test_batch.py binds the two.
 """
 import numpy as np
 
-from sma_fmu.runtime.constants import KELVIN_OFFSET
 from sma_fmu.runtime.phase_lag import tustin_coefficients
+from sma_fmu.studies.batch_minor_loops import (MinorLoopMemory, clamp_fractions,
+                                               temperature_of_fractions)
 
 __all__ = ["BatchFeedforward", "FeedforwardChunk"]
 
@@ -28,7 +31,7 @@ class FeedforwardChunk:
 
 
 def _inverse_key(scenario, reference_group, wires):
-    """What the inverse depends on: model parameters, reference, and the load it uses.
+    """What the inverse depends on: model parameters, reference, inverse, and the load it uses.
 
     ``wires`` maps id(parameters) -> their values, so a shared parameter set is read once.
     """
@@ -38,7 +41,7 @@ def _inverse_key(scenario, reference_group, wires):
     params = scenario.compensator_params
     if id(params) not in wires:
         wires[id(params)] = tuple(params.values().items())
-    return wires[id(params)], reference_group, c.adapt_to_load, load
+    return wires[id(params)], reference_group, c.inverse, c.adapt_to_load, load
 
 
 class BatchFeedforward:
@@ -59,6 +62,9 @@ class BatchFeedforward:
         self.of_run = np.array(self.of_run, dtype=int)     # inverse column of each ff run
         self.columns = np.array(chosen, dtype=int)          # a run that stands for each inverse
         self._tables([scenarios[run] for run in chosen])
+        minor = np.array([scenarios[run].controller.inverse == "minor-loop" for run in chosen],
+                         dtype=bool)
+        self.minor = MinorLoopMemory(np.flatnonzero(minor)) if minor.any() else None
         coefficients = [tustin_coefficients(scenarios[run].controller.alpha,
                                             scenarios[run].controller.beta, inputs.step_s)
                         for run in self.runs]
@@ -81,7 +87,7 @@ class BatchFeedforward:
             [q.R_F - q.R_P for q in p])
         delta = column([q.saturation_margin for q in p]) * M
         self._terms = {"hot": hot, "cold": hot + M * self.span, "delta": delta,
-                       "upper": M - delta, "energy": table["energy_over_kB"][:, runs],
+                       "upper": M - delta, "M": M, "energy": table["energy_over_kB"][:, runs],
                        "inv_heating": table["inv_centre_heating"][:, runs],
                        "inv_cooling": table["inv_centre_cooling"][:, runs]}
 
@@ -133,16 +139,17 @@ class BatchFeedforward:
         xi_p = (take("cold") - reference) / self.span
         # temperature_of_fractions: clamp into [delta, M - delta] and flag it
         delta, upper = take("delta"), take("upper")
-        low = ~(xi_mf >= delta)
-        high = ~low & ~(xi_p >= delta)
-        xi_mf = np.where(low, delta, np.where(high, upper, xi_mf))
-        xi_p = np.where(low, upper, np.where(high, delta, xi_p))
-        exponent = np.log(xi_p / xi_mf)
+        mf, p, clamped = clamp_fractions(xi_mf, xi_p, delta, upper)
         energy = take("energy")
         inverse = np.where(heating, take("inv_heating"), take("inv_cooling"))
-        inverse_kelvin = inverse - exponent / energy
-        sensed = 1.0 / inverse_kelvin - KELVIN_OFFSET
-        return (sensed, low | high, ~(inverse_kelvin > 0.0), exponent,
+        sensed, exponent, inverse_kelvin = temperature_of_fractions(mf, p, inverse, energy)
+        out = {"T_ref": sensed, "saturated": clamped, "bad": ~(inverse_kelvin > 0.0),
+               "exponent": exponent}
+        if self.minor is not None:     # where a reversal is stored: the minor branch's inverse
+            self.minor.invert({"xi_mf": xi_mf, "mf": mf, "p": p, "clamped": clamped,
+                               "delta": delta, "upper": upper, "M": take("M"),
+                               "energy": energy, "inverse": inverse, "heating": heating}, out)
+        return (out["T_ref"], out["saturated"], out["bad"], out["exponent"],
                 np.broadcast_to(energy, exponent.shape))
 
     def _filter(self, values):
