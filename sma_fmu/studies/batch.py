@@ -155,12 +155,11 @@ def _loop(scenarios, inputs, record):
     failed = dict(inputs.failures)
     rows = chunk_steps(size, n)
     work, raw, mask = np.empty(size), np.empty(size), np.empty(size)
-    integrate, positive = np.empty(size, dtype=bool), np.empty(size, dtype=bool)
+    integrate = np.empty(size, dtype=bool)
     zero, step = np.zeros(size), np.full(size, h)
     changes = set(inputs.change_steps)
     subtract, multiply, add, maximum = np.subtract, np.multiply, np.add, np.maximum
-    greater_equal, greater, logical_or, copyto = (np.greater_equal, np.greater, np.logical_or,
-                                                  np.copyto)
+    greater_equal, copyto = np.greater_equal, np.copyto
     for start, stop in chunk_bounds(n, rows, inputs.change_steps):
         references = inputs.references(start, stop + 1)
         compensator = feedforward.chunk(start, stop)
@@ -184,9 +183,10 @@ def _loop(scenarios, inputs, record):
             add(fb, work, fb)
             add(P_ff[j], fb, raw)
             maximum(raw, zero, out=u)                  # the clamp; the plant applies u <= 0 as 0
-            greater_equal(raw, zero, integrate)        # held while raw < 0 and e <= 0
-            greater(e, zero, positive)
-            logical_or(integrate, positive, integrate)
+            # held while raw < 0 and e <= 0, i.e. integrate where max(raw, e) >= 0 (at e = 0
+            # both add h * 0 = 0)
+            maximum(raw, e, out=work)
+            greater_equal(work, zero, integrate)
             copyto(mask, integrate)
             multiply(step, e, work)
             multiply(work, mask, work)                 # I + (h e) * 1 = I + h e; * 0 adds 0
@@ -216,8 +216,10 @@ def run_batch(scenarios, record="metrics"):
     """
     scenarios = list(scenarios)
     _check(scenarios, record)
-    # feedforward runs first: the compensators then work on column slices
-    order = sorted(range(len(scenarios)), key=lambda i: not scenarios[i].controller.feedforward)
+    # feedforward runs first, the major inverse before the minor-loop one: the compensators
+    # then work on column slices
+    order = sorted(range(len(scenarios)), key=lambda i: (
+        not scenarios[i].controller.feedforward, scenarios[i].controller.inverse == "minor-loop"))
     ordered = [scenarios[i] for i in order]
     inputs = BatchInputs(ordered)
     with np.errstate(all="ignore"):
