@@ -43,12 +43,12 @@ def random_walk_reference(rng, stop_time_s):
     return ReferenceSignal("table", {"times_s": times, "values_ohm": values})
 
 
-def mixed_set(count, seed, stop_time_s=3.0):
+def mixed_set(count, seed, stop_time_s=3.0, load_step_s=None):
     """random_scenarios with every controller; every other run on a random-walk reference,
     every fourth compensator with a saturation margin far below the minor branches'
     denominator floor (1e-12), so its clamped samples can leave it on a flat branch."""
     rng = np.random.default_rng(seed + 100)
-    out = random_scenarios(count, seed, stop_time_s, controllers=ALL_CONTROLLERS)
+    out = random_scenarios(count, seed, stop_time_s, load_step_s, controllers=ALL_CONTROLLERS)
     for i, s in enumerate(out):
         if i % 2:
             s = dataclasses.replace(s, reference=random_walk_reference(rng, stop_time_s))
@@ -60,11 +60,14 @@ def mixed_set(count, seed, stop_time_s=3.0):
     return out
 
 
-@pytest.mark.parametrize("seed, chunk", [(1, None), (2, 64), (4, 17)])
-def test_random_sets_equal_the_library_path(seed, chunk, monkeypatch):
+@pytest.mark.parametrize("seed, chunk, load_step_s", [(1, None, None), (2, 64, None),
+                                                      (4, 17, None), (5, 100, 1.5)])
+def test_random_sets_equal_the_library_path(seed, chunk, load_step_s, monkeypatch):
+    """Load steps at random times (one run each), or at 1.5 s in every run (then the
+    plants' minor branches are re-evaluated for many runs at once)."""
     if chunk:   # tiny chunks: load steps and reversals inside chunks, many chunk boundaries
         monkeypatch.setattr(batch, "CHUNK_ELEMENTS", chunk)
-    scenarios = mixed_set(24, seed)
+    scenarios = mixed_set(24, seed, load_step_s=load_step_s)
     results = run_batch(scenarios, "timeseries")
     kinds = {(s.controller.kind, s.controller.inverse, s.hysteresis_mode) for s in scenarios}
     assert kinds == {(kind, inverse, mode) for (kind, inverse), mode

@@ -17,6 +17,7 @@ diverges, a load beyond the model's range, a non-finite power) is run again on t
 path, so its outcome, and its error message, are exactly the scalar path's.
 """
 import dataclasses
+import functools
 import math
 import time
 
@@ -61,18 +62,25 @@ class BatchRun:
     path: str
 
 
+@functools.lru_cache(maxsize=None)
+def _unknown_fields(scenario_type, controller_type):
+    """(scenario fields, controller fields) the engine does not know, per pair of classes."""
+    return ({f.name for f in dataclasses.fields(scenario_type)} - _KNOWN_SCENARIO_FIELDS,
+            [f.name for f in dataclasses.fields(controller_type)
+             if f.name not in _KNOWN_CONTROLLER_FIELDS])
+
+
 def unsupported_reason(scenario):
     """Why the batch engine cannot run ``scenario`` (a sentence), or None when it can."""
     if not isinstance(scenario, Scenario):
         return f"{scenario!r} is not a Scenario"
-    extra = {f.name for f in dataclasses.fields(scenario)} - _KNOWN_SCENARIO_FIELDS
+    controller = scenario.controller
+    extra, options = _unknown_fields(type(scenario), type(controller))
     if extra:
         return f"scenario option(s) {', '.join(sorted(extra))} are not implemented in the batch engine"
-    controller = scenario.controller
-    for field in dataclasses.fields(controller):   # an option added later must be added here
-        if field.name not in _KNOWN_CONTROLLER_FIELDS:
-            return (f"{scenario.name}: controller option {field.name} = "
-                    f"{getattr(controller, field.name)!r} is not implemented in the batch engine")
+    for name in options:                   # an option added later must be added here
+        return (f"{scenario.name}: controller option {name} = "
+                f"{getattr(controller, name)!r} is not implemented in the batch engine")
     if controller.kind not in CONTROLLERS:
         return f"{scenario.name}: controller kind {controller.kind!r} is not implemented"
     if scenario.hysteresis_mode not in HYSTERESIS_MODES:

@@ -210,11 +210,11 @@ class BatchFeedforward:
         multiply, add, subtract = np.multiply, np.add, np.subtract
         for row in range(values.shape[0]):
             y, v = out[row], values[row]
-            multiply(b0, v, out=y)
-            multiply(b1, previous_input, out=work)
-            add(y, work, out=y)
-            multiply(a1, previous_output, out=work)
-            subtract(y, work, out=y)
+            multiply(b0, v, y)
+            multiply(b1, previous_input, work)
+            add(y, work, y)
+            multiply(a1, previous_output, work)
+            subtract(y, work, y)
             previous_input, previous_output = v, y
         self.previous_input, self.previous_output = previous_input.copy(), previous_output.copy()
         return out

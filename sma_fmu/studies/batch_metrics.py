@@ -113,9 +113,15 @@ class MetricsAccumulator:
     def add(self, start, errors, power, saturated):
         """Rows k = start ... of e [ohm], applied power P [W] (nan at k = n) and flags, (c, N)."""
         stop = start + errors.shape[0]
-        below, above = self.inputs.unreachable(start, stop)
-        outside = below | above
-        anywhere = bool(outside.any())         # usually not: then reachable = overall here
+        bands = self.inputs.unreachable(start, stop)    # None: all reachable, usually
+        if bands is None:
+            below = above = np.zeros(errors.shape, dtype=bool) if any(
+                inside.any() for inside in self._inside.values()) else None
+            anywhere = False
+        else:
+            below, above = bands
+            outside = below | above
+            anywhere = bool(outside.any())     # usually not: then reachable = overall here
         absolute = np.abs(errors)              # each once per chunk, for every sum below
         squares = absolute * absolute
         for group in self.groups:

@@ -42,10 +42,12 @@ def clamp_fractions(xi_mf, xi_p, delta, upper):
     high = np.greater_equal(xi_p, delta)
     np.logical_or(high, low, out=high)
     np.logical_not(high, out=high)                  # not low and not xi_p >= delta
-    np.copyto(xi_mf, delta, where=low)
-    np.copyto(xi_mf, upper, where=high)
-    np.copyto(xi_p, upper, where=low)
-    np.copyto(xi_p, delta, where=high)
+    if low.any():                                   # usually none: R_ref inside the band
+        np.copyto(xi_mf, delta, where=low)
+        np.copyto(xi_p, upper, where=low)
+    if high.any():
+        np.copyto(xi_mf, upper, where=high)
+        np.copyto(xi_p, delta, where=high)
     return np.logical_or(low, high, out=low)
 
 
@@ -118,7 +120,8 @@ class MinorLoopMemory:
         flat = (at_reversal < DENOMINATOR_FLOOR) | np.where(heating, xi_r <= 0.0,
                                                              remaining <= 0.0)
         flat &= has
-        # major_equivalent: heating xi_MF = xi_mf L_h(T_r)/xi_r; cooling xi_P = xi_p ... /(M - xi_r)
+        # major_equivalent: heating xi_MF = xi_mf L_h(T_r)/xi_r,
+        # cooling xi_P = xi_p xi_P,c(T_r)/(M - xi_r)
         mf, p = stage["mf"][rows], stage["p"][rows]
         major_mf = mf * at_reversal
         major_mf /= xi_r
@@ -138,7 +141,7 @@ class MinorLoopMemory:
         np.logical_or(saturated, flat, out=saturated)
 
     def _remember(self, row, stage, out, uniform):
-        """(T_ref, xi_MF) assumed at ``row``: the fraction of R_ref, or of the branch if clamped."""
+        """(T_ref, xi_MF) assumed at ``row``: the fraction of R_ref, or if clamped the branch's."""
         self.last_T = out["T_ref"][row].copy()
         self.last_xi = stage["mf"][row].copy()          # = the fraction of R_ref where not clamped
         chosen = np.flatnonzero(out["saturated"][row])

@@ -20,6 +20,7 @@ reversal or a load step.
 """
 import numpy as np
 
+from sma_fmu.runtime.constant_load import BranchConstants, branch_fractions
 from sma_fmu.runtime.constants import KELVIN_OFFSET
 from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR
 
@@ -126,13 +127,33 @@ class BatchPlant:
         self._new_constants = False
 
     def _refresh_minor(self, runs):
-        """Cache, for ``runs`` (index array), the minor branch's reversal-point terms."""
+        """Cache, for ``runs`` (index array), the minor branch's reversal-point terms.
+
+        A few runs (a reversal) one by one with the runtime's :func:`branch_fractions`,
+        many (a load step) with :func:`major_fractions`: the same operations.
+        """
+        if runs.size > 8:
+            self._refresh_many(runs)
+            return
+        for run in runs.tolist():
+            heating, M = bool(self.heating[run]), float(self.M[run])
+            xi_r = float(self.reversal_xi[run])
+            centre = self.inv_heating[run] if heating else self.inv_cooling[run]
+            xi_mf, xi_p = branch_fractions(float(self.reversal_T[run]), BranchConstants(
+                M, float(self.xi_F_min[run]), -float(self.minus_energy[run]), float(centre), None))
+            at_reversal = xi_mf if heating else xi_p
+            flat = at_reversal < DENOMINATOR_FLOOR      # the branch stays at xi_r: value = base
+            self._divisor[run] = 1.0 if flat else at_reversal
+            self._flat[run] = 1.0 if flat else 0.0
+            self._base[run] = xi_r if heating else M - xi_r
+
+    def _refresh_many(self, runs):
         heating = self.heating[runs]
         inverse = np.where(heating, self.inv_heating[runs], self.inv_cooling[runs])
         M = self.M[runs]
         xi_mf, xi_p = major_fractions(self.reversal_T[runs], M, self.minus_energy[runs], inverse)
         at_reversal = np.where(heating, xi_mf, xi_p)
-        flat = at_reversal < DENOMINATOR_FLOOR         # the branch stays at xi_r: value = base
+        flat = at_reversal < DENOMINATOR_FLOOR
         self._divisor[runs] = np.where(flat, 1.0, at_reversal)
         self._flat[runs] = flat
         self._base[runs] = np.where(heating, self.reversal_xi[runs], M - self.reversal_xi[runs])
