@@ -113,20 +113,17 @@ class BatchFeedforward:
         if runs.size == 0:
             return FeedforwardChunk(np.zeros((rows, size)), np.zeros((rows, size), dtype=bool),
                                     {}, lambda: np.full((rows, size), np.nan))
-        sensed, low, bad, reason = self._inverse(start, stop)
-        values = (sensed - self.T_room) / self.gain
+        values, low, sensed, failures = self._inverse(start, stop)
         diverged = {}
-        if bad.any():
-            for row, inverse in zip(*np.nonzero(bad)):
-                exponent, energy = reason(row, inverse)
-                message = (f"temperature-sensing inverse diverges at Lambda = {exponent!r}: "
-                           f"dH(f)/k_B = {energy!r} K is too small for the hysteresis centre")
-                for column in np.flatnonzero(self.of_run == inverse):
-                    diverged.setdefault(int(runs[column]), message)
+        for row, inverse, exponent, energy in failures:
+            message = (f"temperature-sensing inverse diverges at Lambda = {exponent!r}: "
+                       f"dH(f)/k_B = {energy!r} K is too small for the hysteresis centre")
+            for column in np.flatnonzero(self.of_run == inverse):
+                diverged.setdefault(int(runs[column]), message)
         expand = self._expander(rows)
         filtered = self._filter(expand(values))
         if runs.size == size:                           # every run has a compensator
-            return FeedforwardChunk(filtered, expand(low), diverged, lambda: expand(sensed))
+            return FeedforwardChunk(filtered, expand(low), diverged, lambda: expand(sensed()))
         place = slice(0, runs.size) if self._leading else runs
         P_ff = np.zeros((rows, size))
         saturated = np.zeros((rows, size), dtype=bool)
@@ -134,7 +131,7 @@ class BatchFeedforward:
 
         def T_ref():
             out = np.full((rows, size), np.nan)
-            out[:, place] = expand(sensed)
+            out[:, place] = expand(sensed())
             return out
         return FeedforwardChunk(P_ff, saturated, diverged, T_ref)
 
@@ -147,10 +144,11 @@ class BatchFeedforward:
         return lambda a: a[:, self.of_run]
 
     def _inverse(self, start, stop):
-        """sense_temperature at R_ref(t_k) per inverse: (T_ref, saturated, diverged, reason).
+        """sense_temperature at R_ref(t_k) per inverse, (c, inverses) each: v = (T_ref -
+        T_room)/K_th [W], saturated, T_ref [degC] (a function: built when asked for), and
+        [(row, inverse, Lambda, dH/k_B [K])] where the inverse diverges.
 
-        ``reason(row, column)`` gives (Lambda, dH/k_B [K]) of a diverged inverse. The
-        major and the minor-loop columns are computed apart, each in contiguous arrays.
+        The major and the minor-loop columns are computed apart, each in contiguous arrays.
         """
         inputs, columns = self.inputs, self.columns
         if inputs.changes_within(start, stop):
@@ -160,13 +158,22 @@ class BatchFeedforward:
         segments = np.array(np.broadcast_to(segments, (segments.shape[0], columns.size)))
         segments[:, ~self.adaptive] = inputs.model_row
         index = segments * columns.size + np.arange(columns.size)
-        parts = [self._part(start, stop, part, index[:, part], memory) for part, memory in
-                 ((slice(0, self.split), None), (slice(self.split, columns.size), self.minor))
-                 if part.stop > part.start]
-        joined = [np.concatenate(pieces, axis=1) if len(parts) > 1 else pieces[0]
-                  for pieces in zip(*parts)]
-        return (*joined[:3], lambda row, column: (float(joined[3][row, column]),
-                                                  float(joined[4][row, column])))
+        values, saturated, sensed, failures = [], [], [], []
+        for part, memory in ((slice(0, self.split), None),
+                             (slice(self.split, columns.size), self.minor)):
+            if part.stop == part.start:
+                continue
+            T_ref, low, bad, exponent, energy = self._part(start, stop, part, index[:, part],
+                                                           memory)
+            if bad.any():
+                failures += [(row, part.start + column, float(exponent[row, column]),
+                              float(energy[row, column])) for row, column in zip(*np.nonzero(bad))]
+            values.append((T_ref - self.T_room[part]) / self.gain[part])
+            saturated.append(low)
+            sensed.append(T_ref)
+        join = lambda arrays: (np.concatenate(arrays, axis=1)  # noqa: E731
+                               if len(arrays) > 1 else arrays[0])
+        return join(values), join(saturated), lambda: join(sensed), failures
 
     def _part(self, start, stop, part, index, memory):
         """(T_ref, saturated, bad, Lambda, E) of the inverse columns ``part`` (a slice);
