@@ -6,18 +6,19 @@ gains, filters, loads, references, wire and model parameters; some runs get a ra
 piecewise-linear reference, so the compensators reverse at different samples, on plateaus
 and outside the band the wire can reach.
 """
+import dataclasses
 import itertools
 
 import numpy as np
 import pytest
 
+import sma_fmu.runtime.sensing as sensing
 import sma_fmu.studies.batch as batch
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
-from sma_fmu.studies import BatchUnsupported, StudyError, run_batch, run_many, template
-import sma_fmu.runtime.sensing as sensing
 from sma_fmu.runtime.signals import ReferenceSignal
+from sma_fmu.studies import BatchUnsupported, StudyError, run_batch, run_many, template
 from sma_fmu.studies.random_set import ALL_CONTROLLERS, gain_grid_scenarios, random_scenarios
 
 TOLERANCE = 1e-10   # ohm, degC, m, W, kg, 1: the issue's bound on every column
