@@ -218,12 +218,12 @@ def test_cli_error_is_one_line_and_writes_nothing(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
-def test_a_task_runs_what_the_batch_engine_lacks_on_the_library_path():
+def test_a_task_runs_both_inverses_in_the_batch():
     base = template("load-step-pi+ff-adaptive")
     overrides = [{"scenario.stop_time_s": 3.0, "controller.inverse": inverse}
                  for inverse in ("major", "minor-loop")]
     rows = run_task([base], [StudyRunSpec(i, 0, o) for i, o in enumerate(overrides)])
-    assert [row["path"] for row in rows] == ["batch", "library"]
+    assert [row["path"] for row in rows] == ["batch", "batch"]
     assert [row["status"] for row in rows] == ["ok", "ok"]
     for row, changes in zip(rows, overrides):
         item = base.scenario(changes)

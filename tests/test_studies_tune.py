@@ -17,12 +17,14 @@ else:  # pragma: no cover
 
 def test_tune_improves_and_the_snippet_reproduces_the_rmse(tmp_path, capsys):
     out = tmp_path / "tune"
-    assert main(["tune", "load-step-pi", "heavy-pi+ff-adaptive", "--stop-time", "3",
+    assert main(["tune", "load-step-pi", "heavy-pi+ff-adaptive",
+                 "load-step-continuous-pi+ff-adaptive-minor-loop", "--stop-time", "3",
                  "--generations", "3", "--population", "4", "--out", str(out)]) == 0
     assert "written:" in capsys.readouterr().out
     records = json.loads((out / "report.json").read_text())
-    assert [r["scenario"] for r in records] == ["load-step-pi", "heavy-pi+ff-adaptive"]
-    assert set(records[1]["tuned"]) == {"Kp", "Ki", "alpha", "beta"}
+    assert [r["scenario"] for r in records] == ["load-step-pi", "heavy-pi+ff-adaptive",
+                                                "load-step-continuous-pi+ff-adaptive-minor-loop"]
+    assert set(records[1]["tuned"]) == set(records[2]["tuned"]) == {"Kp", "Ki", "alpha", "beta"}
     for record in records:
         # the scenario's own gains are in the first population, so tuning cannot lose
         assert record["rmse_ohm"]["tuned"] <= record["rmse_ohm"]["given"] + 1e-12

@@ -17,6 +17,7 @@ diverges, a load beyond the model's range, a non-finite power) is run again on t
 path, so its outcome, and its error message, are exactly the scalar path's.
 """
 import dataclasses
+import functools
 import math
 import time
 
@@ -37,10 +38,7 @@ __all__ = ["BatchUnsupported", "BatchRun", "RECORDS", "unsupported_reason", "run
 RECORDS = ("timeseries", "metrics")
 CHUNK_ELEMENTS = 65536      # steps x runs per chunk of precomputed signals and errors
 _KNOWN_SCENARIO_FIELDS = {f.name for f in dataclasses.fields(Scenario)}
-_KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load"}
-# Controller options added later whose value here means "what the batch engine computes"
-# (the compensator inverts the major branches, as the paper's does).
-_MAJOR_BRANCH_VALUES = {None, "major", "major-branch", "major-branches"}
+_KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load", "inverse"}
 
 
 class BatchUnsupported(ValueError):
@@ -64,20 +62,25 @@ class BatchRun:
     path: str
 
 
+@functools.lru_cache(maxsize=None)
+def _unknown_fields(scenario_type, controller_type):
+    """(scenario fields, controller fields) the engine does not know, per pair of classes."""
+    return ({f.name for f in dataclasses.fields(scenario_type)} - _KNOWN_SCENARIO_FIELDS,
+            [f.name for f in dataclasses.fields(controller_type)
+             if f.name not in _KNOWN_CONTROLLER_FIELDS])
+
+
 def unsupported_reason(scenario):
     """Why the batch engine cannot run ``scenario`` (a sentence), or None when it can."""
     if not isinstance(scenario, Scenario):
         return f"{scenario!r} is not a Scenario"
-    extra = {f.name for f in dataclasses.fields(scenario)} - _KNOWN_SCENARIO_FIELDS
+    controller = scenario.controller
+    extra, options = _unknown_fields(type(scenario), type(controller))
     if extra:
         return f"scenario option(s) {', '.join(sorted(extra))} are not implemented in the batch engine"
-    controller = scenario.controller
-    for field in dataclasses.fields(controller):
-        if field.name not in _KNOWN_CONTROLLER_FIELDS:
-            value = getattr(controller, field.name)
-            if value not in _MAJOR_BRANCH_VALUES:
-                return (f"{scenario.name}: controller option {field.name} = {value!r} is not "
-                        f"implemented in the batch engine")
+    for name in options:                   # an option added later must be added here
+        return (f"{scenario.name}: controller option {name} = "
+                f"{getattr(controller, name)!r} is not implemented in the batch engine")
     if controller.kind not in CONTROLLERS:
         return f"{scenario.name}: controller kind {controller.kind!r} is not implemented"
     if scenario.hysteresis_mode not in HYSTERESIS_MODES:
@@ -160,12 +163,11 @@ def _loop(scenarios, inputs, record):
     failed = dict(inputs.failures)
     rows = chunk_steps(size, n)
     work, raw, mask = np.empty(size), np.empty(size), np.empty(size)
-    integrate, positive = np.empty(size, dtype=bool), np.empty(size, dtype=bool)
+    integrate = np.empty(size, dtype=bool)
     zero, step = np.zeros(size), np.full(size, h)
     changes = set(inputs.change_steps)
     subtract, multiply, add, maximum = np.subtract, np.multiply, np.add, np.maximum
-    greater_equal, greater, logical_or, copyto = (np.greater_equal, np.greater, np.logical_or,
-                                                  np.copyto)
+    greater_equal, copyto = np.greater_equal, np.copyto
     for start, stop in chunk_bounds(n, rows, inputs.change_steps):
         references = inputs.references(start, stop + 1)
         compensator = feedforward.chunk(start, stop)
@@ -189,9 +191,10 @@ def _loop(scenarios, inputs, record):
             add(fb, work, fb)
             add(P_ff[j], fb, raw)
             maximum(raw, zero, out=u)                  # the clamp; the plant applies u <= 0 as 0
-            greater_equal(raw, zero, integrate)        # held while raw < 0 and e <= 0
-            greater(e, zero, positive)
-            logical_or(integrate, positive, integrate)
+            # held while raw < 0 and e <= 0, i.e. integrate where max(raw, e) >= 0 (at e = 0
+            # both add h * 0 = 0)
+            maximum(raw, e, out=work)
+            greater_equal(work, zero, integrate)
             copyto(mask, integrate)
             multiply(step, e, work)
             multiply(work, mask, work)                 # I + (h e) * 1 = I + h e; * 0 adds 0
@@ -221,8 +224,10 @@ def run_batch(scenarios, record="metrics"):
     """
     scenarios = list(scenarios)
     _check(scenarios, record)
-    # feedforward runs first: the compensators then work on column slices
-    order = sorted(range(len(scenarios)), key=lambda i: not scenarios[i].controller.feedforward)
+    # feedforward runs first, the major inverse before the minor-loop one: the compensators
+    # then work on column slices
+    order = sorted(range(len(scenarios)), key=lambda i: (
+        not scenarios[i].controller.feedforward, scenarios[i].controller.inverse == "minor-loop"))
     ordered = [scenarios[i] for i in order]
     inputs = BatchInputs(ordered)
     with np.errstate(all="ignore"):

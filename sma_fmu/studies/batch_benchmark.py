@@ -2,12 +2,14 @@
 library path, at N = 1, 100, 1,000 and 10,000 runs in one batch (one process, one core).
 
 Two sets of runs: "mixed" (:func:`~sma_fmu.studies.random_set.random_scenarios`: every
-controller in both modes, random gains, loads, wire, with the load step at one time and
-four references; the hard case, since the batch pays for every branch of every run) and "gain grid" (one scenario, random Kp and Ki: what a
-tuning or a gain sweep runs). Each rate includes the batch's setup (constants per run and load segment), which weighs
-less the longer the runs (5 s by default; the paper's scenarios last 30 s). The scalar
-rate is the median of three measurements taken
-before, between and after the batch sizes, so a change of machine load shows in both.
+shipped controller, pi, pi+ff-fixed, pi+ff-adaptive with the major and with the minor-loop
+inverse, in both modes, random gains, loads, wire, with the load step at one time and four
+references; the hard case, since the batch pays for every branch of every run) and "gain
+grid" (one scenario, random Kp and Ki: what a tuning or a gain sweep runs). Each rate
+includes the batch's setup (constants per run and load segment), which weighs less the
+longer the runs (5 s by default; the paper's scenarios last 30 s). The scalar rate, on
+runs of the same set, is the median of three measurements taken before, between and
+after the batch sizes, so a change of machine load shows in both.
 Part of ``sma-fmu bench``; alone: ``sma-fmu bench --only batch [--quick]``.
 """
 import statistics

@@ -9,11 +9,13 @@ it; once per distinct reference). The load segment at t_k is the lookup of
 :meth:`LoadProfile.value` (bisect_right, with its tolerance) done by ``numpy.searchsorted``. Runs whose constants cannot be built
 (a load beyond the model's range) are listed in :attr:`BatchInputs.failures`.
 """
+import warnings
+
 import numpy as np
 
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
-from sma_fmu.runtime.reachable_band import reachable_band
+from sma_fmu.runtime.reachable_band import band_of_branch
 from sma_fmu.runtime.thermal import step_decay
 
 __all__ = ["BatchInputs", "CONSTANT_FIELDS", "LOAD_TOLERANCE_S"]
@@ -117,7 +119,8 @@ class BatchInputs:
                                - len(s.load.values)) for s in scenarios]).T  # (S, N)
 
     def _constants(self, scenarios):
-        self.constants = self._table(scenarios, lambda s: s.params, lambda s: [])
+        self._heating = {}     # (id(parameters), load) -> heating BranchConstants of the plants
+        self.constants = self._table(scenarios, lambda s: s.params, lambda s: [], self._heating)
         fixed = lambda s: ([s.controller.model_load] if s.controller.feedforward  # noqa: E731
                            and not s.controller.adapt_to_load else [])
         self.compensator_constants = self._table(
@@ -126,52 +129,64 @@ class BatchInputs:
         self.model_row = self.segment_count
 
     def _bands(self, scenarios):
-        """R_hot, R_cold [ohm] of the plant's wire per load segment and run: (S, N) each."""
-        self.band_hot = np.full((self.segment_count, self.size), np.nan)
-        self.band_cold = np.full((self.segment_count, self.size), np.nan)
-        memo = {}
-        for run, scenario in enumerate(scenarios):
-            for row, load in enumerate(self.loads[:, run].tolist()):
-                key = (id(scenario.params), load)
-                if key not in memo:
-                    try:
-                        memo[key] = reachable_band(load, scenario.params)
-                    except ValueError as error:
-                        self.failures[run] = str(error)
-                        memo[key] = (np.nan, np.nan)
-                self.band_hot[row, run], self.band_cold[row, run] = memo[key]
+        """R_hot, R_cold [ohm] of the plant's wire per load segment and run: (S, N) each.
+
+        :func:`~sma_fmu.runtime.reachable_band.band_of_branch` of the plants' heating
+        branches (:func:`reachable_band`'s); NaN where the constants could not be built.
+        """
+        values = np.full((self.size, self.segment_count, 2), np.nan)
+        nan = (np.nan, np.nan)
+        for run, (scenario, loads) in enumerate(zip(scenarios, self.loads.T.tolist())):
+            params, memo = scenario.params, self._heating
+            values[run] = [band_of_branch(memo[key], params) if key in memo else nan
+                           for key in ((id(params), load) for load in loads)]
+        self.band_hot = np.ascontiguousarray(values[:, :, 0].T)
+        self.band_cold = np.ascontiguousarray(values[:, :, 1].T)
+        with warnings.catch_warnings():                 # all NaN: no fast path
+            warnings.simplefilter("ignore", RuntimeWarning)
+            self._hot_max, self._cold_min = np.nanmax(self.band_hot), np.nanmin(self.band_cold)
 
     def unreachable(self, start, stop):
-        """(below, above), (c, N) each: R_ref(t_k) <= R_hot(f_k), R_ref(t_k) >= R_cold(f_k)."""
+        """(below, above), (c, N) each: R_ref(t_k) <= R_hot(f_k), R_ref(t_k) >= R_cold(f_k);
+        None when every R_ref of the chunk lies inside every run's band."""
+        values = self.reference_values[start:stop]      # (c, references)
+        if values.min() > self._hot_max and values.max() < self._cold_min:
+            return None
+        reference = self.references(start, stop)
         rows = stop - start if self.changes_within(start, stop) else 1   # else one row broadcasts
         segments = np.broadcast_to(self.segments(start, start + rows), (rows, self.size))
         columns = np.arange(self.size)
-        reference = self.references(start, stop)
         return (reference <= self.band_hot[segments, columns],
                 reference >= self.band_cold[segments, columns])
 
-    def _table(self, scenarios, params_of, extra_loads):
-        """{field: (S + 1, N)} of branch constants per load segment (+ extra loads) and run."""
-        table = {name: np.full((self.segment_count + 1, self.size), np.nan)
-                 for name in CONSTANT_FIELDS}
+    def _table(self, scenarios, params_of, extra_loads, heating=None):
+        """{field: (S + 1, N)} of branch constants per load segment (+ extra loads) and run.
+
+        ``heating``, a dict, collects the heating branches' BranchConstants.
+        """
+        values = np.full((self.size, self.segment_count + 1, len(CONSTANT_FIELDS)), np.nan)
         memo = {}     # (parameters, load) -> row: runs that share a wire share the work
-        for run, scenario in enumerate(scenarios):
+        for run, (scenario, loads) in enumerate(zip(scenarios, self.loads.T.tolist())):
             if scenario is None:
                 continue
-            params = params_of(scenario)
+            params, rows = params_of(scenario), []
             try:
-                for row, load in enumerate(list(self.loads[:, run]) + extra_loads(scenario)):
+                for load in loads + extra_loads(scenario):
                     key = (id(params), load)
                     if key not in memo:
-                        heating = branch_constants(load, HEATING, params)
+                        branch = branch_constants(load, HEATING, params)
+                        if heating is not None:
+                            heating[key] = branch
                         cooling = branch_constants(load, COOLING, params)
-                        memo[key] = (heating.M, heating.xi_F_min, heating.energy_over_kB,
-                                     heating.inv_centre_K, cooling.inv_centre_K)
-                    for name, value in zip(CONSTANT_FIELDS, memo[key]):
-                        table[name][row, run] = value
+                        memo[key] = (branch.M, branch.xi_F_min, branch.energy_over_kB,
+                                     branch.inv_centre_K, cooling.inv_centre_K)
+                    rows.append(memo[key])
             except ValueError as error:
                 self.failures[run] = str(error)
-        return table
+            if rows:
+                values[run, :len(rows)] = rows
+        return {name: np.ascontiguousarray(values[:, :, i].T)
+                for i, name in enumerate(CONSTANT_FIELDS)}
 
     def changes_within(self, start, stop):
         """True when some run's load segment changes at a step start < k < stop."""

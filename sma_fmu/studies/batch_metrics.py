@@ -36,21 +36,33 @@ class _Totals:
         self.squares, self.absolute = np.zeros(size), np.zeros(size)
         self.largest, self.count = np.zeros(size), np.zeros(size, dtype=np.int64)
 
-    def add(self, start, errors, columns, keep=None):
-        low, high = max(self.first, start), min(self.stop, start + errors.shape[0])
+    def add(self, start, absolute, squares, columns, keep=None):
+        """Add rows of |e| and e^2 (c, N) from step ``start``; returns what was added, or None.
+
+        ``columns``: the runs (an index array, or a slice of all).
+        """
+        low, high = max(self.first, start), min(self.stop, start + absolute.shape[0])
         if low >= high:
-            return
+            return None
         rows = slice(low - start, high - start)
-        part = np.abs(errors[rows][:, columns])
+        part, square = absolute[rows, columns], squares[rows, columns]
         if keep is not None:
-            chosen = keep[rows][:, columns]
-            part = np.where(chosen, part, 0.0)
-            self.count[columns] += np.count_nonzero(chosen, axis=0)
+            chosen = keep[rows, columns]
+            part, square = np.where(chosen, part, 0.0), np.where(chosen, square, 0.0)
+            count = np.count_nonzero(chosen, axis=0)
         else:
-            self.count[columns] += high - low
-        self.squares[columns] += np.sum(part * part, axis=0)
-        self.absolute[columns] += np.sum(part, axis=0)
-        self.largest[columns] = np.maximum(self.largest[columns], np.max(part, axis=0))
+            count = high - low
+        added = (np.sum(square, axis=0), np.sum(part, axis=0), np.max(part, axis=0), count)
+        self.include(added, columns)
+        return added
+
+    def include(self, added, columns):
+        """Add sums returned by :meth:`add` (of the same rows) to ``columns``."""
+        squares, absolute, largest, count = added
+        self.squares[columns] += squares
+        self.absolute[columns] += absolute
+        self.largest[columns] = np.maximum(self.largest[columns], largest)
+        self.count[columns] += count
 
     def metrics(self, run, step_s):
         count = int(self.count[run])
@@ -88,7 +100,8 @@ class MetricsAccumulator:
                 parts.append(_Totals(*_index_range(inside), size))
             window = _index_range(window)
             self._group_of.update((run, len(self.groups)) for run in runs)
-            self.groups.append({"runs": np.array(runs), "window": window, "segments": parts,
+            columns = slice(None) if runs == list(range(size)) else np.array(runs)
+            self.groups.append({"columns": columns, "window": window, "segments": parts,
                                 "overall": _Totals(*window, size),
                                 "reachable": _Totals(*window, size)})
         self.saturated, self.clamped = np.zeros(size), np.zeros(size)
@@ -100,23 +113,34 @@ class MetricsAccumulator:
     def add(self, start, errors, power, saturated):
         """Rows k = start ... of e [ohm], applied power P [W] (nan at k = n) and flags, (c, N)."""
         stop = start + errors.shape[0]
-        below, above = self.inputs.unreachable(start, stop)
-        outside = below | above
-        anywhere = bool(outside.any())         # usually not: then reachable = overall here
+        bands = self.inputs.unreachable(start, stop)    # None: all reachable, usually
+        if bands is None:
+            below = above = np.zeros(errors.shape, dtype=bool) if any(
+                inside.any() for inside in self._inside.values()) else None
+            anywhere = False
+        else:
+            below, above = bands
+            outside = below | above
+            anywhere = bool(outside.any())     # usually not: then reachable = overall here
+        absolute = np.abs(errors)              # each once per chunk, for every sum below
+        squares = absolute * absolute
         for group in self.groups:
-            runs = group["runs"]
-            group["overall"].add(start, errors, runs)
-            group["reachable"].add(start, errors, runs, keep=~outside if anywhere else None)
+            runs = group["columns"]
+            overall = group["overall"].add(start, absolute, squares, runs)
+            if anywhere:
+                group["reachable"].add(start, absolute, squares, runs, keep=~outside)
+            elif overall is not None:          # the same rows, all of them reachable
+                group["reachable"].include(overall, runs)
             for part in group["segments"]:
-                part.add(start, errors, runs)
+                part.add(start, absolute, squares, runs)
             first, last = group["window"]
             low, high = max(first, start), min(last, stop)
             if low < high:
                 rows = slice(low - start, high - start)
-                self.saturated[runs] += np.count_nonzero(saturated[rows][:, runs], axis=0)
-                self.clamped[runs] += np.count_nonzero(power[rows][:, runs] == 0.0, axis=0)
+                self.saturated[runs] += np.count_nonzero(saturated[rows, runs], axis=0)
+                self.clamped[runs] += np.count_nonzero(power[rows, runs] == 0.0, axis=0)
                 if anywhere:
-                    self.unreachable[runs] += np.count_nonzero(outside[rows][:, runs], axis=0)
+                    self.unreachable[runs] += np.count_nonzero(outside[rows, runs], axis=0)
         for side, mask in zip(_SIDES, (below, above)):
             if anywhere or self._inside[side].any():
                 self._track(side, start, mask)

@@ -1,10 +1,12 @@
 """Random sets of scenarios for the batch engine's benchmark and equality checks.
 
-Every controller in both hysteresis modes (in turn), with random PI gains, phase-lag
-times, model load, a two-step load profile, start temperature, reference offset and
-amplitude, and wire parameters (a_h, R_P, c_p, nu of the plant; a_c of half of the
-compensators' models, so model and wire differ; :data:`WIRES` variants, in turn). Built with ``dataclasses.replace``
-from the shipped load-step scenarios, so ten thousand take about a second.
+Every controller (:data:`SHIPPED_CONTROLLERS`: pi, pi+ff-fixed, pi+ff-adaptive with the
+major and with the minor-loop inverse) in both hysteresis modes (in turn), with random PI
+gains, phase-lag times, model load, a two-step load profile, start temperature, reference
+offset and amplitude, and wire parameters (a_h, R_P, c_p, nu of the plant; a_c of half of
+the compensators' models, so model and wire differ; :data:`WIRES` variants, in turn).
+Built with ``dataclasses.replace`` from the shipped load-step scenarios, so ten thousand
+take about a second.
 """
 import dataclasses
 import itertools
@@ -16,9 +18,14 @@ from sma_fmu.package_data import shipped_file
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.signals import LoadProfile, ReferenceSignal
 
-__all__ = ["WIRES", "random_scenarios", "gain_grid_scenarios"]
+__all__ = ["WIRES", "SHIPPED_CONTROLLERS", "ALL_CONTROLLERS", "random_scenarios",
+           "gain_grid_scenarios"]
 
 WIRES = 64        # distinct random wires (and models) of a set; runs beyond share them
+# (kind, inverse): the controllers of the shipped scenarios, and every combination
+SHIPPED_CONTROLLERS = (("pi", "major"), ("pi+ff-fixed", "major"), ("pi+ff-adaptive", "major"),
+                       ("pi+ff-adaptive", "minor-loop"))
+ALL_CONTROLLERS = SHIPPED_CONTROLLERS + (("pi+ff-fixed", "minor-loop"),)
 
 
 def _wires(params, draws):
@@ -36,8 +43,11 @@ def _bases():
             for kind in CONTROLLERS}
 
 
-def random_scenarios(count, seed=1, stop_time_s=3.0, load_step_s=None, references=None):
+def random_scenarios(count, seed=1, stop_time_s=3.0, load_step_s=None, references=None,
+                     controllers=SHIPPED_CONTROLLERS):
     """``count`` random scenarios of ``stop_time_s`` [s] (a whole number of 1 ms steps).
+
+    ``controllers``: the (kind, inverse) pairs, taken in turn with each hysteresis mode.
 
     The load steps at a random time per run, or at ``load_step_s`` [s] in every run (as
     in a sweep of one load profile: the batch then has one load step, not one per run).
@@ -46,19 +56,19 @@ def random_scenarios(count, seed=1, stop_time_s=3.0, load_step_s=None, reference
     """
     rng = np.random.default_rng(seed)
     bases = _bases()
-    combos = itertools.cycle(itertools.product(CONTROLLERS, HYSTERESIS_MODES))
+    combos = itertools.cycle(itertools.product(controllers, HYSTERESIS_MODES))
     variants = rng.random((references or 1, 2))
     draws = rng.random((WIRES, 6))
     wires = {kind: _wires(base.params, draws) for kind, base in bases.items()}
     out = []
     for _ in range(count):
-        kind, mode = next(combos)
+        (kind, inverse), mode = next(combos)
         base = bases[kind]
         u = rng.random(16)
         wire, model = wires[kind][len(out) % WIRES]
         controller = dataclasses.replace(
             base.controller, Kp=2.0 * u[6], Ki=6.0 * u[7], alpha=2.0 * u[8],
-            beta=0.05 + 0.95 * u[9], model_load=0.2 * u[10])
+            beta=0.05 + 0.95 * u[9], model_load=0.2 * u[10], inverse=inverse)
         switch = round(0.2 + (stop_time_s - 0.2) * u[11], 3) if load_step_s is None \
             else load_step_s
         shape = (u[12], u[13]) if references is None else variants[int(u[12] * references)]

@@ -1,13 +1,11 @@
 """One Dask task of a sweep: build its runs' scenarios, run them, return one row per run.
 
-Runs that share the step and duration and use only what the batch engine implements go
-through :func:`~sma_fmu.studies.batch.run_batch` (metrics only, no time series kept); the
-others run one by one on the scalar library path. A run that cannot be built or fails is
+Runs that share the step and duration go through :func:`~sma_fmu.studies.batch.run_batch`
+(metrics only, no time series kept; a run that fails there is run again on the scalar
+library path, so its row says ``path = library``). A run that cannot be built or fails is
 a row with ``status = "failed"`` and the reason in ``error``, never dropped.
 """
-from sma_fmu.cosim.loop import run_library
-from sma_fmu.cosim.metrics import scenario_metrics
-from sma_fmu.studies.batch import run_batch, unsupported_reason
+from sma_fmu.studies.batch import run_batch
 from sma_fmu.studies.overrides import StudyError
 from sma_fmu.studies.runs import metrics_record
 
@@ -36,7 +34,7 @@ def _finish(row, scenario, metrics, path, error=None):
 
 def run_task(templates, runs):
     """Rows (dicts) of ``runs`` (:class:`~sma_fmu.studies.spec.StudyRunSpec`), in order."""
-    rows, batches, single = {}, {}, []
+    rows, batches = {}, {}
     for run in runs:
         row = rows[run.run_id] = _row(run, templates[run.base])
         try:
@@ -44,18 +42,8 @@ def run_task(templates, runs):
         except StudyError as error:
             row.update(status="failed", error=str(error))
             continue
-        if unsupported_reason(scenario) is None:
-            batches.setdefault((scenario.step_s, scenario.steps), []).append((row, scenario))
-        else:
-            single.append((row, scenario))
+        batches.setdefault((scenario.step_s, scenario.steps), []).append((row, scenario))
     for members in batches.values():
         for (row, scenario), outcome in zip(members, run_batch([s for _, s in members])):
             _finish(row, scenario, outcome.metrics, outcome.path, outcome.error)
-    for row, scenario in single:
-        try:
-            result = run_library(scenario)
-        except ValueError as error:
-            _finish(row, scenario, None, "library", str(error))
-            continue
-        _finish(row, scenario, scenario_metrics(result.data, scenario), "library")
     return [rows[run.run_id] for run in runs]

@@ -72,7 +72,8 @@ def tune_scenario(scenario, seed=1, generations=30, population=12):
     tuned = scenario_metrics(run_library(best).data, best)   # the reported RMSE: scalar path
     given = scenario_metrics(run_library(scenario).data, scenario)
     return {"scenario": scenario.name, "group": scenario.group,
-            "controller": scenario.controller.kind, "hysteresis_mode": scenario.hysteresis_mode,
+            "controller": scenario.controller.kind, "inverse": scenario.controller.inverse,
+            "hysteresis_mode": scenario.hysteresis_mode,
             "tuned": {name: float(v) for name, v in zip(names, result.x)},
             "given": {name: float(v) for name, v in zip(names, start)},
             "window": given["window"],
@@ -95,28 +96,43 @@ def controller_snippet(record):
              f"RMSE {record['rmse_ohm']['tuned']:.4f} ohm, against "
              f"{record['rmse_ohm']['given']:.4f} ohm at the scenario's gains",
              "[controller]", f"kind = {json.dumps(record['controller'])}"]
+    if record.get("inverse", "major") != "major":
+        lines.append(f"inverse = {json.dumps(record['inverse'])}")
     lines += [f"{KEYS[name]} = {value!r}" for name, value in record["tuned"].items()]
     return "\n".join(lines) + "\n"
 
 
+def _label(record):
+    """The controller's column: its kind, with a non-default inverse in parentheses."""
+    inverse = record.get("inverse", "major")
+    return record["controller"] + ("" if inverse == "major" else f" ({inverse})")
+
+
 def ranking_markdown(records):
-    """Per group of scenarios with every controller: RMSE [ohm] and order, given vs tuned gains."""
-    groups = {}
+    """Per group of scenarios with every controller: RMSE [ohm] and order, given vs tuned gains.
+
+    Columns: the three controllers, then any other inverse present (a group without it
+    shows "-" there and ranks the rest).
+    """
+    groups, labels = {}, list(CONTROLLERS)
     for record in records:
-        groups.setdefault((record["group"], record["hysteresis_mode"]), {})[
-            record["controller"]] = record
+        label = _label(record)
+        if label not in labels:
+            labels.append(label)
+        groups.setdefault((record["group"], record["hysteresis_mode"]), {})[label] = record
     windows = ", ".join(sorted({record["window"] for record in records}))
     lines = ["# Tuned gains", "", f"RMSE of R - R_ref over {windows} [ohm], on the library path.",
-             "", "| scenario | mode | gains | pi | pi+ff-fixed | pi+ff-adaptive | ranking, best first |",
-             "|---|---|---|---:|---:|---:|---|"]
+             "", "| scenario | mode | gains | " + " | ".join(labels) + " | ranking, best first |",
+             "|---|---|---|" + "---:|" * len(labels) + "---|"]
     for (group, mode), members in groups.items():
-        if set(members) != set(CONTROLLERS):
+        if not set(CONTROLLERS) <= set(members):
             continue
         for gains in ("given", "tuned"):
-            rmse = {c: members[c]["rmse_ohm"][gains] for c in CONTROLLERS}
+            rmse = {c: members[c]["rmse_ohm"][gains] for c in labels if c in members}
             order = " < ".join(sorted(rmse, key=rmse.get))
             lines.append(f"| {group} | {mode} | {gains} | " +
-                         " | ".join(f"{rmse[c]:.3f}" for c in CONTROLLERS) + f" | {order} |")
+                         " | ".join(f"{rmse[c]:.3f}" if c in rmse else "-" for c in labels)
+                         + f" | {order} |")
     lines += ["", "| scenario | RMSE given | RMSE tuned | tuned values (* at a bound) |",
               "|---|---:|---:|---|"]
     for record in records:
