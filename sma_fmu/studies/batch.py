@@ -18,8 +18,6 @@ path, so its outcome, and its error message, are exactly the scalar path's.
 """
 import dataclasses
 import functools
-import math
-import time
 
 import numpy as np
 
@@ -140,8 +138,9 @@ class _Series:
         n = inputs.steps
         data = np.zeros(n + 1, dtype=TIMESERIES_DTYPE)
         data["t"] = inputs.times
-        data["R_ref"] = np.broadcast_to(inputs.references(0, n + 1), (n + 1, inputs.size))[:, run]
-        data["load"] = inputs.load_rows(0, n + 1)[:, run]
+        one = np.array([run])  # this run's column only (not the whole batch's)
+        data["R_ref"] = inputs.references(0, n + 1, one)[:, 0]
+        data["load"] = inputs.loads[inputs.segments(0, n + 1, one)[:, 0], run]
         for name, values in c.items():
             data[name] = values[:, run]
         data["stroke"] = c["x"][0, run] - c["x"][:, run]
@@ -253,12 +252,3 @@ def _scalar_run(scenario, record):
     return BatchRun(scenario, result.data if record == "timeseries" else None, metrics, None,
                     "library")
 
-
-def throughput(scenarios, repeats=1):
-    """Closed-loop steps per second of one batch of ``scenarios`` (record "metrics")."""
-    best = math.inf
-    for _ in range(repeats):
-        began = time.perf_counter()
-        run_batch(scenarios, "metrics")
-        best = min(best, time.perf_counter() - began)
-    return len(scenarios) * scenarios[0].steps / best
