@@ -41,6 +41,7 @@ from pathlib import Path
 
 from sma_fmu.parameter_file import load_parameter_set
 from sma_fmu.package_data import shipped_file, shipped_files
+from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.feedforward import INVERSES
@@ -83,6 +84,8 @@ def default_analysis(stop_time_s):
     margin = min(2.0, 0.1 * stop_time_s)
     zoom_end = stop_time_s - margin
     return AnalysisWindow(margin, zoom_end - min(4.0, 0.4 * stop_time_s), zoom_end)
+
+
 _GAIN_KEYS = {"Kp_W_per_ohm": "Kp", "Ki_W_per_ohm_s": "Ki", "alpha_s": "phase_lag_alpha",
               "beta_s": "beta", "model_load_kg": "model_load"}
 
@@ -306,7 +309,7 @@ def scenario_from_document(document, path, parameter_set=None):
     _check_loads(path, signals["load"], parameter_set.params)
     plant = document.get("plant", {})
     mode = plant.get("hysteresis_mode", "continuous")
-    if mode not in ("switch", "continuous"):
+    if mode not in HYSTERESIS_MODES:
         _fail(path, f"[plant] hysteresis_mode must be 'switch' or 'continuous', got {mode!r}")
     t_start = _number(path, "plant", plant, "T_start_degC", default=parameter_set.params.T_room)
     return Scenario(
