@@ -109,14 +109,18 @@ class CallGuard:
             return False
 
     def _run_initialization(self):
-        """The model's exitInitializationMode computation; returns an error text or None."""
+        """The model's exitInitializationMode computation; returns an error text or None.
+
+        A ``ValueError`` (bad parameter or input) gives its message, anything else also
+        its type.
+        """
         try:
             self._model["exit_initialization_mode"]()
+        except ValueError as error:
+            return str(error)
         except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
-            self.interface.initialization_error = f"{type(error).__name__}: {error}"
-        if self.interface.initialization_error is None and not self.outputs_finite():
-            self.interface.initialization_error = "the outputs are not finite"
-        return self.interface.initialization_error
+            return f"{type(error).__name__}: {error}"
+        return None if self.outputs_finite() else "the outputs are not finite"
 
     def _refresh_initial_outputs(self, function):
         """Initialization Mode: recompute the outputs from what was set; False if impossible."""
@@ -204,8 +208,10 @@ class CallGuard:
         try:
             done = bool(self._model["do_step"](current_time, step_size))
         except Exception as error:  # noqa: BLE001 - a step the model rejects is discarded
-            return self.refuse(function, f"step at t = {current_time!r} s discarded: {error}",
+            # "<model> '<instance>': step at t = ... s discarded: <why>" (no function name)
+            self.interface.log(f"step at t = {current_time!r} s discarded: {error}",
                                Fmi2Status.discard)
+            return False
         if not done:
             return False
         if not self.outputs_finite():

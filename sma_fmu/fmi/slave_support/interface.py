@@ -38,7 +38,6 @@ class SlaveInterface:
         self.slave = slave
         self.units = {}
         self.exposed = []
-        self.initialization_error = None
         # value reference -> (name, kind, causality, variability); table lookups replace
         # pythonfmu's generic accessors (they run at every step)
         self._variables = {}
@@ -171,39 +170,6 @@ class SlaveInterface:
     def decorate(self, root):
         """Add units, output dependencies and InitialUnknowns to pythonfmu's description."""
         return decorate_model_description(root, self.units)
-
-    def initialize(self, start, invalid_outputs):
-        """Run ``start()`` -> (stepper, outputs) for exitInitializationMode; never raise.
-
-        pythonfmu turns an exception here into fmi2Fatal. Invalid parameters instead set
-        :attr:`initialization_error` and give ``invalid_outputs``; the guard then refuses
-        fmi2ExitInitializationMode with fmi2Error naming the reason, and the instance stays
-        in Initialization Mode, where the host may correct the parameters.
-        """
-        try:
-            stepper, outputs = start()
-        except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
-            self.initialization_error = (str(error) if isinstance(error, ValueError)
-                                         else f"{type(error).__name__}: {error}")
-            return None, invalid_outputs
-        self.initialization_error = None
-        return stepper, outputs
-
-    def not_initialized(self, current_time):
-        """Discard a doStep of an instance without a valid initialization; returns False.
-
-        (The guard refuses such a doStep before the slave sees it; kept for slaves that ask.)
-        """
-        reason = self.initialization_error or "exitInitializationMode was not called"
-        return self.report(f"step at t = {current_time!r} s discarded", f"not initialized: {reason}")
-
-    def report(self, where, error):
-        """Log a rejected step: ``error`` with status fmi2Discard, naming ``where``; return False.
-
-        The FMU answers fmi2Discard; the step changed nothing and may be retried.
-        """
-        self.log(f"{where}: {error}", Fmi2Status.discard)
-        return False
 
     @staticmethod
     def state_with(state, stepper):

@@ -8,8 +8,8 @@ call and its outputs then hold u_ff,k for that step; step it before the plant
 (Gauss-Seidel) so u_ff,k reaches the plant's step k without delay. After
 initialization the outputs are those of the first sample (filter in steady state); in
 Initialization Mode they follow R_ref, load and the parameters as they are set.
-Invalid parameters are logged as fmi2Error at exitInitializationMode; the outputs are
-then NaN and every doStep is discarded.
+Invalid parameters make exitInitializationMode fail with fmi2Error naming the reason;
+the instance stays in Initialization Mode, where they can be corrected.
 """
 from pythonfmu.default_experiment import DefaultExperiment
 
@@ -18,8 +18,6 @@ from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
-
-INVALID_OUTPUTS = (float("nan"), float("nan"), False)
 
 
 def _mid_transformation_resistance(params):
@@ -31,7 +29,6 @@ def _mid_transformation_resistance(params):
 
 class SmaFeedforward(StepperSlave):
 
-    INVALID_OUTPUTS = INVALID_OUTPUTS
     author = "sma-fmu"
     description = "SMA feedforward compensator: temperature-sensing inverse model + phase-lag filter"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
