@@ -48,7 +48,6 @@ class SmaActuator(StepperSlave):
                              "(paper: branch follows sgn dT/dt; limit-cycles at a set-point)")
         fmi.model_parameters(extra=("T_max",))
         self.stepper = None
-        self._publish(PlantStepper(fmi.defaults, self.T_start, self.hysteresis_mode, self.load).outputs)
 
     def _publish(self, outputs):
         self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.P, self.heating = outputs

@@ -49,7 +49,6 @@ class SmaFeedforward(StepperSlave):
                              "continuous-mode minor branches, reversals taken from R_ref)")
         fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin"))
         self.stepper = None
-        self._publish(FeedforwardStepper(fmi.defaults).initial_outputs(self.R_ref, self.load))
 
     def _start(self):
         stepper = FeedforwardStepper(self.interface.wire_parameters(),
