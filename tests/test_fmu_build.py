@@ -35,6 +35,14 @@ def test_every_variable_has_description_and_every_real_a_defined_unit(fmus, name
     assert all(u.dependencies == [] for u in description.outputs)
 
 
+@pytest.mark.parametrize("name", sorted(FMU_SCRIPTS))
+def test_every_fmu_names_its_author_and_default_experiment(fmus, name):
+    description = read_model_description(str(fmus[name]))
+    assert description.author == "sma-fmu"
+    experiment = description.defaultExperiment
+    assert (experiment.startTime, experiment.stopTime, experiment.stepSize) == ("0.0", "30.0", "0.001")
+
+
 def test_plant_interface(fmus, parameter_set):
     variables = {v.name: v for v in read_model_description(str(fmus["SmaActuator"])).modelVariables}
     assert (variables["P_in"].causality, variables["P_in"].unit) == ("input", "W")

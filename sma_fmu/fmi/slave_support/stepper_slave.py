@@ -15,12 +15,17 @@ the saved state (the pythonfmu variables plus the stepper's hidden state) are th
 every slave, here.
 """
 from pythonfmu import Fmi2Slave
+from pythonfmu.default_experiment import DefaultExperiment
 
 __all__ = ["StepperSlave"]
 
 
 class StepperSlave(Fmi2Slave):
     """pythonfmu slave over a runtime stepper (see the module docstring)."""
+
+    # modelDescription.xml attributes every sma-fmu FMU shares (pythonfmu reads the class's)
+    author = "sma-fmu"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def exit_initialization_mode(self):
         self.stepper = None  # a failed start leaves none (and a saved state says so)

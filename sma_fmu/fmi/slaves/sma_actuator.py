@@ -11,8 +11,6 @@ they follow them as they are set). Invalid parameters make exitInitializationMod
 fail with fmi2Error naming the reason; the instance stays in Initialization Mode, where
 they can be corrected (see the guard, ``slave_support/guards.py``).
 """
-from pythonfmu.default_experiment import DefaultExperiment
-
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.plant import PlantStepper
@@ -30,9 +28,7 @@ OUTPUTS = (
 
 class SmaActuator(StepperSlave):
 
-    author = "sma-fmu"
     description = "SMA wire actuator: Joule heating, first-order thermal model, resistance hysteresis under load"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

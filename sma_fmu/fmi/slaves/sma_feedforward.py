@@ -11,8 +11,6 @@ Initialization Mode they follow R_ref, load and the parameters as they are set.
 Invalid parameters make exitInitializationMode fail with fmi2Error naming the reason;
 the instance stays in Initialization Mode, where they can be corrected.
 """
-from pythonfmu.default_experiment import DefaultExperiment
-
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.feedforward import FeedforwardStepper
@@ -29,9 +27,7 @@ def _mid_transformation_resistance(params):
 
 class SmaFeedforward(StepperSlave):
 
-    author = "sma-fmu"
     description = "SMA feedforward compensator: temperature-sensing inverse model + phase-lag filter"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

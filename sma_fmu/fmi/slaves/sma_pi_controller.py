@@ -11,8 +11,6 @@ inputs with I = 0. Non-finite inputs discard the step. Invalid gains make
 exitInitializationMode fail with fmi2Error naming the reason; the instance stays in
 Initialization Mode, where they can be corrected.
 """
-from pythonfmu.default_experiment import DefaultExperiment
-
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.pi_control import PIController
@@ -20,9 +18,7 @@ from sma_fmu.runtime.pi_control import PIController
 
 class SmaPiController(StepperSlave):
 
-    author = "sma-fmu"
     description = "PI resistance controller of the SMA wire: anti-windup, power clamped at 0 W"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

@@ -14,7 +14,6 @@ instance stays in Initialization Mode, where they can be corrected.
 import json
 import os
 
-from pythonfmu.default_experiment import DefaultExperiment
 
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
@@ -25,9 +24,7 @@ DEFAULTS_FILE = "signals.json"
 
 class SmaScenarioSignals(StepperSlave):
 
-    author = "sma-fmu"
     description = "Scenario signals of the SMA wire loop: reference resistance R_ref(t) and load f(t)"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
