@@ -11,18 +11,16 @@ Initialization Mode they follow R_ref, load and the parameters as they are set.
 Invalid parameters make exitInitializationMode fail with fmi2Error naming the reason;
 the instance stays in Initialization Mode, where they can be corrected.
 """
-from sma_fmu.runtime.constant_load import branch_constants
-from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.feedforward import FeedforwardStepper
+from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 
 
 def _mid_transformation_resistance(params):
-    """Resistance [ohm] half way through the heating transformation at the model load."""
-    constants = branch_constants(params.model_load, HEATING, params)
-    return (params.R_P + constants.xi_F_min * (params.R_F - params.R_P)
-            + 0.5 * constants.M * (params.R_MF - params.R_P))
+    """Resistance [ohm] half way through the transformation at the model load: mid-band."""
+    band = reachable_band(params.model_load, params)
+    return 0.5 * (band.hot + band.cold)
 
 
 class SmaFeedforward(StepperSlave):
