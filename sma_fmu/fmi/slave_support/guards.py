@@ -71,7 +71,12 @@ class CallGuard:
             setattr(slave, name, getattr(self, name))
         slave._get_fmu_state = self.states.get
         slave._set_fmu_state = self.states.set
+        # tables of the variables, built at first use: never while the slave's __init__ still
+        # declares variables (outputs are checked from Initialization Mode on, the two fast
+        # paths run in stepComplete only); the variables never change afterwards
         self._real_outputs = None
+        self._real_names = None      # {value reference: name} of the Reals (fmi2GetReal)
+        self._real_settable = None   # ... of the Reals settable in stepComplete (fmi2SetReal)
 
     # ---- logging ----------------------------------------------------------------------------
     def log(self, status, function, text):
@@ -290,7 +295,10 @@ class CallGuard:
         # hot path of a running co-simulation: stepComplete, known references (one dict
         # lookup each); anything else takes the checked path, which logs what is wrong
         if self.state is STEP_COMPLETE:
-            slave, names = self.slave, self.interface.names("Real")
+            names = self._real_names
+            if names is None:
+                names = self._real_names = self.interface.names("Real")
+            slave = self.slave
             try:
                 return [float(getattr(slave, names[reference])) for reference in references]
             except Exception:  # noqa: BLE001 - an unknown reference: the checked path says which
@@ -309,7 +317,9 @@ class CallGuard:
     def set_real(self, references, values):
         # hot path: stepComplete, settable references, float values; else the checked path
         if self.state is STEP_COMPLETE:
-            settable = self.interface.settable("Real", STEP_COMPLETE)
+            settable = self._real_settable
+            if settable is None:
+                settable = self._real_settable = self.interface.settable("Real", STEP_COMPLETE)
             try:
                 names = [settable[reference] for reference in references]
             except Exception:  # noqa: BLE001 - not settable now: the checked path says why
