@@ -27,7 +27,6 @@ __all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
 
 PARAMETERS_FILE = "parameters.json"
 MODEL_SECTIONS = ("geometry", "phases", "hysteresis", "constant_load", "thermal")
-_STATE_KEY = "__stepper__"
 _KIND_OF = ((Real, "Real"), (Boolean, "Boolean"), (String, "String"), (Integer, "Integer"))
 
 
@@ -170,15 +169,3 @@ class SlaveInterface:
     def decorate(self, root):
         """Add units, output dependencies and InitialUnknowns to pythonfmu's description."""
         return decorate_model_description(root, self.units)
-
-    @staticmethod
-    def state_with(state, stepper):
-        """Add a stepper's hidden state to pythonfmu's variable state (JSON-ready)."""
-        state[_STATE_KEY] = None if stepper is None else stepper.state()
-        return state
-
-    @staticmethod
-    def split_state(state):
-        """(variable state, stepper state) of a state made by :meth:`state_with`."""
-        variables = dict(state)
-        return variables, variables.pop(_STATE_KEY, None)

@@ -20,12 +20,24 @@ import re
 
 from .lifecycle import STATES, STEP_COMPLETE, TERMINATED
 
-__all__ = ["SavedStates", "state_to_bytes", "state_from_bytes"]
+__all__ = ["SavedStates", "state_to_bytes", "state_from_bytes", "state_with", "split_state"]
 
 _META = "__fmi__"
 _STEPPER = "__stepper__"
 _INVALID = "__invalid__"
 _KINDS = {"Real": (float, int), "Boolean": (bool,), "String": (str,), "Integer": (int,)}
+
+
+def state_with(state, stepper):
+    """Add a stepper's hidden state to pythonfmu's variable state (JSON-ready); returns it."""
+    state[_STEPPER] = None if stepper is None else stepper.state()
+    return state
+
+
+def split_state(state):
+    """(variable state, stepper state) of a state made by :func:`state_with`."""
+    variables = dict(state)
+    return variables, variables.pop(_STEPPER, None)
 
 
 def state_to_bytes(state):

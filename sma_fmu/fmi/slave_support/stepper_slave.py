@@ -17,6 +17,8 @@ every slave, here.
 from pythonfmu import Fmi2Slave
 from pythonfmu.default_experiment import DefaultExperiment
 
+from sma_fmu.fmi.slave_support.saved_state import split_state, state_with
+
 __all__ = ["StepperSlave"]
 
 
@@ -40,10 +42,10 @@ class StepperSlave(Fmi2Slave):
         return self.interface.decorate(super().to_xml({} if model_options is None else model_options))
 
     def _get_fmu_state(self):
-        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
+        return state_with(super()._get_fmu_state(), self.stepper)
 
     def _set_fmu_state(self, state):
-        variables, stepper_state = self.interface.split_state(state)
+        variables, stepper_state = split_state(state)
         super()._set_fmu_state(variables)
         # a new stepper with the restored parameters, then its hidden state
         self.stepper = None if stepper_state is None else self._start()[0]
