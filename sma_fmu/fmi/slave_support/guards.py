@@ -19,20 +19,13 @@ from operator import attrgetter
 
 from pythonfmu.enums import Fmi2Status
 
-from .lifecycle import (ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED,
-                        setting_refusal)
+from .lifecycle import ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED
 from .saved_state import SavedStates
 
 __all__ = ["CallGuard"]
 
 _INF = float("inf")
 _NAN = float("nan")
-_TYPES = {"Real": "Real", "Boolean": "Boolean", "String": "String", "Integer": "Integer"}
-
-
-def _vr(reference):
-    """A value reference as the host passed it (pythonfmu hands it over as a signed int)."""
-    return reference & 0xFFFFFFFF
 
 
 def _close(a, b, step):
@@ -279,7 +272,7 @@ class CallGuard:
             name = settable.get(reference)
             problem = None if name is None else check(value)
             if name is None or problem:
-                why = problem or self.interface.setting_refusal(kind, reference, self.state, setting_refusal)
+                why = problem or self.interface.setting_refusal(kind, reference, self.state)
                 return self.refuse(function, f"{why}; nothing was set (value {value!r})")
             names.append(name)
         slave = self.slave
@@ -289,7 +282,7 @@ class CallGuard:
             self.outputs_current = False
 
     def _unknown(self, kind, references):
-        return ", ".join(self.interface.describe_reference(kind, _vr(r)) for r in references)
+        return ", ".join(self.interface.describe_reference(kind, r) for r in references)
 
     def get_real(self, references):
         # hot path of a running co-simulation: stepComplete, known references (one dict

@@ -80,16 +80,20 @@ class SlaveInterface:
             vr: v[0] for vr, v in self._variables.items()
             if v[1] == kind and setting_refusal(v[2], v[3], state) is None})
 
-    def setting_refusal(self, kind, reference, state, rule):
+    def setting_refusal(self, kind, reference, state):
         """Why value reference ``reference`` cannot be set as a ``kind`` in ``state``."""
         variable = self._variables.get(reference)
         if variable is None or variable[1] != kind:
-            return self.describe_reference(kind, reference & 0xFFFFFFFF)
+            return self.describe_reference(kind, reference)
         return f"{variable[0]} (value reference {reference}) cannot be set: " \
-               f"{rule(variable[2], variable[3], state)}"
+               f"{setting_refusal(variable[2], variable[3], state)}"
 
     def describe_reference(self, kind, reference):
-        """Text for a value reference that is not a variable of type ``kind``."""
+        """Text for a value reference that is not a variable of type ``kind``.
+
+        ``reference`` as pythonfmu passes it (a signed int); the text names it as the host did.
+        """
+        reference &= 0xFFFFFFFF  # fmi2ValueReference is unsigned
         variable = self._variables.get(reference)
         if variable is None:
             return f"value reference {reference} is not a variable of {self.slave.modelName}"
