@@ -8,6 +8,7 @@ from fmpy import read_model_description
 from sma_fmu.cli import main
 from sma_fmu.fmi.build import FMU_SCRIPTS, build_fmu, code_stamp, validate_fmus
 from sma_fmu.parameter_file import write_parameter_file
+from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
 
 PLANT_OUTPUTS = {"R": "ohm", "T": "degC", "x": "m", "xi_P": "1", "xi_M": "1", "xi_F": "1", "P": "W"}
@@ -33,6 +34,14 @@ def test_every_variable_has_description_and_every_real_a_defined_unit(fmus, name
     outputs = {v for v in description.modelVariables if v.causality == "output"}
     assert {u.variable for u in description.initialUnknowns} == outputs
     assert all(u.dependencies == [] for u in description.outputs)
+
+
+@pytest.mark.parametrize("name", sorted(FMU_SCRIPTS))
+def test_every_fmu_names_its_author_and_default_experiment(fmus, name):
+    description = read_model_description(str(fmus[name]))
+    assert description.author == "sma-fmu"
+    experiment = description.defaultExperiment
+    assert (experiment.startTime, experiment.stopTime, experiment.stepSize) == ("0.0", "30.0", "0.001")
 
 
 def test_plant_interface(fmus, parameter_set):
@@ -64,6 +73,8 @@ def test_feedforward_interface(fmus, parameter_set):
     assert float(variables["alpha"].start) == params.tau_th
     assert (float(variables["beta"].start), variables["beta"].unit) == (params.beta, "s")
     assert float(variables["model_load"].start) == 0.05 == params.model_load
+    band = reachable_band(params.model_load, params)
+    assert float(variables["R_ref"].start) == 0.5 * (band.hot + band.cold)  # mid-transformation
 
 
 @pytest.mark.parametrize("name", ["SmaActuator", "SmaFeedforward"])

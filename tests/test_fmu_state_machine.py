@@ -162,7 +162,9 @@ def test_states_of_another_build_or_corrupt_ones_are_refused(fmus, tmp_path, par
     for corrupt in ({**document, "__stepper__": {**document["__stepper__"], "temperature": "hot"}},
                     {k: v for k, v in document.items() if k != "T_start"},
                     {**document, "R": True},
-                    {**document, "extra": 1.0}):
+                    {**document, "extra": 1.0},
+                    {**document, "__stepper__": None},  # forged: initialized without a stepper
+                    {**document, "__stepper__": None, "__fmi__": {**document["__fmi__"], "state": "terminated"}}):
         payload = json.dumps(corrupt).encode()
         state = plant.fmu.deSerializeFMUstate(_header(payload) + payload)
         plant.refused(plant.fmu.setFMUstate, state, words=["state refused, the instance is unchanged"])

@@ -22,13 +22,17 @@ class PIController:
         self.Ki = require_nonnegative("Ki", Ki)
         self.integral = 0.0   # I_k [ohm.s]
 
+    def _unclamped(self, error, feedforward):
+        """(u_raw = u_ff + Kp e + Ki I, feedback part Kp e + Ki I) [W] with the present integral."""
+        feedback = self.Kp * error + self.Ki * self.integral
+        return feedforward + feedback, feedback
+
     def output(self, error, feedforward):
         """(power u_k [W], feedback part Kp e + Ki I [W]) with the present integral; no change.
 
         ``error`` e_k [ohm], ``feedforward`` u_ff,k [W].
         """
-        feedback = self.Kp * error + self.Ki * self.integral
-        raw = feedforward + feedback
+        raw, feedback = self._unclamped(error, feedforward)
         return (0.0 if raw < 0.0 else raw), feedback
 
     def step(self, error, feedforward, step_size):
@@ -36,11 +40,11 @@ class PIController:
 
         ``error`` e_k [ohm], ``feedforward`` u_ff,k [W], ``step_size`` h [s].
         """
-        power, feedback = self.output(error, feedforward)
-        clamped = feedforward + feedback < 0.0
+        raw, feedback = self._unclamped(error, feedforward)
+        clamped = raw < 0.0
         if not clamped or error > 0.0:
             self.integral += step_size * error
-        return power, feedback
+        return (0.0 if clamped else raw), feedback
 
     def sample(self, resistance, reference, feedforward, step_size):
         """:meth:`step` for R [ohm], R_ref [ohm], u_ff [W] and h [s], each checked first.

@@ -13,8 +13,8 @@
 #include "front.h"
 
 Backend backend;
-char load_error[2048] = "";
-char load_info[1024] = "";
+char load_error[sizeof load_error] = ""; /* sizes: front.h */
+char load_info[sizeof load_info] = "";
 
 static pthread_mutex_t load_mutex = PTHREAD_MUTEX_INITIALIZER;
 static int load_state = 0; /* 0 not tried, 1 loaded, -1 failed */

@@ -54,10 +54,11 @@ typedef struct {
 extern Backend backend;
 
 /* Loads libpython (if the process has none) and the backend once per process; returns 1 on
- * success, else 0 with the reason in load_error. load_info says which libpython is used. */
+ * success, else 0 with the reason in load_error. load_info says which libpython is used.
+ * Their sizes are given here only: write into them with sizeof. */
 int load_backend(void);
-extern char load_error[];
-extern char load_info[];
+extern char load_error[2048];
+extern char load_info[1024];
 
 /* ---- the embedded Python (python_runtime.c) --------------------------------------------- */
 int ensure_libpython(void);          /* 1: the Python C API is in the global scope */

@@ -86,7 +86,7 @@ static int try_libpython(const char* path, char* tried, size_t size)
     dlerror();
     void* handle = dlopen(path, RTLD_NOW | RTLD_GLOBAL);
     if (handle && dlsym(handle, "Py_IsInitialized")) {
-        snprintf(load_info, 1024, "loaded libpython %s", path);
+        snprintf(load_info, sizeof load_info, "loaded libpython %s", path);
         return 1;
     }
     const char* reason = dlerror();
@@ -98,7 +98,7 @@ static int try_libpython(const char* path, char* tried, size_t size)
 int ensure_libpython(void)
 {
     if (dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
-        snprintf(load_info, 1024, "the process already has Python (global scope)");
+        snprintf(load_info, sizeof load_info, "the process already has Python (global scope)");
         return 1;
     }
     char mapped[PATH_MAX] = "";
@@ -106,25 +106,26 @@ int ensure_libpython(void)
         /* mapped with RTLD_LOCAL: promote that same copy to the global scope */
         if (dlopen(mapped, RTLD_NOW | RTLD_GLOBAL | RTLD_NOLOAD) &&
             dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
-            snprintf(load_info, 1024, "made the process's %s global", mapped);
+            snprintf(load_info, sizeof load_info, "made the process's %s global", mapped);
             return 1;
         }
-        snprintf(load_error, 2048, "the process has %s loaded privately and it could not be "
-                 "made global; not loading a second libpython", mapped);
+        snprintf(load_error, sizeof load_error, "the process has %s loaded privately and it "
+                 "could not be made global; not loading a second libpython", mapped);
         return 0;
     }
     char tried[1536] = "";
     const char* chosen = getenv("SMA_FMU_LIBPYTHON");
     if (chosen && *chosen) {
         if (try_libpython(chosen, tried, sizeof tried)) return 1;
-        snprintf(load_error, 2048, "SMA_FMU_LIBPYTHON=%s could not be loaded:%s", chosen, tried);
+        snprintf(load_error, sizeof load_error, "SMA_FMU_LIBPYTHON=%s could not be loaded:%s",
+                 chosen, tried);
         return 0;
     }
     if (try_libpython(SMA_FRONT_LIBPYTHON, tried, sizeof tried) ||
         try_libpython(SMA_FRONT_LIBPYTHON_SONAME, tried, sizeof tried) ||
         try_libpython(DEBIAN_LIBPYTHON, tried, sizeof tried))
         return 1;
-    snprintf(load_error, 2048,
+    snprintf(load_error, sizeof load_error,
              "this FMU runs Python and needs a shared libpython (%s), but none was found. "
              "Tried:%s\nSet SMA_FMU_LIBPYTHON to the full path of a libpython3 shared library "
              "(python3 -c \"import sysconfig,os;print(os.path.join(sysconfig.get_config_var("

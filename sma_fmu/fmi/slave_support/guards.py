@@ -19,20 +19,13 @@ from operator import attrgetter
 
 from pythonfmu.enums import Fmi2Status
 
-from .lifecycle import (ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED,
-                        setting_refusal)
+from .lifecycle import ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED
 from .saved_state import SavedStates
 
 __all__ = ["CallGuard"]
 
 _INF = float("inf")
 _NAN = float("nan")
-_TYPES = {"Real": "Real", "Boolean": "Boolean", "String": "String", "Integer": "Integer"}
-
-
-def _vr(reference):
-    """A value reference as the host passed it (pythonfmu hands it over as a signed int)."""
-    return reference & 0xFFFFFFFF
 
 
 def _close(a, b, step):
@@ -71,7 +64,12 @@ class CallGuard:
             setattr(slave, name, getattr(self, name))
         slave._get_fmu_state = self.states.get
         slave._set_fmu_state = self.states.set
+        # tables of the variables, built at first use: never while the slave's __init__ still
+        # declares variables (outputs are checked from Initialization Mode on, the two fast
+        # paths run in stepComplete only); the variables never change afterwards
         self._real_outputs = None
+        self._real_names = None      # {value reference: name} of the Reals (fmi2GetReal)
+        self._real_settable = None   # ... of the Reals settable in stepComplete (fmi2SetReal)
 
     # ---- logging ----------------------------------------------------------------------------
     def log(self, status, function, text):
@@ -109,14 +107,18 @@ class CallGuard:
             return False
 
     def _run_initialization(self):
-        """The model's exitInitializationMode computation; returns an error text or None."""
+        """The model's exitInitializationMode computation; returns an error text or None.
+
+        A ``ValueError`` (bad parameter or input) gives its message, anything else also
+        its type.
+        """
         try:
             self._model["exit_initialization_mode"]()
+        except ValueError as error:
+            return str(error)
         except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
-            self.interface.initialization_error = f"{type(error).__name__}: {error}"
-        if self.interface.initialization_error is None and not self.outputs_finite():
-            self.interface.initialization_error = "the outputs are not finite"
-        return self.interface.initialization_error
+            return f"{type(error).__name__}: {error}"
+        return None if self.outputs_finite() else "the outputs are not finite"
 
     def _refresh_initial_outputs(self, function):
         """Initialization Mode: recompute the outputs from what was set; False if impossible."""
@@ -204,8 +206,10 @@ class CallGuard:
         try:
             done = bool(self._model["do_step"](current_time, step_size))
         except Exception as error:  # noqa: BLE001 - a step the model rejects is discarded
-            return self.refuse(function, f"step at t = {current_time!r} s discarded: {error}",
+            # "<model> '<instance>': step at t = ... s discarded: <why>" (no function name)
+            self.interface.log(f"step at t = {current_time!r} s discarded: {error}",
                                Fmi2Status.discard)
+            return False
         if not done:
             return False
         if not self.outputs_finite():
@@ -268,7 +272,7 @@ class CallGuard:
             name = settable.get(reference)
             problem = None if name is None else check(value)
             if name is None or problem:
-                why = problem or self.interface.setting_refusal(kind, reference, self.state, setting_refusal)
+                why = problem or self.interface.setting_refusal(kind, reference, self.state)
                 return self.refuse(function, f"{why}; nothing was set (value {value!r})")
             names.append(name)
         slave = self.slave
@@ -278,13 +282,16 @@ class CallGuard:
             self.outputs_current = False
 
     def _unknown(self, kind, references):
-        return ", ".join(self.interface.describe_reference(kind, _vr(r)) for r in references)
+        return ", ".join(self.interface.describe_reference(kind, r) for r in references)
 
     def get_real(self, references):
         # hot path of a running co-simulation: stepComplete, known references (one dict
         # lookup each); anything else takes the checked path, which logs what is wrong
         if self.state is STEP_COMPLETE:
-            slave, names = self.slave, self.interface.names("Real")
+            names = self._real_names
+            if names is None:
+                names = self._real_names = self.interface.names("Real")
+            slave = self.slave
             try:
                 return [float(getattr(slave, names[reference])) for reference in references]
             except Exception:  # noqa: BLE001 - an unknown reference: the checked path says which
@@ -303,7 +310,9 @@ class CallGuard:
     def set_real(self, references, values):
         # hot path: stepComplete, settable references, float values; else the checked path
         if self.state is STEP_COMPLETE:
-            settable = self.interface.settable("Real", STEP_COMPLETE)
+            settable = self._real_settable
+            if settable is None:
+                settable = self._real_settable = self.interface.settable("Real", STEP_COMPLETE)
             try:
                 names = [settable[reference] for reference in references]
             except Exception:  # noqa: BLE001 - not settable now: the checked path says why

@@ -27,7 +27,6 @@ __all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
 
 PARAMETERS_FILE = "parameters.json"
 MODEL_SECTIONS = ("geometry", "phases", "hysteresis", "constant_load", "thermal")
-_STATE_KEY = "__stepper__"
 _KIND_OF = ((Real, "Real"), (Boolean, "Boolean"), (String, "String"), (Integer, "Integer"))
 
 
@@ -38,7 +37,6 @@ class SlaveInterface:
         self.slave = slave
         self.units = {}
         self.exposed = []
-        self.initialization_error = None
         # value reference -> (name, kind, causality, variability); table lookups replace
         # pythonfmu's generic accessors (they run at every step)
         self._variables = {}
@@ -82,16 +80,20 @@ class SlaveInterface:
             vr: v[0] for vr, v in self._variables.items()
             if v[1] == kind and setting_refusal(v[2], v[3], state) is None})
 
-    def setting_refusal(self, kind, reference, state, rule):
+    def setting_refusal(self, kind, reference, state):
         """Why value reference ``reference`` cannot be set as a ``kind`` in ``state``."""
         variable = self._variables.get(reference)
         if variable is None or variable[1] != kind:
-            return self.describe_reference(kind, reference & 0xFFFFFFFF)
+            return self.describe_reference(kind, reference)
         return f"{variable[0]} (value reference {reference}) cannot be set: " \
-               f"{rule(variable[2], variable[3], state)}"
+               f"{setting_refusal(variable[2], variable[3], state)}"
 
     def describe_reference(self, kind, reference):
-        """Text for a value reference that is not a variable of type ``kind``."""
+        """Text for a value reference that is not a variable of type ``kind``.
+
+        ``reference`` as pythonfmu passes it (a signed int); the text names it as the host did.
+        """
+        reference &= 0xFFFFFFFF  # fmi2ValueReference is unsigned
         variable = self._variables.get(reference)
         if variable is None:
             return f"value reference {reference} is not a variable of {self.slave.modelName}"
@@ -171,48 +173,3 @@ class SlaveInterface:
     def decorate(self, root):
         """Add units, output dependencies and InitialUnknowns to pythonfmu's description."""
         return decorate_model_description(root, self.units)
-
-    def initialize(self, start, invalid_outputs):
-        """Run ``start()`` -> (stepper, outputs) for exitInitializationMode; never raise.
-
-        pythonfmu turns an exception here into fmi2Fatal. Invalid parameters instead set
-        :attr:`initialization_error` and give ``invalid_outputs``; the guard then refuses
-        fmi2ExitInitializationMode with fmi2Error naming the reason, and the instance stays
-        in Initialization Mode, where the host may correct the parameters.
-        """
-        try:
-            stepper, outputs = start()
-        except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
-            self.initialization_error = (str(error) if isinstance(error, ValueError)
-                                         else f"{type(error).__name__}: {error}")
-            return None, invalid_outputs
-        self.initialization_error = None
-        return stepper, outputs
-
-    def not_initialized(self, current_time):
-        """Discard a doStep of an instance without a valid initialization; returns False.
-
-        (The guard refuses such a doStep before the slave sees it; kept for slaves that ask.)
-        """
-        reason = self.initialization_error or "exitInitializationMode was not called"
-        return self.report(f"step at t = {current_time!r} s discarded", f"not initialized: {reason}")
-
-    def report(self, where, error):
-        """Log a rejected step: ``error`` with status fmi2Discard, naming ``where``; return False.
-
-        The FMU answers fmi2Discard; the step changed nothing and may be retried.
-        """
-        self.log(f"{where}: {error}", Fmi2Status.discard)
-        return False
-
-    @staticmethod
-    def state_with(state, stepper):
-        """Add a stepper's hidden state to pythonfmu's variable state (JSON-ready)."""
-        state[_STATE_KEY] = None if stepper is None else stepper.state()
-        return state
-
-    @staticmethod
-    def split_state(state):
-        """(variable state, stepper state) of a state made by :meth:`state_with`."""
-        variables = dict(state)
-        return variables, variables.pop(_STATE_KEY, None)

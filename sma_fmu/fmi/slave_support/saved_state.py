@@ -6,9 +6,10 @@ hidden state under ``__stepper__`` (the slave's ``_get_fmu_state``) and, under
 
 Restoring checks everything before it changes anything: the GUID must be this FMU's (a
 state of another build, that is another parameter file or code, is refused), every
-variable must be present with its type, nothing unknown may be there, and the stepper
-must take the hidden state back unchanged (it is saved again and compared). If a check
-or the restore fails, the instance is put back as it was and fmi2Error is logged.
+variable must be present with its type, nothing unknown may be there, a state after
+initialization (stepComplete, terminated) must hold the stepper's hidden state, and the
+stepper must take it back unchanged (it is saved again and compared). If a check or the
+restore fails, the instance is put back as it was and fmi2Error is logged.
 Bytes that are not JSON become a state that is refused when it is set (pythonfmu calls
 the byte conversions on the class, where no instance can log).
 """
@@ -19,12 +20,24 @@ import re
 
 from .lifecycle import STATES, STEP_COMPLETE, TERMINATED
 
-__all__ = ["SavedStates", "state_to_bytes", "state_from_bytes"]
+__all__ = ["SavedStates", "state_to_bytes", "state_from_bytes", "state_with", "split_state"]
 
 _META = "__fmi__"
 _STEPPER = "__stepper__"
 _INVALID = "__invalid__"
 _KINDS = {"Real": (float, int), "Boolean": (bool,), "String": (str,), "Integer": (int,)}
+
+
+def state_with(state, stepper):
+    """Add a stepper's hidden state to pythonfmu's variable state (JSON-ready); returns it."""
+    state[_STEPPER] = None if stepper is None else stepper.state()
+    return state
+
+
+def split_state(state):
+    """(variable state, stepper state) of a state made by :func:`state_with`."""
+    variables = dict(state)
+    return variables, variables.pop(_STEPPER, None)
 
 
 def state_to_bytes(state):
@@ -125,6 +138,9 @@ class SavedStates:
                 return f"variable {name!r} = {value!r} is not a {kind}"
         if not _json_like(state.get(_STEPPER)):
             return "the hidden model state holds a value that is not a finite number, text or list"
+        if meta["state"] in (STEP_COMPLETE, TERMINATED) and state.get(_STEPPER) is None:
+            # only a forged state: an initialized instance always has a stepper
+            return f"a state in '{meta['state']}' must hold the hidden model state ({_STEPPER} is null)"
         return None
 
     def set(self, state):

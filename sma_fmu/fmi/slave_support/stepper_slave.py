@@ -6,13 +6,18 @@ A slave subclasses :class:`StepperSlave`, declares its variables through its
 - ``_start()`` -> (stepper, outputs): a new stepper from the present parameters and inputs,
   and the outputs after initialization;
 - ``_advance(current_time, step_size)`` -> outputs: one step of the stepper from the inputs;
-- ``_publish(outputs)``: copy outputs into the output variables;
+- ``_publish(outputs)``: copy outputs into the output variables.
 
-and the class attribute ``INVALID_OUTPUTS`` (the outputs while the parameters are invalid).
-Initialization, guarded steps, the model description's additions and the saved state (the
-pythonfmu variables plus the stepper's hidden state) are the same for every slave, here.
+``_start`` and ``_advance`` may raise (``ValueError`` naming the parameter or input): the
+guard (:class:`~.guards.CallGuard`) turns that into a refused fmi2ExitInitializationMode
+or a discarded step. Initialization, guarded steps, the model description's additions and
+the saved state (the pythonfmu variables plus the stepper's hidden state) are the same for
+every slave, here.
 """
 from pythonfmu import Fmi2Slave
+from pythonfmu.default_experiment import DefaultExperiment
+
+from sma_fmu.fmi.slave_support.saved_state import split_state, state_with
 
 __all__ = ["StepperSlave"]
 
@@ -20,29 +25,27 @@ __all__ = ["StepperSlave"]
 class StepperSlave(Fmi2Slave):
     """pythonfmu slave over a runtime stepper (see the module docstring)."""
 
-    INVALID_OUTPUTS = ()
+    # modelDescription.xml attributes every sma-fmu FMU shares (pythonfmu reads the class's)
+    author = "sma-fmu"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def exit_initialization_mode(self):
-        self.stepper, outputs = self.interface.initialize(self._start, self.INVALID_OUTPUTS)
+        self.stepper = None  # a failed start leaves none (and a saved state says so)
+        self.stepper, outputs = self._start()
         self._publish(outputs)
 
     def do_step(self, current_time, step_size):
-        if self.stepper is None:
-            return self.interface.not_initialized(current_time)
-        try:
-            self._publish(self._advance(current_time, step_size))
-        except Exception as error:  # an exception here would reach the host as fmi2Fatal
-            return self.interface.report(f"step at t = {current_time!r} s discarded", error)
+        self._publish(self._advance(current_time, step_size))
         return True
 
     def to_xml(self, model_options=None):
         return self.interface.decorate(super().to_xml({} if model_options is None else model_options))
 
     def _get_fmu_state(self):
-        return self.interface.state_with(super()._get_fmu_state(), self.stepper)
+        return state_with(super()._get_fmu_state(), self.stepper)
 
     def _set_fmu_state(self, state):
-        variables, stepper_state = self.interface.split_state(state)
+        variables, stepper_state = split_state(state)
         super()._set_fmu_state(variables)
         # a new stepper with the restored parameters, then its hidden state
         self.stepper = None if stepper_state is None else self._start()[0]

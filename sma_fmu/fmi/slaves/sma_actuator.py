@@ -7,12 +7,10 @@ versions loaded into one process never share a module.
 Semantics: doStep(t, h) holds P_in and load over the step (P_in <= 0 is applied as 0 W);
 the outputs are then the state at t + h with the held load (no direct feedthrough). After initialization the
 outputs reflect T_start and the load set during initialization (in Initialization Mode
-they follow them as they are set). Invalid parameters are
-logged as fmi2Error at exitInitializationMode; the outputs are then NaN and every
-doStep is discarded (pythonfmu would turn an exception there into fmi2Fatal).
+they follow them as they are set). Invalid parameters make exitInitializationMode
+fail with fmi2Error naming the reason; the instance stays in Initialization Mode, where
+they can be corrected (see the guard, ``slave_support/guards.py``).
 """
-from pythonfmu.default_experiment import DefaultExperiment
-
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.plant import PlantStepper
@@ -26,15 +24,11 @@ OUTPUTS = (
     ("xi_F", "1", "F-phase (detwinned martensite) fraction"),
     ("P", "W", "power applied to the wire over the last step: max(0, P_in)"),
 )
-INVALID_OUTPUTS = (float("nan"),) * len(OUTPUTS) + (False,)
 
 
 class SmaActuator(StepperSlave):
 
-    INVALID_OUTPUTS = INVALID_OUTPUTS
-    author = "sma-fmu"
     description = "SMA wire actuator: Joule heating, first-order thermal model, resistance hysteresis under load"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -50,7 +44,6 @@ class SmaActuator(StepperSlave):
                              "(paper: branch follows sgn dT/dt; limit-cycles at a set-point)")
         fmi.model_parameters(extra=("T_max",))
         self.stepper = None
-        self._publish(PlantStepper(fmi.defaults, self.T_start, self.hysteresis_mode, self.load).outputs)
 
     def _publish(self, outputs):
         self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.P, self.heating = outputs

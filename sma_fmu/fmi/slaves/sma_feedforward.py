@@ -8,33 +8,24 @@ call and its outputs then hold u_ff,k for that step; step it before the plant
 (Gauss-Seidel) so u_ff,k reaches the plant's step k without delay. After
 initialization the outputs are those of the first sample (filter in steady state); in
 Initialization Mode they follow R_ref, load and the parameters as they are set.
-Invalid parameters are logged as fmi2Error at exitInitializationMode; the outputs are
-then NaN and every doStep is discarded.
+Invalid parameters make exitInitializationMode fail with fmi2Error naming the reason;
+the instance stays in Initialization Mode, where they can be corrected.
 """
-from pythonfmu.default_experiment import DefaultExperiment
-
-from sma_fmu.runtime.constant_load import branch_constants
-from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.feedforward import FeedforwardStepper
+from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 
-INVALID_OUTPUTS = (float("nan"), float("nan"), False)
-
 
 def _mid_transformation_resistance(params):
-    """Resistance [ohm] half way through the heating transformation at the model load."""
-    constants = branch_constants(params.model_load, HEATING, params)
-    return (params.R_P + constants.xi_F_min * (params.R_F - params.R_P)
-            + 0.5 * constants.M * (params.R_MF - params.R_P))
+    """Resistance [ohm] half way through the transformation at the model load: mid-band."""
+    band = reachable_band(params.model_load, params)
+    return 0.5 * (band.hot + band.cold)
 
 
 class SmaFeedforward(StepperSlave):
 
-    INVALID_OUTPUTS = INVALID_OUTPUTS
-    author = "sma-fmu"
     description = "SMA feedforward compensator: temperature-sensing inverse model + phase-lag filter"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -52,7 +43,6 @@ class SmaFeedforward(StepperSlave):
                              "continuous-mode minor branches, reversals taken from R_ref)")
         fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin"))
         self.stepper = None
-        self._publish(FeedforwardStepper(fmi.defaults).initial_outputs(self.R_ref, self.load))
 
     def _start(self):
         stepper = FeedforwardStepper(self.interface.wire_parameters(),

@@ -7,24 +7,18 @@ Semantics: a sampled block, like SmaFeedforward. doStep(t_k, h) samples R, R_ref
 as set before the call; its outputs then hold u_k = max(0, P_ff + Kp e_k + Ki I_k) with
 e_k = R - R_ref for that step, and the integrator advances. Before the first step (also
 in Initialization Mode) the outputs are those the first step will give: the present
-inputs with I = 0. Non-finite inputs discard the step. Invalid gains are logged as
-fmi2Error at exitInitializationMode; the outputs are then NaN and every doStep is discarded.
+inputs with I = 0. Non-finite inputs discard the step. Invalid gains make
+exitInitializationMode fail with fmi2Error naming the reason; the instance stays in
+Initialization Mode, where they can be corrected.
 """
-from pythonfmu.default_experiment import DefaultExperiment
-
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.pi_control import PIController
 
-INVALID_OUTPUTS = (float("nan"), float("nan"))
-
 
 class SmaPiController(StepperSlave):
 
-    INVALID_OUTPUTS = INVALID_OUTPUTS
-    author = "sma-fmu"
     description = "PI resistance controller of the SMA wire: anti-windup, power clamped at 0 W"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

@@ -7,29 +7,24 @@ Parameters: ``reference`` and ``load_profile``, String parameters holding a scen
 ``[reference]`` and ``[load]`` tables as JSON objects (FMI 2.0 has no arrays); their
 defaults, from ``resources/signals.json``, are the paper's load-step scenario.
 Semantics: a source. After initialization the outputs are the signals at the start
-time; after doStep(t, h) they are the signals at t + h. Invalid tables are logged as
-fmi2Error at exitInitializationMode, naming the parameter and the key; the outputs are
-then NaN and every doStep is discarded.
+time; after doStep(t, h) they are the signals at t + h. Invalid tables make
+exitInitializationMode fail with fmi2Error naming the parameter and the key; the
+instance stays in Initialization Mode, where they can be corrected.
 """
 import json
 import os
 
-from pythonfmu.default_experiment import DefaultExperiment
 
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.scenario_signals import SignalSource, signals_from_text, table_text
 
-INVALID_OUTPUTS = (float("nan"), float("nan"))
 DEFAULTS_FILE = "signals.json"
 
 
 class SmaScenarioSignals(StepperSlave):
 
-    INVALID_OUTPUTS = INVALID_OUTPUTS
-    author = "sma-fmu"
     description = "Scenario signals of the SMA wire loop: reference resistance R_ref(t) and load f(t)"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
