@@ -27,7 +27,7 @@ from sma_fmu.output_folder import write_file
 from sma_fmu.studies.overrides import StudyError
 from sma_fmu.studies.results import write_results
 from sma_fmu.studies.spec import load_spec
-from sma_fmu.studies.tasks import run_task
+from sma_fmu.studies.tasks import run_row, run_task
 
 __all__ = ["PARTS", "run_sweep", "finished_runs", "dask_client", "task_size"]
 
@@ -101,8 +101,9 @@ def _write_part(out, rows):
 
 
 def _error_rows(spec, runs, reason):
-    return [{"run_id": r.run_id, "scenario": spec.templates[r.base].name, "point": r.point,
-             "draw": r.draw, "status": "error", "error": reason, **r.overrides} for r in runs]
+    """Rows of ``runs`` whose task failed: status "error" (retried on resume), ``reason``."""
+    return [{**run_row(run, spec.templates[run.base]), "status": "error", "error": reason}
+            for run in runs]
 
 
 def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True):

@@ -10,12 +10,14 @@ from sma_fmu.studies.batch import run_batches
 from sma_fmu.studies.overrides import StudyError
 from sma_fmu.studies.runs import metrics_record
 
-__all__ = ["STATUSES", "run_task"]
+__all__ = ["STATUSES", "run_row", "run_task"]
 
 STATUSES = ("ok", "failed", "error")   # error: the task itself failed (retried on resume)
 
 
-def _row(run, template):
+def run_row(run, template):
+    """The row of ``run`` before it ran: its id, base scenario name, point, draw and
+    overrides; status "ok", no error, path, controller or mode yet."""
     row = {"run_id": run.run_id, "scenario": template.name, "point": run.point,
            "draw": run.draw, "status": "ok", "error": None, "path": None,
            "controller": None, "hysteresis_mode": None}
@@ -37,7 +39,7 @@ def run_task(templates, runs):
     """Rows (dicts) of ``runs`` (:class:`~sma_fmu.studies.spec.StudyRunSpec`), in order."""
     rows, built = {}, []
     for run in runs:
-        row = rows[run.run_id] = _row(run, templates[run.base])
+        row = rows[run.run_id] = run_row(run, templates[run.base])
         try:
             scenario = templates[run.base].scenario(run.overrides)
         except StudyError as error:
