@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import write_file
+from sma_fmu.output_folder import check_folder, write_file
 from sma_fmu.studies.overrides import StudyError
 from sma_fmu.studies.results import write_results
 from sma_fmu.studies.spec import load_spec
@@ -76,8 +76,7 @@ def finished_runs(out):
 def _check_folder(out, spec):
     """Create ``out`` for ``spec``, or check that it holds a sweep of the same spec."""
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise StudyError(f"--out {out}: exists and is not a folder")
+    check_folder(out)
     marker = out / "study.json"
     fingerprint = spec.fingerprint()
     if marker.is_file():
@@ -86,7 +85,6 @@ def _check_folder(out, spec):
             raise StudyError(f"--out {out}: holds the results of another study spec "
                              f"(study.json); give another --out, or remove that folder")
         return
-    (out / PARTS).mkdir(parents=True, exist_ok=True)
     write_file(marker, json_text({"spec": str(spec.path), "fingerprint": fingerprint,
                                   "runs": len(spec.runs())}))
 
