@@ -19,7 +19,8 @@ from sma_fmu.studies import StudyError, template
 from sma_fmu.studies.design import monte_carlo_draws
 from sma_fmu.studies.spec import StudyRunSpec, load_spec
 from sma_fmu.studies.tasks import run_task
-from sma_fmu.studies.sweep import run_sweep
+from sma_fmu.studies.results import read_parts
+from sma_fmu.studies.sweep import _error_rows, _write_part, finished_runs, run_sweep
 
 GRID = """
 [study]
@@ -230,3 +231,19 @@ def test_a_task_runs_both_inverses_in_the_batch():
         expected = scenario_metrics(run_library(item).data, item)["overall"]["rmse_ohm"]
         assert row["rmse_ohm"] == pytest.approx(expected, rel=1e-12)
     assert rows[0]["rmse_ohm"] != rows[1]["rmse_ohm"]      # the minor-loop inverse differs
+
+
+def test_a_final_status_beats_a_task_error(grid_spec, tmp_path):
+    """Runs of a failed task are not finished; once run again, their rows replace the error."""
+    spec = load_spec(grid_spec)
+    runs, out = spec.runs()[:3], tmp_path / "out"
+    _write_part(out, _error_rows(spec, runs, "task failed: KilledWorker: gone"))
+    assert finished_runs(out) == {}
+    rows = run_task(spec.templates, runs[1:])               # Kp = 0.3 (ok), -1.0 (failed)
+    _write_part(out, rows)
+    assert finished_runs(out) == {1: "ok", 2: "failed"}
+    table = read_parts(out)
+    assert list(table["run_id"]) == [0, 1, 2]
+    assert list(table["status"]) == ["error", "ok", "failed"]
+    assert table["error"][0] == "task failed: KilledWorker: gone"
+    assert table["rmse_ohm"][1] == rows[0]["rmse_ohm"] and table["error"][2] == rows[1]["error"]

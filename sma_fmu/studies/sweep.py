@@ -25,13 +25,12 @@ import pandas as pd
 from sma_fmu.json_output import json_text
 from sma_fmu.output_folder import check_folder, write_file
 from sma_fmu.studies.overrides import StudyError
-from sma_fmu.studies.results import write_results
+from sma_fmu.studies.results import PARTS, read_parts, write_results
 from sma_fmu.studies.spec import load_spec
 from sma_fmu.studies.tasks import run_row, run_task
 
-__all__ = ["PARTS", "run_sweep", "finished_runs", "dask_client", "task_size"]
+__all__ = ["run_sweep", "finished_runs", "dask_client", "task_size"]
 
-PARTS = "runs"
 MOST_RUNS_PER_TASK = 1000
 
 
@@ -64,13 +63,9 @@ def task_size(remaining, workers, requested=None):
 
 def finished_runs(out):
     """{run_id: status} of the runs already written to ``out``/runs (an error is not final)."""
-    done = {}
-    for part in sorted((Path(out) / PARTS).glob("part-*.parquet")):
-        table = pd.read_parquet(part, columns=["run_id", "status"])
-        for run_id, status in zip(table["run_id"].tolist(), table["status"].tolist()):
-            if status != "error" or run_id not in done:
-                done[run_id] = status
-    return {run_id: status for run_id, status in done.items() if status != "error"}
+    table = read_parts(out, ["run_id", "status"])
+    table = table[table["status"] != "error"]
+    return dict(zip(table["run_id"].tolist(), table["status"].tolist()))
 
 
 def _check_folder(out, spec):
