@@ -202,12 +202,22 @@ def test_monte_carlo_sweep_from_the_shipped_spec(fit_report, dask_processes, tmp
     ("[study]\nscenarios = ['heavy-pi']\n[overrides]\n'controller.Ki_W_per_ohm_s' = -2\n",
      "Ki_W_per_ohm_s must be >= 0, got -2"),
     ("[study]\nscenarios = ['heavy-pi']\n[extra]\n", "unknown section \\[extra\\]"),
+    ("[study]\nscenarios = ['load-step-pi+ff-adaptive', 'heavy-pi']\n[overrides]\n"
+     "'controller.inverse' = 'minor-loop'\n[axes.values]\n'controller.Kp_W_per_ohm' = [0.1, 0.2]\n",
+     "heavy-pi.toml: \\[controller\\] inverse = 'minor-loop' needs a feedforward controller"),
 ])
 def test_bad_specs_are_refused_before_any_run(tmp_path, text, message):
     spec = tmp_path / "bad.toml"
     spec.write_text(text)
     with pytest.raises(StudyError, match=message):
         load_spec(spec)
+
+
+def test_spec_lists_its_runs_once(grid_spec):
+    spec = load_spec(grid_spec)
+    assert spec.runs() is spec.runs() and len(spec.runs()) == 12
+    assert [run.run_id for run in spec.runs()] == list(range(12))
+    assert spec.inputs == ["controller.Kp_W_per_ohm", "controller.Ki_W_per_ohm_s"]
 
 
 def test_cli_error_is_one_line_and_writes_nothing(tmp_path, capsys):
