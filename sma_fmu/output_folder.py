@@ -10,7 +10,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-__all__ = ["OutputError", "staged_folder", "write_file"]
+__all__ = ["OutputError", "check_folder", "staged_folder", "write_file"]
 
 
 def _umask():
@@ -22,6 +22,13 @@ def _umask():
 
 class OutputError(ValueError):
     """An output path cannot be used; the message names the argument and the path."""
+
+
+def check_folder(out, argument="--out"):
+    """Raise :class:`OutputError` when ``out`` exists and is not a folder."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{argument} {out}: exists and is not a folder")
 
 
 def _writable_parent(path, argument):
@@ -47,8 +54,7 @@ def staged_folder(out, argument="--out"):
     Raises :class:`OutputError` when ``out`` is an existing file or cannot be written.
     """
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"{argument} {out}: exists and is not a folder")
+    check_folder(out, argument)
     parent = _writable_parent(out, argument)
     try:
         stage = Path(tempfile.mkdtemp(prefix=f".{out.absolute().name or 'out'}.", suffix=".partial",

@@ -173,3 +173,17 @@ def test_runs_must_share_step_and_duration():
     with pytest.raises(ValueError, match="one step and duration"):
         run_batch([base.scenario({"scenario.stop_time_s": 3.0}),
                    base.scenario({"scenario.stop_time_s": 4.0})])
+
+
+def test_run_batches_groups_by_step_and_duration_and_keeps_the_order():
+    base = template("load-step-pi")
+    items = [base.scenario({"scenario.stop_time_s": t, "controller.Ki_W_per_ohm_s": k})
+             for t, k in ((3.0, 1.0), (4.0, 2.0), (3.0, 3.0))]
+    outcomes = batch.run_batches(items)
+    assert all(outcome.scenario is item for outcome, item in zip(outcomes, items))
+    # t >= 10 % of the run, 1 ms steps: 0.3-3 s and 0.4-4 s
+    assert [o.metrics["overall"]["samples"] for o in outcomes] == [2701, 3601, 2701]
+    together = run_batch([items[0], items[2]])           # the two 3-s runs: one batch
+    assert [outcomes[0].metrics, outcomes[2].metrics] == [r.metrics for r in together]
+    assert all(o.path == "batch" and o.wall_time_s > 0 for o in outcomes)
+    assert batch.run_batches([]) == []

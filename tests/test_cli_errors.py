@@ -62,6 +62,7 @@ def test_folder_given_as_scenario_or_csv(tmp_path, capsys):
 @pytest.mark.parametrize("command", [
     ["build"], ["run", "heavy-pi", "--path", "library"], ["bench", "--runs", "1"],
     ["fit", "constant-load", str(shipped_file("examples", "constant_load.csv"))],
+    ["sweep", str(shipped_file("examples", "gain-grid.toml"))],
 ])
 def test_out_is_an_existing_file(tmp_path, capsys, command):
     target = tmp_path / "taken"
@@ -74,6 +75,7 @@ def test_out_is_an_existing_file(tmp_path, capsys, command):
     ["build"], ["run", "heavy-pi", "--path", "library"],
     ["fit", "constant-load", str(shipped_file("examples", "constant_load.csv"))],
     ["synth", "constant-load"],
+    ["sweep", str(shipped_file("examples", "gain-grid.toml"))],
 ])
 def test_out_under_a_file_cannot_be_written(tmp_path, capsys, command):
     blocker = tmp_path / "file"

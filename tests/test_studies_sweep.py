@@ -19,7 +19,8 @@ from sma_fmu.studies import StudyError, template
 from sma_fmu.studies.design import monte_carlo_draws
 from sma_fmu.studies.spec import StudyRunSpec, load_spec
 from sma_fmu.studies.tasks import run_task
-from sma_fmu.studies.sweep import run_sweep
+from sma_fmu.studies.results import read_parts
+from sma_fmu.studies.sweep import _error_rows, _write_part, finished_runs, run_sweep
 
 GRID = """
 [study]
@@ -201,12 +202,22 @@ def test_monte_carlo_sweep_from_the_shipped_spec(fit_report, dask_processes, tmp
     ("[study]\nscenarios = ['heavy-pi']\n[overrides]\n'controller.Ki_W_per_ohm_s' = -2\n",
      "Ki_W_per_ohm_s must be >= 0, got -2"),
     ("[study]\nscenarios = ['heavy-pi']\n[extra]\n", "unknown section \\[extra\\]"),
+    ("[study]\nscenarios = ['load-step-pi+ff-adaptive', 'heavy-pi']\n[overrides]\n"
+     "'controller.inverse' = 'minor-loop'\n[axes.values]\n'controller.Kp_W_per_ohm' = [0.1, 0.2]\n",
+     "heavy-pi.toml: \\[controller\\] inverse = 'minor-loop' needs a feedforward controller"),
 ])
 def test_bad_specs_are_refused_before_any_run(tmp_path, text, message):
     spec = tmp_path / "bad.toml"
     spec.write_text(text)
     with pytest.raises(StudyError, match=message):
         load_spec(spec)
+
+
+def test_spec_lists_its_runs_once(grid_spec):
+    spec = load_spec(grid_spec)
+    assert spec.runs() is spec.runs() and len(spec.runs()) == 12
+    assert [run.run_id for run in spec.runs()] == list(range(12))
+    assert spec.inputs == ["controller.Kp_W_per_ohm", "controller.Ki_W_per_ohm_s"]
 
 
 def test_cli_error_is_one_line_and_writes_nothing(tmp_path, capsys):
@@ -230,3 +241,19 @@ def test_a_task_runs_both_inverses_in_the_batch():
         expected = scenario_metrics(run_library(item).data, item)["overall"]["rmse_ohm"]
         assert row["rmse_ohm"] == pytest.approx(expected, rel=1e-12)
     assert rows[0]["rmse_ohm"] != rows[1]["rmse_ohm"]      # the minor-loop inverse differs
+
+
+def test_a_final_status_beats_a_task_error(grid_spec, tmp_path):
+    """Runs of a failed task are not finished; once run again, their rows replace the error."""
+    spec = load_spec(grid_spec)
+    runs, out = spec.runs()[:3], tmp_path / "out"
+    _write_part(out, _error_rows(spec, runs, "task failed: KilledWorker: gone"))
+    assert finished_runs(out) == {}
+    rows = run_task(spec.templates, runs[1:])               # Kp = 0.3 (ok), -1.0 (failed)
+    _write_part(out, rows)
+    assert finished_runs(out) == {1: "ok", 2: "failed"}
+    table = read_parts(out)
+    assert list(table["run_id"]) == [0, 1, 2]
+    assert list(table["status"]) == ["error", "ok", "failed"]
+    assert table["error"][0] == "task failed: KilledWorker: gone"
+    assert table["rmse_ohm"][1] == rows[0]["rmse_ohm"] and table["error"][2] == rows[1]["error"]

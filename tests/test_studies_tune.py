@@ -42,8 +42,22 @@ def test_tune_improves_and_the_snippet_reproduces_the_rmse(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("stop, message", [("2.0005", "not a whole number of steps"),
-                                           ("0", "must be > 0")])
+                                           ("0", "must be > 0"),
+                                           ("1e5", "at most 2000000 steps")])
 def test_tune_refuses_a_bad_stop_time(tmp_path, capsys, stop, message):
     assert main(["tune", "heavy-pi", "--stop-time", stop, "--out", str(tmp_path / "t")]) == 2
-    assert message in capsys.readouterr().err
+    error = capsys.readouterr().err
+    assert message in error and f"--stop-time {float(stop)!r}" in error
+    assert not (tmp_path / "t").exists()
+
+
+def test_tune_refuses_a_stop_time_before_the_analysis_window(tmp_path, capsys):
+    """The file's [analysis] window is checked against the new duration, as in a file."""
+    path = tmp_path / "windowed.toml"
+    path.write_text(resolve_scenarios(["heavy-pi"])[0].read_text()
+                    + "\n[analysis]\nmetrics_start_s = 2.0\n")
+    assert main(["tune", str(path), "--stop-time", "1.5", "--out", str(tmp_path / "t")]) == 2
+    error = capsys.readouterr().err
+    assert "--stop-time 1.5" in error and str(path) in error
+    assert "[analysis] metrics_start_s = 2.0 must be in [0, stop_time_s = 1.5)" in error
     assert not (tmp_path / "t").exists()

@@ -13,17 +13,20 @@ import numpy as np
 
 from sma_fmu.runtime.reachable_band import reachable_band
 
-__all__ = ["error_metrics", "band_edges", "unreachable_samples", "unreachable_intervals",
-           "reachability_warning", "scenario_metrics"]
+__all__ = ["EMPTY_METRICS", "error_metrics", "band_edges", "unreachable_samples",
+           "unreachable_intervals", "reachability_warning", "metric_windows", "assemble_metrics",
+           "scenario_metrics"]
 
 _LISTED_INTERVALS = 4  # a warning names at most this many intervals, then counts the rest
+EMPTY_METRICS = {"rmse_ohm": None, "max_abs_ohm": None, "iae_ohm_s": None, "samples": 0}
+"""The metrics of a window without samples (copy it before changing it)."""
 
 
 def error_metrics(errors, step_size):
     """{"rmse_ohm", "max_abs_ohm", "iae_ohm_s", "samples"} of an error array [ohm]."""
     errors = np.asarray(errors, dtype=float)
     if errors.size == 0:
-        return {"rmse_ohm": None, "max_abs_ohm": None, "iae_ohm_s": None, "samples": 0}
+        return dict(EMPTY_METRICS)
     with np.errstate(over="ignore", invalid="ignore"):  # a diverged run gives inf, reported as such
         return {
             "rmse_ohm": float(np.sqrt(np.mean(errors ** 2))),
@@ -85,23 +88,34 @@ def reachability_warning(intervals, fraction):
             f"metric window; no controller can track it there")
 
 
-def scenario_metrics(data, scenario):
-    """Metrics of one run: overall (t >= 2 s) and per load segment, ready for JSON."""
-    t = data["t"]
-    error = data["R"] - data["R_ref"]
-    metrics_start = scenario.analysis.metrics_start_s
-    window = t >= metrics_start - 1e-9 * scenario.step_s
+def metric_windows(times, scenario):
+    """Boolean masks over ``times`` [s]: (the metrics window, [one per load segment]).
+
+    The window is t >= ``[analysis] metrics_start_s`` (to 1e-9 steps); a segment's mask is
+    the window within [start, end) of the segment, the last segment including the final
+    sample. The segments are those of ``scenario.load.segments(stop_time_s)``, in order.
+    """
+    times = np.asarray(times, dtype=float)
+    window = times >= scenario.analysis.metrics_start_s - 1e-9 * scenario.step_s
     segments = []
-    for start, end, load in scenario.load.segments(scenario.stop_time_s):
+    for start, end, _ in scenario.load.segments(scenario.stop_time_s):
         last = end >= scenario.stop_time_s  # the last segment includes the final sample
-        inside = window & (t >= start - 1e-9) & ((t <= end + 1e-9) if last else (t < end - 1e-9))
-        segments.append({"start_s": start, "end_s": end, "load_kg": load,
-                         **error_metrics(error[inside], scenario.step_s)})
-    below, above = unreachable_samples(data["R_ref"], data["load"], scenario.params)
-    unreachable = below | above
-    fraction = float(np.mean(unreachable[window]))
-    intervals = unreachable_intervals(t, below, above)
-    warning = reachability_warning(intervals, fraction)
+        segments.append(window & (times >= start - 1e-9)
+                        & ((times <= end + 1e-9) if last else (times < end - 1e-9)))
+    return window, segments
+
+
+def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped_fraction,
+                     unreachable_fraction, reachable, intervals):
+    """The metrics record of one run of ``scenario``, ready for JSON, from its parts.
+
+    ``overall``, ``reachable`` and each of ``segments`` (one per load segment, in order) are
+    :func:`error_metrics` dicts; the fractions [1] are shares of the metrics window;
+    ``intervals`` are the :func:`unreachable_intervals` of the whole run. Adds the header
+    (scenario, controller, window), each segment's times and load, and the warning.
+    """
+    metrics_start = scenario.analysis.metrics_start_s
+    warning = reachability_warning(intervals, unreachable_fraction)
     return {
         "scenario": scenario.name,
         "controller": scenario.controller.kind,
@@ -109,13 +123,33 @@ def scenario_metrics(data, scenario):
         "hysteresis_mode": scenario.hysteresis_mode,
         "window": f"t >= {metrics_start:g} s",
         "metrics_start_s": metrics_start,
-        "overall": error_metrics(error[window], scenario.step_s),
-        "segments": segments,
-        "saturated_fraction": float(np.mean(data["saturated"][window])),
-        "clamped_fraction": (float(np.mean(data["P"][window][:-1] == 0.0))
-                             if window.sum() > 1 else None),
-        "unreachable_fraction": fraction,
-        "reachable": error_metrics(error[window & ~unreachable], scenario.step_s),
+        "overall": overall,
+        "segments": [{"start_s": start, "end_s": end, "load_kg": load, **metrics}
+                     for (start, end, load), metrics in
+                     zip(scenario.load.segments(scenario.stop_time_s), segments)],
+        "saturated_fraction": saturated_fraction,
+        "clamped_fraction": clamped_fraction,
+        "unreachable_fraction": unreachable_fraction,
+        "reachable": reachable,
         "unreachable_intervals_s": intervals,
         "warnings": [] if warning is None else [warning],
     }
+
+
+def scenario_metrics(data, scenario):
+    """Metrics of one run: overall (t >= 2 s) and per load segment, ready for JSON."""
+    t = data["t"]
+    error = data["R"] - data["R_ref"]
+    window, segments = metric_windows(t, scenario)
+    below, above = unreachable_samples(data["R_ref"], data["load"], scenario.params)
+    unreachable = below | above
+    return assemble_metrics(
+        scenario,
+        overall=error_metrics(error[window], scenario.step_s),
+        segments=[error_metrics(error[inside], scenario.step_s) for inside in segments],
+        saturated_fraction=float(np.mean(data["saturated"][window])),
+        clamped_fraction=(float(np.mean(data["P"][window][:-1] == 0.0))
+                          if window.sum() > 1 else None),
+        unreachable_fraction=float(np.mean(unreachable[window])),
+        reachable=error_metrics(error[window & ~unreachable], scenario.step_s),
+        intervals=unreachable_intervals(t, below, above))

@@ -18,6 +18,7 @@ path, so its outcome, and its error message, are exactly the scalar path's.
 """
 import dataclasses
 import functools
+import time
 
 import numpy as np
 
@@ -31,7 +32,7 @@ from sma_fmu.studies.batch_metrics import MetricsAccumulator
 from sma_fmu.studies.batch_plant import BatchPlant
 
 __all__ = ["BatchUnsupported", "BatchRun", "RECORDS", "unsupported_reason", "run_batch",
-           "chunk_steps", "chunk_bounds"]
+           "run_batches", "chunk_steps", "chunk_bounds"]
 
 RECORDS = ("timeseries", "metrics")
 CHUNK_ELEMENTS = 65536      # steps x runs per chunk of precomputed signals and errors
@@ -50,7 +51,8 @@ class BatchRun:
     ``data``: the time series (record "timeseries", else None); ``metrics``: the
     :func:`~sma_fmu.cosim.metrics.scenario_metrics` record (None when the run failed);
     ``error``: the failure's message (None when it succeeded); ``path``: "batch", or
-    "library" when the run failed in the batch and was run again on the scalar path.
+    "library" when the run failed in the batch and was run again on the scalar path;
+    ``wall_time_s``: the wall time of the whole batch [s] divided by its runs.
     """
 
     scenario: object
@@ -58,6 +60,7 @@ class BatchRun:
     metrics: object
     error: object
     path: str
+    wall_time_s: float = None
 
 
 @functools.lru_cache(maxsize=None)
@@ -221,6 +224,7 @@ def run_batch(scenarios, record="metrics"):
     ``record``: "metrics" (default; no time series kept) or "timeseries".
     Raises :class:`BatchUnsupported` when a scenario uses an option the engine lacks.
     """
+    began = time.perf_counter()
     scenarios = list(scenarios)
     _check(scenarios, record)
     # feedforward runs first, the major inverse before the minor-loop one: the compensators
@@ -239,6 +243,23 @@ def run_batch(scenarios, record="metrics"):
         data = series.data(position) if series is not None else None
         metrics = scenario_metrics(data, scenario) if data is not None else totals.metrics(position)
         results[run] = BatchRun(scenario, data, metrics, None, "batch")
+    wall = (time.perf_counter() - began) / len(scenarios)
+    for result in results:
+        result.wall_time_s = wall
+    return results
+
+
+def run_batches(scenarios, record="metrics"):
+    """Run ``scenarios`` of any steps and durations: one :func:`run_batch` per (step, steps)
+    they share. Returns a :class:`BatchRun` per scenario, in the order given."""
+    scenarios = list(scenarios)
+    groups = {}
+    for index, scenario in enumerate(scenarios):
+        groups.setdefault((scenario.step_s, scenario.steps), []).append(index)
+    results = [None] * len(scenarios)
+    for members in groups.values():
+        for index, outcome in zip(members, run_batch([scenarios[i] for i in members], record)):
+            results[index] = outcome
     return results
 
 

@@ -1,16 +1,17 @@
 """Tracking metrics of a batch, accumulated chunk by chunk: no run's time series is kept.
 
-The same record as :func:`sma_fmu.cosim.metrics.scenario_metrics`: the windows are built
-with its predicates on t_k = k h, then turned into index ranges; the reachable band comes
-from :func:`~sma_fmu.runtime.reachable_band.reachable_band` per run and load segment; the
-warning from :func:`~sma_fmu.cosim.metrics.reachability_warning`. Sums run over chunks
-instead of a stored series, so they agree to rounding (tests/test_batch.py binds the two).
+The same record as :func:`sma_fmu.cosim.metrics.scenario_metrics`: the windows are its
+:func:`~sma_fmu.cosim.metrics.metric_windows` on t_k = k h, turned into index ranges; the
+reachable band comes from :func:`~sma_fmu.runtime.reachable_band.reachable_band` per run
+and load segment; the record (and its warning) from
+:func:`~sma_fmu.cosim.metrics.assemble_metrics`. Sums run over chunks instead of a stored
+series, so they agree to rounding (tests/test_batch.py binds the two).
 """
 import math
 
 import numpy as np
 
-from sma_fmu.cosim.metrics import reachability_warning
+from sma_fmu.cosim.metrics import EMPTY_METRICS, assemble_metrics, metric_windows
 
 __all__ = ["MetricsAccumulator"]
 
@@ -67,7 +68,7 @@ class _Totals:
     def metrics(self, run, step_s):
         count = int(self.count[run])
         if count == 0:
-            return {"rmse_ohm": None, "max_abs_ohm": None, "iae_ohm_s": None, "samples": 0}
+            return dict(EMPTY_METRICS)
         return {"rmse_ohm": math.sqrt(float(self.squares[run]) / count),
                 "max_abs_ohm": float(self.largest[run]),
                 "iae_ohm_s": float(step_s * self.absolute[run]), "samples": count}
@@ -89,15 +90,9 @@ class MetricsAccumulator:
             start = scenario.analysis.metrics_start_s
             key = (start, tuple((a, b) for a, b, _ in scenario.load.segments(scenario.stop_time_s)))
             keys.setdefault(key, []).append(run)
-        for (metrics_start, segments), runs in keys.items():
-            window = t >= metrics_start - 1e-9 * inputs.step_s
-            stop_time = scenarios[runs[0]].stop_time_s
-            parts = []
-            for start, end in segments:
-                last = end >= stop_time
-                inside = window & (t >= start - 1e-9) & ((t <= end + 1e-9) if last else
-                                                        (t < end - 1e-9))
-                parts.append(_Totals(*_index_range(inside), size))
+        for runs in keys.values():      # the same window and segments: the first run's
+            window, segments = metric_windows(t, scenarios[runs[0]])
+            parts = [_Totals(*_index_range(inside), size) for inside in segments]
             window = _index_range(window)
             self._group_of.update((run, len(self.groups)) for run in runs)
             columns = slice(None) if runs == list(range(size)) else np.array(runs)
@@ -171,25 +166,12 @@ class MetricsAccumulator:
                 intervals.append([float(self.inputs.times[self._opened[side][run]]),
                                   float(self.inputs.times[-1]), side])
         intervals.sort()
-        fraction = float(self.unreachable[run] / count) if count else math.nan
-        warning = reachability_warning(intervals, fraction)
-        start = scenario.analysis.metrics_start_s
-        return {
-            "scenario": scenario.name,
-            "controller": scenario.controller.kind,
-            "inverse": scenario.controller.inverse if scenario.controller.feedforward else None,
-            "hysteresis_mode": scenario.hysteresis_mode,
-            "window": f"t >= {start:g} s",
-            "metrics_start_s": start,
-            "overall": group["overall"].metrics(run, self.step_s),
-            "segments": [{"start_s": a, "end_s": b, "load_kg": load,
-                          **part.metrics(run, self.step_s)}
-                         for part, (a, b, load) in
-                         zip(group["segments"], scenario.load.segments(scenario.stop_time_s))],
-            "saturated_fraction": float(self.saturated[run] / count) if count else math.nan,
-            "clamped_fraction": float(self.clamped[run] / (count - 1)) if count > 1 else None,
-            "unreachable_fraction": fraction,
-            "reachable": group["reachable"].metrics(run, self.step_s),
-            "unreachable_intervals_s": intervals,
-            "warnings": [] if warning is None else [warning],
-        }
+        return assemble_metrics(
+            scenario,
+            overall=group["overall"].metrics(run, self.step_s),
+            segments=[part.metrics(run, self.step_s) for part in group["segments"]],
+            saturated_fraction=float(self.saturated[run] / count) if count else math.nan,
+            clamped_fraction=float(self.clamped[run] / (count - 1)) if count > 1 else None,
+            unreachable_fraction=float(self.unreachable[run] / count) if count else math.nan,
+            reachable=group["reachable"].metrics(run, self.step_s),
+            intervals=intervals)

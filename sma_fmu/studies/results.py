@@ -17,15 +17,20 @@ from sma_fmu.json_output import json_text
 from sma_fmu.output_folder import staged_folder
 from sma_fmu.studies.figures import distribution_figure, heat_map_figure, line_figure
 
-__all__ = ["read_parts", "summary", "summary_markdown", "write_results"]
+__all__ = ["PARTS", "read_parts", "summary", "summary_markdown", "write_results"]
+
+PARTS = "runs"   # the folder of OUT that holds the part files
 
 
-def read_parts(out):
-    """All rows written to ``out``/runs, one per run (a final status beats "error")."""
-    parts = sorted((Path(out) / "runs").glob("part-*.parquet"))
+def read_parts(out, columns=None):
+    """All rows written to ``out``/runs, one per run (a final status beats "error").
+
+    ``columns``: read only these (with "run_id" and "status"); default: all.
+    """
+    parts = sorted((Path(out) / PARTS).glob("part-*.parquet"))
     if not parts:
-        return pd.DataFrame(columns=["run_id", "scenario", "status", "error"])
-    table = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
+        return pd.DataFrame(columns=columns or ["run_id", "scenario", "status", "error"])
+    table = pd.concat([pd.read_parquet(p, columns=columns) for p in parts], ignore_index=True)
     table["_retry"] = table["status"] == "error"
     table = table.sort_values(["run_id", "_retry"], kind="stable")
     return table.drop_duplicates("run_id").drop(columns="_retry").reset_index(drop=True)

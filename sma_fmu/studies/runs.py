@@ -11,9 +11,8 @@
 
 Paths: ``"library"`` (the runtime steppers, :func:`sma_fmu.cosim.loop.run_library`),
 ``"fmu"`` (the built FMUs under fmpy, :func:`sma_fmu.cosim.master.run_fmus`) and
-``"batch"`` (:func:`sma_fmu.studies.batch.run_batch`; many runs in lock-step).
+``"batch"`` (:func:`sma_fmu.studies.batch.run_batches`; many runs in lock-step).
 """
-import time
 from dataclasses import dataclass
 
 import pandas as pd
@@ -22,7 +21,7 @@ from sma_fmu.cosim.loop import COLUMN_NAMES, COLUMNS, run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import Scenario
 from sma_fmu.fmi.build import DEFAULT_FMU_DIR
-from sma_fmu.studies.batch import run_batch, unsupported_reason
+from sma_fmu.studies.batch import run_batches, unsupported_reason
 from sma_fmu.studies.overrides import StudyError, template
 
 __all__ = ["PATHS", "StudyRun", "scenario", "run", "run_many", "timeseries_frame",
@@ -99,25 +98,12 @@ def run_many(scenarios, path="batch", fmu_dir=DEFAULT_FMU_DIR):
         reason = unsupported_reason(item)
         if reason:
             raise StudyError(f"{reason}; use path='library'")
-    results = [None] * len(scenarios)
-    for members in _batches(scenarios).values():
-        began = time.perf_counter()
-        batch = run_batch([scenarios[i] for i in members], "timeseries")
-        wall = (time.perf_counter() - began) / len(members)
-        for index, outcome in zip(members, batch):
-            if outcome.error is not None:
-                raise ValueError(f"scenario {outcome.scenario.name}: {outcome.error}")
-            results[index] = StudyRun(outcome.scenario, timeseries_frame(outcome.data),
-                                      outcome.metrics, outcome.path, wall)
-    return results
-
-
-def _batches(scenarios):
-    """{(step, steps): [indices]}: the scenarios that can share a batch."""
-    groups = {}
-    for index, item in enumerate(scenarios):
-        groups.setdefault((item.step_s, item.steps), []).append(index)
-    return groups
+    outcomes = run_batches(scenarios, "timeseries")
+    for outcome in outcomes:
+        if outcome.error is not None:
+            raise ValueError(f"scenario {outcome.scenario.name}: {outcome.error}")
+    return [StudyRun(outcome.scenario, timeseries_frame(outcome.data), outcome.metrics,
+                     outcome.path, outcome.wall_time_s) for outcome in outcomes]
 
 
 def _single(item, path, fmu_dir):

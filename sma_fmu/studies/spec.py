@@ -28,10 +28,11 @@
 Runs: every base scenario x every axis point x every draw. Problems raise
 :class:`~sma_fmu.studies.overrides.StudyError` naming the file, the key and the value.
 """
+import functools
 import hashlib
 import itertools
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.cosim.scenario import ScenarioError, check_sections
@@ -62,7 +63,8 @@ class StudyRunSpec:
 
 @dataclass
 class StudySpec:
-    """A validated study spec; :meth:`runs` lists its runs."""
+    """A validated study spec; :meth:`runs` lists its runs (built once: a spec is not
+    changed after :func:`load_spec`)."""
 
     path: Path
     description: str
@@ -75,10 +77,18 @@ class StudySpec:
     seed: int
     runs_per_task: object
     report: object = None
-    inputs: list = field(default_factory=list)   # names of the varied inputs
+
+    @property
+    def inputs(self):
+        """Names of the varied inputs: the axes' keys, then the drawn wire parameters."""
+        return list(self.axes) + (list(self.draws[0]) if self.draws else [])
 
     def runs(self):
-        """Every :class:`StudyRunSpec`, in a fixed order (ids 0, 1, ...)."""
+        """Every :class:`StudyRunSpec`, in a fixed order (ids 0, 1, ...), as a tuple."""
+        return self._runs
+
+    @functools.cached_property
+    def _runs(self):
         points = self.points or [{}]
         draws = self.draws or [{}]
         out = []
@@ -87,7 +97,7 @@ class StudySpec:
             out.append(StudyRunSpec(len(out), base, {**self.overrides, **point, **draw},
                                     p_index if self.points else None,
                                     d_index if self.draws else None))
-        return out
+        return tuple(out)
 
     def fingerprint(self):
         """A hash of everything that decides the runs: resuming needs the same one."""
@@ -159,19 +169,15 @@ def load_spec(path):
         draws = [{f"{target}.{name}": value for target in targets for name, value in d.items()}
                  for d in drawn]
     spec = StudySpec(path, str(head.get("description", "")), templates, overrides, kind, values,
-                     points, draws, seed, per_task, report,
-                     inputs=list(values) + (list(draws[0]) if draws else []))
+                     points, draws, seed, per_task, report)
     _check_first_runs(spec)
     return spec
 
 
 def _check_first_runs(spec):
-    """Build one run of each base scenario now, so a bad override fails before any run."""
-    seen = set()
-    for run in spec.runs():
-        if run.base in seen:
-            continue
-        seen.add(run.base)
-        drawn = set(spec.draws[0]) if spec.draws else set()   # a draw may fail: one run's fate
+    """Build the first run of each base scenario now, so a bad override fails before any run."""
+    drawn = set(spec.draws[0]) if spec.draws else set()   # a draw may fail: one run's fate
+    runs = spec.runs()
+    for run in runs[::len(runs) // len(spec.templates)]:  # runs are base-major
         fixed = {k: v for k, v in run.overrides.items() if k not in drawn}
         spec.templates[run.base].scenario(fixed)

@@ -23,15 +23,14 @@ from pathlib import Path
 import pandas as pd
 
 from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import write_file
+from sma_fmu.output_folder import check_folder, write_file
 from sma_fmu.studies.overrides import StudyError
-from sma_fmu.studies.results import write_results
+from sma_fmu.studies.results import PARTS, read_parts, write_results
 from sma_fmu.studies.spec import load_spec
-from sma_fmu.studies.tasks import run_task
+from sma_fmu.studies.tasks import run_row, run_task
 
-__all__ = ["PARTS", "run_sweep", "finished_runs", "dask_client", "task_size"]
+__all__ = ["run_sweep", "finished_runs", "dask_client", "task_size"]
 
-PARTS = "runs"
 MOST_RUNS_PER_TASK = 1000
 
 
@@ -64,20 +63,15 @@ def task_size(remaining, workers, requested=None):
 
 def finished_runs(out):
     """{run_id: status} of the runs already written to ``out``/runs (an error is not final)."""
-    done = {}
-    for part in sorted((Path(out) / PARTS).glob("part-*.parquet")):
-        table = pd.read_parquet(part, columns=["run_id", "status"])
-        for run_id, status in zip(table["run_id"].tolist(), table["status"].tolist()):
-            if status != "error" or run_id not in done:
-                done[run_id] = status
-    return {run_id: status for run_id, status in done.items() if status != "error"}
+    table = read_parts(out, ["run_id", "status"])
+    table = table[table["status"] != "error"]
+    return dict(zip(table["run_id"].tolist(), table["status"].tolist()))
 
 
 def _check_folder(out, spec):
     """Create ``out`` for ``spec``, or check that it holds a sweep of the same spec."""
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise StudyError(f"--out {out}: exists and is not a folder")
+    check_folder(out)
     marker = out / "study.json"
     fingerprint = spec.fingerprint()
     if marker.is_file():
@@ -86,7 +80,6 @@ def _check_folder(out, spec):
             raise StudyError(f"--out {out}: holds the results of another study spec "
                              f"(study.json); give another --out, or remove that folder")
         return
-    (out / PARTS).mkdir(parents=True, exist_ok=True)
     write_file(marker, json_text({"spec": str(spec.path), "fingerprint": fingerprint,
                                   "runs": len(spec.runs())}))
 
@@ -101,8 +94,9 @@ def _write_part(out, rows):
 
 
 def _error_rows(spec, runs, reason):
-    return [{"run_id": r.run_id, "scenario": spec.templates[r.base].name, "point": r.point,
-             "draw": r.draw, "status": "error", "error": reason, **r.overrides} for r in runs]
+    """Rows of ``runs`` whose task failed: status "error" (retried on resume), ``reason``."""
+    return [{**run_row(run, spec.templates[run.base]), "status": "error", "error": reason}
+            for run in runs]
 
 
 def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True):

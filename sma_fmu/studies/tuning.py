@@ -24,7 +24,7 @@ from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
 from sma_fmu.json_output import json_text
 from sma_fmu.output_folder import staged_folder
 from sma_fmu.studies.batch import run_batch, unsupported_reason
-from sma_fmu.studies.overrides import StudyError
+from sma_fmu.studies.overrides import StudyError, template
 
 __all__ = ["BOUNDS", "TUNED", "KEYS", "tune_scenario", "controller_snippet", "run_tuning",
            "ranking_markdown"]
@@ -143,6 +143,15 @@ def ranking_markdown(records):
     return "\n".join(lines) + "\n"
 
 
+def _with_stop_time(scenario, stop_time_s):
+    """``scenario`` lasting ``stop_time_s`` [s], checked as in a file (whole steps, at most
+    MAX_STEPS, the [analysis] windows inside the run)."""
+    try:
+        return template(scenario).scenario({"scenario.stop_time_s": float(stop_time_s)})
+    except StudyError as error:
+        raise StudyError(f"--stop-time {stop_time_s!r}: {error}") from None
+
+
 def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_s=None,
                progress=print):
     """Tune every scenario file in ``paths``; write snippets and reports; return the records."""
@@ -150,11 +159,7 @@ def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_
     if stop_time_s is not None and not stop_time_s > 0.0:
         raise StudyError(f"--stop-time {stop_time_s!r}: must be > 0 s")
     if stop_time_s is not None:
-        scenarios = [dataclasses.replace(s, stop_time_s=float(stop_time_s)) for s in scenarios]
-        for s in scenarios:
-            if abs(s.steps * s.step_s - s.stop_time_s) > 1e-9 * s.stop_time_s:
-                raise StudyError(f"--stop-time {stop_time_s!r}: not a whole number of steps of "
-                                 f"{s.step_s!r} s")
+        scenarios = [_with_stop_time(s, stop_time_s) for s in scenarios]
     records = []
     for index, scenario in enumerate(scenarios, start=1):
         progress(f"[{index}/{len(scenarios)}] tuning {scenario.name} "
