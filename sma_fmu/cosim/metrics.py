@@ -137,7 +137,7 @@ def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped
 
 
 def scenario_metrics(data, scenario):
-    """Metrics of one run: overall (t >= 2 s) and per load segment, ready for JSON."""
+    """Metrics of one run: over the metrics window and per load segment, ready for JSON."""
     t = data["t"]
     error = data["R"] - data["R_ref"]
     window, segments = metric_windows(t, scenario)
