@@ -12,29 +12,15 @@ import os
 import shutil
 import statistics
 import subprocess
-import zipfile
 from pathlib import Path
 
-from sma_fmu.fmi.front import libpython_path
+from sma_fmu.fmi.front import libpython_path, remove_front
 from sma_fmu.fmi.hosts import compile_cosim_run, compile_host
 
 __all__ = ["C_HOST_STEPS", "c_host_step_costs"]
 
 C_HOST_STEPS = 30_000
 _STEP = 1e-3
-
-
-def _without_front(fmu, destination):
-    """A copy of ``fmu`` whose binary is pythonfmu's own again (the FMUs before the front)."""
-    with zipfile.ZipFile(fmu) as source, zipfile.ZipFile(destination, "w", zipfile.ZIP_DEFLATED) as target:
-        names = source.namelist()
-        for item in source.infolist():
-            if item.filename.endswith("_pythonfmu.so"):
-                continue
-            backend = item.filename.replace(".so", "_pythonfmu.so")
-            data = source.read(backend if backend in names else item.filename)
-            target.writestr(item, data)
-    return destination
 
 
 def _references(fmu):
@@ -81,7 +67,7 @@ def c_host_step_costs(fmu, runs, folder):
     """{host and configuration: {mean_us, p50_us, p99_us, p99_9_us}} (medians of ``runs``)."""
     folder = Path(folder)
     refs = _references(fmu)
-    before = _without_front(fmu, folder / "SmaActuator-pythonfmu.fmu")
+    before = remove_front(fmu, folder / "SmaActuator-pythonfmu.fmu")
     unpacked = {}
     for name, path in (("front", fmu), ("pythonfmu", before)):
         unpacked[name] = folder / f"unpacked-{name}"

@@ -20,7 +20,7 @@ from fmpy import read_model_description
 
 from fmi_host import ERROR, OK, WARNING, FmiHost, text, unpack
 from sma_fmu.fmi.build import build_fmu
-from sma_fmu.fmi.front import NativeFrontWarning, compile_front
+from sma_fmu.fmi.front import NativeFrontWarning, compile_front, remove_front
 from sma_fmu.fmi.hosts import compile_cosim_run
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
@@ -215,6 +215,22 @@ def test_without_a_compiler_the_build_keeps_pythonfmus_binary_and_says_so(
     assert "binaries/linux64/SmaActuator.so" in names
     assert not any(n.endswith("_pythonfmu.so") for n in names)
     result, values = _run(cosim_run, path, 1e-3, 10, {}, ["R"])  # pythonfmu alone: needs libpython
+    assert result.returncode != 0 and not values
+    assert "undefined symbol" in result.stdout + result.stderr
+
+
+def test_remove_front_gives_back_pythonfmus_binary(fmus, tmp_path, cosim_run):
+    """The benchmark's "before": the FMU as pythonfmu wrote it, which needs libpython preloaded."""
+    fmu = fmus["SmaActuator"]
+    before = remove_front(fmu, tmp_path / "before.fmu")
+    with zipfile.ZipFile(fmu) as front, zipfile.ZipFile(before) as plain:
+        binary = "binaries/linux64/SmaActuator.so"
+        assert sorted(plain.namelist()) == sorted(
+            n for n in front.namelist() if n != "binaries/linux64/SmaActuator_pythonfmu.so")
+        assert plain.read(binary) == front.read("binaries/linux64/SmaActuator_pythonfmu.so")
+        assert plain.read(binary) != front.read(binary)
+        assert all(plain.read(n) == front.read(n) for n in plain.namelist() if n != binary)
+    result, values = _run(cosim_run, before, 1e-3, 10, {}, ["R"])
     assert result.returncode != 0 and not values
     assert "undefined symbol" in result.stdout + result.stderr
 

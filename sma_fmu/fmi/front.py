@@ -23,9 +23,11 @@ import zipfile
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["NativeFrontWarning", "FrontBuild", "compile_front", "install_front", "libpython_path"]
+__all__ = ["NativeFrontWarning", "FrontBuild", "compile_front", "install_front", "remove_front",
+           "libpython_path"]
 
 _PLATFORM = "linux64"
+_BACKEND_SUFFIX = "_pythonfmu.so"
 _FLAGS = ["-std=c11", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Wall",
           "-Wl,-z,nodelete", "-Wl,--no-undefined"]
 _LIBRARIES = ["-ldl", "-lpthread"]
@@ -95,11 +97,16 @@ def _compile(compiler, sources, library_path, soname):
         return FrontBuild(library=output.read_bytes())
 
 
+def _backend(binary):
+    """The name pythonfmu's binary ``binaries/<platform>/<model>.so`` gets behind the front."""
+    return binary[:-len(".so")] + _BACKEND_SUFFIX
+
+
 def install_front(fmu_path, model_identifier, library):
     """Put ``library`` (the front) into the FMU as its binary; pythonfmu's becomes ``*_pythonfmu.so``."""
     fmu_path = Path(fmu_path)
     binary = f"binaries/{_PLATFORM}/{model_identifier}.so"
-    backend = f"binaries/{_PLATFORM}/{model_identifier}_pythonfmu.so"
+    backend = _backend(binary)
     rewritten = fmu_path.with_suffix(".front.tmp")
     with zipfile.ZipFile(fmu_path) as source, \
             zipfile.ZipFile(rewritten, "w", zipfile.ZIP_DEFLATED) as target:
@@ -118,3 +125,20 @@ def install_front(fmu_path, model_identifier, library):
             else:
                 target.writestr(item, data)
     shutil.move(str(rewritten), str(fmu_path))
+
+
+def remove_front(fmu_path, destination):
+    """Write to ``destination`` a copy of the FMU ``fmu_path`` whose binaries are pythonfmu's
+    own again (the inverse of :func:`install_front`: the FMU as it was before the front).
+
+    Returns ``destination``.
+    """
+    with zipfile.ZipFile(fmu_path) as source, \
+            zipfile.ZipFile(destination, "w", zipfile.ZIP_DEFLATED) as target:
+        names = set(source.namelist())
+        for item in source.infolist():
+            if item.filename.endswith(_BACKEND_SUFFIX):
+                continue
+            backend = _backend(item.filename) if item.filename.endswith(".so") else None
+            target.writestr(item, source.read(backend if backend in names else item.filename))
+    return destination
