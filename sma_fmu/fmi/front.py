@@ -6,14 +6,13 @@ refused call. The front (C sources in ``sma_fmu/fmi/native/``, shipped with the 
 fixes that: it becomes ``binaries/linux64/<model>.so`` and forwards every call to
 pythonfmu's binary, renamed ``<model>_pythonfmu.so`` (see ``native/fmi2_exports.c``).
 
-The compiler is ``$CC`` (default ``cc``). It records the shared libpython of the Python
-running the build, so a C host finds one without any environment variable. Where no
+The compiler is :func:`~sma_fmu.fmi.hosts.c_compiler` (``$CC``, default ``cc``). It
+records the shared libpython of the Python running the build, so a C host finds one
+without any environment variable. Where no
 compiler works the FMU keeps pythonfmu's plain binary and the build says so
 (:class:`NativeFrontWarning`); docs/fmus.md lists what is then lost.
 """
 import hashlib
-import os
-import shlex
 import shutil
 import subprocess
 import sys
@@ -22,6 +21,8 @@ import tempfile
 import zipfile
 from importlib import resources
 from pathlib import Path
+
+from sma_fmu.fmi.hosts import c_compiler
 
 __all__ = ["NativeFrontWarning", "FrontBuild", "compile_front", "install_front", "remove_front",
            "libpython_path"]
@@ -69,7 +70,7 @@ def compile_front(libpython=None):
     """
     if not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
         return FrontBuild(problem=f"the native front is built for Linux x86-64 only (this is {sys.platform})")
-    compiler = shlex.split(os.environ.get("CC") or "cc")
+    compiler = c_compiler()
     sources = _sources()
     library_path, soname = libpython_path() if libpython is None else libpython
     digest = hashlib.sha256(b"".join(name.encode() + data for name, data in sorted(sources.items())))
