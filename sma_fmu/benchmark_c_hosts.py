@@ -9,7 +9,6 @@ Each host runs 30,000 steps of 1 ms (P_in = 2.6 W, load = 0.05 kg) and times eve
 without that keeper (SMA_FMU_NO_TSTATE=1) shows what the keeper alone is worth.
 """
 import importlib.util
-import os
 import shutil
 import statistics
 import subprocess
@@ -17,6 +16,7 @@ from pathlib import Path
 
 from sma_fmu.fmi.front import libpython_path, remove_front
 from sma_fmu.fmi.hosts import compile_host
+from sma_fmu.systems.c_host import host_environment
 
 __all__ = ["C_HOST_STEPS", "c_host_step_costs"]
 
@@ -30,10 +30,8 @@ def _references(fmu):
 
 
 def _environment(extra):
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON", "SMA_FMU_NO_TSTATE")}
-    env.update(extra)
-    return env
+    """The C host's environment without the front's switches, plus ``extra``."""
+    return {**host_environment(drop=("SMA_FMU_LIBPYTHON", "SMA_FMU_NO_TSTATE")), **extra}
 
 
 def _plain_host(exe, folder, refs, env):

@@ -8,7 +8,6 @@
 The results equal the library steppers'. Without the native front (no C compiler at build
 time) the FMU's binary is pythonfmu's own, which does not load in a C host.
 """
-import os
 import re
 import shutil
 import subprocess
@@ -25,14 +24,13 @@ from sma_fmu.fmi.front import NativeFrontWarning, compile_front, remove_front
 from sma_fmu.fmi.hosts import CHostError, c_compiler, compile_host
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
+from sma_fmu.systems.c_host import host_environment
 
 libcosimpy = pytest.importorskip("libcosimpy", reason="libcosimpy (test extra) provides libcosimc")
 
 
 def _clean_env(**extra):
-    env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
-    env.update(extra)
-    return env
+    return {**host_environment(drop=("SMA_FMU_LIBPYTHON",)), **extra}
 
 
 @pytest.fixture(scope="module")
@@ -103,6 +101,13 @@ def test_c_host_timing_and_start_value_errors(cosim_host, fmus):
         result = subprocess.run([str(cosim_host), *args], capture_output=True, text=True,
                                 env=_clean_env(), timeout=120)
         assert result.returncode == 2 and message in result.stderr, result.stderr
+
+
+def test_host_environment_drops_ld_preload_and_the_keys_asked():
+    environment = {"LD_PRELOAD": "/lib/libpython.so", "SMA_FMU_LIBPYTHON": "/lib/x.so", "PATH": "/bin"}
+    assert host_environment(environment) == {"SMA_FMU_LIBPYTHON": "/lib/x.so", "PATH": "/bin"}
+    assert host_environment(environment, drop=("SMA_FMU_LIBPYTHON",)) == {"PATH": "/bin"}
+    assert "LD_PRELOAD" in environment  # the caller's mapping is left as it was
 
 
 def test_cc_is_split_like_a_shell(monkeypatch, tmp_path):

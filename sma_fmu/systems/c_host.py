@@ -21,11 +21,16 @@ __all__ = ["CHostError", "host_environment", "run_c_host"]
 _OUTPUT_LINE = re.compile(r"([^=\s]+)=(\S+)")
 
 
-def host_environment(environment=None):
+def host_environment(environment=None, drop=()):
     """The environment for a C host process: ``environment`` (default os.environ) without
-    LD_PRELOAD: the FMUs load libpython themselves."""
+    LD_PRELOAD (the FMUs load libpython themselves) and without the keys in ``drop``.
+
+    ``sma-fmu check`` drops nothing more, so a user's ``SMA_FMU_LIBPYTHON`` is honoured;
+    the benchmark also drops the front's own switches to measure it as shipped.
+    """
     environment = dict(os.environ if environment is None else environment)
-    environment.pop("LD_PRELOAD", None)
+    for key in ("LD_PRELOAD", *drop):
+        environment.pop(key, None)
     return environment
 
 
