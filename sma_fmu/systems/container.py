@@ -16,7 +16,7 @@ import zipfile
 from pathlib import Path
 
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
+from sma_fmu.fmi.slave_support.model_description import set_units
 from sma_fmu.output_folder import OutputError, write_file
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.toolbox_log import toolbox_messages
@@ -96,17 +96,7 @@ def _with_units(archive, units):
         for item in source.infolist():
             data = source.read(item.filename)
             if item.filename == "modelDescription.xml":
-                root = ET.fromstring(data)
-                for variable in root.iter("ScalarVariable"):
-                    real = variable.find("Real")
-                    if real is not None and variable.get("name") in units:
-                        real.set("unit", units[variable.get("name")])
-                definitions = ET.Element("UnitDefinitions")
-                for name in sorted(set(units.values())):
-                    unit = ET.SubElement(definitions, "Unit", name=name)
-                    ET.SubElement(unit, "BaseUnit", {key: str(value)
-                                                     for key, value in UNIT_DEFINITIONS[name].items()})
-                root.insert(list(root).index(root.find("CoSimulation")) + 1, definitions)
+                root = set_units(ET.fromstring(data), units)
                 data = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
             target.writestr(item, data)
     return buffer.getvalue()
