@@ -12,6 +12,7 @@ import json
 import math
 import xml.etree.ElementTree as ET
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -106,6 +107,20 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
     inputs = {c.get("name") for c in root.iter(f"{{{NAMESPACES['ssd']}}}Connector")
               if c.get("kind") == "input"}
     assert "P_ff" not in inputs  # no compensator, and no unconnected input connector
+
+
+def test_each_fmu_is_read_once_for_the_ssp_and_the_container(fmu_dir, tmp_path, monkeypatch):
+    import fmpy
+
+    reads, read = [], fmpy.read_model_description
+    monkeypatch.setattr(fmpy, "read_model_description",
+                        lambda filename, *args, **kwargs: reads.append(Path(filename).name)
+                        or read(filename, *args, **kwargs))
+    system = closed_loop(short("heavy-pi+ff-fixed", stop_time_s=0.5), fmu_dir)
+    write_ssp(system, tmp_path / "loop.ssp")
+    build_container(system, tmp_path / "loop.fmu")
+    assert sorted(reads) == sorted(f"{component.model}.fmu" for component in system.components)
+    assert len(reads) == 4
 
 
 def test_every_host_matches_the_library_loop_of_its_coupling(adaptive, fmu_dir):

@@ -76,15 +76,12 @@ def _configure(container, system):
 
 
 def _units(system):
-    """{container output: unit} from the embedded FMUs' model descriptions."""
-    from fmpy import read_model_description
-
+    """{container output: unit} from the embedded FMUs' model variables."""
     units = {}
     for exposed, (name, variable) in container_outputs(system).items():
-        fmu = system.component(name).fmu
-        declared = {v.name: v.unit for v in read_model_description(str(fmu)).modelVariables}
-        if declared.get(variable):
-            units[exposed] = declared[variable]
+        unit = system.component(name).variables[variable].unit
+        if unit:
+            units[exposed] = unit
     return units
 
 

@@ -56,12 +56,6 @@ def _text(value, kind):
     return str(value)
 
 
-def _variables(fmu):
-    from fmpy import read_model_description
-
-    return {v.name: v for v in read_model_description(str(fmu)).modelVariables}
-
-
 def _connectors(system):
     """{component: {variable: kind}} of every connection end."""
     ends = {}
@@ -71,7 +65,8 @@ def _connectors(system):
     return ends
 
 
-def _component(elements, component, variables, connectors, units):
+def _component(elements, component, connectors, units):
+    variables = component.variables
     node = _add(elements, "ssd:Component", name=component.name, type=_FMU_MIME,
                 source=f"resources/{component.model}.fmu")
     if connectors:
@@ -107,8 +102,7 @@ def ssd_document(system):
     elements = _add(top, "ssd:Elements")
     ends, units = _connectors(system), set()
     for component in system.components:
-        _component(elements, component, _variables(component.fmu),
-                   ends.get(component.name, {}), units)
+        _component(elements, component, ends.get(component.name, {}), units)
     connections = _add(top, "ssd:Connections")
     for c in system.connections:
         _add(connections, "ssd:Connection", startElement=c.source, startConnector=c.output,
