@@ -16,7 +16,7 @@ from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.container import build_container
 from sma_fmu.systems.ssp import write_ssp
 
-__all__ = ["HOSTS", "run_host", "run_ssp", "run_container"]
+__all__ = ["HOSTS", "write_artifact", "run_host", "run_ssp", "run_container"]
 
 # host -> (artifact, coupling the host applies, function(artifact path, scenario) -> samples)
 HOSTS = {
@@ -28,6 +28,13 @@ HOSTS = {
                            lambda path, s: hosts.run_container_libcosim(path, s.step_s, s.steps)),
 }
 _BUILDERS = {"ssp": write_ssp, "container": build_container}
+
+
+def write_artifact(kind, system, folder):
+    """Write the ``kind`` ("ssp" or "container") of ``system`` into ``folder``; returns its path."""
+    path = Path(folder) / f"{system.scenario.name}.{'ssp' if kind == 'ssp' else 'fmu'}"
+    _BUILDERS[kind](system, path)
+    return path
 
 
 def run_host(host, scenario, fmu_dir, artifact=None):
@@ -42,8 +49,7 @@ def run_host(host, scenario, fmu_dir, artifact=None):
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="sma_fmu_run_") as folder:
         if artifact is None:
-            artifact = Path(folder) / f"{scenario.name}.{'ssp' if kind == 'ssp' else 'fmu'}"
-            _BUILDERS[kind](closed_loop(scenario, fmu_dir), artifact)
+            artifact = write_artifact(kind, closed_loop(scenario, fmu_dir), folder)
         data = hosts.loop_series(scenario, run(artifact, scenario), scenario.steps)
     return LoopResult(scenario, data, f"{kind} ({host})", time.perf_counter() - start)
 
