@@ -144,6 +144,25 @@ def test_pi_controller_ssp_has_no_compensator_and_matches_in_both_ssp_hosts(fmu_
     assert [row["deviation"] <= TOLERANCE for row in rows] == [True] * 4
 
 
+def test_every_host_fails_on_a_feedforward_system_without_its_compensator(fmu_dir, tmp_path):
+    """A loop with feedforward must give its compensator's outputs: none is taken as 0 W."""
+    from sma_fmu.systems import hosts
+    from sma_fmu.systems.container import loop_outputs
+
+    system = closed_loop(short("heavy-pi", stop_time_s=0.01, load=None), fmu_dir)
+    ssp, container = write_ssp(system, tmp_path / "pi.ssp"), build_container(system, tmp_path / "pi.fmu")
+    expected = loop_outputs(short("heavy-pi+ff-fixed", stop_time_s=0.01))
+    assert expected["P_ff"] == ("compensator", "P_ff")
+    runs = [(lambda: hosts.run_ssp_libcosim(ssp, 10, expected), "has no variable compensator.P_ff"),
+            (lambda: hosts.run_ssp_ecos(ssp, 1e-3, 10, expected), "cannot read compensator::P_ff"),
+            (lambda: hosts.run_container_fmpy(container, 1e-3, 10, expected), "has no output P_ff"),
+            (lambda: hosts.run_container_libcosim(container, 1e-3, 10, expected),
+             "has no variable loop.P_ff")]
+    for run, message in runs:
+        with pytest.raises(hosts.HostError, match=message):
+            run()
+
+
 def test_fmpy_simulate_ssp_cannot_run_the_loop(adaptive, fmu_dir):
     """As docs/systems.md says: fmpy's simulate_ssp feeds 0.0 into every input at t = 0."""
     from fmpy.ssp.simulation import simulate_ssp

@@ -21,7 +21,7 @@ from sma_fmu.output_folder import OutputError, write_file
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
-__all__ = ["OUTPUTS", "container_outputs", "build_container", "export_container"]
+__all__ = ["OUTPUTS", "loop_outputs", "build_container", "export_container"]
 
 # container output -> (component, variable): what the time-series CSV needs
 OUTPUTS = {
@@ -33,10 +33,13 @@ OUTPUTS = {
 }
 
 
-def container_outputs(system):
-    """The :data:`OUTPUTS` that ``system`` has (the "pi" controller has no compensator)."""
-    names = {component.name for component in system.components}
-    return {name: source for name, source in OUTPUTS.items() if source[0] in names}
+def loop_outputs(scenario):
+    """The :data:`OUTPUTS` the loop of ``scenario`` has: its container's outputs and what
+    every host must read. Without feedforward (the "pi" controller) there is no
+    compensator, so no P_ff, T_ref, saturated."""
+    feedforward = scenario.controller.feedforward
+    return {name: source for name, source in OUTPUTS.items()
+            if feedforward or source[0] != "compensator"}
 
 
 def _text(value):
@@ -66,7 +69,7 @@ def _configure(container, system):
         container.get_fmu(Path(component.fmu).name, name=component.name)
     for connection in system.connections:
         container.add_link(connection.source, connection.output, connection.target, connection.input)
-    for exposed, (component, variable) in container_outputs(system).items():
+    for exposed, (component, variable) in loop_outputs(system.scenario).items():
         container.add_output(component, variable, exposed)
     for component in system.components:
         for name, value in component.parameters.items():
@@ -78,7 +81,7 @@ def _configure(container, system):
 def _units(system):
     """{container output: unit} from the embedded FMUs' model variables."""
     units = {}
-    for exposed, (name, variable) in container_outputs(system).items():
+    for exposed, (name, variable) in loop_outputs(system.scenario).items():
         unit = system.component(name).variables[variable].unit
         if unit:
             units[exposed] = unit

@@ -13,19 +13,20 @@ from pathlib import Path
 from sma_fmu.cosim.loop import LoopResult
 from sma_fmu.systems import hosts
 from sma_fmu.systems.closed_loop import closed_loop
-from sma_fmu.systems.container import build_container
+from sma_fmu.systems.container import build_container, loop_outputs
 from sma_fmu.systems.ssp import write_ssp
 
 __all__ = ["HOSTS", "write_artifact", "run_host", "run_ssp", "run_container"]
 
-# host -> (artifact, coupling the host applies, function(artifact path, scenario) -> samples)
+# host -> (artifact, coupling the host applies,
+#          function(artifact path, scenario, the loop's outputs) -> samples)
 HOSTS = {
-    "libcosim": ("ssp", "jacobi", lambda path, s: hosts.run_ssp_libcosim(path, s.steps)),
-    "ecos": ("ssp", "jacobi", lambda path, s: hosts.run_ssp_ecos(path, s.step_s, s.steps)),
+    "libcosim": ("ssp", "jacobi", lambda path, s, out: hosts.run_ssp_libcosim(path, s.steps, out)),
+    "ecos": ("ssp", "jacobi", lambda path, s, out: hosts.run_ssp_ecos(path, s.step_s, s.steps, out)),
     "fmpy": ("container", "gauss-seidel",
-             lambda path, s: hosts.run_container_fmpy(path, s.step_s, s.steps)),
-    "libcosim-container": ("container", "gauss-seidel",
-                           lambda path, s: hosts.run_container_libcosim(path, s.step_s, s.steps)),
+             lambda path, s, out: hosts.run_container_fmpy(path, s.step_s, s.steps, out)),
+    "libcosim-container": ("container", "gauss-seidel", lambda path, s, out:
+                           hosts.run_container_libcosim(path, s.step_s, s.steps, out)),
 }
 _BUILDERS = {"ssp": write_ssp, "container": build_container}
 
@@ -50,7 +51,8 @@ def run_host(host, scenario, fmu_dir, artifact=None):
     with tempfile.TemporaryDirectory(prefix="sma_fmu_run_") as folder:
         if artifact is None:
             artifact = write_artifact(kind, closed_loop(scenario, fmu_dir), folder)
-        data = hosts.loop_series(scenario, run(artifact, scenario), scenario.steps)
+        samples = run(artifact, scenario, loop_outputs(scenario))
+        data = hosts.loop_series(scenario, samples, scenario.steps)
     return LoopResult(scenario, data, f"{kind} ({host})", time.perf_counter() - start)
 
 
