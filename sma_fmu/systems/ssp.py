@@ -138,19 +138,19 @@ def write_ssp(system, path, argument="--out"):
 
 
 def ssp_targets(names, out):
-    """{scenario name: .ssp path}: ``out`` is the file for one scenario, else a folder.
+    """(folder, {scenario name: .ssp path}): ``out`` is the file for one scenario, else a folder.
 
-    One scenario with ``out`` ending in ``.ssp`` writes that file; otherwise ``out`` is a
-    folder that gets ``NAME.ssp`` per scenario.
+    One scenario with ``out`` ending in ``.ssp`` writes that file (``folder`` None);
+    otherwise ``out`` is the ``folder`` that gets ``NAME.ssp`` per scenario.
     """
     out = Path(out)
     if out.suffix.lower() == ".ssp":
         if len(names) > 1:
             raise OutputError(f"--out {out}: {len(names)} scenarios need a folder, not one .ssp file")
-        return {names[0]: out}
+        return None, {names[0]: out}
     if out.exists() and not out.is_dir():
         raise OutputError(f"--out {out}: exists and is not a folder")
-    return {name: out / f"{name}.ssp" for name in names}
+    return out, {name: out / f"{name}.ssp" for name in names}
 
 
 def export_ssp(scenario_paths, out, fmu_dir):
@@ -165,11 +165,11 @@ def export_ssp(scenario_paths, out, fmu_dir):
     if repeated:
         raise ValueError(f"two scenario files are both named {repeated[0]!r}; each .ssp is "
                          "named after its scenario")
-    targets = ssp_targets(names, out)
+    folder, targets = ssp_targets(names, out)
     systems = [closed_loop(scenario, fmu_dir) for scenario in scenarios]
-    if len(systems) == 1 and Path(out).suffix.lower() == ".ssp":
-        return [write_ssp(systems[0], out)]
-    with staged_folder(out) as stage:
-        for system in systems:
-            write_ssp(system, stage / f"{system.scenario.name}.ssp")
+    if folder is None:
+        return [write_ssp(systems[0], targets[names[0]])]
+    with staged_folder(folder) as stage:
+        for system, target in zip(systems, targets.values()):
+            write_ssp(system, stage / target.name)
     return list(targets.values())
