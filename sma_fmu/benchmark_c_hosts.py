@@ -2,39 +2,26 @@
 
 Each host runs 30,000 steps of 1 ms (P_in = 2.6 W, load = 0.05 kg) and times every step:
 - the plain ``dlopen`` C host (``sma_fmu/fmi/hosts/fmi_host.c``): set P_in + doStep + get T;
-- libcosim (``hosts/cosim_run.c``, if libcosimpy is installed): one ``cosim_execution_step``
-  (libcosim sets, steps and reads the FMU's variables itself).
+- libcosim (sma-fmu's C host ``hosts/cosim_host.c --timing``, if libcosimpy is installed):
+  one ``cosim_execution_step`` (libcosim sets, steps and reads the FMU's variables itself).
 "Before" is pythonfmu's own binary with libpython in LD_PRELOAD (what the FMUs were);
 "after" is the front, which also keeps one Python thread state per host thread; the front
 without that keeper (SMA_FMU_NO_TSTATE=1) shows what the keeper alone is worth.
 """
-import os
+import importlib.util
 import shutil
 import statistics
 import subprocess
-import zipfile
 from pathlib import Path
 
-from sma_fmu.fmi.front import libpython_path
-from sma_fmu.fmi.hosts import compile_cosim_run, compile_host
+from sma_fmu.fmi.front import libpython_path, remove_front
+from sma_fmu.fmi.hosts import compile_host
+from sma_fmu.systems.c_host import host_environment
 
 __all__ = ["C_HOST_STEPS", "c_host_step_costs"]
 
 C_HOST_STEPS = 30_000
 _STEP = 1e-3
-
-
-def _without_front(fmu, destination):
-    """A copy of ``fmu`` whose binary is pythonfmu's own again (the FMUs before the front)."""
-    with zipfile.ZipFile(fmu) as source, zipfile.ZipFile(destination, "w", zipfile.ZIP_DEFLATED) as target:
-        names = source.namelist()
-        for item in source.infolist():
-            if item.filename.endswith("_pythonfmu.so"):
-                continue
-            backend = item.filename.replace(".so", "_pythonfmu.so")
-            data = source.read(backend if backend in names else item.filename)
-            target.writestr(item, data)
-    return destination
 
 
 def _references(fmu):
@@ -43,10 +30,8 @@ def _references(fmu):
 
 
 def _environment(extra):
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON", "SMA_FMU_NO_TSTATE")}
-    env.update(extra)
-    return env
+    """The C host's environment without the front's switches, plus ``extra``."""
+    return {**host_environment(drop=("SMA_FMU_LIBPYTHON", "SMA_FMU_NO_TSTATE")), **extra}
 
 
 def _plain_host(exe, folder, refs, env):
@@ -64,12 +49,11 @@ def _plain_host(exe, folder, refs, env):
     return total / C_HOST_STEPS * 1e6, p50, p99, p999
 
 
-def _libcosim(exe, fmu, refs, env):
+def _libcosim(exe, fmu, env):
     """(mean, p50, p99, p99.9) [us] of one libcosim step."""
     result = subprocess.run(
-        [str(exe), str(fmu), repr(_STEP), str(C_HOST_STEPS), f"{refs['P_in']}=2.6",
-         f"{refs['load']}=0.05", "--", str(refs["T"])], capture_output=True, text=True,
-        env=_environment({**env, "COSIM_RUN_TIMING": "1"}), timeout=600)
+        [str(exe), "--timing", "fmu", str(fmu), repr(_STEP), str(C_HOST_STEPS), "P_in=2.6",
+         "load=0.05"], capture_output=True, text=True, env=_environment(env), timeout=600)
     timing = [line.split() for line in result.stdout.splitlines() if line.startswith("timing ")]
     if result.returncode != 0 or not timing:
         raise RuntimeError(f"libcosim run failed: {(result.stdout + result.stderr)[-500:]}")
@@ -81,23 +65,23 @@ def c_host_step_costs(fmu, runs, folder):
     """{host and configuration: {mean_us, p50_us, p99_us, p99_9_us}} (medians of ``runs``)."""
     folder = Path(folder)
     refs = _references(fmu)
-    before = _without_front(fmu, folder / "SmaActuator-pythonfmu.fmu")
+    before = remove_front(fmu, folder / "SmaActuator-pythonfmu.fmu")
     unpacked = {}
     for name, path in (("front", fmu), ("pythonfmu", before)):
         unpacked[name] = folder / f"unpacked-{name}"
         shutil.unpack_archive(str(path), str(unpacked[name]), "zip")
     preload = {"LD_PRELOAD": libpython_path()[0]}
-    host = compile_host(folder)
+    host = compile_host("fmi_host", folder)
     cases = {
         "plain C host, pythonfmu + LD_PRELOAD (before)": lambda: _plain_host(host, unpacked["pythonfmu"], refs, preload),
         "plain C host, front without thread-state keeper": lambda: _plain_host(
             host, unpacked["front"], refs, {"SMA_FMU_NO_TSTATE": "1"}),
         "plain C host, front (after)": lambda: _plain_host(host, unpacked["front"], refs, {}),
     }
-    cosim = compile_cosim_run(folder)
-    if cosim is not None:
-        cases["libcosim step, pythonfmu + LD_PRELOAD (before)"] = lambda: _libcosim(cosim, before, refs, preload)
-        cases["libcosim step, front (after)"] = lambda: _libcosim(cosim, fmu, refs, {})
+    if importlib.util.find_spec("libcosimpy") is not None:
+        cosim = compile_host("cosim_host", folder)
+        cases["libcosim step, pythonfmu + LD_PRELOAD (before)"] = lambda: _libcosim(cosim, before, preload)
+        cases["libcosim step, front (after)"] = lambda: _libcosim(cosim, fmu, {})
     results = {}
     for name, measure in cases.items():
         samples = list(zip(*(measure() for _ in range(runs))))

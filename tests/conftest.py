@@ -31,6 +31,6 @@ def unpacked(fmus, tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def fmi_host_exe(tmp_path_factory):
-    """tests/c_host/fmi_host.c compiled once per session (a plain C FMI host)."""
+    """sma_fmu/fmi/hosts/fmi_host.c compiled once per session (a plain C FMI host)."""
     from sma_fmu.fmi.hosts import compile_host
-    return compile_host(tmp_path_factory.mktemp("fmi_host"))
+    return compile_host("fmi_host", tmp_path_factory.mktemp("fmi_host"))

@@ -1,15 +1,15 @@
 """The FMUs in hosts that are not Python, with no environment variable set (no LD_PRELOAD).
 
-- libcosim (Open Simulation Platform, from the libcosimpy wheel) driven from a C program
-  (sma_fmu/fmi/hosts/cosim_run.c): it loads the FMU through the FMI Library;
+- libcosim (Open Simulation Platform, from the libcosimpy wheel) driven from a C program,
+  sma-fmu's C host (sma_fmu/fmi/hosts/cosim_host.c): it loads the FMU through the FMI Library;
 - a plain dlopen C host (sma_fmu/fmi/hosts/fmi_host.c), as fmusim does;
 - fmpy under Debian's statically linked /usr/bin/python3 (the front must use that
   process's Python, not load a second libpython).
 The results equal the library steppers'. Without the native front (no C compiler at build
 time) the FMU's binary is pythonfmu's own, which does not load in a C host.
 """
-import os
 import re
+import shutil
 import subprocess
 import warnings
 import zipfile
@@ -20,44 +20,39 @@ from fmpy import read_model_description
 
 from fmi_host import ERROR, OK, WARNING, FmiHost, text, unpack
 from sma_fmu.fmi.build import build_fmu
-from sma_fmu.fmi.front import NativeFrontWarning, compile_front
-from sma_fmu.fmi.hosts import compile_cosim_run
+from sma_fmu.fmi.front import NativeFrontWarning, compile_front, remove_front
+from sma_fmu.fmi.hosts import CHostError, c_compiler, compile_host
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
+from sma_fmu.systems.c_host import host_environment
 
 libcosimpy = pytest.importorskip("libcosimpy", reason="libcosimpy (test extra) provides libcosimc")
 
 
 def _clean_env(**extra):
-    env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
-    env.update(extra)
-    return env
+    return {**host_environment(drop=("SMA_FMU_LIBPYTHON",)), **extra}
 
 
 @pytest.fixture(scope="module")
-def cosim_run(tmp_path_factory):
-    exe = compile_cosim_run(tmp_path_factory.mktemp("c_host"))
-    assert exe is not None, "libcosimpy and a C compiler are needed to build the libcosim host"
-    return exe
+def cosim_host(tmp_path_factory):
+    return compile_host("cosim_host", tmp_path_factory.mktemp("c_host"))
 
 
-def _run(exe, fmu, step, steps, assignments, outputs, env=None):
-    refs = {v.name: v.valueReference for v in read_model_description(str(fmu)).modelVariables}
-    args = [str(exe), str(fmu), repr(step), str(steps)]
-    args += [f"{refs[name]}={value!r}" for name, value in assignments.items()]
-    args += ["--"] + [str(refs[name]) for name in outputs]
+def _run(exe, fmu, step, steps, start_values, outputs, env=None):
+    """Run ``fmu`` alone in the C host; returns (the process, {output in ``outputs``: value})."""
+    args = [str(exe), "fmu", str(fmu), repr(step), str(steps)]
+    args += [f"{name}={value!r}" for name, value in start_values.items()]
     result = subprocess.run(args, capture_output=True, text=True, env=env or _clean_env(), timeout=120)
     values = {}
-    names = {ref: name for name, ref in refs.items()}
     for line in result.stdout.splitlines():  # libcosim also logs to stdout
-        match = re.fullmatch(r"(\d+)=(\S+)", line.strip())
-        if match:
-            values[names[int(match.group(1))]] = float(match.group(2))
+        match = re.fullmatch(r"fmu\.(\w+)=(\S+)", line.strip())
+        if match and match.group(1) in outputs:
+            values[match.group(1)] = float(match.group(2))
     return result, values
 
 
-def test_plant_fmu_runs_in_libcosim_without_ld_preload(cosim_run, fmus, params):
-    result, values = _run(cosim_run, fmus["SmaActuator"], 1e-3, 5000,
+def test_plant_fmu_runs_in_libcosim_without_ld_preload(cosim_host, fmus, params):
+    result, values = _run(cosim_host, fmus["SmaActuator"], 1e-3, 5000,
                           {"P_in": 2.6, "load": 0.05}, ["R", "T", "xi_F"])
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     library = PlantStepper(params, load=0.05)
@@ -70,8 +65,8 @@ def test_plant_fmu_runs_in_libcosim_without_ld_preload(cosim_run, fmus, params):
     assert out.R < 48.0  # the run went into the transformation
 
 
-def test_feedforward_fmu_runs_in_libcosim_without_ld_preload(cosim_run, fmus, params):
-    result, values = _run(cosim_run, fmus["SmaFeedforward"], 1e-3, 500,
+def test_feedforward_fmu_runs_in_libcosim_without_ld_preload(cosim_host, fmus, params):
+    result, values = _run(cosim_host, fmus["SmaFeedforward"], 1e-3, 500,
                           {"R_ref": 42.0, "load": 0.15}, ["P_ff", "T_ref"])
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     library = FeedforwardStepper(params)
@@ -79,6 +74,52 @@ def test_feedforward_fmu_runs_in_libcosim_without_ld_preload(cosim_run, fmus, pa
         out = library.step(42.0, 0.15, 1e-3)
     assert values["T_ref"] == pytest.approx(out.T_ref, abs=1e-9)
     assert values["P_ff"] == pytest.approx(out.P_ff, abs=1e-9)
+
+
+def test_c_host_timing_and_start_value_errors(cosim_host, fmus):
+    fmu = fmus["SmaActuator"]
+    plain, values = _run(cosim_host, fmu, 1e-3, 50, {"P_in": 2.6}, ["R", "T"])
+    timed = subprocess.run([str(cosim_host), "--timing", "fmu", str(fmu), "0.001", "50", "P_in=2.6"],
+                           capture_output=True, text=True, env=_clean_env(), timeout=120)
+    assert plain.returncode == 0 and timed.returncode == 0, timed.stderr
+    timing = [line.split() for line in timed.stdout.splitlines() if line.startswith("timing ")]
+    assert len(timing) == 1 and len(timing[0]) == 5
+    p50, p99, p999, total = map(float, timing[0][1:])
+    assert 0 < p50 <= p99 <= p999 and total > 0
+    # stepping one step at a time computes the same outputs, to the last digit
+    assert [line for line in timed.stdout.splitlines() if line.startswith("fmu.")] == [
+        line for line in plain.stdout.splitlines() if line.startswith("fmu.")]
+    assert set(values) == {"R", "T"}
+    for start, message in (({"P_inn": 1.0}, "the FMU has no Real variable 'P_inn'"),
+                           ({"hysteresis_mode": 1.0}, "no Real variable 'hysteresis_mode'")):
+        result, values = _run(cosim_host, fmu, 1e-3, 5, start, ["R"])
+        assert result.returncode == 2 and message in result.stderr and not values
+    for args, message in ((["fmu", str(fmu), "0.001", "5", "P_in=2.6W"], "bad start value 'P_in=2.6W'"),
+                          (["ssp", str(fmu), "0.001", "5", "P_in=1"], "are for an FMU, not an SSP"),
+                          (["--timing", "fmu", str(fmu), "0.001", "1"], "STEPS >= 2"),
+                          (["fmi", str(fmu), "0.001", "5"], "usage: cosim_host")):
+        result = subprocess.run([str(cosim_host), *args], capture_output=True, text=True,
+                                env=_clean_env(), timeout=120)
+        assert result.returncode == 2 and message in result.stderr, result.stderr
+
+
+def test_host_environment_drops_ld_preload_and_the_keys_asked():
+    environment = {"LD_PRELOAD": "/lib/libpython.so", "SMA_FMU_LIBPYTHON": "/lib/x.so", "PATH": "/bin"}
+    assert host_environment(environment) == {"SMA_FMU_LIBPYTHON": "/lib/x.so", "PATH": "/bin"}
+    assert host_environment(environment, drop=("SMA_FMU_LIBPYTHON",)) == {"PATH": "/bin"}
+    assert "LD_PRELOAD" in environment  # the caller's mapping is left as it was
+
+
+def test_cc_is_split_like_a_shell(monkeypatch, tmp_path):
+    """CC="ccache gcc" style: a compiler command with words, as make and the build take it."""
+    monkeypatch.setenv("CC", f"{shutil.which('gcc')} -O0")
+    assert c_compiler() == [shutil.which("gcc"), "-O0"]
+    host = compile_host("fmi_host", tmp_path)
+    assert host.is_file() and host.parent.parent == tmp_path
+    assert compile_host("fmi_host", tmp_path) == host  # cached: built once
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    with pytest.raises(CHostError, match="no-such-compiler.*could not run to build fmi_host"):
+        compile_host("fmi_host", tmp_path)
 
 
 def _start(host, name="plant", uri="ok", logging=0):
@@ -204,7 +245,7 @@ def test_missing_libpython_gives_null_and_says_what_to_set(fmi_host_exe, fmus, t
 
 
 def test_without_a_compiler_the_build_keeps_pythonfmus_binary_and_says_so(
-        fmi_host_exe, tmp_path, monkeypatch, cosim_run):
+        fmi_host_exe, tmp_path, monkeypatch, cosim_host):
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -214,7 +255,23 @@ def test_without_a_compiler_the_build_keeps_pythonfmus_binary_and_says_so(
     names = zipfile.ZipFile(path).namelist()
     assert "binaries/linux64/SmaActuator.so" in names
     assert not any(n.endswith("_pythonfmu.so") for n in names)
-    result, values = _run(cosim_run, path, 1e-3, 10, {}, ["R"])  # pythonfmu alone: needs libpython
+    result, values = _run(cosim_host, path, 1e-3, 10, {}, ["R"])  # pythonfmu alone: needs libpython
+    assert result.returncode != 0 and not values
+    assert "undefined symbol" in result.stdout + result.stderr
+
+
+def test_remove_front_gives_back_pythonfmus_binary(fmus, tmp_path, cosim_host):
+    """The benchmark's "before": the FMU as pythonfmu wrote it, which needs libpython preloaded."""
+    fmu = fmus["SmaActuator"]
+    before = remove_front(fmu, tmp_path / "before.fmu")
+    with zipfile.ZipFile(fmu) as front, zipfile.ZipFile(before) as plain:
+        binary = "binaries/linux64/SmaActuator.so"
+        assert sorted(plain.namelist()) == sorted(
+            n for n in front.namelist() if n != "binaries/linux64/SmaActuator_pythonfmu.so")
+        assert plain.read(binary) == front.read("binaries/linux64/SmaActuator_pythonfmu.so")
+        assert plain.read(binary) != front.read(binary)
+        assert all(plain.read(n) == front.read(n) for n in plain.namelist() if n != binary)
+    result, values = _run(cosim_host, before, 1e-3, 10, {}, ["R"])
     assert result.returncode != 0 and not values
     assert "undefined symbol" in result.stdout + result.stderr
 

@@ -39,6 +39,15 @@ def test_export_writes_one_ssp_per_scenario_into_a_folder(exported):
         assert "resources/SmaFeedforward.fmu" in archive.namelist()
 
 
+def test_export_of_one_scenario_to_a_file_writes_that_file_only(fmu_dir, tmp_path, capsys):
+    out = tmp_path / "one.ssp"
+    assert main(["export", "ssp", "heavy-pi", "--out", str(out), "--fmus", str(fmu_dir)]) == 0
+    assert capsys.readouterr().out.splitlines() == [str(out)]
+    assert list(tmp_path.iterdir()) == [out]
+    with zipfile.ZipFile(out) as archive:
+        assert "resources/SmaActuator.fmu" in archive.namelist()
+
+
 @pytest.mark.parametrize("argv, message", [
     (["export", "ssp", "paper", "--out", "{tmp}/one.ssp"], "--out {tmp}/one.ssp: 6 scenarios need a folder"),
     (["export", "container", "paper", "--out", "{tmp}/c.fmu"], "names 6 scenarios; a container holds one"),

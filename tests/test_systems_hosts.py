@@ -12,6 +12,7 @@ import json
 import math
 import xml.etree.ElementTree as ET
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -108,6 +109,20 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
     assert "P_ff" not in inputs  # no compensator, and no unconnected input connector
 
 
+def test_each_fmu_is_read_once_for_the_ssp_and_the_container(fmu_dir, tmp_path, monkeypatch):
+    import fmpy
+
+    reads, read = [], fmpy.read_model_description
+    monkeypatch.setattr(fmpy, "read_model_description",
+                        lambda filename, *args, **kwargs: reads.append(Path(filename).name)
+                        or read(filename, *args, **kwargs))
+    system = closed_loop(short("heavy-pi+ff-fixed", stop_time_s=0.5), fmu_dir)
+    write_ssp(system, tmp_path / "loop.ssp")
+    build_container(system, tmp_path / "loop.fmu")
+    assert sorted(reads) == sorted(f"{component.model}.fmu" for component in system.components)
+    assert len(reads) == 4
+
+
 def test_every_host_matches_the_library_loop_of_its_coupling(adaptive, fmu_dir):
     scenario, artifacts = adaptive
     rows = compare_hosts(scenario, fmu_dir, artifacts=artifacts)
@@ -127,6 +142,25 @@ def test_pi_controller_ssp_has_no_compensator_and_matches_in_both_ssp_hosts(fmu_
     scenario = short("heavy-pi", load=None)
     rows = compare_hosts(scenario, fmu_dir, hosts=("libcosim", "ecos"))
     assert [row["deviation"] <= TOLERANCE for row in rows] == [True] * 4
+
+
+def test_every_host_fails_on_a_feedforward_system_without_its_compensator(fmu_dir, tmp_path):
+    """A loop with feedforward must give its compensator's outputs: none is taken as 0 W."""
+    from sma_fmu.systems import hosts
+    from sma_fmu.systems.container import loop_outputs
+
+    system = closed_loop(short("heavy-pi", stop_time_s=0.01, load=None), fmu_dir)
+    ssp, container = write_ssp(system, tmp_path / "pi.ssp"), build_container(system, tmp_path / "pi.fmu")
+    expected = loop_outputs(short("heavy-pi+ff-fixed", stop_time_s=0.01))
+    assert expected["P_ff"] == ("compensator", "P_ff")
+    runs = [(lambda: hosts.run_ssp_libcosim(ssp, 10, expected), "has no variable compensator.P_ff"),
+            (lambda: hosts.run_ssp_ecos(ssp, 1e-3, 10, expected), "cannot read compensator::P_ff"),
+            (lambda: hosts.run_container_fmpy(container, 1e-3, 10, expected), "has no output P_ff"),
+            (lambda: hosts.run_container_libcosim(container, 1e-3, 10, expected),
+             "has no variable loop.P_ff")]
+    for run, message in runs:
+        with pytest.raises(hosts.HostError, match=message):
+            run()
 
 
 def test_fmpy_simulate_ssp_cannot_run_the_loop(adaptive, fmu_dir):

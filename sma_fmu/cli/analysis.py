@@ -1,16 +1,14 @@
 """Analysis command: bound, the best tracking any controller can reach on a scenario."""
 from pathlib import Path
 
-from .arguments import positive_number
+from .arguments import add_scenario_arguments, positive_number, scenario_paths
 
 __all__ = ["register"]
 
 
 def _bound(args):
     from sma_fmu.analysis.bound_report import bound_markdown, bound_scenarios
-    from sma_fmu.cosim.scenario import resolve_scenarios
-    paths = resolve_scenarios(args.scenarios, everything=args.all)
-    rows = bound_scenarios(paths, args.out, args.power_cap)
+    rows = bound_scenarios(scenario_paths(args), args.out, args.power_cap)
     print(bound_markdown(rows))
     print(f"written: {args.out}/bound.json, bound.md")
     return 0
@@ -21,9 +19,7 @@ def register(commands):
     bound = commands.add_parser(
         "bound", help="lower bound and achievable benchmark of the tracking RMSE, beside each "
                       "scenario's controller")
-    bound.add_argument("scenarios", nargs="*", metavar="SCENARIO",
-                       help="a .toml file, the name of a shipped scenario, or 'paper'")
-    bound.add_argument("--all", action="store_true", help="every shipped scenario")
+    add_scenario_arguments(bound)
     bound.add_argument("--power-cap", type=positive_number, metavar="W",
                        help="largest power the driver can give [W] (default: unlimited)")
     bound.add_argument("--out", type=Path, default=Path("results") / "bound", metavar="DIR",

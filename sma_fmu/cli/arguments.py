@@ -1,12 +1,15 @@
-"""Argument parsing shared by the commands: one-line errors, defaults in --help, checked types."""
+"""Argument parsing shared by the commands: one-line errors, defaults in --help, checked types,
+and the arguments several commands take (SCENARIO... with --all, --fmus)."""
 import argparse
 import math
 import sys
+from pathlib import Path
 
 from sma_fmu.runtime.checks import direction_sign
 
 __all__ = ["Parser", "HelpFormatter", "finite_number", "positive_number", "nonnegative_number",
-           "positive_integer", "number_list", "direction", "fail"]
+           "positive_integer", "number_list", "direction", "fail", "add_scenario_arguments",
+           "scenario_paths", "add_fmus_argument"]
 
 
 def fail(message):
@@ -94,3 +97,24 @@ def direction(text):
         return direction_sign(text)
     except ValueError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def add_scenario_arguments(parser):
+    """Add ``SCENARIO...`` and ``--all`` to ``parser``; :func:`scenario_paths` reads them."""
+    parser.add_argument("scenarios", nargs="*", metavar="SCENARIO",
+                        help="a .toml file, the name of a shipped scenario, or 'paper'")
+    parser.add_argument("--all", action="store_true", help="every shipped scenario")
+
+
+def scenario_paths(args):
+    """The scenario files named by the arguments of :func:`add_scenario_arguments`."""
+    from sma_fmu.cosim.scenario import resolve_scenarios
+
+    return resolve_scenarios(args.scenarios, everything=args.all)
+
+
+def add_fmus_argument(parser, help_text="folder of the built FMUs"):
+    """Add ``--fmus DIR`` (default: where ``sma-fmu build`` writes) to ``parser``."""
+    from sma_fmu.fmi.build import DEFAULT_FMU_DIR
+
+    parser.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR", help=help_text)

@@ -1,17 +1,15 @@
 """Export commands: the closed loop for system-level tools (SSP package, container FMU)."""
 from pathlib import Path
 
-from sma_fmu.fmi.build import DEFAULT_FMU_DIR
+from .arguments import add_fmus_argument, add_scenario_arguments, scenario_paths
 
 __all__ = ["register"]
 
 
 def _ssp(args):
-    from sma_fmu.cosim.scenario import resolve_scenarios
     from sma_fmu.systems.ssp import export_ssp
 
-    for path in export_ssp(resolve_scenarios(args.scenarios, everything=args.all), args.out,
-                           args.fmus):
+    for path in export_ssp(scenario_paths(args), args.out, args.fmus):
         print(path)
     return 0
 
@@ -38,13 +36,10 @@ def register(commands):
                     "scenario's parameters",
         description="One .ssp per scenario: --out FILE.ssp for one scenario, else --out is a "
                     "folder that gets NAME.ssp for each.")
-    ssp.add_argument("scenarios", nargs="*", metavar="SCENARIO",
-                     help="a .toml file, the name of a shipped scenario, or 'paper'")
-    ssp.add_argument("--all", action="store_true", help="every shipped scenario")
+    add_scenario_arguments(ssp)
     ssp.add_argument("--out", type=Path, required=True, metavar="FILE.ssp|DIR",
                      help="the .ssp file (one scenario) or a folder")
-    ssp.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR",
-                     help="folder of the built FMUs (sma-fmu build)")
+    add_fmus_argument(ssp, "folder of the built FMUs (sma-fmu build)")
     ssp.set_defaults(handler=_ssp)
 
     container = kinds.add_parser(
@@ -53,6 +48,5 @@ def register(commands):
                            help="a .toml file or the name of a shipped scenario")
     container.add_argument("--out", type=Path, required=True, metavar="FILE.fmu",
                            help="the container FMU to write")
-    container.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR",
-                           help="folder of the built FMUs (sma-fmu build)")
+    add_fmus_argument(container, "folder of the built FMUs (sma-fmu build)")
     container.set_defaults(handler=_container)

@@ -1,7 +1,7 @@
 """Study commands: sweep (a study spec on Dask) and tune (PI and compensator gains)."""
 from pathlib import Path
 
-from .arguments import positive_integer
+from .arguments import add_scenario_arguments, positive_integer, scenario_paths
 
 __all__ = ["register"]
 
@@ -24,11 +24,9 @@ def _sweep(args):
 
 
 def _tune(args):
-    from sma_fmu.cosim.scenario import resolve_scenarios
     from sma_fmu.studies.tuning import run_tuning
-    paths = resolve_scenarios(args.scenarios, everything=args.all)
     out = args.out or Path("results") / "tune"
-    run_tuning(paths, out, seed=args.seed, generations=args.generations,
+    run_tuning(scenario_paths(args), out, seed=args.seed, generations=args.generations,
                population=args.population, stop_time_s=args.stop_time)
     print(f"written: {out}/report.md, report.json, NAME/controller.toml")
     return 0
@@ -50,9 +48,7 @@ def register(commands):
 
     tune = commands.add_parser("tune", help="optimise Kp, Ki (and alpha, beta with "
                                             "feedforward) for RMSE; [controller] snippets")
-    tune.add_argument("scenarios", nargs="*", metavar="SCENARIO",
-                      help="a .toml file, the name of a shipped scenario, or 'paper'")
-    tune.add_argument("--all", action="store_true", help="every shipped scenario")
+    add_scenario_arguments(tune)
     tune.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: results/tune)")
     tune.add_argument("--seed", type=int, default=1, help="seed of differential evolution")
     tune.add_argument("--generations", type=positive_integer, default=30,

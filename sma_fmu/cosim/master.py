@@ -18,10 +18,15 @@ class MissingFmuError(FileNotFoundError):
     """A needed FMU has not been built."""
 
 
-def model_parameter_values(fmu_path, params):
-    """Start values for every wire parameter the FMU exposes, from ``params``."""
+def model_parameter_values(fmu_path, params, variables=None):
+    """Start values for every wire parameter the FMU exposes, from ``params``.
+
+    ``variables``: the FMU's model variables if already read (else they are read from
+    ``fmu_path``).
+    """
     values = params.values()
-    return {v.name: values[v.name] for v in read_description(fmu_path).modelVariables
+    variables = read_description(fmu_path).modelVariables if variables is None else variables
+    return {v.name: values[v.name] for v in variables
             if v.causality == "parameter" and v.name in values}
 
 

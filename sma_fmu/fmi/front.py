@@ -6,14 +6,13 @@ refused call. The front (C sources in ``sma_fmu/fmi/native/``, shipped with the 
 fixes that: it becomes ``binaries/linux64/<model>.so`` and forwards every call to
 pythonfmu's binary, renamed ``<model>_pythonfmu.so`` (see ``native/fmi2_exports.c``).
 
-The compiler is ``$CC`` (default ``cc``). It records the shared libpython of the Python
-running the build, so a C host finds one without any environment variable. Where no
+The compiler is :func:`~sma_fmu.fmi.hosts.c_compiler` (``$CC``, default ``cc``). It
+records the shared libpython of the Python running the build, so a C host finds one
+without any environment variable. Where no
 compiler works the FMU keeps pythonfmu's plain binary and the build says so
 (:class:`NativeFrontWarning`); docs/fmus.md lists what is then lost.
 """
 import hashlib
-import os
-import shlex
 import shutil
 import subprocess
 import sys
@@ -23,9 +22,13 @@ import zipfile
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["NativeFrontWarning", "FrontBuild", "compile_front", "install_front", "libpython_path"]
+from sma_fmu.fmi.hosts import c_compiler
+
+__all__ = ["NativeFrontWarning", "FrontBuild", "compile_front", "install_front", "remove_front",
+           "libpython_path"]
 
 _PLATFORM = "linux64"
+_BACKEND_SUFFIX = "_pythonfmu.so"
 _FLAGS = ["-std=c11", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Wall",
           "-Wl,-z,nodelete", "-Wl,--no-undefined"]
 _LIBRARIES = ["-ldl", "-lpthread"]
@@ -67,7 +70,7 @@ def compile_front(libpython=None):
     """
     if not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
         return FrontBuild(problem=f"the native front is built for Linux x86-64 only (this is {sys.platform})")
-    compiler = shlex.split(os.environ.get("CC") or "cc")
+    compiler = c_compiler()
     sources = _sources()
     library_path, soname = libpython_path() if libpython is None else libpython
     digest = hashlib.sha256(b"".join(name.encode() + data for name, data in sorted(sources.items())))
@@ -95,11 +98,16 @@ def _compile(compiler, sources, library_path, soname):
         return FrontBuild(library=output.read_bytes())
 
 
+def _backend(binary):
+    """The name pythonfmu's binary ``binaries/<platform>/<model>.so`` gets behind the front."""
+    return binary[:-len(".so")] + _BACKEND_SUFFIX
+
+
 def install_front(fmu_path, model_identifier, library):
     """Put ``library`` (the front) into the FMU as its binary; pythonfmu's becomes ``*_pythonfmu.so``."""
     fmu_path = Path(fmu_path)
     binary = f"binaries/{_PLATFORM}/{model_identifier}.so"
-    backend = f"binaries/{_PLATFORM}/{model_identifier}_pythonfmu.so"
+    backend = _backend(binary)
     rewritten = fmu_path.with_suffix(".front.tmp")
     with zipfile.ZipFile(fmu_path) as source, \
             zipfile.ZipFile(rewritten, "w", zipfile.ZIP_DEFLATED) as target:
@@ -118,3 +126,20 @@ def install_front(fmu_path, model_identifier, library):
             else:
                 target.writestr(item, data)
     shutil.move(str(rewritten), str(fmu_path))
+
+
+def remove_front(fmu_path, destination):
+    """Write to ``destination`` a copy of the FMU ``fmu_path`` whose binaries are pythonfmu's
+    own again (the inverse of :func:`install_front`: the FMU as it was before the front).
+
+    Returns ``destination``.
+    """
+    with zipfile.ZipFile(fmu_path) as source, \
+            zipfile.ZipFile(destination, "w", zipfile.ZIP_DEFLATED) as target:
+        names = set(source.namelist())
+        for item in source.infolist():
+            if item.filename.endswith(_BACKEND_SUFFIX):
+                continue
+            backend = _backend(item.filename) if item.filename.endswith(".so") else None
+            target.writestr(item, source.read(backend if backend in names else item.filename))
+    return destination

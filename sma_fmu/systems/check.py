@@ -10,6 +10,7 @@ Per SSP also ``SSD schema``: SystemStructure.ssd against the SSP 1.0 schemas (fm
 copy), and the C-host run is of the whole system, with its parameter bindings.
 Each check gives a :class:`CheckResult`; an exception inside a check is its failure.
 """
+import functools
 import logging
 import math
 import tempfile
@@ -53,9 +54,9 @@ def _run(file, check, function):
 
 
 def _fmpy_validation(path):
-    from fmpy.validation import validate_fmu
+    from sma_fmu.fmi.build import validate_fmus
 
-    problems = validate_fmu(str(path))
+    problems = validate_fmus([path])[Path(path)]
     return ("ok", "no problems") if not problems else ("FAIL", "; ".join(problems))
 
 
@@ -69,10 +70,9 @@ def _toolbox_checker(path):
     return ("ok", "compliant") if not errors else ("FAIL", "; ".join(errors))
 
 
-def _fmu_step(path):
-    from fmpy import read_model_description
-
-    experiment = read_model_description(str(path)).defaultExperiment
+def _fmu_step(description):
+    """The step size [s] of the FMU's default experiment (``description``: fmpy's)."""
+    experiment = description.defaultExperiment
     step = experiment.stepSize if experiment is not None and experiment.stepSize else None
     return float(step) if step else _DEFAULT_STEP_S
 
@@ -87,16 +87,13 @@ def _short_run(kind, path, step_size):
     return "ok", f"{SHORT_RUN_STEPS} steps of {step_size:g} s, {len(values)} outputs finite"
 
 
-def _state_round_trip(path):
-    from fmpy import read_model_description
-
+def _state_round_trip(path, description):
     from sma_fmu.fmi.instance import FmuInstance
 
-    description = read_model_description(str(path))
     cs = description.coSimulation
     if cs is None or not cs.canGetAndSetFMUstate:
         return "n/a", "the FMU does not declare canGetAndSetFMUstate"
-    step = _fmu_step(path)
+    step = _fmu_step(description)
     outputs = tuple(v.name for v in description.modelVariables
                     if v.type == "Real" and v.causality == "output")
     with FmuInstance(path, "state_check") as fmu:
@@ -122,12 +119,17 @@ def _state_round_trip(path):
 
 
 def _fmu_checks(path, label, c_host=True):
+    from fmpy import read_model_description
+
+    # read once for the checks that need it; a failure to read fails each of them, as it
+    # would have alone (exceptions are not cached)
+    description = functools.cache(lambda: read_model_description(str(path)))
     results = [_run(label, "fmpy validation", lambda: _fmpy_validation(path)),
                _run(label, "FMI checker", lambda: _toolbox_checker(path))]
     if c_host:
         results.append(_run(label, "C host (libcosim)",
-                            lambda: _short_run("fmu", path, _fmu_step(path))))
-    results.append(_run(label, "state round trip", lambda: _state_round_trip(path)))
+                            lambda: _short_run("fmu", path, _fmu_step(description()))))
+    results.append(_run(label, "state round trip", lambda: _state_round_trip(path, description())))
     return results
 
 

@@ -14,7 +14,7 @@ plant's start temperature and hysteresis mode, and the signals as JSON tables.
 from dataclasses import dataclass
 
 from sma_fmu.cosim.master import MissingFmuError, model_parameter_values
-from sma_fmu.fmi.build import default_fmu_paths
+from sma_fmu.fmi.build import default_fmu_paths, read_description
 from sma_fmu.runtime.scenario_signals import table_text
 
 __all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "STEP_ORDER"]
@@ -28,13 +28,15 @@ STEP_ORDER = ("compensator", "pi", "plant", "signals")
 
 @dataclass(frozen=True)
 class Component:
-    """One FMU instance: ``name`` in the system, FMU ``model`` name, its ``fmu`` file and
-    ``parameters`` (name -> float, bool or str)."""
+    """One FMU instance: ``name`` in the system, FMU ``model`` name, its ``fmu`` file,
+    ``parameters`` (name -> float, bool or str) and the FMU's model ``variables`` (name ->
+    fmpy's ScalarVariable, read once here for everything written from the system)."""
 
     name: str
     model: str
     fmu: object
     parameters: dict
+    variables: dict
 
 
 @dataclass(frozen=True)
@@ -78,11 +80,24 @@ def _fmu_files(scenario, fmu_dir):
     return paths
 
 
+def _component(name, model, paths, parameters=None, params=None):
+    """The :class:`Component` ``name`` of FMU ``model``; its model description is read once.
+
+    ``params``: the wire parameters whose values the FMU exposes as parameters (then
+    updated with ``parameters``).
+    """
+    variables = {v.name: v for v in read_description(paths[model]).modelVariables}
+    values = {} if params is None else model_parameter_values(paths[model], params,
+                                                              variables.values())
+    values.update(parameters or {})
+    return Component(name, model, paths[model], values, variables)
+
+
 def closed_loop(scenario, fmu_dir):
     """The :class:`LoopSystem` of ``scenario`` with the FMUs built in ``fmu_dir``."""
     paths = _fmu_files(scenario, fmu_dir)
     c = scenario.controller
-    components = [Component("signals", "SmaScenarioSignals", paths["SmaScenarioSignals"], {
+    components = [_component("signals", "SmaScenarioSignals", paths, {
         "reference": table_text(scenario.reference.as_table()),
         "load_profile": table_text(scenario.load.as_table())})]
     connections = [Connection("signals", "R_ref", "pi", "R_ref"),
@@ -90,17 +105,13 @@ def closed_loop(scenario, fmu_dir):
                    Connection("signals", "load", "plant", "load"),
                    Connection("plant", "R", "pi", "R")]
     if c.feedforward:
-        parameters = model_parameter_values(paths["SmaFeedforward"], scenario.compensator_params)
-        parameters.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
-                          adapt_to_load=c.adapt_to_load, inverse=c.inverse)
-        components.append(Component("compensator", "SmaFeedforward", paths["SmaFeedforward"],
-                                    parameters))
+        components.append(_component("compensator", "SmaFeedforward", paths, {
+            "alpha": c.alpha, "beta": c.beta, "model_load": c.model_load,
+            "adapt_to_load": c.adapt_to_load, "inverse": c.inverse}, scenario.compensator_params))
         connections[1:1] = [Connection("signals", "R_ref", "compensator", "R_ref"),
                             Connection("signals", "load", "compensator", "load"),
                             Connection("compensator", "P_ff", "pi", "P_ff")]
-    components.append(Component("pi", "SmaPiController", paths["SmaPiController"],
-                                {"Kp": c.Kp, "Ki": c.Ki}))
-    parameters = model_parameter_values(paths["SmaActuator"], scenario.params)
-    parameters.update(T_start=scenario.T_start, hysteresis_mode=scenario.hysteresis_mode)
-    components.append(Component("plant", "SmaActuator", paths["SmaActuator"], parameters))
+    components.append(_component("pi", "SmaPiController", paths, {"Kp": c.Kp, "Ki": c.Ki}))
+    components.append(_component("plant", "SmaActuator", paths, {
+        "T_start": scenario.T_start, "hysteresis_mode": scenario.hysteresis_mode}, scenario.params))
     return LoopSystem(scenario, tuple(components), tuple(connections))

@@ -7,12 +7,14 @@ column from the library run of the same coupling. :func:`rmse_table` formats the
 (``benchmarks/hosts.py`` prints it for the paper scenarios; docs/systems.md shows it).
 """
 import math
+import tempfile
 
 import numpy as np
 
 from sma_fmu.cosim.loop import COLUMNS, COUPLINGS, run_library
 from sma_fmu.cosim.metrics import scenario_metrics
-from sma_fmu.systems.runs import HOSTS, run_host
+from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.runs import HOSTS, run_host, write_artifact
 
 __all__ = ["deviation", "compare_hosts", "rmse_table"]
 
@@ -38,22 +40,29 @@ def compare_hosts(scenario, fmu_dir, hosts=tuple(HOSTS), artifacts=None):
     """Rows {scenario, run, coupling, rmse_ohm, deviation, wall_time_s} for ``scenario``.
 
     ``artifacts``: optional {"ssp": path, "container": path} already written for the
-    scenario (otherwise each host run builds its own). ``deviation`` is the largest
+    scenario; a kind the ``hosts`` need and that is not given is built once, from the FMUs
+    in ``fmu_dir`` into a temporary folder, and run by each of its hosts. A host row's
+    ``wall_time_s`` is its run alone, without the build. ``deviation`` is the largest
     difference from the library run of the same coupling (0 for the library rows).
     """
-    artifacts = artifacts or {}
+    artifacts = dict(artifacts or {})
     library = {coupling: run_library(scenario, coupling) for coupling in COUPLINGS}
     rows = [{"scenario": scenario.name, "run": "library", "coupling": coupling,
              "rmse_ohm": _rmse(result.data, scenario), "deviation": 0.0,
              "wall_time_s": result.wall_time_s}
             for coupling, result in library.items()]
-    for host in hosts:
-        kind, coupling, _ = HOSTS[host]
-        result = run_host(host, scenario, fmu_dir, artifacts.get(kind))
-        rows.append({"scenario": scenario.name, "run": f"{host} ({kind})", "coupling": coupling,
-                     "rmse_ohm": _rmse(result.data, scenario),
-                     "deviation": deviation(result.data, library[coupling].data),
-                     "wall_time_s": result.wall_time_s})
+    missing = sorted({HOSTS[host][0] for host in hosts} - set(artifacts))
+    with tempfile.TemporaryDirectory(prefix="sma_fmu_compare_") as folder:
+        if missing:
+            system = closed_loop(scenario, fmu_dir)
+            artifacts.update({kind: write_artifact(kind, system, folder) for kind in missing})
+        for host in hosts:
+            kind, coupling, _ = HOSTS[host]
+            result = run_host(host, scenario, fmu_dir, artifacts[kind])
+            rows.append({"scenario": scenario.name, "run": f"{host} ({kind})",
+                         "coupling": coupling, "rmse_ohm": _rmse(result.data, scenario),
+                         "deviation": deviation(result.data, library[coupling].data),
+                         "wall_time_s": result.wall_time_s})
     return rows
 
 

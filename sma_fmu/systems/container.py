@@ -16,12 +16,12 @@ import zipfile
 from pathlib import Path
 
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
+from sma_fmu.fmi.slave_support.model_description import set_units
 from sma_fmu.output_folder import OutputError, write_file
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
-__all__ = ["OUTPUTS", "container_outputs", "build_container", "export_container"]
+__all__ = ["OUTPUTS", "loop_outputs", "build_container", "export_container"]
 
 # container output -> (component, variable): what the time-series CSV needs
 OUTPUTS = {
@@ -33,10 +33,13 @@ OUTPUTS = {
 }
 
 
-def container_outputs(system):
-    """The :data:`OUTPUTS` that ``system`` has (the "pi" controller has no compensator)."""
-    names = {component.name for component in system.components}
-    return {name: source for name, source in OUTPUTS.items() if source[0] in names}
+def loop_outputs(scenario):
+    """The :data:`OUTPUTS` the loop of ``scenario`` has: its container's outputs and what
+    every host must read. Without feedforward (the "pi" controller) there is no
+    compensator, so no P_ff, T_ref, saturated."""
+    feedforward = scenario.controller.feedforward
+    return {name: source for name, source in OUTPUTS.items()
+            if feedforward or source[0] != "compensator"}
 
 
 def _text(value):
@@ -66,7 +69,7 @@ def _configure(container, system):
         container.get_fmu(Path(component.fmu).name, name=component.name)
     for connection in system.connections:
         container.add_link(connection.source, connection.output, connection.target, connection.input)
-    for exposed, (component, variable) in container_outputs(system).items():
+    for exposed, (component, variable) in loop_outputs(system.scenario).items():
         container.add_output(component, variable, exposed)
     for component in system.components:
         for name, value in component.parameters.items():
@@ -76,15 +79,12 @@ def _configure(container, system):
 
 
 def _units(system):
-    """{container output: unit} from the embedded FMUs' model descriptions."""
-    from fmpy import read_model_description
-
+    """{container output: unit} from the embedded FMUs' model variables."""
     units = {}
-    for exposed, (name, variable) in container_outputs(system).items():
-        fmu = system.component(name).fmu
-        declared = {v.name: v.unit for v in read_model_description(str(fmu)).modelVariables}
-        if declared.get(variable):
-            units[exposed] = declared[variable]
+    for exposed, (name, variable) in loop_outputs(system.scenario).items():
+        unit = system.component(name).variables[variable].unit
+        if unit:
+            units[exposed] = unit
     return units
 
 
@@ -96,17 +96,7 @@ def _with_units(archive, units):
         for item in source.infolist():
             data = source.read(item.filename)
             if item.filename == "modelDescription.xml":
-                root = ET.fromstring(data)
-                for variable in root.iter("ScalarVariable"):
-                    real = variable.find("Real")
-                    if real is not None and variable.get("name") in units:
-                        real.set("unit", units[variable.get("name")])
-                definitions = ET.Element("UnitDefinitions")
-                for name in sorted(set(units.values())):
-                    unit = ET.SubElement(definitions, "Unit", name=name)
-                    ET.SubElement(unit, "BaseUnit", {key: str(value)
-                                                     for key, value in UNIT_DEFINITIONS[name].items()})
-                root.insert(list(root).index(root.find("CoSimulation")) + 1, definitions)
+                root = set_units(ET.fromstring(data), units)
                 data = ET.tostring(root, encoding="UTF-8", xml_declaration=True)
             target.writestr(item, data)
     return buffer.getvalue()

@@ -4,8 +4,10 @@
 - :func:`run_ssp_ecos`: Ecos through ecospy (its library needs libtbb, from the ``tbb`` wheel);
 - :func:`run_container_fmpy`, :func:`run_container_libcosim`: the container FMU alone.
 
-Each returns the samples at the communication points t_0 ... t_n (t_0: after
-initialization) as {column of :data:`~sma_fmu.cosim.loop.COLUMNS`: array};
+Each takes the ``outputs`` the system has ({column: (component, variable)}, from
+:func:`~.container.loop_outputs`): a missing one is an error. Each returns their samples
+at the communication points t_0 ... t_n (t_0: after initialization) as {column of
+:data:`~sma_fmu.cosim.loop.COLUMNS`: array};
 :func:`loop_series` turns them into the loop's time-series array, row k holding the
 values at t_k and the outputs of step k, as the library loop does.
 """
@@ -14,7 +16,7 @@ import math
 import numpy as np
 
 from sma_fmu.cosim.loop import COLUMNS
-from sma_fmu.systems.container import OUTPUTS
+from sma_fmu.systems.container import loop_outputs
 from sma_fmu.systems.ssp import PARAMETER_SET
 
 __all__ = ["HostError", "STATE_COLUMNS", "STEP_COLUMNS", "loop_series", "run_ssp_libcosim",
@@ -24,7 +26,8 @@ __all__ = ["HostError", "STATE_COLUMNS", "STEP_COLUMNS", "loop_series", "run_ssp
 STATE_COLUMNS = ("R_ref", "R", "T", "x", "xi_P", "xi_M", "xi_F", "load")
 # ... and columns whose row k is the block's output after step k (what acts over [t_k, t_k+1))
 STEP_COLUMNS = ("P", "P_fb", "P_ff", "T_ref", "saturated")
-# without a compensator the loop's rows hold u_ff = 0 W, T_ref = nan, not saturated
+# the columns of a block the loop lacks (the "pi" controller's compensator), as the library
+# loop's rows hold them: u_ff = 0 W, T_ref = nan, not saturated
 _NO_COMPENSATOR = {"P_ff": 0.0, "T_ref": math.nan, "saturated": False}
 
 
@@ -35,27 +38,24 @@ class HostError(RuntimeError):
 def loop_series(scenario, samples, steps):
     """The loop's time-series array from host ``samples`` ({column: n + 1 values}).
 
-    Columns the system lacks (the compensator's, for the "pi" controller) get the values
-    the library loop writes; the last row has no step outputs (nan), as there.
+    Columns the loop lacks (not in :func:`~.container.loop_outputs`: the compensator's,
+    for the "pi" controller) get the values the library loop writes; the last row has no
+    step outputs (nan), as there.
     """
+    present = loop_outputs(scenario)
     dtype = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
     data = np.zeros(steps + 1, dtype=dtype)
     data["t"] = np.arange(steps + 1) * scenario.step_s
     for name in STATE_COLUMNS:
         data[name] = samples[name]
     for name in STEP_COLUMNS:
-        if name in samples:
+        if name in present:
             data[name][:-1] = np.asarray(samples[name])[1:]
         else:
             data[name][:-1] = _NO_COMPENSATOR[name]
         data[name][-1] = False if name == "saturated" else math.nan
     data["stroke"] = data["x"][0] - data["x"]
     return data
-
-
-def _ssp_sources():
-    """{column: (component, variable)} observed in an SSP (as the container exposes them)."""
-    return dict(OUTPUTS)
 
 
 # --------------------------------------------------------------------------- libcosim
@@ -79,8 +79,6 @@ def _libcosim_run(execution, observed, steps, what):
     reals, booleans = {}, {}
     for column, key in observed.items():
         if key not in variables:
-            if column in _NO_COMPENSATOR:  # the "pi" controller has no compensator
-                continue
             raise HostError(f"libcosim: {what} has no variable {key[0]}.{key[1]}")
         variable = variables[key]
         if variable.type == CosimVariableType.BOOLEAN.value:
@@ -116,7 +114,7 @@ def _quiet_libcosim():
     log_output_level(CosimLogLevel.WARNING)
 
 
-def run_ssp_libcosim(ssp_path, steps):
+def run_ssp_libcosim(ssp_path, steps, outputs):
     """Run an SSP of :mod:`.ssp` for ``steps`` steps in libcosim; returns {column: samples}.
 
     The step size comes from the SSD's OSP annotation. libcosim couples by Jacobi.
@@ -128,10 +126,10 @@ def run_ssp_libcosim(ssp_path, steps):
         execution = CosimExecution.from_ssp_file(str(ssp_path))
     except AssertionError:
         raise HostError(f"libcosim cannot load {ssp_path}; see its log") from None
-    return _libcosim_run(execution, _ssp_sources(), steps, str(ssp_path))
+    return _libcosim_run(execution, outputs, steps, str(ssp_path))
 
 
-def run_container_libcosim(fmu_path, step_size, steps):
+def run_container_libcosim(fmu_path, step_size, steps, outputs):
     """Run the container FMU alone in libcosim, ``steps`` steps of ``step_size`` [s]."""
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimSlave import CosimLocalSlave
@@ -141,7 +139,7 @@ def run_container_libcosim(fmu_path, step_size, steps):
     slave = CosimLocalSlave(fmu_path=str(fmu_path), instance_name="loop")
     if execution.add_local_slave(local_slave=slave) < 0:
         raise HostError(f"libcosim cannot load {fmu_path}; see its log")
-    observed = {column: ("loop", column) for column in OUTPUTS}
+    observed = {column: ("loop", column) for column in outputs}
     return _libcosim_run(execution, observed, steps, str(fmu_path))
 
 
@@ -161,17 +159,17 @@ def load_tbb():
     raise HostError("Ecos needs libtbb.so.12: pip install tbb (or install Debian's libtbb12)")
 
 
-def run_ssp_ecos(ssp_path, step_size, steps):
+def run_ssp_ecos(ssp_path, step_size, steps, outputs):
     """Run an SSP of :mod:`.ssp` in Ecos, ``steps`` steps of ``step_size`` [s] (Jacobi)."""
     load_tbb()
     from ecospy import EcosLib, EcosSimulation
 
     EcosLib.set_log_level("warn")
-    samples = {column: [] for column in OUTPUTS}
+    samples = {column: [] for column in outputs}
     try:
         with EcosSimulation(ssp_path=str(ssp_path), step_size=step_size) as simulation:
             simulation.init(parameter_set=PARAMETER_SET)  # without the name Ecos binds nothing
-            readers = _ecos_readers(simulation)
+            readers = _ecos_readers(simulation, outputs, ssp_path)
             for k in range(steps + 1):
                 if k:
                     simulation.step()
@@ -182,33 +180,35 @@ def run_ssp_ecos(ssp_path, step_size, steps):
         if isinstance(error, HostError):
             raise
         raise HostError(f"Ecos: {ssp_path}: {error}") from None
-    return {column: np.array(values) for column, values in samples.items() if values}
+    return {column: np.array(values) for column, values in samples.items()}
 
 
-def _ecos_readers(simulation):
+def _ecos_readers(simulation, outputs, ssp_path):
+    """{column: function reading its value now}; a variable Ecos cannot read is an error."""
     readers = {}
-    for column, (component, variable) in OUTPUTS.items():
+    for column, (component, variable) in outputs.items():
         name = f"{component}::{variable}"
         read = simulation.get_bool if column == "saturated" else simulation.get_real
         try:
             read(name)
-        except Exception:  # noqa: BLE001 - ecospy raises bare Exception
-            if column in _NO_COMPENSATOR:  # the "pi" controller has no compensator
-                continue
-            raise
+        except Exception as error:  # noqa: BLE001 - ecospy raises bare Exception
+            raise HostError(f"Ecos: {ssp_path}: cannot read {name}: {error}") from None
         readers[column] = (lambda read=read, name=name: read(name))
     return readers
 
 
 # ------------------------------------------------------------------------------ fmpy
-def run_container_fmpy(fmu_path, step_size, steps):
+def run_container_fmpy(fmu_path, step_size, steps, outputs):
     """Run the container FMU in fmpy's ``simulate_fmu``; returns {column: samples}."""
     from fmpy import read_model_description, simulate_fmu
 
-    names = [v.name for v in read_model_description(str(fmu_path)).modelVariables
-             if v.causality == "output"]
+    names = {v.name for v in read_model_description(str(fmu_path)).modelVariables
+             if v.causality == "output"}
+    missing = [column for column in outputs if column not in names]
+    if missing:
+        raise HostError(f"fmpy: {fmu_path} has no output {missing[0]}")
     result = simulate_fmu(str(fmu_path), stop_time=steps * step_size, step_size=step_size,
-                          output_interval=step_size, output=names)
+                          output_interval=step_size, output=list(outputs))
     if result.size != steps + 1:
         raise HostError(f"fmpy: {fmu_path}: the run stopped after {result.size - 1} of {steps} steps")
-    return {name: result[name] for name in names if name in OUTPUTS}
+    return {column: result[column] for column in outputs}

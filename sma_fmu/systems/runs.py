@@ -13,21 +13,29 @@ from pathlib import Path
 from sma_fmu.cosim.loop import LoopResult
 from sma_fmu.systems import hosts
 from sma_fmu.systems.closed_loop import closed_loop
-from sma_fmu.systems.container import build_container
+from sma_fmu.systems.container import build_container, loop_outputs
 from sma_fmu.systems.ssp import write_ssp
 
-__all__ = ["HOSTS", "run_host", "run_ssp", "run_container"]
+__all__ = ["HOSTS", "write_artifact", "run_host", "run_ssp", "run_container"]
 
-# host -> (artifact, coupling the host applies, function(artifact path, scenario) -> samples)
+# host -> (artifact, coupling the host applies,
+#          function(artifact path, scenario, the loop's outputs) -> samples)
 HOSTS = {
-    "libcosim": ("ssp", "jacobi", lambda path, s: hosts.run_ssp_libcosim(path, s.steps)),
-    "ecos": ("ssp", "jacobi", lambda path, s: hosts.run_ssp_ecos(path, s.step_s, s.steps)),
+    "libcosim": ("ssp", "jacobi", lambda path, s, out: hosts.run_ssp_libcosim(path, s.steps, out)),
+    "ecos": ("ssp", "jacobi", lambda path, s, out: hosts.run_ssp_ecos(path, s.step_s, s.steps, out)),
     "fmpy": ("container", "gauss-seidel",
-             lambda path, s: hosts.run_container_fmpy(path, s.step_s, s.steps)),
-    "libcosim-container": ("container", "gauss-seidel",
-                           lambda path, s: hosts.run_container_libcosim(path, s.step_s, s.steps)),
+             lambda path, s, out: hosts.run_container_fmpy(path, s.step_s, s.steps, out)),
+    "libcosim-container": ("container", "gauss-seidel", lambda path, s, out:
+                           hosts.run_container_libcosim(path, s.step_s, s.steps, out)),
 }
 _BUILDERS = {"ssp": write_ssp, "container": build_container}
+
+
+def write_artifact(kind, system, folder):
+    """Write the ``kind`` ("ssp" or "container") of ``system`` into ``folder``; returns its path."""
+    path = Path(folder) / f"{system.scenario.name}.{'ssp' if kind == 'ssp' else 'fmu'}"
+    _BUILDERS[kind](system, path)
+    return path
 
 
 def run_host(host, scenario, fmu_dir, artifact=None):
@@ -42,9 +50,9 @@ def run_host(host, scenario, fmu_dir, artifact=None):
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="sma_fmu_run_") as folder:
         if artifact is None:
-            artifact = Path(folder) / f"{scenario.name}.{'ssp' if kind == 'ssp' else 'fmu'}"
-            _BUILDERS[kind](closed_loop(scenario, fmu_dir), artifact)
-        data = hosts.loop_series(scenario, run(artifact, scenario), scenario.steps)
+            artifact = write_artifact(kind, closed_loop(scenario, fmu_dir), folder)
+        samples = run(artifact, scenario, loop_outputs(scenario))
+        data = hosts.loop_series(scenario, samples, scenario.steps)
     return LoopResult(scenario, data, f"{kind} ({host})", time.perf_counter() - start)
 
 

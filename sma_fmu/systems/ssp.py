@@ -56,12 +56,6 @@ def _text(value, kind):
     return str(value)
 
 
-def _variables(fmu):
-    from fmpy import read_model_description
-
-    return {v.name: v for v in read_model_description(str(fmu)).modelVariables}
-
-
 def _connectors(system):
     """{component: {variable: kind}} of every connection end."""
     ends = {}
@@ -71,7 +65,8 @@ def _connectors(system):
     return ends
 
 
-def _component(elements, component, variables, connectors, units):
+def _component(elements, component, connectors, units):
+    variables = component.variables
     node = _add(elements, "ssd:Component", name=component.name, type=_FMU_MIME,
                 source=f"resources/{component.model}.fmu")
     if connectors:
@@ -107,8 +102,7 @@ def ssd_document(system):
     elements = _add(top, "ssd:Elements")
     ends, units = _connectors(system), set()
     for component in system.components:
-        _component(elements, component, _variables(component.fmu),
-                   ends.get(component.name, {}), units)
+        _component(elements, component, ends.get(component.name, {}), units)
     connections = _add(top, "ssd:Connections")
     for c in system.connections:
         _add(connections, "ssd:Connection", startElement=c.source, startConnector=c.output,
@@ -144,19 +138,19 @@ def write_ssp(system, path, argument="--out"):
 
 
 def ssp_targets(names, out):
-    """{scenario name: .ssp path}: ``out`` is the file for one scenario, else a folder.
+    """(folder, {scenario name: .ssp path}): ``out`` is the file for one scenario, else a folder.
 
-    One scenario with ``out`` ending in ``.ssp`` writes that file; otherwise ``out`` is a
-    folder that gets ``NAME.ssp`` per scenario.
+    One scenario with ``out`` ending in ``.ssp`` writes that file (``folder`` None);
+    otherwise ``out`` is the ``folder`` that gets ``NAME.ssp`` per scenario.
     """
     out = Path(out)
     if out.suffix.lower() == ".ssp":
         if len(names) > 1:
             raise OutputError(f"--out {out}: {len(names)} scenarios need a folder, not one .ssp file")
-        return {names[0]: out}
+        return None, {names[0]: out}
     if out.exists() and not out.is_dir():
         raise OutputError(f"--out {out}: exists and is not a folder")
-    return {name: out / f"{name}.ssp" for name in names}
+    return out, {name: out / f"{name}.ssp" for name in names}
 
 
 def export_ssp(scenario_paths, out, fmu_dir):
@@ -171,11 +165,11 @@ def export_ssp(scenario_paths, out, fmu_dir):
     if repeated:
         raise ValueError(f"two scenario files are both named {repeated[0]!r}; each .ssp is "
                          "named after its scenario")
-    targets = ssp_targets(names, out)
+    folder, targets = ssp_targets(names, out)
     systems = [closed_loop(scenario, fmu_dir) for scenario in scenarios]
-    if len(systems) == 1 and Path(out).suffix.lower() == ".ssp":
-        return [write_ssp(systems[0], out)]
-    with staged_folder(out) as stage:
-        for system in systems:
-            write_ssp(system, stage / f"{system.scenario.name}.ssp")
+    if folder is None:
+        return [write_ssp(systems[0], targets[names[0]])]
+    with staged_folder(folder) as stage:
+        for system, target in zip(systems, targets.values()):
+            write_ssp(system, stage / target.name)
     return list(targets.values())

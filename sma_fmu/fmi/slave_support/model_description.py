@@ -6,7 +6,7 @@
 """
 from xml.etree.ElementTree import Element, SubElement
 
-__all__ = ["UNIT_DEFINITIONS", "decorate_model_description"]
+__all__ = ["UNIT_DEFINITIONS", "set_units", "decorate_model_description"]
 
 # FMI 2.0 BaseUnit exponents (kg, m, s, A, K) and offset for every unit the FMUs use
 UNIT_DEFINITIONS = {
@@ -41,26 +41,32 @@ def _unit_definitions(units):
     return node
 
 
-def decorate_model_description(root, units):
-    """Complete pythonfmu's ``root`` element in place and return it.
-
-    ``units`` maps variable names to unit names (keys of :data:`UNIT_DEFINITIONS`).
-    """
-    variables = root.find("ModelVariables")
-    output_indices = []
-    for index, variable in enumerate(variables, start=1):
-        name = variable.get("name")
+def set_units(root, units):
+    """Set ``unit`` on each Real variable of the model description ``root`` named in
+    ``units`` (variable name -> a key of :data:`UNIT_DEFINITIONS`), add their
+    ``<UnitDefinitions>`` in schema order; returns ``root``, changed in place."""
+    for variable in root.find("ModelVariables"):
         real = variable.find("Real")
-        if real is not None and name in units:
-            real.set("unit", units[name])
-        if variable.get("causality") == "output" and variable.get("initial") in ("calculated", "approx"):
-            output_indices.append(index)
+        if real is not None and variable.get("name") in units:
+            real.set("unit", units[variable.get("name")])
     if units:
         root.insert(_ORDER.index("UnitDefinitions"), _unit_definitions(units.values()))
         children = sorted(root, key=lambda child: _ORDER.index(child.tag))
         for child in list(root):
             root.remove(child)
         root.extend(children)
+    return root
+
+
+def decorate_model_description(root, units):
+    """Complete pythonfmu's ``root`` element in place and return it.
+
+    ``units`` maps variable names to unit names (keys of :data:`UNIT_DEFINITIONS`).
+    """
+    set_units(root, units)
+    output_indices = [index for index, variable in enumerate(root.find("ModelVariables"), start=1)
+                      if variable.get("causality") == "output"
+                      and variable.get("initial") in ("calculated", "approx")]
     structure = root.find("ModelStructure")
     outputs = structure.find("Outputs")
     if outputs is not None:
