@@ -16,7 +16,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
-from sma_fmu.output_folder import OutputError, staged_folder, write_file
+from sma_fmu.output_folder import OutputError, check_folder, staged_folder, write_file
 from sma_fmu.systems.closed_loop import closed_loop
 
 __all__ = ["PARAMETER_SET", "SSD_NAME", "NAMESPACES", "ssd_document", "ssp_bytes", "write_ssp",
@@ -148,8 +148,7 @@ def ssp_targets(names, out):
         if len(names) > 1:
             raise OutputError(f"--out {out}: {len(names)} scenarios need a folder, not one .ssp file")
         return None, {names[0]: out}
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"--out {out}: exists and is not a folder")
+    check_folder(out)
     return out, {name: out / f"{name}.ssp" for name in names}
 
 
