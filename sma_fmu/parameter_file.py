@@ -141,7 +141,8 @@ def parameter_file_text(params, name, description="", meanings=None, header=()):
         if spec.section != section:
             section = spec.section
             lines += ["", f"[{section}]"]
-        lines.append(f"{spec.name} = {{ value = {float(value)!r}, unit = {json.dumps(spec.unit)}, "
+        rendered = repr(value) if spec.rule == "depth" else repr(float(value))
+        lines.append(f"{spec.name} = {{ value = {rendered}, unit = {json.dumps(spec.unit)}, "
                      f"meaning = {json.dumps(meanings.get(spec.name, ''))} }}")
     return "\n".join(lines) + "\n"
 

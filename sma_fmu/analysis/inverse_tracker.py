@@ -3,7 +3,7 @@
 A controller that knows the plant's whole state (temperature, direction, reversal memory)
 can choose the power that puts R_(k+1) on R_ref(t_(k+1)) exactly, whenever the thermal
 step allows it: the temperature comes from inverting the branch the plant will follow
-(:func:`~sma_fmu.runtime.sensing.temperature_on_branch`: the present branch, or a new minor
+(:func:`~sma_fmu.runtime.sensing.temperature_on_stack`: the present branch, or a new minor
 branch from the present state after a reversal; the major branch in mode "switch"), and
 the power from the thermal step, clamped into [0, P_max].
 
@@ -20,8 +20,8 @@ import numpy as np
 
 from sma_fmu.runtime.constant_load import BranchCache
 from sma_fmu.runtime.constants import COOLING, HEATING
-from sma_fmu.runtime.minor_loops import Reversal
-from sma_fmu.runtime.sensing import mixed_fractions_of_resistance, temperature_on_branch
+from sma_fmu.runtime.minor_loops import push_reversal
+from sma_fmu.runtime.sensing import mixed_fractions_of_resistance, temperature_on_stack
 
 __all__ = ["OneStepInverse", "track"]
 
@@ -42,14 +42,15 @@ class OneStepInverse:
     def _temperature_towards(self, reference, load, direction):
         """T [degC] on the branch the plant follows in ``direction`` that gives ``reference``."""
         plant, params = self.plant, self.problem.params
-        reversal = None
+        points = []
         if plant.mode == "continuous":
-            reversal = (plant.reversal if direction == plant.direction
-                        else Reversal(plant.temperature, plant.xi_MF))
+            points = list(plant.reversals)
+            if direction != plant.direction:
+                push_reversal(points, plant.temperature, plant.xi_MF, params.memory_depth)
         constants = self._branches.get(load, direction)
         xi_mf, xi_p = mixed_fractions_of_resistance(reference, constants, params)
-        return temperature_on_branch(xi_mf, xi_p, constants, direction, reversal,
-                                     params.saturation_margin).temperature
+        return temperature_on_stack(xi_mf, xi_p, constants, direction, points,
+                                    params.saturation_margin)[0].temperature
 
     def power_for(self, reference, load):
         """Power [W] in [0, P_max] for the next step (``load`` [kg] held) towards ``reference`` [ohm]."""

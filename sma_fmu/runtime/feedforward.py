@@ -10,13 +10,15 @@ Two inverses (``inverse``):
 
 - ``"major"`` (default, the paper's): the major branch of d_ref (section 5).
 - ``"minor-loop"``: the branch the plant's continuous mode (section 6) is on. The
-  compensator keeps its own reversal memory: when d_ref changes at sample k, the reversal
-  point is the state it assumed at sample k-1, (T_ref,k-1, xi_MF,k-1), where xi_MF,k-1 is
-  the fraction of R_ref(t_k-1) at the load then (or, where that sample was clamped, the
-  fraction of its branch at the clamped T_ref,k-1). The minor branch leaving it is
-  inverted in closed form (:func:`~.sensing.temperature_on_branch`). After a load change
-  the branch is re-evaluated with the new load, as the plant does. Before the first
-  reversal it is the major heating branch, where the plant starts.
+  compensator keeps its own stack of reversal points with the plant's rules: when d_ref
+  changes at sample k, it pushes the state it assumed at sample k-1, (T_ref,k-1,
+  xi_MF,k-1), where xi_MF,k-1 is the fraction of R_ref(t_k-1) at the load then (or, where
+  that sample was clamped, the fraction of its branch at the clamped T_ref,k-1). The
+  branch of the stack is inverted in closed form, walking the stack: a target beyond the
+  branch's end B lies on the outer branch, and the loop it closes is wiped out
+  (:func:`~.sensing.temperature_on_stack`). After a load change the branches are
+  re-evaluated with the new load, as the plant does. With an empty stack it is the major
+  branch of d_ref; it starts heating, as the plant does.
 
 In both, a reference outside what the branch can reach at the present load gives the
 temperature of the nearest reachable edge (xi_MF clamped to delta or M - delta of the
@@ -25,13 +27,17 @@ section 5 clamp) and ``saturated`` = True.
 from collections import namedtuple
 
 from .checks import fast_nonnegative, fast_positive, require_nonnegative, require_positive
-from .constant_load import BranchCache, branch_fractions
+from .constant_load import BranchCache
 from .constants import COOLING, HEATING
-from .minor_loops import Reversal, minor_branch_fractions
+from .minor_loops import fractions_on_stack, push_reversal, read_points
 from .phase_lag import PhaseLagFilter
-from .sensing import mixed_fractions_of_resistance, temperature_on_branch
+from .sensing import (mixed_fractions_of_resistance, temperature_of_fractions,
+                      temperature_on_stack)
 
-__all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStepper"]
+__all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStepper",
+           "STATE_FORMAT"]
+
+STATE_FORMAT = "sma-fmu compensator state 2: reversal stack"   # what state() writes
 
 INVERSES = ("major", "minor-loop")
 
@@ -67,7 +73,7 @@ class FeedforwardStepper:
         True: the inverse uses the measured load ("adaptive"); False: ``model_load``.
     inverse : "major" | "minor-loop"
         Invert the major branches (the paper's) or the minor branches of the plant's
-        continuous mode, with a reversal memory taken from d_ref (see the module docstring).
+        continuous mode, with a stack of reversals taken from d_ref (see the module docstring).
     """
 
     def __init__(self, params, alpha=None, beta=None, model_load=None, adapt_to_load=True,
@@ -83,25 +89,34 @@ class FeedforwardStepper:
         self._minor_loops = self.inverse == "minor-loop"
         self.direction = HEATING
         self.previous_reference = None
-        self.reversal = None              # minor-loop memory: Reversal(T_r [degC], xi_r [1])
+        self.reversals = []               # minor-loop memory: ReversalPoint(T [degC], xi_MF [1])
         self.previous_temperature = None  # T_ref,k-1 [degC] (minor-loop inverse only)
         self.previous_fraction = None     # xi_MF,k-1 [1] the compensator assumed
         self._branches = BranchCache(params)
 
     def _invert(self, reference, load, direction):
-        """(SensedTemperature, v [W], reversal, xi_MF assumed) for one sample; no state change."""
+        """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
+
+        The stack returned is the compensator's list itself when it is unchanged, else a copy.
+        """
         params = self.params
         constants = self._branches.get(load if self.adapt_to_load else self.model_load, direction)
         xi_mf, xi_p = mixed_fractions_of_resistance(reference, constants, params)
-        reversal = self.reversal
-        if self._minor_loops and direction != self.direction and self.previous_temperature is not None:
-            reversal = Reversal(self.previous_temperature, self.previous_fraction)
-        sensed = temperature_on_branch(xi_mf, xi_p, constants, direction, reversal,
-                                       params.saturation_margin)
-        if sensed.saturated and self._minor_loops:  # the state assumed is on the branch's edge
-            xi_mf = (branch_fractions(sensed.temperature, constants)[0] if reversal is None else
-                     minor_branch_fractions(sensed.temperature, constants, direction, reversal)[0])
-        return sensed, (sensed.temperature - params.T_room) / params.K_th, reversal, xi_mf
+        points = self.reversals
+        if not self._minor_loops:
+            return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin), \
+                points, xi_mf
+        if direction != self.direction and self.previous_temperature is not None:
+            points = list(points)
+            push_reversal(points, self.previous_temperature, self.previous_fraction,
+                          params.memory_depth)
+        sensed, kept = temperature_on_stack(xi_mf, xi_p, constants, direction, points,
+                                            params.saturation_margin)
+        if kept < len(points):
+            points = points[:kept]
+        if sensed.saturated:  # the state assumed is on the branch's edge
+            xi_mf = fractions_on_stack(sensed.temperature, constants, direction, points)[0]
+        return sensed, points, xi_mf
 
     def _direction_for(self, reference):
         previous = self.previous_reference
@@ -118,8 +133,8 @@ class FeedforwardStepper:
             raise RuntimeError("initial_outputs is only defined before the first step")
         reference = require_positive("R_ref", reference)
         load = require_nonnegative("load", load)
-        sensed, power, _, _ = self._invert(reference, load, self._direction_for(reference))
-        return FeedforwardOutputs(power, sensed.temperature, sensed.saturated)
+        sensed = self._invert(reference, load, self._direction_for(reference))[0]
+        return FeedforwardOutputs(self._power(sensed), sensed.temperature, sensed.saturated)
 
     def step(self, reference, load, step_size):
         """Compensate one sample: R_ref [ohm] and load [kg] at t_k, step h [s] -> outputs.
@@ -130,29 +145,38 @@ class FeedforwardStepper:
         load = fast_nonnegative("load", load)
         step_size = fast_positive("step_size", step_size)
         direction = self._direction_for(reference)
-        sensed, power, reversal, fraction = self._invert(reference, load, direction)
-        output = self.filter.step(power, step_size)
+        sensed, points, fraction = self._invert(reference, load, direction)
+        output = self.filter.step(self._power(sensed), step_size)
         self.direction = direction
         self.previous_reference = reference
-        self.reversal = reversal
+        self.reversals = points
         self.previous_temperature = sensed.temperature
         self.previous_fraction = fraction
         return _new_tuple(FeedforwardOutputs, (output, sensed.temperature, sensed.saturated))
 
+    def _power(self, sensed):
+        """v = (T_ref - T_room)/K_th [W]: the steady-state power of the sensed temperature."""
+        return (sensed.temperature - self.params.T_room) / self.params.K_th
+
     def state(self):
-        """JSON-ready hidden state (direction, last reference, minor-loop memory, filter)."""
-        return {"direction": self.direction, "previous_reference": self.previous_reference,
-                "reversal": None if self.reversal is None else list(self.reversal),
+        """JSON-ready hidden state (direction, last reference, reversal stack, filter)."""
+        return {"format": STATE_FORMAT,
+                "direction": self.direction, "previous_reference": self.previous_reference,
+                "reversals": [list(point) for point in self.reversals],
                 "previous_temperature": self.previous_temperature,
                 "previous_fraction": self.previous_fraction,
                 "filter": self.filter.state()}
 
     def restore(self, state):
-        """Restore a state saved by :meth:`state`."""
+        """Restore a state saved by :meth:`state`; one of an earlier build raises ``ValueError``."""
+        if state.get("format") != STATE_FORMAT:
+            raise ValueError(
+                f"the compensator state has format {state.get('format')!r}, not {STATE_FORMAT!r}: "
+                "it was saved by an earlier sma-fmu build (minor-loop memory of one reversal) "
+                "and cannot be restored by this one")
         self.direction = state["direction"]
         self.previous_reference = state["previous_reference"]
-        reversal = state.get("reversal")
-        self.reversal = None if reversal is None else Reversal(*reversal)
+        self.reversals = read_points(state["reversals"], self.params.memory_depth, "reversals")
         self.previous_temperature = state.get("previous_temperature")
         self.previous_fraction = state.get("previous_fraction")
         self.filter.restore(state["filter"])

@@ -9,6 +9,7 @@ from collections import namedtuple
 from dataclasses import dataclass, field
 
 from .constants import BOLTZMANN
+from .minor_loops import DEFAULT_DEPTH
 from .lattice import lattice_constants
 from .thermal import thermal_gain, thermal_time_constant
 
@@ -23,7 +24,7 @@ ParameterSpec = namedtuple("ParameterSpec", ["name", "section", "unit", "rule", 
 ParameterSpec.__doc__ = "One entry of the parameter schema: where it lives, its unit, its rule."
 
 # rule: "positive" (> 0), "nonnegative" (>= 0), "fraction" (0 <= v < 1), "finite",
-#       "margin" (0 < v < 0.5)
+#       "margin" (0 < v < 0.5), "depth" (a whole number in [2, MAX_MEMORY_DEPTH])
 PARAMETER_SPECS = (
     ParameterSpec("x0", "geometry", "m", "positive", True),
     ParameterSpec("x_min", "geometry", "m", "positive", True),
@@ -39,6 +40,7 @@ PARAMETER_SPECS = (
     ParameterSpec("b_h", "hysteresis", "degC/kg", "finite", True),
     ParameterSpec("a_c", "hysteresis", "degC", "finite", True),
     ParameterSpec("b_c", "hysteresis", "degC/kg", "finite", True),
+    ParameterSpec("memory_depth", "hysteresis", "1", "depth", False),
     ParameterSpec("xi_F_inf", "constant_load", "1", "fraction", True),
     ParameterSpec("f_F", "constant_load", "kg", "positive", True),
     ParameterSpec("eps_T", "constant_load", "J", "positive", True),
@@ -66,7 +68,9 @@ _RULE_TEXT = {
     "fraction": "must be in [0, 1)",
     "finite": "must be finite",
     "margin": "must be in (0, 0.5)",
+    "depth": "must be a whole number in [2, 100000]",
 }
+MAX_MEMORY_DEPTH = 100_000
 
 
 def _rule_holds(rule, value):
@@ -80,6 +84,8 @@ def _rule_holds(rule, value):
         return 0.0 <= value < 1.0
     if rule == "margin":
         return 0.0 < value < 0.5
+    if rule == "depth":
+        return value == int(value) and 2 <= value <= MAX_MEMORY_DEPTH
     return True
 
 
@@ -91,6 +97,8 @@ class WireParameters:
     ``line_density`` = mass/x0 [kg/m], ``l_P`` = x_min [m], ``x_T`` = l_P - (l_M + l_F)/2 [m],
     ``x_f`` = l_F - (l_P + l_M)/2 [m], ``R_MF`` = (R_M + R_F)/2 [ohm], ``K_th`` [K/W],
     ``tau_th`` [s], ``phase_lag_alpha`` = alpha, or tau_th when alpha is not given [s].
+    ``memory_depth`` [1] is the most reversal points the minor-loop memory keeps (an int;
+    optional in a file, default 64).
     """
 
     x0: float
@@ -124,6 +132,7 @@ class WireParameters:
     Ki: float
     T_max: float
     alpha: float = None
+    memory_depth: int = DEFAULT_DEPTH
     source: str = field(default="<parameters>", compare=False, repr=False)
 
     lattice: tuple = field(init=False, repr=False, compare=False)
@@ -158,7 +167,7 @@ class WireParameters:
         value = float(value)
         if not _rule_holds(spec.rule, value):
             self._fail(f"parameter {key} = {value!r} {_RULE_TEXT[spec.rule]} [{spec.unit}]")
-        object.__setattr__(self, spec.name, value)
+        object.__setattr__(self, spec.name, int(value) if spec.rule == "depth" else value)
 
     def _derived(self, what, unit, keys, compute):
         """``compute()`` -> value(s) that must be finite and > 0, else ParameterError naming ``keys``."""

@@ -3,9 +3,10 @@
 One :meth:`PlantStepper.step` advances from t_k to t_k + h with the input power and the
 load held, and evaluates the outputs at the end of the step with the held load.
 The direction is sgn(T+ - T) (unchanged when T+ = T). In mode "continuous" (the
-default) a reversal found in a step stores (T_k, xi_MF_k) and the minor branch of
-section 6 follows; in mode "switch" (the paper's) the fractions follow the major branch
-of that direction. A power of 0 W or less is applied as 0 W (the paper's rule), so a
+default) a reversal found in a step pushes (T_k, xi_MF_k) onto the stack of reversal
+points, closed loops are wiped out, and the branch of the top point follows (section 6,
+:mod:`.minor_loops`: return-point memory); in mode "switch" (the paper's) the fractions
+follow the major branch of that direction. A power of 0 W or less is applied as 0 W (the paper's rule), so a
 compensator output wired straight to the plant is valid; non-finite power is rejected,
 and so is a finite power so large that the temperature would leave the floating-point
 range. Leaving the validity range (T above ``validity.T_max``) sets :attr:`PlantStepper.warning`
@@ -18,10 +19,13 @@ from .checks import (direction_sign, fast_finite, fast_nonnegative, fast_positiv
                      require_finite, require_mode, require_nonnegative)
 from .constant_load import BranchCache, branch_fractions, require_temperature
 from .constants import COOLING, HEATING
-from .minor_loops import Reversal, minor_branch_fractions
+from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_points,
+                          wipe_out)
 from .thermal import step_decay, thermal_step
 
-__all__ = ["PlantOutputs", "PlantStepper"]
+__all__ = ["PlantOutputs", "PlantStepper", "STATE_FORMAT"]
+
+STATE_FORMAT = "sma-fmu plant state 2: reversal stack"   # what state() writes, restore() reads
 
 PlantOutputs = namedtuple("PlantOutputs", ["R", "T", "x", "xi_P", "xi_M", "xi_F", "P", "heating"])
 _new_tuple = tuple.__new__
@@ -47,7 +51,8 @@ class PlantStepper:
     load : float
         Load during initialization [kg]; the initial outputs reflect it.
 
-    The wire starts heating, on the major branch. ``warning`` is a message for the one
+    The wire starts heating, on the major branch, with an empty reversal memory
+    (:attr:`reversals`, at most ``params.memory_depth`` points). ``warning`` is a message for the one
     step (or the start) in which the temperature rises above ``params.T_max``, else None.
     """
 
@@ -60,7 +65,9 @@ class PlantStepper:
         self.temperature = (params.T_room if T_start is None
                             else require_temperature("T_start", T_start))
         self.direction = HEATING
-        self.reversal = None
+        self.reversals = []          # the stack of ReversalPoint (T [degC], xi_MF [1])
+        self._branch = None          # the Branch of the top point (None: the major branch)
+        self._branch_key = None      # the BranchConstants it was made for
         self.load = require_nonnegative("load", load)
         self.power = 0.0
         constants = self._branches.get(self.load, HEATING)
@@ -97,18 +104,24 @@ class PlantStepper:
                              "temperature out of the floating-point range")
         direction = HEATING if after > before else (COOLING if after < before else self.direction)
         constants = self._branches.get(load, direction)
-        reversal = self.reversal
         if self._continuous:
-            if direction != self.direction:
-                reversal = Reversal(before, self.xi_MF)
-            if reversal is None:
+            points = self.reversals
+            changed = direction != self.direction
+            if changed:
+                push_reversal(points, before, self.xi_MF, params.memory_depth)
+            if len(points) >= 2 and wipe_out(points, after, direction):
+                changed = True
+            if not points:
                 xi_mf, xi_p = branch_fractions(after, constants)
             else:
-                xi_mf, xi_p = minor_branch_fractions(after, constants, direction, reversal)
+                if changed or constants is not self._branch_key:
+                    self._branch = branch_of(points, len(points), constants, direction)
+                    self._branch_key = constants
+                xi_mf, xi_p = fractions_on_branch(after, constants, direction, self._branch)
         else:
             xi_mf, xi_p = branch_fractions(after, constants)
-        self.temperature, self.direction, self.reversal, self.load, self.power = (
-            after, direction, reversal, load, power)
+        self.temperature, self.direction, self.load, self.power = (
+            after, direction, load, power)
         self.xi_MF, self.xi_P = xi_mf, xi_p
         self.outputs = self._evaluate(constants)
         self.warning = None
@@ -132,11 +145,12 @@ class PlantStepper:
         ))
 
     def state(self):
-        """JSON-ready hidden state (temperature, direction, minor-loop memory, fractions, load)."""
+        """JSON-ready hidden state (temperature, direction, reversal stack, fractions, load)."""
         return {
+            "format": STATE_FORMAT,
             "temperature": self.temperature,
             "direction": self.direction,
-            "reversal": None if self.reversal is None else list(self.reversal),
+            "reversals": [list(point) for point in self.reversals],
             "load": self.load,
             "xi_MF": self.xi_MF,
             "xi_P": self.xi_P,
@@ -146,16 +160,19 @@ class PlantStepper:
     def restore(self, state):
         """Restore a state saved by :meth:`state` and re-evaluate the outputs.
 
-        A value of the wrong kind raises ``ValueError`` (``KeyError`` if one is missing).
+        A value of the wrong kind raises ``ValueError`` (``KeyError`` if one is missing); so
+        does a state of an earlier build (one reversal, no stack), which is never misread.
         """
-        reversal = state["reversal"]
-        if reversal is not None:
-            if not isinstance(reversal, (list, tuple)) or len(reversal) != 2:
-                raise ValueError(f"reversal must be None or [T, xi_MF], got {reversal!r}")
-            reversal = Reversal(*(require_finite("reversal", v) for v in reversal))
+        if state.get("format") != STATE_FORMAT:
+            raise ValueError(
+                f"the plant state has format {state.get('format')!r}, not {STATE_FORMAT!r}: it "
+                "was saved by an earlier sma-fmu build (minor-loop memory of one reversal) "
+                "and cannot be restored by this one")
+        points = read_points(state["reversals"], self.params.memory_depth, "reversals")
         values = [require_finite(key, state[key]) for key in ("temperature", "load", "xi_MF", "xi_P")]
         self.direction = direction_sign(state["direction"])
         self.temperature, self.load, self.xi_MF, self.xi_P = values
-        self.reversal = reversal
+        self.reversals = points
+        self._branch_key = None
         self.power = require_finite("power", state.get("power", 0.0))
         self.outputs = self._evaluate(self._branches.get(self.load, self.direction))

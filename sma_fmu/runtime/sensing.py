@@ -8,9 +8,13 @@ information. There xi_MF is clamped into [delta, M - delta], delta = saturation_
 the clamped temperature is returned and ``saturated`` is set. The flag is set whenever
 the clamp acts: outside (0, M) and also within delta of either end.
 
-On a minor branch of section 6 (after a reversal) the inverse maps the point to the major
-branch at the same temperature (:func:`~.minor_loops.major_equivalent`) and inverts that;
-the clamp then acts twice: into the band the load allows, then into what the branch reaches.
+On the minor branches of section 6 (a stack of reversal points) the inverse walks the
+stack: a target beyond the branch's end point B lies on the outer branch (A and B are
+popped, as a loop that closes is wiped out), and on the branch A -> B the affine map of
+section 6 is inverted in closed form, L_d(T) = L_d(T_B) + (v* - v_B)(L_d(T_A) - L_d(T_B))/
+(v_A - v_B) (v = xi_MF heating, M - xi_MF cooling), then T from the major branch's inverse.
+The clamp then acts twice: into the band the load allows, then into what the major branch
+reaches.
 """
 import math
 from collections import namedtuple
@@ -18,11 +22,12 @@ from collections import namedtuple
 from .checks import direction_sign, require_positive
 from .constant_load import branch_constants
 from .constants import KELVIN_OFFSET
-from .minor_loops import major_equivalent
+from .constants import HEATING
+from .minor_loops import DENOMINATOR_FLOOR, fractions_of_value, major_value, value_of
 from .reachable_band import band_of_branch
 
 __all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of_fractions",
-           "temperature_on_branch", "sense_temperature"]
+           "temperature_on_stack", "sense_temperature"]
 
 SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
 SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
@@ -65,42 +70,63 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin):
     return _new_tuple(SensedTemperature, (1.0 / inverse_kelvin - KELVIN_OFFSET, saturated))
 
 
-def temperature_on_branch(xi_mf, xi_p, constants, direction, reversal, margin):
-    """Invert the branch the wire is on: (xi_MF, xi_P) [1] -> :class:`SensedTemperature`.
+def temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin, count=None):
+    """Invert the branch the wire is on: (xi_MF, xi_P) [1] -> (:class:`SensedTemperature`, kept).
 
-    ``reversal`` None: the major branch of ``direction`` (as :func:`temperature_of_fractions`).
-    A :class:`~.minor_loops.Reversal`: the minor branch that left it in ``direction``. The
-    fractions are first clamped into [delta, M - delta] (what the load allows), then the
-    major equivalent is clamped the same way (what this branch reaches); ``saturated`` is
-    set when either clamp acts. Where the branch is flat (its denominator below the floor,
-    so no temperature moves it) the result is the reversal temperature, saturated.
-    No argument checks: this is on the compensator's hot path.
+    ``points[:count]`` (default all) is the stack of :class:`~.minor_loops.ReversalPoint`
+    (empty: the major branch of ``direction``, as :func:`temperature_of_fractions`). The
+    fractions are first clamped into [delta, M - delta] (what the load allows); a target
+    beyond B pops A and B (the loop it closes is wiped out) and the walk repeats; on the
+    branch A -> B the major value is found in closed form and inverted, clamped again into
+    what the major branch reaches. ``saturated`` is set when either clamp acts. Where the
+    branch is flat (a denominator below the floor) the result is T_A, saturated. ``kept``
+    is how many points of the stack remain. No argument checks: the compensator's hot path.
     """
-    if reversal is None:
-        return temperature_of_fractions(xi_mf, xi_p, constants, margin)
-    delta = margin * constants.M
+    count = len(points) if count is None else count
+    if not count:
+        return temperature_of_fractions(xi_mf, xi_p, constants, margin), 0
+    total = constants.M
+    delta = margin * total
     clamped = False
     if not (xi_mf >= delta and xi_p >= delta):
-        xi_mf, xi_p, clamped = _clamped(xi_mf, constants.M, delta)
-    major = major_equivalent(xi_mf, xi_p, constants, direction, reversal)
-    if major is None:
-        return _new_tuple(SensedTemperature, (reversal.temperature, True))
-    sensed = temperature_of_fractions(major[0], major[1], constants, margin)
-    if clamped and not sensed.saturated:
-        return _new_tuple(SensedTemperature, (sensed.temperature, True))
-    return sensed
+        xi_mf, xi_p, clamped = _clamped(xi_mf, total, delta)
+    heating = direction == HEATING
+    target = xi_mf if heating else xi_p
+    while count:
+        top = points[count - 1]
+        value_A = value_of(top, total, heating)
+        if count >= 2:
+            below = points[count - 2]
+            value_B = value_of(below, total, heating)
+            if (target - value_B) * (value_A - value_B) < 0.0:   # beyond B: the outer branch
+                count -= 2
+                continue
+            major_B = major_value(below.temperature, constants, heating)
+        else:
+            value_B = major_B = 0.0
+        major_A = major_value(top.temperature, constants, heating)
+        span = value_A - value_B
+        if abs(major_A - major_B) < DENOMINATOR_FLOOR or abs(span) < DENOMINATOR_FLOOR:
+            return _new_tuple(SensedTemperature, (top.temperature, True)), count
+        major = major_B + (target - value_B) * ((major_A - major_B) / span)
+        major_mf, major_p = fractions_of_value(major, total, heating)
+        sensed = temperature_of_fractions(major_mf, major_p, constants, margin)
+        if clamped and not sensed.saturated:
+            sensed = _new_tuple(SensedTemperature, (sensed.temperature, True))
+        return sensed, count
+    return temperature_of_fractions(xi_mf, xi_p, constants, margin), 0
 
 
-def sense_temperature(resistance, load, direction, params, reversal=None):
+def sense_temperature(resistance, load, direction, params, reversals=()):
     """Temperature [degC] of a wire with ``resistance`` [ohm] under ``load`` [kg].
 
-    ``direction`` is +1/"heating" or -1/"cooling". With ``reversal`` (a
-    :class:`~.minor_loops.Reversal`) the point is on the continuous-mode minor branch
-    that left that reversal; otherwise on the major branch (see :func:`temperature_on_branch`).
+    ``direction`` is +1/"heating" or -1/"cooling". With ``reversals`` (a stack of
+    :class:`~.minor_loops.ReversalPoint`, oldest first) the point is on the continuous-mode
+    branch of that memory; otherwise on the major branch (see :func:`temperature_on_stack`).
     """
     resistance = require_positive("resistance", resistance)
     sign = direction_sign(direction)
     constants = branch_constants(load, sign, params)
     xi_mf, xi_p = mixed_fractions_of_resistance(resistance, constants, params)
-    return temperature_on_branch(xi_mf, xi_p, constants, sign, reversal,
-                                 params.saturation_margin)
+    return temperature_on_stack(xi_mf, xi_p, constants, sign, list(reversals),
+                                params.saturation_margin)[0]

@@ -131,7 +131,11 @@ class SlaveInterface:
                 start = getattr(self.defaults, "phase_lag_alpha" if spec.name == "alpha" else spec.name)
                 meaning = entry.get("meaning") or (
                     "phase-lag lead time (default: thermal time constant)" if spec.name == "alpha" else spec.name)
-                self.parameter(spec.name, start, spec.unit, f"{meaning} [{spec.section}]")
+                if spec.rule == "depth":  # a count: an Integer (FMI 2.0 Integers have no unit)
+                    self.parameter(spec.name, int(start), None, f"{meaning} [{spec.section}, 1]",
+                                   kind=Integer)
+                else:
+                    self.parameter(spec.name, start, spec.unit, f"{meaning} [{spec.section}]")
                 self.exposed.append(spec.name)
 
     def string_parameter(self, name, start, description):
