@@ -26,6 +26,11 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     [plant]
     hysteresis_mode = "switch"  # default "continuous"; optional T_start_degC (default T_room)
 
+    [drive]                     # optional: how the controller's power reaches the wire
+    kind = "pwm"                # "power" (default: the demanded power itself) or "pwm"
+    frequency_Hz = 50.0         # pwm: switching frequency; the demand sets each period's duty
+    peak_W = 1.0                # pwm: power while on (duty = clip(P_demand / peak_W, 0, 1))
+
     [analysis]                  # optional; defaults derived from the duration (see AnalysisWindow)
     metrics_start_s = 2.0       # metrics over t >= this
     zoom_start_s = 24.0         # enlarged window of the comparison figures
@@ -45,11 +50,13 @@ from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.feedforward import INVERSES
+from sma_fmu.runtime.pwm import DRIVE_KINDS
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
 from sma_fmu.toml_files import read_toml
 
-__all__ = ["ScenarioError", "ControllerSettings", "AnalysisWindow", "Scenario", "CONTROLLERS",
+__all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "AnalysisWindow", "Scenario",
+           "CONTROLLERS",
            "PAPER_SET", "MAX_STEPS", "load_scenario", "read_scenario_document",
            "scenario_from_document", "check_sections", "default_analysis", "scenario_names",
            "resolve_scenarios"]
@@ -66,6 +73,7 @@ _SECTIONS = {
                    "inverse"},
     "plant": {"hysteresis_mode", "T_start_degC"},
     "analysis": {"metrics_start_s", "zoom_start_s", "zoom_end_s"},
+    "drive": {"kind", "frequency_Hz", "peak_W"},
 }
 
 AnalysisWindow = namedtuple("AnalysisWindow", ["metrics_start_s", "zoom_start_s", "zoom_end_s"])
@@ -120,6 +128,22 @@ class ControllerSettings:
 
 
 @dataclass(frozen=True)
+class DriveSettings:
+    """How the loop's power reaches the wire: ``kind`` "power" (the demanded power itself) or
+    "pwm" (:class:`~sma_fmu.runtime.pwm.PwmDriver` at ``frequency_Hz`` [Hz] between 0 and
+    ``peak_W`` [W]; the plant gets the PWM wave's mean over each step)."""
+
+    kind: str = "power"
+    frequency_Hz: float = None
+    peak_W: float = None
+
+    @property
+    def pwm(self):
+        """True when the power is switched by a PWM driver."""
+        return self.kind == "pwm"
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A validated scenario (see the module docstring for the file format)."""
 
@@ -137,6 +161,7 @@ class Scenario:
     analysis_window: AnalysisWindow = None   # the file's [analysis]; None: from the duration
     group_name: str = None
     compensator_parameter_set: object = None   # the compensator's model; None: the wire's
+    drive: DriveSettings = DriveSettings()     # the file's [drive]; default: power as demanded
 
     @property
     def params(self):
@@ -254,6 +279,19 @@ def _controller(path, table, params):
                               values["beta"], values["model_load"], inverse)
 
 
+def _drive(path, table):
+    kind = table.get("kind", "power")
+    if kind not in DRIVE_KINDS:
+        _fail(path, f"[drive] kind must be one of {', '.join(DRIVE_KINDS)}, got {kind!r}")
+    if kind == "power":
+        extra = sorted(set(table) - {"kind"})
+        if extra:
+            _fail(path, f"[drive] {', '.join(extra)} only apply to kind = 'pwm'")
+        return DriveSettings()
+    return DriveSettings("pwm", _number(path, "drive", table, "frequency_Hz", positive=True),
+                         _number(path, "drive", table, "peak_W", positive=True))
+
+
 def check_sections(path, document, sections, required, error=ScenarioError):
     """Raise ``error`` for a section or key not in ``sections`` (name -> allowed keys, or None
     for any) and for a missing ``required`` section, naming ``path``."""
@@ -318,7 +356,8 @@ def scenario_from_document(document, path, parameter_set=None):
         controller=_controller(path, document["controller"], parameter_set.params),
         hysteresis_mode=mode, T_start=t_start, parameter_set=parameter_set,
         analysis_window=_analysis(path, document["analysis"], stop) if "analysis" in document else None,
-        group_name=_string(path, "scenario", head, "group"))
+        group_name=_string(path, "scenario", head, "group"),
+        drive=_drive(path, document["drive"]) if "drive" in document else DriveSettings())
 
 
 def scenario_names():
