@@ -5,7 +5,7 @@ import pytest
 
 from sma_fmu.runtime.constant_load import branch_constants, constant_load_fractions
 from sma_fmu.runtime.constants import COOLING, HEATING
-from sma_fmu.runtime.minor_loops import Reversal, minor_branch_fractions
+from sma_fmu.runtime.minor_loops import ReversalPoint, fractions_on_stack
 from sma_fmu.runtime.phases import resistance_of
 from sma_fmu.runtime.sensing import sense_temperature
 
@@ -64,16 +64,16 @@ def test_clamped_temperatures_bracket_the_transformation(params):
 def test_continuous_mode_round_trip_after_reversal(params, load, reversal_temperature, direction):
     previous = -direction  # the branch the wire was on before reversing
     xi_r = 2.0 * constant_load_fractions(reversal_temperature, load, previous, params).xi_M
-    reversal = Reversal(reversal_temperature, xi_r)
+    reversals = [ReversalPoint(reversal_temperature, xi_r)]
     constants = branch_constants(load, direction, params)
     worst, checked = 0.0, 0
     for temperature in TEMPERATURES:
         if (temperature - reversal_temperature) * direction < 0.0:
             continue  # the minor branch only runs onwards from the reversal
-        xi_mf, xi_p = minor_branch_fractions(temperature, constants, direction, reversal)
+        xi_mf, xi_p = fractions_on_stack(temperature, constants, direction, reversals)
         resistance = (params.R_P * xi_p + params.R_MF * xi_mf
                       + constants.xi_F_min * params.R_F)
-        sensed = sense_temperature(resistance, load, direction, params, reversal=reversal)
+        sensed = sense_temperature(resistance, load, direction, params, reversals=reversals)
         if _inside(xi_mf, constants.M):
             assert not sensed.saturated
             worst = max(worst, abs(sensed.temperature - temperature))

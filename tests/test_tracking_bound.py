@@ -118,11 +118,11 @@ def test_continuous_benchmark_replays_and_beats_every_controller(tmp_path):
     np.testing.assert_array_equal(problem.replay(powers), resistances)
     bound = tracking_bound(scenario)
     assert bound.lower_bound_ohm == bound.saturation_bound_ohm == 0.0
-    assert bound.achievable.rmse_ohm <= problem.rmse_of(resistances) < 0.1
+    assert bound.achievable.rmse_ohm <= problem.rmse_of(resistances)
     assert bound.achievable.reversals_per_s > 100  # the best chatters (see docs/compensator.md)
     assert bound.smooth.reversals_per_s <= 2 and bound.smooth.rmse_ohm > bound.achievable.rmse_ohm
-    for controller in CONTROLLERS:
-        assert _rmse(_short(tmp_path, "continuous", controller)) > bound.smooth.rmse_ohm
+    for controller in CONTROLLERS:  # a perfect-knowledge inverse beats them all by far
+        assert _rmse(_short(tmp_path, "continuous", controller)) > 5.0 * bound.smooth.rmse_ohm
 
 
 def test_grid_passive_step_lands_at_most_one_cell_down(switch_bound):
@@ -158,7 +158,7 @@ def test_one_step_inverse_lands_on_the_target(switch_bound, mode, offset):
     for power in [3.5] * 1500 + [0.0] * 100 + [3.0] * 100:  # heat, cool a little, heat again
         inverse.plant.step(power, 0.05, problem.step_s)
     before = inverse.plant.outputs.R
-    assert 36.0 < before < 47.0 and (mode == "switch" or inverse.plant.reversal is not None)
+    assert 36.0 < before < 47.0 and (mode == "switch" or len(inverse.plant.reversals) > 0)
     target = before + offset
     power = inverse.power_for(target, 0.05)
     after = inverse.plant.step(power, 0.05, problem.step_s).R

@@ -184,15 +184,15 @@ class FmuInstance:
         return FmuError(f"{self.instance_name}: {what} failed ({_STATUS[status]}): {log}", status)
 
     def set(self, values):
-        """Set variables by name: {name: value} (Real, Boolean or String)."""
-        groups = {"Real": {}, "Boolean": {}, "String": {}}
+        """Set variables by name: {name: value} (Real, Integer, Boolean or String)."""
+        groups = {"Real": {}, "Integer": {}, "Boolean": {}, "String": {}}
         for name, value in values.items():
             variable = self.variables.get(name)
             if variable is None:
                 raise KeyError(f"{self.instance_name}: no variable {name!r} in {self.path}")
             groups[variable.type][name] = value
-        for kind, setter in (("Real", self._fmu.setReal), ("Boolean", self._fmu.setBoolean),
-                             ("String", self._fmu.setString)):
+        for kind, setter in (("Real", self._fmu.setReal), ("Integer", self._fmu.setInteger),
+                             ("Boolean", self._fmu.setBoolean), ("String", self._fmu.setString)):
             if groups[kind]:
                 refs = [self.variables[n].valueReference for n in groups[kind]]
                 self._call(f"fmi2Set{kind}", setter, refs, list(groups[kind].values()))
