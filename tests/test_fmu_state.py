@@ -1,8 +1,14 @@
 """FMU state: save at t = 5 s, run on, restore, rerun -> identical outputs (hidden state included)."""
+import json
+import math
+import zlib
+
 import pytest
 
 from fmu_signals import STEP, plant_load, plant_power, reference
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.parameter_file import load_parameters
+from sma_fmu.runtime.plant import PlantStepper
 
 SAVE_AT, RUN_TO = 5000, 8000  # steps: 5 s and 8 s
 
@@ -57,13 +63,44 @@ def test_serialized_state_moves_to_a_fresh_instance(fmus, case):
         assert _run(target, inputs, outputs, SAVE_AT, SAVE_AT + 1000) == expected
 
 
-def test_restored_minor_loop_memory_matters(fmus):
-    """Without the hidden minor-loop memory a restored plant would diverge: check it is saved."""
-    import json
-    name, start, inputs, outputs = CASES["plant-continuous"]
-    with FmuInstance(fmus[name], "memory", start) as fmu:
-        _run(fmu, inputs, outputs, 0, SAVE_AT)
-        saved = json.loads(fmu.serialize_state(fmu.get_state())[20:])  # after the front's header
-    stepper = saved["__stepper__"]
-    assert stepper["reversal"] is not None and len(stepper["reversal"]) == 2
-    assert stepper["direction"] in (1, -1)
+def _nested_power(k):
+    """Power [W] with two superposed oscillations: nested minor loops, a deep stack."""
+    t = k * STEP
+    return max(0.0, plant_power(k) + 0.5 * math.sin(2.0 * math.pi * 2.3 * t))
+
+
+def test_restored_stack_of_reversals_matters(fmus):
+    """The FMU saves the plant's reversal stack; without it a restored plant would diverge,
+    and a state in the format of an earlier build (one reversal) is refused."""
+    probe = PlantStepper(load_parameters(), load=0.05)   # where is the stack two deep?
+    save_at = next(k for k in range(SAVE_AT * 4) if len(probe.reversals) >= 2 and k > SAVE_AT
+                   or probe.step(_nested_power(k), 0.05, STEP) is None)
+    with FmuInstance(fmus["SmaActuator"], "memory", {}) as fmu:
+        for k in range(save_at):
+            fmu.set_real(("P_in", "load"), (_nested_power(k), 0.05))
+            fmu.step(k * STEP, STEP)
+        data = bytes(fmu.serialize_state(fmu.get_state()))
+        document = json.loads(data[20:])                # after the front's header
+        stack = document["__stepper__"]["reversals"]
+        assert len(stack) >= 2
+        expected = []
+        for k in range(save_at, save_at + 2000):
+            fmu.set_real(("P_in", "load"), (_nested_power(k), 0.05))
+            fmu.step(k * STEP, STEP)
+            expected.append(fmu.get_real(("R",))[0])
+    runtime = PlantStepper(load_parameters(), load=0.05)
+    runtime.restore(document["__stepper__"])         # the runtime reads what the FMU wrote
+    forgetful = PlantStepper(load_parameters(), load=0.05)
+    forgetful.restore({**document["__stepper__"], "reversals": []})
+    powers = [_nested_power(k) for k in range(save_at, save_at + 2000)]
+    assert [runtime.step(p, 0.05, STEP).R for p in powers] == pytest.approx(expected, abs=1e-12)
+    assert max(abs(forgetful.step(p, 0.05, STEP).R - r) for p, r in zip(powers, expected)) > 0.1
+    old = {**document, "__stepper__": {**{k: v for k, v in document["__stepper__"].items()
+                                          if k not in ("format", "reversals")},
+                                       "reversal": stack[-1]}}
+    payload = json.dumps(old).encode()
+    header = (b"SMAF" + (1).to_bytes(4, "little") + len(payload).to_bytes(8, "little")
+              + zlib.crc32(payload).to_bytes(4, "little"))
+    with FmuInstance(fmus["SmaActuator"], "old-state", {}) as fresh:
+        with pytest.raises(FmuError, match="earlier sma-fmu build"):
+            fresh.set_state(fresh.deserialize_state(header + payload))
