@@ -58,6 +58,8 @@ def residual_f_fraction(load, params):
 def domain_energy(load, params):
     """Transformation energy per cooperative domain dH(f) [J]; must stay positive."""
     energy = params.nu * (params.eps_T - STANDARD_GRAVITY * load * params.x_T / params.N)
+    if not energy < math.inf or not energy / BOLTZMANN < math.inf:
+        raise ValueError(f"load = {load!r} kg is beyond the model's range: dH(f) overflows")
     if not energy > 0.0:
         raise ValueError(
             f"load = {load!r} kg is beyond the model's range: dH(f) = {energy!r} J <= 0")
@@ -68,6 +70,9 @@ def branch_constants(load, direction, params):
     """The :class:`BranchConstants` of the major branch for ``load`` [kg] and ``direction``."""
     load = require_nonnegative("load", load)
     centre = hysteresis_centre(load, direction, params)
+    if not centre < math.inf:
+        raise ValueError(f"load = {load!r} kg is beyond the model's range: the hysteresis "
+                         f"centre {centre!r} degC is not finite")
     if centre <= -KELVIN_OFFSET:
         raise ValueError(f"hysteresis centre {centre!r} degC at load {load!r} kg is below 0 K")
     xi_f_min = residual_f_fraction(load, params)

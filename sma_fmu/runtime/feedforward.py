@@ -24,13 +24,16 @@ In both, a reference outside what the branch can reach at the present load gives
 temperature of the nearest reachable edge (xi_MF clamped to delta or M - delta of the
 section 5 clamp) and ``saturated`` = True.
 """
+import math
 from collections import namedtuple
 
 from .checks import fast_nonnegative, fast_positive, require_nonnegative, require_positive
 from .constant_load import BranchCache
-from .constants import COOLING, HEATING
+from .constants import COOLING, HEATING, KELVIN_OFFSET
 from .minor_loops import fractions_on_stack, push_reversal, read_points
 from .phase_lag import PhaseLagFilter
+from .state_entries import StateError, read_direction, read_entries, read_optional_number
+from .validity import validity_warning
 from .sensing import (mixed_fractions_of_resistance, temperature_of_fractions,
                       temperature_on_stack)
 
@@ -38,6 +41,8 @@ __all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStep
            "STATE_FORMAT"]
 
 STATE_FORMAT = "sma-fmu compensator state 2: reversal stack"   # what state() writes
+_STATE_ENTRIES = ("format", "direction", "previous_reference", "reversals",
+                  "previous_temperature", "previous_fraction", "filter")
 
 INVERSES = ("major", "minor-loop")
 
@@ -93,6 +98,8 @@ class FeedforwardStepper:
         self.previous_temperature = None  # T_ref,k-1 [degC] (minor-loop inverse only)
         self.previous_fraction = None     # xi_MF,k-1 [1] the compensator assumed
         self._branches = BranchCache(params)
+        self.warning = None               # validity warning of the last step (the load)
+        self._load_before = -math.inf     # load of the last step [kg]
 
     def _invert(self, reference, load, direction):
         """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
@@ -146,10 +153,13 @@ class FeedforwardStepper:
         step_size = fast_positive("step_size", step_size)
         direction = self._direction_for(reference)
         sensed, points, fraction = self._invert(reference, load, direction)
+        warning = (validity_warning(self.params, -math.inf, -math.inf, load, self._load_before)
+                   if load > self.params.load_max else None)
         output = self.filter.step(self._power(sensed), step_size)
         self.direction = direction
         self.previous_reference = reference
         self.reversals = points
+        self.warning, self._load_before = warning, load
         self.previous_temperature = sensed.temperature
         self.previous_fraction = fraction
         return _new_tuple(FeedforwardOutputs, (output, sensed.temperature, sensed.saturated))
@@ -168,15 +178,31 @@ class FeedforwardStepper:
                 "filter": self.filter.state()}
 
     def restore(self, state):
-        """Restore a state saved by :meth:`state`; one of an earlier build raises ``ValueError``."""
-        if state.get("format") != STATE_FORMAT:
-            raise ValueError(
-                f"the compensator state has format {state.get('format')!r}, not {STATE_FORMAT!r}: "
-                "it was saved by an earlier sma-fmu build (minor-loop memory of one reversal) "
-                "and cannot be restored by this one")
-        self.direction = state["direction"]
-        self.previous_reference = state["previous_reference"]
-        self.reversals = read_points(state["reversals"], self.params.memory_depth, "reversals")
-        self.previous_temperature = state.get("previous_temperature")
-        self.previous_fraction = state.get("previous_fraction")
-        self.filter.restore(state["filter"])
+        """Restore a state saved by :meth:`state`.
+
+        Every entry is checked first (direction +1/-1; R_ref > 0; T_ref above absolute
+        zero; xi_MF in [0, 1]; the stack; the filter's memory): a malformed state, or one
+        of an earlier build, raises ``ValueError`` naming the entry and changes nothing.
+        """
+        if not isinstance(state, dict) or state.get("format") != STATE_FORMAT:
+            found = state.get("format") if isinstance(state, dict) else None
+            raise StateError(
+                f"the compensator state has format {found!r}, not {STATE_FORMAT!r}: it was "
+                "saved by an earlier sma-fmu build (minor-loop memory of one reversal) and "
+                "cannot be restored by this one")
+        read_entries(state, _STATE_ENTRIES, what="compensator state")
+        direction = read_direction(state)
+        reference = read_optional_number(state, "previous_reference", 5e-324, unit="ohm")
+        temperature = read_optional_number(state, "previous_temperature", -KELVIN_OFFSET,
+                                           unit="degC")
+        if temperature == -KELVIN_OFFSET:
+            raise StateError("state entry previous_temperature must be above -273.15 degC")
+        fraction = read_optional_number(state, "previous_fraction", 0.0, 1.0)
+        if (temperature is None) != (fraction is None):
+            raise StateError("state entries previous_temperature and previous_fraction must "
+                             "both be numbers or both be null")
+        points = read_points(state["reversals"], self.params.memory_depth, "reversals")
+        self.filter.restore(state["filter"])          # checks, then changes: the last check
+        self.direction, self.previous_reference = direction, reference
+        self.previous_temperature, self.previous_fraction = temperature, fraction
+        self.reversals = points

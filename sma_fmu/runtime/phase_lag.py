@@ -6,6 +6,7 @@
 The filter starts in steady state at its first input: v_(-1) = y_(-1) = v_0.
 """
 from .checks import require_nonnegative, require_positive
+from .state_entries import StateError, read_entries, read_optional_number
 
 __all__ = ["tustin_coefficients", "PhaseLagFilter"]
 
@@ -52,6 +53,12 @@ class PhaseLagFilter:
         return {"previous_input": self.previous_input, "previous_output": self.previous_output}
 
     def restore(self, state):
-        """Restore memory saved by :meth:`state`."""
-        self.previous_input = state["previous_input"]
-        self.previous_output = state["previous_output"]
+        """Restore memory saved by :meth:`state`: both entries null (before the first
+        sample) or both finite numbers [W]; else ``ValueError`` naming the entry, no change."""
+        read_entries(state, ("previous_input", "previous_output"), what="filter state")
+        previous_input = read_optional_number(state, "previous_input", unit="W")
+        previous_output = read_optional_number(state, "previous_output", unit="W")
+        if (previous_input is None) != (previous_output is None):
+            raise StateError("filter state entries previous_input and previous_output must both "
+                             "be numbers or both be null")
+        self.previous_input, self.previous_output = previous_input, previous_output

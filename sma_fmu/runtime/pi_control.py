@@ -10,6 +10,7 @@ The library loop calls :meth:`PIController.step` with e_k; the SmaPiController F
 before its first step.
 """
 from .checks import fast_finite, fast_positive, require_finite, require_nonnegative
+from .state_entries import read_entries, read_number
 
 __all__ = ["PIController"]
 
@@ -68,5 +69,6 @@ class PIController:
         return {"integral": self.integral}
 
     def restore(self, state):
-        """Restore a state saved by :meth:`state`."""
-        self.integral = float(state["integral"])
+        """Restore a state saved by :meth:`state` (``ValueError`` naming a bad entry; no change)."""
+        read_entries(state, ("integral",), what="PI state")
+        self.integral = read_number(state, "integral", unit="ohm.s")

@@ -9,23 +9,27 @@ points, closed loops are wiped out, and the branch of the top point follows (sec
 follow the major branch of that direction. A power of 0 W or less is applied as 0 W (the paper's rule), so a
 compensator output wired straight to the plant is valid; non-finite power is rejected,
 and so is a finite power so large that the temperature would leave the floating-point
-range. Leaving the validity range (T above ``validity.T_max``) sets :attr:`PlantStepper.warning`
-for that one step, so the FMU can warn once per excursion.
+range. Leaving the validity range (T above ``validity.T_max``, or a load above the one
+``validity.stress_max`` gives) sets :attr:`PlantStepper.warning` for that one step, so the
+FMU can warn once per excursion.
 """
 import math
 from collections import namedtuple
 
-from .checks import (direction_sign, fast_finite, fast_nonnegative, fast_positive,
-                     require_finite, require_mode, require_nonnegative)
+from .checks import fast_finite, fast_nonnegative, fast_positive, require_mode, require_nonnegative
 from .constant_load import BranchCache, branch_fractions, require_temperature
-from .constants import COOLING, HEATING
+from .constants import COOLING, HEATING, KELVIN_OFFSET
 from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_points,
                           wipe_out)
+from .state_entries import StateError, read_direction, read_entries, read_number
 from .thermal import step_decay, thermal_step
+from .validity import validity_warning
 
 __all__ = ["PlantOutputs", "PlantStepper", "STATE_FORMAT"]
 
 STATE_FORMAT = "sma-fmu plant state 2: reversal stack"   # what state() writes, restore() reads
+_STATE_ENTRIES = ("format", "temperature", "direction", "reversals", "load", "xi_MF", "xi_P",
+                  "power")
 
 PlantOutputs = namedtuple("PlantOutputs", ["R", "T", "x", "xi_P", "xi_M", "xi_F", "P", "heating"])
 _new_tuple = tuple.__new__
@@ -74,14 +78,13 @@ class PlantStepper:
         self.xi_MF, self.xi_P = branch_fractions(self.temperature, constants)
         self.outputs = self._evaluate(constants)
         self.warning = None
-        self._check_validity(-math.inf)
+        self._check_validity(-math.inf, -math.inf)
 
-    def _check_validity(self, before):
-        """Set :attr:`warning` when the temperature crosses ``T_max`` upwards."""
-        limit = self.params.T_max
-        if self.temperature > limit >= before:
-            self.warning = (f"T = {self.temperature:.6g} degC rose above validity.T_max = {limit:g} "
-                            "degC: outside the range the model's parameters describe")
+    def _check_validity(self, before, load_before):
+        """Set :attr:`warning` when the temperature crosses ``T_max`` or the load crosses
+        ``load_max`` upwards (once per excursion)."""
+        self.warning = validity_warning(self.params, self.temperature, before, self.load,
+                                        load_before)
 
     def step(self, power, load, step_size):
         """Advance one step of ``step_size`` [s] with ``power`` [W] and ``load`` [kg] held.
@@ -120,13 +123,14 @@ class PlantStepper:
                 xi_mf, xi_p = fractions_on_branch(after, constants, direction, self._branch)
         else:
             xi_mf, xi_p = branch_fractions(after, constants)
+        load_before = self.load
         self.temperature, self.direction, self.load, self.power = (
             after, direction, load, power)
         self.xi_MF, self.xi_P = xi_mf, xi_p
         self.outputs = self._evaluate(constants)
         self.warning = None
-        if after > params.T_max:
-            self._check_validity(before)
+        if after > params.T_max or load > params.load_max:
+            self._check_validity(before, load_before)
         return self.outputs
 
     def _evaluate(self, constants):
@@ -160,19 +164,38 @@ class PlantStepper:
     def restore(self, state):
         """Restore a state saved by :meth:`state` and re-evaluate the outputs.
 
-        A value of the wrong kind raises ``ValueError`` (``KeyError`` if one is missing); so
-        does a state of an earlier build (one reversal, no stack), which is never misread.
+        Every entry is checked first (kinds; T above absolute zero; a load the model
+        covers; fractions in [0, M] with xi_MF + xi_P = M; a well-formed stack of at most
+        ``memory_depth`` points): a malformed state raises ``ValueError`` naming the entry
+        and changes nothing. So does a state of an earlier build (one reversal, no stack),
+        which is never misread.
         """
-        if state.get("format") != STATE_FORMAT:
-            raise ValueError(
-                f"the plant state has format {state.get('format')!r}, not {STATE_FORMAT!r}: it "
-                "was saved by an earlier sma-fmu build (minor-loop memory of one reversal) "
-                "and cannot be restored by this one")
+        if not isinstance(state, dict) or state.get("format") != STATE_FORMAT:
+            found = state.get("format") if isinstance(state, dict) else None
+            raise StateError(
+                f"the plant state has format {found!r}, not {STATE_FORMAT!r}: it was saved by "
+                "an earlier sma-fmu build (minor-loop memory of one reversal) and cannot be "
+                "restored by this one")
+        read_entries(state, _STATE_ENTRIES, what="plant state")
+        temperature = read_number(state, "temperature", unit="degC")
+        if temperature <= -KELVIN_OFFSET:
+            raise StateError(f"state entry temperature = {temperature!r} degC is not above -273.15 degC")
+        direction = read_direction(state)
+        load = read_number(state, "load", 0.0, unit="kg")
+        try:
+            constants = self._branches.get(load, direction)
+        except ValueError as error:
+            raise StateError(f"state entry load: {error}") from None
+        total = constants.M
+        xi_mf = read_number(state, "xi_MF", 0.0, total)
+        xi_p = read_number(state, "xi_P", 0.0, total)
+        if abs(xi_mf + xi_p - total) > 1e-9:
+            raise StateError(f"state entries xi_MF = {xi_mf!r} and xi_P = {xi_p!r} must add up to "
+                             f"M = 1 - xi_Fmin(load) = {total!r}")
+        power = read_number(state, "power", 0.0, unit="W")
         points = read_points(state["reversals"], self.params.memory_depth, "reversals")
-        values = [require_finite(key, state[key]) for key in ("temperature", "load", "xi_MF", "xi_P")]
-        self.direction = direction_sign(state["direction"])
-        self.temperature, self.load, self.xi_MF, self.xi_P = values
+        self.temperature, self.direction, self.load = temperature, direction, load
+        self.xi_MF, self.xi_P, self.power = xi_mf, xi_p, power
         self.reversals = points
         self._branch_key = None
-        self.power = require_finite("power", state.get("power", 0.0))
-        self.outputs = self._evaluate(self._branches.get(self.load, self.direction))
+        self.outputs = self._evaluate(constants)

@@ -16,6 +16,7 @@ t = k h meets j / f although neither is exact in binary.
 import math
 
 from .checks import fast_finite, fast_positive, require_positive
+from .state_entries import read_entries
 
 __all__ = ["PwmDriver", "PERIOD_TOLERANCE", "DRIVE_KINDS"]
 
@@ -89,7 +90,8 @@ class PwmDriver:
         return {"held": None if self.held is None else list(self.held), "power": self.power}
 
     def restore(self, state):
-        """Restore a state saved by :meth:`state` (``ValueError`` on a malformed one)."""
+        """Restore a state saved by :meth:`state` (``ValueError`` on a malformed one; no change)."""
+        read_entries(state, ("held", "power"), what="PWM state")
         held = state["held"]
         if held is not None:
             if (not isinstance(held, (list, tuple)) or len(held) != 2

@@ -15,6 +15,7 @@ from collections import namedtuple
 
 from .checks import fast_finite, fast_positive, require_finite
 from .signals import load_from_table, reference_from_table
+from .state_entries import read_entries, read_number
 
 __all__ = ["SignalOutputs", "SignalSource", "table_text", "signals_from_text"]
 
@@ -87,6 +88,8 @@ class SignalSource:
         return {"time": self.time}
 
     def restore(self, state):
-        """Restore a state saved by :meth:`state`."""
-        self.time = float(state["time"])
-        self.outputs = self._sample(self.time)
+        """Restore a state saved by :meth:`state` (``ValueError`` naming a bad entry; no change)."""
+        read_entries(state, ("time",), what="signals state")
+        time = read_number(state, "time", 0.0, unit="s")
+        outputs = self._sample(time)
+        self.time, self.outputs = time, outputs

@@ -42,7 +42,7 @@ class SmaActuator(StepperSlave):
         fmi.string_parameter("hysteresis_mode", "continuous",
                              "'continuous' (minor loops; holds a set-point) or 'switch' "
                              "(paper: branch follows sgn dT/dt; limit-cycles at a set-point)")
-        fmi.model_parameters(extra=("T_max",))
+        fmi.model_parameters(extra=("T_max", "stress_max"))
         self.stepper = None
 
     def _publish(self, outputs):

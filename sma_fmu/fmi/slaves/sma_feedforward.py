@@ -41,7 +41,7 @@ class SmaFeedforward(StepperSlave):
         fmi.string_parameter("inverse", "major",
                              "'major' (the paper's: major branches) or 'minor-loop' (the plant's "
                              "continuous-mode minor branches, reversals taken from R_ref)")
-        fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin"))
+        fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin", "stress_max"))
         self.stepper = None
 
     def _start(self):
