@@ -164,8 +164,8 @@ class PlantStepper:
     def restore(self, state):
         """Restore a state saved by :meth:`state` and re-evaluate the outputs.
 
-        Every entry is checked first (kinds; T above absolute zero; a load the model
-        covers; fractions in [0, M] with xi_MF + xi_P = M; a well-formed stack of at most
+        Every entry is checked first (kinds; T above absolute zero and at most
+        ``validity.T_max``, where the model is valid; a load the model covers; fractions in [0, M] with xi_MF + xi_P = M; a well-formed stack of at most
         ``memory_depth`` points): a malformed state raises ``ValueError`` naming the entry
         and changes nothing. So does a state of an earlier build (one reversal, no stack),
         which is never misread.
@@ -177,7 +177,7 @@ class PlantStepper:
                 "an earlier sma-fmu build (minor-loop memory of one reversal) and cannot be "
                 "restored by this one")
         read_entries(state, _STATE_ENTRIES, what="plant state")
-        temperature = read_number(state, "temperature", unit="degC")
+        temperature = read_number(state, "temperature", high=self.params.T_max, unit="degC")
         if temperature <= -KELVIN_OFFSET:
             raise StateError(f"state entry temperature = {temperature!r} degC is not above -273.15 degC")
         direction = read_direction(state)

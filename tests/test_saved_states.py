@@ -1,0 +1,124 @@
+"""Saved stepper states are read like inputs: a malformed entry is refused, naming it,
+and the stepper is left as it was (issue: edited saved states)."""
+import math
+
+import pytest
+
+from sma_fmu.runtime.feedforward import FeedforwardStepper
+from sma_fmu.runtime.pi_control import PIController
+from sma_fmu.runtime.plant import PlantStepper
+from sma_fmu.runtime.pwm import PwmDriver
+
+STEP = 1e-3
+
+
+def _plant(params):
+    plant = PlantStepper(params, load=0.05)
+    for k in range(3000):
+        plant.step(2.2 + math.sin(0.01 * k), 0.05, STEP)
+    return plant
+
+
+def _compensator(params):
+    compensator = FeedforwardStepper(params, inverse="minor-loop")
+    for reference in (44.0, 40.0, 42.0, 41.0):
+        compensator.step(reference, 0.05, STEP)
+    return compensator
+
+
+PLANT_EDITS = [
+    ({"xi_P": -5.0}, "xi_P"),
+    ({"xi_MF": -5.0}, "xi_MF"),
+    ({"xi_MF": 0.5, "xi_P": 0.5}, "must add up to"),
+    ({"temperature": 1e308}, "temperature"),
+    ({"temperature": -300.0}, "temperature"),
+    ({"temperature": "hot"}, "temperature must be a number"),
+    ({"direction": 0}, "direction"),
+    ({"direction": True}, "direction"),
+    ({"load": -1.0}, "load"),
+    ({"load": 1e308}, "load"),
+    ({"power": float("nan")}, "power"),
+    ({"reversals": "none"}, "reversals"),
+    ({"reversals": [[60.0, float("inf")]]}, r"reversals\[0\]"),
+    ({"extra": 1}, "unknown entry extra"),
+]
+
+
+@pytest.mark.parametrize("edit,words", PLANT_EDITS)
+def test_plant_refuses_an_edited_state_and_stays_as_it_was(params, edit, words):
+    plant = _plant(params)
+    saved, before, outputs = plant.state(), plant.state(), plant.outputs
+    with pytest.raises(ValueError, match=words):
+        plant.restore({**saved, **edit})
+    assert plant.state() == before and plant.outputs == outputs
+
+
+def test_plant_refuses_a_state_with_a_missing_entry(params):
+    plant = _plant(params)
+    saved = plant.state()
+    del saved["xi_P"]
+    with pytest.raises(ValueError, match="lacks entry xi_P"):
+        plant.restore(saved)
+
+
+COMPENSATOR_EDITS = [
+    ({"previous_reference": "hot"}, "previous_reference must be a number"),
+    ({"previous_reference": -1.0}, "previous_reference"),
+    ({"previous_fraction": 2.0}, "previous_fraction"),
+    ({"previous_fraction": None}, "both be numbers or both be null"),
+    ({"direction": 2}, "direction"),
+    ({"filter": {"previous_input": 1.0, "previous_output": None}}, "both be numbers or both"),
+    ({"filter": {"previous_input": "x", "previous_output": 1.0}}, "previous_input"),
+    ({"reversals": [[60.0, 0.5, 1.0]]}, r"reversals\[0\]"),
+]
+
+
+@pytest.mark.parametrize("edit,words", COMPENSATOR_EDITS)
+def test_compensator_refuses_an_edited_state_and_stays_as_it_was(params, edit, words):
+    compensator = _compensator(params)
+    saved, before = compensator.state(), compensator.state()
+    with pytest.raises(ValueError, match=words):
+        compensator.restore({**saved, **edit})
+    assert compensator.state() == before
+    assert compensator.step(42.5, 0.05, STEP) == _compensator(params).step(42.5, 0.05, STEP)
+
+
+@pytest.mark.parametrize("block,state,words", [
+    (lambda: PIController(0.3, 1.0), {"integral": "x"}, "integral must be a number"),
+    (lambda: PIController(0.3, 1.0), {"integral": 1.0, "more": 2}, "unknown entry more"),
+    (lambda: PwmDriver(50.0, 2.0), {"held": [1, 2.0], "power": 0.0}, "duty"),
+    (lambda: PwmDriver(50.0, 2.0), {"held": None}, "lacks entry power"),
+])
+def test_control_blocks_refuse_edited_states(block, state, words):
+    instance = block()
+    before = instance.state()
+    with pytest.raises(ValueError, match=words):
+        instance.restore(state)
+    assert instance.state() == before
+
+
+def test_load_beyond_the_validity_limit_warns_once_per_excursion(params):
+    assert params.load_max == pytest.approx(
+        params.stress_max * 1e6 * math.pi * params.diameter ** 2 / 4 / 9.80665, rel=1e-12)
+    plant = PlantStepper(params, load=0.05)
+    compensator = FeedforwardStepper(params)
+    above, below = 1.01 * params.load_max, 0.99 * params.load_max
+    warnings = []
+    for load in (below, above, above, below, above):
+        plant.step(1.0, load, STEP)
+        compensator.step(42.0, load, STEP)
+        warnings.append((plant.warning, compensator.warning))
+    assert [w[0] is not None for w in warnings] == [False, True, False, False, True]
+    assert [w[1] is not None for w in warnings] == [False, True, False, False, True]
+    assert "load = " in warnings[1][0] and "validity.stress_max = 300 MPa" in warnings[1][1]
+
+
+def test_a_load_that_overflows_the_model_is_refused_naming_the_load(params):
+    compensator = FeedforwardStepper(params)
+    with pytest.raises(ValueError, match=r"load = 1e\+308 kg is beyond the model's range"):
+        compensator.step(42.0, 1e308, STEP)
+    plant = PlantStepper(params)
+    before = plant.state()
+    with pytest.raises(ValueError, match=r"load = 1e\+308 kg"):
+        plant.step(1.0, 1e308, STEP)
+    assert plant.state() == before
