@@ -1,6 +1,6 @@
 """Command line ``sma-fmu``: thin wrappers; each flag maps onto one API argument.
 
-One module per group of commands (model, fmus, cosim, analysis, export, check,
+One module per group of commands (model, fmus, cosim, analysis, loops, export, check,
 identification, studies, bench, examples);
 each has ``register(commands)``. Every failure is one line ``sma-fmu: error: ...`` on stderr
 with exit status 2 (``validate`` and ``check`` exit 1 when a file fails); no traceback, ever.
@@ -8,14 +8,14 @@ with exit status 2 (``validate`` and ``check`` exit 1 when a file fails); no tra
 
 from sma_fmu import __version__
 
-from . import (analysis, bench, check, cosim, examples, export, fmus, identification, model,
-               studies)
+from . import (analysis, bench, check, cosim, examples, export, fmus, identification, loops,
+               model, studies)
 from .arguments import Parser, fail
 
 __all__ = ["main", "build_parser", "COMMAND_GROUPS"]
 
-COMMAND_GROUPS = (model, fmus, cosim, analysis, export, check, identification, studies, bench,
-                  examples)
+COMMAND_GROUPS = (model, fmus, cosim, analysis, loops, export, check, identification, studies,
+                  bench, examples)
 
 
 def build_parser():
