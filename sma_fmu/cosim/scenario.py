@@ -50,6 +50,7 @@ from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.feedforward import INVERSES
+from sma_fmu.runtime.phase_lag import tustin_coefficients
 from sma_fmu.runtime.pwm import DRIVE_KINDS
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
@@ -279,6 +280,16 @@ def _controller(path, table, params):
                               values["beta"], values["model_load"], inverse)
 
 
+def _check_filter(path, controller, step):
+    """The phase-lag filter's Tustin coefficients at this step must be finite numbers."""
+    if not controller.feedforward:
+        return
+    if not all(math.isfinite(c) for c in tustin_coefficients(controller.alpha, controller.beta, step)):
+        _fail(path, f"[controller] alpha_s = {controller.alpha!r}, beta_s = {controller.beta!r}: the "
+                    f"phase-lag filter's coefficients at step_s = {step!r} s are not finite "
+                    "(alpha_s and beta_s must be far below 1e300 s)")
+
+
 def _drive(path, table):
     kind = table.get("kind", "power")
     if kind not in DRIVE_KINDS:
@@ -350,10 +361,15 @@ def scenario_from_document(document, path, parameter_set=None):
     if mode not in HYSTERESIS_MODES:
         _fail(path, f"[plant] hysteresis_mode must be 'switch' or 'continuous', got {mode!r}")
     t_start = _number(path, "plant", plant, "T_start_degC", default=parameter_set.params.T_room)
+    if not -273.15 < t_start <= parameter_set.params.T_max:
+        _fail(path, f"[plant] T_start_degC = {t_start!r} must be above -273.15 degC and at most "
+                    f"validity.T_max = {parameter_set.params.T_max!r} degC")
+    controller = _controller(path, document["controller"], parameter_set.params)
+    _check_filter(path, controller, step)
     return Scenario(
         name=path.stem, path=path, description=str(head.get("description", "")),
         stop_time_s=stop, step_s=step, reference=signals["reference"], load=signals["load"],
-        controller=_controller(path, document["controller"], parameter_set.params),
+        controller=controller,
         hysteresis_mode=mode, T_start=t_start, parameter_set=parameter_set,
         analysis_window=_analysis(path, document["analysis"], stop) if "analysis" in document else None,
         group_name=_string(path, "scenario", head, "group"),
