@@ -1,0 +1,120 @@
+"""Tangent-line transformation temperatures (ASTM E3097-style) of strain-temperature branches.
+
+On one heating or cooling branch:
+
+1. Rough levels: the median strain of the coldest and hottest 10 % of the samples; the
+   temperatures T25, T50, T75 where the strain has gone 25, 50, 75 % of the way from one
+   level to the other (median temperature of the samples within 5 % of that share).
+2. Baselines: straight lines (least squares) through the samples colder than
+   T50 - 2.5 |T75 - T25| (martensite, "cold") and hotter than T50 + 2.5 |T75 - T25|
+   (austenite, "hot"); they keep the slope of the data (thermal expansion, creep).
+3. Transformation tangent: the straight line through the samples between 40 % and 60 % of
+   the way from the hot to the cold baseline: the steepest, most linear part of the
+   branch. It is fitted as temperature against strain, because the temperature carries the
+   noise, so its slope is not flattened by temperature noise.
+4. Heating: A_s where the tangent meets the cold baseline, A_f where it meets the hot one;
+   cooling: M_s at the hot baseline, M_f at the cold one. The midpoint is where the tangent
+   crosses half way between the baselines.
+
+Per cycle (a heating branch and the cooling branch after it):
+- thermal hysteresis = midpoint(heating) - midpoint(cooling) [K], the width of the loop at
+  half the actuation strain;
+- actuation strain = cold baseline at A_s - hot baseline at A_f on heating [1];
+- residual strain = cold baseline of the cooling branch minus that of the heating branch,
+  both at the cycle's lowest temperature [1]: what the cycle leaves behind (open loop).
+
+E3097 leaves the choice of the linear portions to the operator; these rules are ours.
+"""
+import math
+
+import numpy as np
+
+from sma_fmu.runtime.constants import HEATING
+
+__all__ = ["branch_tangents", "cycle_numbers", "QUANTITIES", "TAIL_WIDTHS", "BAND"]
+
+BAND = (0.4, 0.6)
+TAIL_WIDTHS = 2.5
+MIN_BASELINE_POINTS = 5
+QUANTITIES = (("A_s", "degC"), ("A_f", "degC"), ("M_s", "degC"), ("M_f", "degC"),
+              ("thermal_hysteresis", "K"), ("actuation_strain", "%"), ("residual_strain", "%"))
+
+
+def _share_temperature(temperature, share, target):
+    near = np.abs(share - target) <= 0.05
+    if near.sum() < 2:
+        return None
+    return float(np.median(temperature[near]))
+
+
+def _line(x, y):
+    """(intercept, slope) of y = a + b x, least squares."""
+    slope, intercept = np.polyfit(x, y, 1)
+    return float(intercept), float(slope)
+
+
+def _meet(tangent, line):
+    """Temperature where T = c + d eps meets eps = a + b T."""
+    c, d = tangent
+    a, b = line
+    return (c + d * a) / (1.0 - d * b)
+
+
+def branch_tangents(temperature, strain, direction, band=BAND, tail=TAIL_WIDTHS):
+    """Tangent-line numbers of one branch, or None when it does not show a transformation.
+
+    ``temperature`` [degC] and ``strain`` [1] are arrays of the branch's samples (any order);
+    ``direction`` is +1 (heating) or -1 (cooling). Returns {"start", "finish", "midpoint"
+    [degC], "cold", "hot" (intercept [1], slope [1/K]) of the baselines, "tangent"
+    (intercept [degC], slope [K]) of T against strain, "lowest" [degC]}.
+    """
+    order = np.argsort(temperature, kind="stable")
+    t = np.asarray(temperature, dtype=float)[order]
+    e = np.asarray(strain, dtype=float)[order]
+    ends = max(3, t.size // 10)
+    cold_level, hot_level = float(np.median(e[:ends])), float(np.median(e[-ends:]))
+    if not cold_level > hot_level:
+        return None
+    share = (e - hot_level) / (cold_level - hot_level)
+    marks = [_share_temperature(t, share, q) for q in (0.75, 0.5, 0.25)]
+    if None in marks:
+        return None
+    t75, t50, t25 = marks
+    width = max(abs(t25 - t75), 1e-6)
+    cold_rows, hot_rows = t < t50 - tail * width, t > t50 + tail * width
+    if cold_rows.sum() < MIN_BASELINE_POINTS or hot_rows.sum() < MIN_BASELINE_POINTS:
+        return None
+    cold, hot = _line(t[cold_rows], e[cold_rows]), _line(t[hot_rows], e[hot_rows])
+    low_line = hot[0] + hot[1] * t
+    progress = (e - low_line) / (cold[0] + cold[1] * t - low_line)
+    rows = (progress >= band[0]) & (progress <= band[1])
+    if rows.sum() < 2 or np.ptp(e[rows]) == 0.0:
+        return None
+    tangent = _line(e[rows], t[rows])
+    middle = (0.5 * (cold[0] + hot[0]), 0.5 * (cold[1] + hot[1]))
+    at_cold, at_hot = _meet(tangent, cold), _meet(tangent, hot)
+    start, finish = (at_cold, at_hot) if direction == HEATING else (at_hot, at_cold)
+    return {"start": start, "finish": finish, "midpoint": _meet(tangent, middle), "cold": cold,
+            "hot": hot, "tangent": tangent, "lowest": float(t[0])}
+
+
+def cycle_numbers(heating, cooling):
+    """{quantity: value} of one cycle from its branches' :func:`branch_tangents` (None allowed).
+
+    Temperatures [degC], hysteresis [K], strains in percent; NaN where a branch is missing.
+    """
+    nan = math.nan
+    out = {name: nan for name, _ in QUANTITIES}
+    if heating:
+        out["A_s"], out["A_f"] = heating["start"], heating["finish"]
+        cold, hot = heating["cold"], heating["hot"]
+        out["actuation_strain"] = 100.0 * ((cold[0] + cold[1] * heating["start"])
+                                           - (hot[0] + hot[1] * heating["finish"]))
+    if cooling:
+        out["M_s"], out["M_f"] = cooling["start"], cooling["finish"]
+    if heating and cooling:
+        out["thermal_hysteresis"] = heating["midpoint"] - cooling["midpoint"]
+        low = heating["lowest"]
+        before, after = heating["cold"], cooling["cold"]
+        out["residual_strain"] = 100.0 * ((after[0] + after[1] * low) - (before[0] + before[1] * low))
+    return out
