@@ -12,6 +12,26 @@ Jacobi (``coupling="jacobi"``): all blocks step together, each with the outputs 
 had at t_k, so the PI gets u_ff,k-1 and the plant gets u_k-1 (at k = 0: the outputs after
 initialization, u_ff of the first sample and the PI's output before its first step).
 The signals R_ref(t_k), f(t_k) and R_k reach the blocks alike in both.
+
+A scenario with a PWM drive (``[drive] kind = "pwm"``) puts a driver between the PI and the
+plant: the driver gets the PI's (clamped) output u_k as its demand and the plant gets the
+driver's output, the exact mean of the PWM wave over the step (:mod:`sma_fmu.runtime.pwm`).
+Gauss-Seidel: PI -> driver -> plant in the same step, the plant gets PWM(u_k) over
+[t_k, t_k+1). Jacobi: the driver gets the PI's output held from the step before (u_k-1; at
+k = 0 the PI's output before its first step) and the plant the driver's output from the
+step before, so the power reaches the wire one step later than without a driver; at k = 0
+the plant gets the driver's output after initialization (0 W for the PWM driver). The P
+column is the power the plant applied in both.
+
+The driver is any object with
+
+- ``step(time_s, demand_W, step_size) -> P_in``: the power [W] the plant gets over
+  [time_s, time_s + step_size) for the demand ``demand_W`` [W] held over that step;
+- ``initial() -> P_in``: its output [W] after initialization, before its first step (what a
+  Jacobi host passes to the plant at k = 0);
+
+:class:`LibraryDriver` (the runtime :class:`~sma_fmu.runtime.pwm.PwmDriver`) is one; an
+FMU master passes its own as ``run_loop(..., driver=...)``.
 """
 import math
 import time
@@ -22,9 +42,11 @@ import numpy as np
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper
+from sma_fmu.runtime.pwm import PwmDriver
 
 __all__ = ["COLUMNS", "COLUMN_NAMES", "TIMESERIES_DTYPE", "PLANT_OUTPUTS", "COUPLINGS",
-           "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator", "run_library"]
+           "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator", "LibraryDriver",
+           "library_driver", "run_library"]
 
 COLUMNS = (("t", "s"), ("R_ref", "ohm"), ("R", "ohm"), ("T", "degC"), ("T_ref", "degC"),
            ("x", "m"), ("stroke", "m"), ("xi_P", ""), ("xi_M", ""), ("xi_F", ""),
@@ -84,20 +106,50 @@ class LibraryCompensator:
         """Nothing to release."""
 
 
-def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel"):
+class LibraryDriver:
+    """The scenario's PWM drive as the runtime :class:`PwmDriver` (library path)."""
+
+    def __init__(self, scenario):
+        drive = scenario.drive
+        self.pwm = PwmDriver(drive.frequency_Hz, drive.peak_W)
+
+    def initial(self):
+        """P_in [W] after initialization, before the first step: 0 W (the wave's first period
+        has not started)."""
+        return self.pwm.power
+
+    def step(self, time_s, demand, step_size):
+        """P_in [W]: the mean of the PWM wave over [time_s, time_s + step_size) for ``demand`` [W]."""
+        return self.pwm.step(demand, time_s, step_size)
+
+    def close(self):
+        """Nothing to release."""
+
+
+def library_driver(scenario):
+    """The :class:`LibraryDriver` of ``scenario``'s ``[drive]``, or None for kind "power"."""
+    return LibraryDriver(scenario) if scenario.drive.pwm else None
+
+
+def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=None):
     """Close the loop over ``scenario``; returns the structured time-series array.
 
     ``plant`` has ``outputs()`` and ``step(t, power, load, h)`` returning the
     :data:`PLANT_OUTPUTS` (R, T, x, xi_P, xi_M, xi_F, applied power P); ``compensator``
     (None for the "pi" controller) has ``step(t, R_ref, load, h)`` returning
     (P_ff, T_ref, saturated), and for Jacobi ``initial(R_ref, load)``. ``coupling`` is one
-    of :data:`COUPLINGS`. Row k holds the samples at t_k, the compensator's and the PI's
-    outputs of step k and the power the plant applied over [t_k, t_k+1); the stroke is the
-    contraction x_0 - x_k [m] (positive: the wire shortened).
+    of :data:`COUPLINGS`. ``driver`` (see the module docstring: ``step(t, demand, h)``,
+    ``initial()``) sits between the PI and the plant; None takes :func:`library_driver` of
+    the scenario (none for a ``[drive]`` of kind "power": the plant gets the PI's output).
+    Row k holds the samples at t_k, the compensator's and the PI's outputs of step k and the
+    power the plant applied over [t_k, t_k+1); the stroke is the contraction x_0 - x_k [m]
+    (positive: the wire shortened).
     """
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {', '.join(COUPLINGS)}, got {coupling!r}")
     jacobi = coupling == "jacobi"
+    if driver is None:
+        driver = library_driver(scenario)
     h, n = scenario.step_s, scenario.steps
     times = [k * h for k in range(n + 1)]
     references = [scenario.reference.value(t) for t in times]
@@ -113,6 +165,7 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel"):
         held_ff = (no_compensator if compensator is None
                    else compensator.initial(references[0], loads[0]))
         held_power = pi.output(resistance - references[0], held_ff[0])[0]
+        held_drive = None if driver is None else driver.initial()
     for k in range(n):
         time_s, reference, load = times[k], references[k], loads[k]
         error = resistance - reference
@@ -121,12 +174,16 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel"):
         else:
             compensated = compensator.step(time_s, reference, load, h)
         p_ff, t_ref, saturated = compensated
-        if jacobi:  # the PI and the plant get what their sources had at t_k
+        if jacobi:  # the PI, the driver and the plant get what their sources had at t_k
             power, feedback = pi.step(error, held_ff[0], h)
-            plant_power, held_ff, held_power = held_power, compensated, power
+            if driver is None:
+                plant_power = held_power
+            else:
+                plant_power, held_drive = held_drive, driver.step(time_s, held_power, h)
+            held_ff, held_power = compensated, power
         else:
             power, feedback = pi.step(error, p_ff, h)
-            plant_power = power
+            plant_power = power if driver is None else driver.step(time_s, power, h)
         sample = (time_s, reference, resistance, temperature, t_ref, length, start_length - length,
                   xi_p, xi_m, xi_f, p_ff, feedback)
         resistance, temperature, length, xi_p, xi_m, xi_f, applied = plant.step(

@@ -4,8 +4,11 @@ Runs that share the step and the duration (different gains, filters, loads, refe
 wire parameters, hysteresis modes and controllers) go through one loop whose every
 quantity is an array of N. Per step k, as :func:`sma_fmu.cosim.loop.run_loop` does it:
 e_k = R_k - R_ref(t_k); u_k = max(0, u_ff,k + Kp e_k + Ki I_k), with the integrator held
-while clamped with e_k <= 0; the plants step with u_k and f(t_k) held. The results equal
-the scalar library path's to rounding (tests/test_batch.py: <= 1e-10 on every column).
+while clamped with e_k <= 0; the plants step with u_k and f(t_k) held, or, for runs with a
+PWM drive, with the mean of their PWM wave over the step for the demand u_k
+(:mod:`sma_fmu.studies.batch_pwm`; Gauss-Seidel, as the library path's default). The results
+equal the scalar library path's to rounding (tests/test_batch.py, tests/test_pwm.py: <= 1e-10
+on every column).
 
 Two ways to record: ``"timeseries"`` keeps every run's full series (the rows of
 :data:`~sma_fmu.cosim.loop.COLUMNS`; for a few runs), ``"metrics"`` keeps only the metrics,
@@ -30,14 +33,20 @@ from sma_fmu.studies.batch_feedforward import BatchFeedforward
 from sma_fmu.studies.batch_inputs import BatchInputs
 from sma_fmu.studies.batch_metrics import MetricsAccumulator
 from sma_fmu.studies.batch_plant import BatchPlant
+from sma_fmu.studies.batch_pwm import BatchPwm
 
 __all__ = ["BatchUnsupported", "BatchRun", "RECORDS", "unsupported_reason", "run_batch",
            "run_batches", "chunk_steps", "chunk_bounds"]
 
 RECORDS = ("timeseries", "metrics")
 CHUNK_ELEMENTS = 65536      # steps x runs per chunk of precomputed signals and errors
-_KNOWN_SCENARIO_FIELDS = {f.name for f in dataclasses.fields(Scenario)}
+# what the engine implements; a field added later is refused until it is added here
+_KNOWN_SCENARIO_FIELDS = {"name", "path", "description", "stop_time_s", "step_s", "reference",
+                          "load", "controller", "hysteresis_mode", "T_start", "parameter_set",
+                          "analysis_window", "group_name", "compensator_parameter_set", "drive"}
 _KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load", "inverse"}
+_KNOWN_DRIVE_FIELDS = {"kind", "frequency_Hz", "peak_W"}
+_DRIVE_KINDS = ("power", "pwm")   # not runtime.pwm.DRIVE_KINDS: a kind added there is refused
 
 
 class BatchUnsupported(ValueError):
@@ -64,24 +73,28 @@ class BatchRun:
 
 
 @functools.lru_cache(maxsize=None)
-def _unknown_fields(scenario_type, controller_type):
-    """(scenario fields, controller fields) the engine does not know, per pair of classes."""
-    return ({f.name for f in dataclasses.fields(scenario_type)} - _KNOWN_SCENARIO_FIELDS,
-            [f.name for f in dataclasses.fields(controller_type)
-             if f.name not in _KNOWN_CONTROLLER_FIELDS])
+def _unknown_fields(*types):
+    """[fields the engine does not know] of the scenario's, controller's and drive's classes."""
+    return [[f.name for f in dataclasses.fields(kind) if f.name not in known] for kind, known in
+            zip(types, (_KNOWN_SCENARIO_FIELDS, _KNOWN_CONTROLLER_FIELDS, _KNOWN_DRIVE_FIELDS))]
 
 
 def unsupported_reason(scenario):
     """Why the batch engine cannot run ``scenario`` (a sentence), or None when it can."""
     if not isinstance(scenario, Scenario):
         return f"{scenario!r} is not a Scenario"
-    controller = scenario.controller
-    extra, options = _unknown_fields(type(scenario), type(controller))
+    controller, drive = scenario.controller, scenario.drive
+    extra, options, drive_options = _unknown_fields(type(scenario), type(controller), type(drive))
     if extra:
         return f"scenario option(s) {', '.join(sorted(extra))} are not implemented in the batch engine"
     for name in options:                   # an option added later must be added here
         return (f"{scenario.name}: controller option {name} = "
                 f"{getattr(controller, name)!r} is not implemented in the batch engine")
+    for name in drive_options:
+        return (f"{scenario.name}: drive option {name} = "
+                f"{getattr(drive, name)!r} is not implemented in the batch engine")
+    if drive.kind not in _DRIVE_KINDS:
+        return f"{scenario.name}: drive kind {drive.kind!r} is not implemented in the batch engine"
     if controller.kind not in CONTROLLERS:
         return f"{scenario.name}: controller kind {controller.kind!r} is not implemented"
     if scenario.hysteresis_mode not in HYSTERESIS_MODES:
@@ -155,6 +168,10 @@ class _Series:
 def _loop(scenarios, inputs, record):
     """Close the N loops; returns (series or None, metrics accumulator or None, {run: reason})."""
     plant = BatchPlant(inputs, scenarios)
+    pwm = (BatchPwm(inputs.pwm_frequency, inputs.pwm_peak, inputs.pwm_runs)
+           if inputs.pwm_runs.size else None)
+    every_run_pwm = pwm is not None and pwm.runs.size == inputs.size
+    times = inputs.times.tolist()             # t_k as run_loop has them (Python floats)
     feedforward = BatchFeedforward(inputs, scenarios)
     size, n, h = inputs.size, inputs.steps, inputs.step_s
     Kp = np.array([s.controller.Kp for s in scenarios])
@@ -177,8 +194,10 @@ def _loop(scenarios, inputs, record):
             failed.setdefault(run, message)
         errors = np.empty((stop - start + 1, size))
         feedback = np.empty((stop - start, size))
-        power = np.empty((stop - start + 1, size))
+        power = np.empty((stop - start + 1, size))      # the PI's output u_k: the demand
         power[-1] = np.nan
+        applied = power if pwm is None else np.empty_like(power)   # what the plants get
+        applied[-1] = np.nan
         P_ff = compensator.P_ff
         for j in range(stop - start):
             k = start + j
@@ -201,16 +220,24 @@ def _loop(scenarios, inputs, record):
             multiply(step, e, work)
             multiply(work, mask, work)                 # I + (h e) * 1 = I + h e; * 0 adds 0
             add(integral, work, integral)
+            if pwm is not None:                        # the drivers between the PI and the plants
+                driven = applied[j]
+                if every_run_pwm:
+                    copyto(driven, pwm.step(u, times[k], h))
+                else:
+                    copyto(driven, u)
+                    driven[pwm.runs] = pwm.step(u[pwm.runs], times[k], h)
+                u = driven
             plant.step(u)
         np.subtract(plant.R, references[-1], out=errors[-1])   # e_stop, counted by the next chunk
         if series is not None:
-            series.controls(start, compensator, feedback, power[:-1])
+            series.controls(start, compensator, feedback, applied[:-1])
         finite = np.isfinite(power[:-1]).all(axis=0)
         for run in np.flatnonzero(~finite):
             failed.setdefault(int(run), "P_in must be finite")
         if totals is not None:
             last = stop == n
-            totals.add(start, errors if last else errors[:-1], power if last else power[:-1],
+            totals.add(start, errors if last else errors[:-1], applied if last else applied[:-1],
                        compensator.saturated if not last else np.vstack(
                            [compensator.saturated, np.zeros((1, size), dtype=bool)]))
     if series is not None:

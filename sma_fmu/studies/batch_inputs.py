@@ -7,7 +7,8 @@ per load segment and direction, :func:`~sma_fmu.runtime.thermal.step_decay`,
 :meth:`ReferenceSignal.value` at t_k = k h (as :func:`sma_fmu.cosim.loop.run_loop` samples
 it; once per distinct reference). The load segment at t_k is the lookup of
 :meth:`LoadProfile.value` (bisect_right, with its tolerance) done by ``numpy.searchsorted``. Runs whose constants cannot be built
-(a load beyond the model's range) are listed in :attr:`BatchInputs.failures`.
+(a load beyond the model's range) are listed in :attr:`BatchInputs.failures`. The runs with
+a PWM drive and their drivers' frequencies and peak powers are listed too.
 """
 import warnings
 
@@ -64,6 +65,10 @@ class BatchInputs:
         Steps k >= 1 at which some run's load segment changes, sorted.
     failures : dict
         Run index -> message for runs whose constants could not be built.
+    pwm_runs : numpy.ndarray
+        Indices of the runs whose ``[drive]`` is "pwm", ascending (empty when none is).
+    pwm_frequency, pwm_peak : numpy.ndarray
+        Their drivers' frequencies [Hz] and peak powers [W], one entry per ``pwm_runs``.
     """
 
     def __init__(self, scenarios):
@@ -84,6 +89,13 @@ class BatchInputs:
         self._bands(scenarios)
         self.T_start = np.array([s.T_start for s in scenarios])
         self.decay = np.array([step_decay(self.step_s, s.params.tau_th) for s in scenarios])
+        self._drives(scenarios)
+
+    def _drives(self, scenarios):
+        drives = [(run, s.drive) for run, s in enumerate(scenarios) if s.drive.pwm]
+        self.pwm_runs = np.array([run for run, _ in drives], dtype=int)
+        self.pwm_frequency = np.array([drive.frequency_Hz for _, drive in drives], dtype=float)
+        self.pwm_peak = np.array([drive.peak_W for _, drive in drives], dtype=float)
 
     def _references(self, scenarios):
         groups, number, index = {}, {}, []
