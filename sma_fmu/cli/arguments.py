@@ -8,7 +8,7 @@ from pathlib import Path
 from sma_fmu.runtime.checks import direction_sign
 
 __all__ = ["Parser", "HelpFormatter", "finite_number", "positive_number", "nonnegative_number",
-           "positive_integer", "number_list", "direction", "fail", "add_scenario_arguments",
+           "positive_integer", "bounded_integer", "bounded_number", "number_list", "direction", "fail", "add_scenario_arguments",
            "scenario_paths", "add_fmus_argument"]
 
 
@@ -78,6 +78,29 @@ def positive_integer(text):
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
     return value
+
+
+def bounded_integer(low, high):
+    """argparse type factory: a whole number in [low, high] (the range shows in the error)."""
+    def convert(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"expected a whole number in [{low}, {high}], got {text!r}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"expected a whole number in [{low}, {high}], got {text!r}")
+        return value
+    convert.__name__ = f"whole number in [{low}, {high}]"
+    return convert
+
+
+def bounded_number(low, high, unit=""):
+    """argparse type factory: a finite number in (low, high] [unit]."""
+    def convert(text):
+        return _number(text, lambda v: low < v <= high, f"in ({low:g}, {high:g}] {unit}".rstrip())
+    convert.__name__ = f"number in ({low:g}, {high:g}]"
+    return convert
 
 
 def number_list(text):

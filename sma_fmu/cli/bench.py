@@ -1,7 +1,9 @@
 """Benchmark command: how fast the FMUs, the co-simulation and the fits run."""
 from pathlib import Path
 
-from .arguments import positive_integer
+from .arguments import bounded_integer
+
+MAX_RUNS = 1000   # choice: repetitions per measurement; more only takes longer
 
 __all__ = ["register"]
 
@@ -16,7 +18,8 @@ def register(commands):
     bench = commands.add_parser("bench", help="measure speed; print a table and write JSON")
     bench.add_argument("--out", type=Path, default=Path("results/benchmark"), metavar="DIR",
                        help="output folder")
-    bench.add_argument("--runs", type=positive_integer, default=5, help="repetitions per measurement")
+    bench.add_argument("--runs", type=bounded_integer(1, MAX_RUNS), default=5,
+                       help=f"repetitions per measurement, 1-{MAX_RUNS}")
     bench.add_argument("--only", choices=("batch",),
                        help="only this section (batch: the batch engine's throughput table)")
     bench.add_argument("--quick", action="store_true",

@@ -1,7 +1,14 @@
 """Study commands: sweep (a study spec on Dask) and tune (PI and compensator gains)."""
 from pathlib import Path
 
-from .arguments import add_scenario_arguments, positive_integer, scenario_paths
+from .arguments import add_scenario_arguments, bounded_integer, bounded_number, scenario_paths
+
+# choice: ranges wide enough for any real study, narrow enough that a typo cannot start a
+# run that would never end or exhaust memory (checked before any work starts)
+MAX_WORKERS = 256
+MAX_GENERATIONS = 1000
+MAX_POPULATION = 100
+MAX_TUNE_STOP_S = 2000.0   # s: 2,000,000 steps at 1 ms, the scenario run limit
 
 __all__ = ["register"]
 
@@ -39,8 +46,9 @@ def register(commands):
     sweep.add_argument("spec", metavar="SPEC.toml", help="study spec (see docs/studies.md)")
     sweep.add_argument("--scheduler", metavar="ADDRESS",
                        help="address of a running Dask scheduler (default: a local cluster)")
-    sweep.add_argument("--workers", type=positive_integer, metavar="N",
-                       help="worker processes of the local cluster (default: one per core)")
+    sweep.add_argument("--workers", type=bounded_integer(1, MAX_WORKERS), metavar="N",
+                       help=f"worker processes of the local cluster, 1-{MAX_WORKERS} "
+                            "(default: one per core)")
     sweep.add_argument("--out", type=Path, metavar="DIR",
                        help="output folder (default: results/sweep-SPEC); rerun to resume")
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -50,11 +58,13 @@ def register(commands):
                                             "feedforward) for RMSE; [controller] snippets")
     add_scenario_arguments(tune)
     tune.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: results/tune)")
-    tune.add_argument("--seed", type=int, default=1, help="seed of differential evolution")
-    tune.add_argument("--generations", type=positive_integer, default=30,
-                      help="most generations of differential evolution")
-    tune.add_argument("--population", type=positive_integer, default=12,
-                      help="population size per tuned parameter (scipy's popsize)")
-    tune.add_argument("--stop-time", type=float, metavar="S",
-                      help="tune over the first S seconds (default: the scenario's duration)")
+    tune.add_argument("--seed", type=bounded_integer(0, 2 ** 32 - 1), default=1,
+                      help="seed of differential evolution, 0-4294967295")
+    tune.add_argument("--generations", type=bounded_integer(1, MAX_GENERATIONS), default=30,
+                      help=f"most generations of differential evolution, 1-{MAX_GENERATIONS}")
+    tune.add_argument("--population", type=bounded_integer(1, MAX_POPULATION), default=12,
+                      help=f"population size per tuned parameter (scipy's popsize), 1-{MAX_POPULATION}")
+    tune.add_argument("--stop-time", type=bounded_number(0.0, MAX_TUNE_STOP_S, "s"), metavar="S",
+                      help=f"tune over the first S seconds, 0 < S <= {MAX_TUNE_STOP_S:g} "
+                           "(default: the scenario's duration)")
     tune.set_defaults(handler=_tune)

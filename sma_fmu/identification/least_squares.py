@@ -87,6 +87,7 @@ def fit_parameters(residuals_of, base, parameters, max_evaluations=2000):
     variance = float(np.sum(solution.fun ** 2)) / dof
     # covariance in the scaled unknowns (well conditioned), then back to physical units
     scaled = variance * np.linalg.pinv(solution.jac.T @ solution.jac)
+    scaled = 0.5 * (scaled + scaled.T)   # pinv is symmetric only to rounding; a covariance is exactly
     covariance = scaled * np.outer(scale, scale)
     std_errors = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
     half = stats.t.ppf(0.975, dof) * std_errors

@@ -14,9 +14,12 @@ import math
 import numpy as np
 from scipy.stats import qmc
 
-__all__ = ["axis_points", "monte_carlo_draws"]
+__all__ = ["MAX_POINTS", "axis_points", "monte_carlo_draws"]
 
 _RANGE_KEYS = {"low", "high", "num", "log"}
+# choice: the most axis points or Monte Carlo draws a study may ask for (and runs in all);
+# checked before anything is drawn, so a typo cannot exhaust memory
+MAX_POINTS = 1_000_000
 
 
 def _number(value, where):
@@ -51,8 +54,8 @@ def _grid_values(key, spec):
     if not isinstance(spec, dict):
         raise ValueError(f"{key!r}: expected a list of values or {{low, high, num}}, got {spec!r}")
     low, high, log, num = _range(key, spec, "grid")
-    if isinstance(num, bool) or not isinstance(num, int) or num < 1:
-        raise ValueError(f"{key!r}: num must be a whole number >= 1, got {num!r}")
+    if isinstance(num, bool) or not isinstance(num, int) or not 1 <= num <= MAX_POINTS:
+        raise ValueError(f"{key!r}: num must be a whole number in [1, {MAX_POINTS}], got {num!r}")
     points = np.geomspace(low, high, num) if log else np.linspace(low, high, num)
     return [float(v) for v in points]
 
@@ -89,9 +92,14 @@ def axis_points(kind, axes, samples, seed):
         if samples is not None:
             raise ValueError("samples is for random and lhs axes; a grid has every combination")
         values = {key: _grid_values(key, axes[key]) for key in keys}
+        count = math.prod(len(v) for v in values.values())
+        if count > MAX_POINTS:
+            raise ValueError(f"the grid has {count} points ({' x '.join(str(len(v)) for v in values.values())}); "
+                             f"a study may have at most {MAX_POINTS}")
         return values, [dict(zip(keys, combo)) for combo in itertools.product(*values.values())]
-    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
-        raise ValueError(f"samples must be a whole number >= 1 for {kind} axes, got {samples!r}")
+    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= MAX_POINTS:
+        raise ValueError(f"samples must be a whole number in [1, {MAX_POINTS}] for {kind} axes, "
+                         f"got {samples!r}")
     if kind == "random":
         unit = np.random.default_rng(seed).random((samples, len(keys)))
     else:

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.cosim.scenario import ScenarioError, check_sections
-from sma_fmu.studies.design import axis_points, monte_carlo_draws
+from sma_fmu.studies.design import MAX_POINTS, axis_points, monte_carlo_draws
 from sma_fmu.studies.overrides import StudyError, template
 from sma_fmu.toml_files import read_toml
 
@@ -158,6 +158,8 @@ def load_spec(path):
             _fail(path, "[monte_carlo] report must name the report.json of sma-fmu fit")
         report = path.parent / mc["report"]
         samples = _integer(path, "[monte_carlo] samples", mc.get("samples", 100), low=1)
+        if samples > MAX_POINTS:
+            _fail(path, f"[monte_carlo] samples = {samples} exceeds the limit of {MAX_POINTS}")
         targets = mc.get("apply_to", ["wire"])
         if not isinstance(targets, list) or not targets or set(targets) - set(APPLY_TO):
             _fail(path, f"[monte_carlo] apply_to must be a list of {' and '.join(APPLY_TO)}, "
@@ -168,6 +170,11 @@ def load_spec(path):
             _fail(path, f"[monte_carlo] {error}")
         draws = [{f"{target}.{name}": value for target in targets for name, value in d.items()}
                  for d in drawn]
+    total = len(templates) * max(1, len(points)) * max(1, len(draws))
+    if total > MAX_POINTS:
+        _fail(path, f"the study has {total} runs ({len(templates)} scenarios x "
+                    f"{max(1, len(points))} points x {max(1, len(draws))} draws); at most "
+                    f"{MAX_POINTS} are allowed")
     spec = StudySpec(path, str(head.get("description", "")), templates, overrides, kind, values,
                      points, draws, seed, per_task, report)
     _check_first_runs(spec)

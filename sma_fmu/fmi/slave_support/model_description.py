@@ -17,6 +17,7 @@ UNIT_DEFINITIONS = {
     "degC": {"K": 1, "offset": 273.15},
     "m": {"m": 1},
     "s": {"s": 1},
+    "Hz": {"s": -1},
     "degC/kg": {"K": 1, "kg": -1},
     "J": {"kg": 1, "m": 2, "s": -2},
     "m2": {"m": 2},
@@ -24,6 +25,7 @@ UNIT_DEFINITIONS = {
     "W/(m2.K)": {"kg": 1, "s": -3, "K": -1},
     "W/ohm": {"A": 2},
     "W/(ohm.s)": {"A": 2, "s": -1},
+    "MPa": {"kg": 1, "m": -1, "s": -2, "factor": 1e6},
 }
 
 # schema order of fmiModelDescription's children (FMI 2.0 XSD)
