@@ -1,20 +1,89 @@
-"""Identification commands: fit (parameters from measurements), synth (synthetic measurements)."""
+"""Identification commands: fit (parameters from measurements), synth (synthetic measurements).
+
+Experiments: constant-load, constant-temperature (resistance, the paper's two) and isobaric
+(strain under constant load through thermal cycles, ASTM E3097-style lab data)."""
+import dataclasses
 from pathlib import Path
 
-from .arguments import finite_number, nonnegative_number, number_list, positive_number
+from .arguments import (finite_number, nonnegative_number, number_list, positive_integer,
+                        positive_number)
 
 __all__ = ["register"]
 
-EXPERIMENTS = ("constant-load", "constant-temperature")
+EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
+_ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length")
+_SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit")
+_T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
+
+
+def _only_for(args, names, experiment, command):
+    for name in names:
+        value = getattr(args, name)
+        if value not in (None, False):
+            raise ValueError(f"{command}: --{name.replace('_', '-')} applies to {experiment} only")
+
+
+def _fit_isobaric(args, out):
+    from sma_fmu.identification.isobaric_runner import format_isobaric_report, run_isobaric_fit
+    report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
+                              args.residual_strain or "per-cycle", args.reference_length,
+                              progress=lambda text: print(text, flush=True))
+    print(format_isobaric_report(report))
+    print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
+          f"figures")
+    return 0
 
 
 def _fit(args):
     from sma_fmu.identification.runner import format_report, run_fit
     out = args.out or Path("results") / f"fit-{args.experiment}"
+    if args.experiment == "isobaric":
+        return _fit_isobaric(args, out)
+    _only_for(args, _ISOBARIC_ONLY, "isobaric", "fit")
     report = run_fit(args.experiment, args.files, out, args.model,
                      progress=lambda text: print(text, flush=True))
     print(format_report(report))
     print(f"written: {out}/identified.toml, report.json, figures")
+    return 0
+
+
+def _synth_isobaric(args, params, t_min, t_max):
+    from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
+                                                           isobaric_text, stress_of_load)
+    from sma_fmu.output_folder import staged_folder, write_file
+    loads = args.loads or [0.15]
+    programme = IsobaricProgramme(
+        t_low=t_min, t_high=t_max, rate=args.rate or 10.0, cycles=args.cycles or 3,
+        dwell=60.0 if args.dwell is None else args.dwell, points=args.points or 3000,
+        noise_K=3.0 if args.noise_K is None else args.noise_K,
+        noise_strain=1e-4 if args.noise_strain is None else args.noise_strain,
+        noise_ohm=0.05 if args.noise_ohm is None else args.noise_ohm,
+        residual=1.5e-3 if args.drift is None else args.drift, seed=args.seed)
+    texts = {}
+    for index, load in enumerate(loads):
+        run = dataclasses.replace(programme, seed=programme.seed + index)
+        columns, truth = isobaric_table(params, load, run, args.strain_unit or "percent",
+                                        not args.no_time, args.resistance)
+        header = [
+            "Isobaric thermal cycling (ASTM E3097-style), synthetic: sma-fmu synth isobaric",
+            f"wire: {args.model or 'reference wire'}; diameter {params.diameter * 1e3:g} mm",
+            f"load: {load:g} kg (stress {stress_of_load(load, params.diameter):.4g} MPa)",
+            f"reference length: {params.x0:g} m (strain = length / reference - 1)",
+            f"programme: {run.t_low:g} -> {run.t_high:g} degC at {run.rate:g} K/min, "
+            f"{run.cycles} cycles, dwell {run.dwell:g} s, {run.points} samples",
+            f"noise: temperature {run.noise_K:g} K, strain {run.noise_strain:g}, resistance "
+            f"{run.noise_ohm:g} ohm; seed {run.seed}",
+            "true residual-strain levels: " + ", ".join(f"{v:.6g}" for v in truth["offsets"])]
+        texts[f"isobaric-{load:g}kg.csv"] = (isobaric_text(columns, header), load, run.points)
+    if len(loads) == 1:
+        (text, load, points), = texts.values()
+        write_file(args.out, text)
+        print(f"{args.out}: {points} rows (isobaric at {load:g} kg, seed {args.seed})")
+        return 0
+    with staged_folder(args.out) as folder:
+        for name, (text, _, _) in texts.items():
+            (folder / name).write_text(text, encoding="utf-8")
+    print(f"{args.out}: {', '.join(texts)} (isobaric, seed {args.seed} onwards)")
     return 0
 
 
@@ -23,14 +92,22 @@ def _synth(args):
                                                   write_rows)
     from sma_fmu.parameter_file import load_parameter_set
     params = load_parameter_set(args.model).params
+    t_min, t_max = _T_RANGE.get(args.experiment, (10.0, 110.0))
+    t_min = t_min if args.t_min is None else args.t_min
+    t_max = t_max if args.t_max is None else args.t_max
+    if args.experiment == "isobaric":
+        return _synth_isobaric(args, params, t_min, t_max)
+    _only_for(args, _SYNTH_ISOBARIC_ONLY + ("no_time", "resistance"), "isobaric", "synth")
+    noise_ohm = args.noise_ohm or 0.0
+    noise_k = args.noise_K or 0.0
     if args.experiment == "constant-load":
-        rows = constant_load_rows(params, args.loads or [0.0032, 0.05, 0.15, 0.25], args.t_min,
-                                  args.t_max, args.t_step, args.noise_ohm, args.noise_K, args.seed,
+        rows = constant_load_rows(params, args.loads or [0.0032, 0.05, 0.15, 0.25], t_min,
+                                  t_max, args.t_step, noise_ohm, noise_k, args.seed,
                                   not args.no_direction)
     else:
         rows = constant_temperature_rows(params, args.temperature,
                                          args.loads or [0.0, 0.1, 0.03, 0.2, 0.03, 0.3],
-                                         args.load_step, args.noise_ohm, args.noise_K, args.seed)
+                                         args.load_step, noise_ohm, noise_k, args.seed)
     write_rows(args.out, rows)
     print(f"{args.out}: {len(rows)} rows ({args.experiment}, seed {args.seed})")
     return 0
@@ -45,6 +122,17 @@ def register(commands):
                      help="output folder (default: results/fit-EXPERIMENT)")
     fit.add_argument("--model", metavar="FILE",
                      help="base parameter file for everything not fitted (default: reference wire)")
+    fit.add_argument("--load", type=number_list, metavar="KG[,KG...]",
+                     help="isobaric: the hung mass [kg], one for all files or one per file "
+                          "(default: the file header's 'load: ... kg')")
+    fit.add_argument("--stress", type=number_list, metavar="MPA[,MPA...]",
+                     help="isobaric: the stress [MPa] instead of --load (uses the wire diameter)")
+    fit.add_argument("--residual-strain", choices=("per-cycle", "none"),
+                     help="isobaric: a strain offset per residual-strain level (each cycle may "
+                          "leave strain behind), or one per file (default: per-cycle)")
+    fit.add_argument("--reference-length", type=positive_number, metavar="M",
+                     help="isobaric: length the strain is measured from [m] (default: the base "
+                          "file's x0)")
     fit.set_defaults(handler=_fit)
 
     synth = commands.add_parser("synth", help="synthetic measurement CSV from a parameter file")
@@ -53,18 +141,37 @@ def register(commands):
     synth.add_argument("--model", metavar="FILE", help="parameter file (default: reference wire)")
     synth.add_argument("--loads", type=number_list, metavar="KG,KG,...",
                        help="constant-load: the loads [kg] (default 0.0032,0.05,0.15,0.25); "
-                            "constant-temperature: the load path (default 0,0.1,0.03,0.2,0.03,0.3)")
-    synth.add_argument("--t-min", type=finite_number, default=10.0, help="sweep start [degC]")
-    synth.add_argument("--t-max", type=finite_number, default=110.0, help="sweep end [degC]")
+                            "constant-temperature: the load path (default 0,0.1,0.03,0.2,0.03,0.3); "
+                            "isobaric: one file per load (default 0.15; several: --out is a folder)")
+    synth.add_argument("--t-min", type=finite_number,
+                       help="sweep start [degC] (default: 10; isobaric 15)")
+    synth.add_argument("--t-max", type=finite_number,
+                       help="sweep end [degC] (default: 110; isobaric 130)")
     synth.add_argument("--t-step", type=positive_number, default=1.0, help="sweep step [K]")
     synth.add_argument("--temperature", type=finite_number, default=20.0,
                        help="constant-temperature: the temperature [degC]")
     synth.add_argument("--load-step", type=positive_number, default=0.005,
                        help="constant-temperature: load sampling step [kg]")
-    synth.add_argument("--noise-ohm", type=nonnegative_number, default=0.0,
-                       help="resistance noise sigma [ohm]")
-    synth.add_argument("--noise-K", type=nonnegative_number, default=0.0,
-                       help="temperature noise sigma [K]")
+    synth.add_argument("--noise-ohm", type=nonnegative_number,
+                       help="resistance noise sigma [ohm] (default: 0; isobaric 0.05)")
+    synth.add_argument("--noise-K", type=nonnegative_number,
+                       help="temperature noise sigma [K] (default: 0; isobaric 3)")
+    synth.add_argument("--noise-strain", type=nonnegative_number,
+                       help="isobaric: strain noise sigma [1] (default: 1e-4)")
+    synth.add_argument("--points", type=positive_integer,
+                       help="isobaric: samples per file, evenly spaced in time (default: 3000)")
+    synth.add_argument("--cycles", type=positive_integer, help="isobaric: thermal cycles (default: 3)")
+    synth.add_argument("--rate", type=positive_number, help="isobaric: ramp rate [K/min] (default: 10)")
+    synth.add_argument("--dwell", type=nonnegative_number,
+                       help="isobaric: hold at each end [s] (default: 60)")
+    synth.add_argument("--drift", type=nonnegative_number,
+                       help="isobaric: residual strain of the first cycle [1], halving each "
+                            "cycle (default: 1.5e-3)")
+    synth.add_argument("--strain-unit", choices=("percent", "fraction", "length"),
+                       help="isobaric: strain_percent, strain or length_m column (default: percent)")
+    synth.add_argument("--no-time", action="store_true", help="isobaric: leave out the time column")
+    synth.add_argument("--resistance", action="store_true",
+                       help="isobaric: add a resistance_ohm column")
     synth.add_argument("--seed", type=int, default=0, help="random seed")
     synth.add_argument("--no-direction", action="store_true",
                        help="constant-load: leave out the direction column")

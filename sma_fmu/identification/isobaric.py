@@ -48,7 +48,7 @@ from sma_fmu.identification.isobaric_model import branch_levels, branch_share
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 
-__all__ = ["RESIDUAL_OPTIONS", "IsobaricFit", "fit_isobaric", "KNOTS_PER_BRANCH"]
+__all__ = ["RESIDUAL_OPTIONS", "IsobaricFit", "fit_isobaric", "file_model", "KNOTS_PER_BRANCH"]
 
 RESIDUAL_OPTIONS = ("per-cycle", "none")
 KNOTS_PER_BRANCH = 10
@@ -169,7 +169,7 @@ def _sigmas(data):
     return out
 
 
-def _file_model(params, data, profile, levels):
+def file_model(params, data, profile, levels):
     """(strain, resistance or None) of the model at the profile temperatures."""
     strain = np.empty(profile.size)
     resistance = np.empty(profile.size) if data.resistance is not None else None
@@ -288,7 +288,7 @@ def _starts(files, layout, base):
     params = layout.params(vector)
     for index, (data, profile) in enumerate(zip(files, profiles)):
         first, count, fixed = layout.offsets[index]
-        strain, _ = _file_model(params, data, profile, np.zeros(count + fixed))
+        strain, _ = file_model(params, data, profile, np.zeros(count + fixed))
         difference = data.strain - strain
         for level in range(fixed, count + fixed):
             rows = data.row_level == level
@@ -390,7 +390,7 @@ def fit_isobaric(files, base, residual="per-cycle", max_evaluations=200):
         out = []
         for index, (data, column, s) in enumerate(zip(files, layout.profiles, sigma)):
             profile = data.basis @ x[column:column + data.knot_count]
-            strain, resistance = _file_model(params, data, profile, layout.levels(x, index))
+            strain, resistance = file_model(params, data, profile, layout.levels(x, index))
             out.append((profile - data.temperature) / s["temperature"])
             out.append((strain - data.strain) / s["strain"])
             if resistance is not None:

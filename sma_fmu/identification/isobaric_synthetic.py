@@ -17,7 +17,7 @@ the direction is that of the programme, kept through each dwell); the file repor
 A header of ``#`` lines states the load, the programme, the noise and the true drift.
 """
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -57,7 +57,6 @@ class IsobaricProgramme:
     residual: float = 1.5e-3       # residual strain of the first cycle [1]
     decay: float = 0.5             # ratio of one cycle's residual strain to the previous
     seed: int = 0
-    extra: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if not self.t_high > self.t_low:

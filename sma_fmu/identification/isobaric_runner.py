@@ -1,0 +1,176 @@
+"""``sma-fmu fit isobaric``: read isobaric files, fit, and write the results in one go.
+
+Writes into ``out_dir``: ``identified.toml`` (a complete wire parameter file, ready for
+``sma-fmu build --model`` and scenarios), ``report.json`` (estimates, standard errors,
+covariance), ``transformation_temperatures.md`` and ``.csv`` (per cycle, data and model)
+and PNG figures. Everything is computed first; nothing is written when reading, checking
+or fitting fails.
+"""
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from sma_fmu.identification.isobaric import RESIDUAL_OPTIONS, fit_isobaric
+from sma_fmu.identification.isobaric_figures import isobaric_figures
+from sma_fmu.identification.isobaric_files import read_isobaric
+from sma_fmu.identification.isobaric_synthetic import load_of_stress, stress_of_load
+from sma_fmu.identification.isobaric_tables import cycle_rows, rows_csv, rows_markdown
+from sma_fmu.json_output import json_text
+from sma_fmu.output_folder import check_folder, staged_folder
+from sma_fmu.parameter_file import load_parameter_set, write_parameter_file
+from sma_fmu.runtime.constants import BOLTZMANN, STANDARD_GRAVITY
+
+__all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report"]
+
+
+def file_loads(files, loads=None, stresses=None, diameter=None):
+    """Load [kg] per file from ``--load`` or ``--stress`` values (one for all, or one per file).
+
+    None per file means: from the file's header.
+    """
+    if loads and stresses:
+        raise ValueError("give --load or --stress, not both")
+    values, option = (loads, "--load") if loads else (stresses, "--stress")
+    if not values:
+        return [None] * len(files)
+    if len(values) not in (1, len(files)):
+        raise ValueError(f"{option} has {len(values)} values for {len(files)} files; give one for "
+                         f"all files or one per file")
+    values = list(values) * len(files) if len(values) == 1 else list(values)
+    for value in values:
+        if not value >= 0:
+            raise ValueError(f"{option} {value!r}: must be >= 0")
+    return values if loads else [load_of_stress(s, diameter) for s in values]
+
+
+def _centres(fit, loads):
+    """Hysteresis centres [degC] at each load, with standard errors from the covariance."""
+    index = {name: i for i, name in enumerate(fit.names)}
+    out = {}
+    for load in loads:
+        entry = {}
+        for direction, a, b in (("heating", "a_h", "b_h"), ("cooling", "a_c", "b_c")):
+            gradient = np.zeros(len(fit.names))
+            gradient[index[a]] = 1.0
+            if b in index:
+                gradient[index[b]] = load
+            value = getattr(fit.params, a) + getattr(fit.params, b) * load
+            error = float(np.sqrt(gradient @ fit.covariance @ gradient))
+            entry[direction] = {"value": value, "std_error": error}
+        out[f"{load:g} kg"] = entry
+    return out
+
+
+def isobaric_report(files, fit, base_set, residual, rows):
+    """The JSON-ready report of an isobaric fit."""
+    params = fit.params
+    half = stats.t.ppf(0.975, fit.dof)
+    loads = sorted({d.load for d in files})
+    parameters = {
+        name: {"value": float(v), "std_error": float(e), "ci95": [float(v - half * e), float(v + half * e)]}
+        for name, v, e in zip(fit.wire_names, fit.wire_values, fit.wire_std_errors)}
+    unknowns = {name: {"value": float(v), "std_error": float(e), "start": float(s)}
+                for name, v, e, s in zip(fit.names, fit.values, fit.std_errors, fit.starts)}
+    fixed = ["eps_T", "xi_F_inf", "f_F"] + [n for n in ("b_h", "b_c", "x_min", "R_P", "R_M", "R_F")
+                                          if n not in fit.wire_names]
+    per_file = []
+    for data, offsets, sigma in zip(files, fit.offsets, fit.sigma):
+        per_file.append({
+            "file": str(data.path), "load_kg": data.load,
+            "stress_MPa": stress_of_load(data.load, params.diameter),
+            "points": int(data.strain.size),
+            "columns": {q: list(v) for q, v in data.columns.items()},
+            "branches": len(data.branches),
+            "cycles": len({b.cycle for b in data.branches if b.complete}),
+            "noise_estimates": sigma,
+            "strain_offsets_per_level": offsets,
+            "residual_strain_per_cycle": list(np.diff(offsets)) if residual == "per-cycle" else []})
+    widths = {}
+    for load in loads:
+        energy = params.nu * (params.eps_T - STANDARD_GRAVITY * load * params.x_T / params.N)
+        widths[f"{load:g} kg"] = {"dH_J": energy, "width_25_75_K_heating": 2 * np.log(3) * BOLTZMANN
+                                  * (params.a_h + params.b_h * load + 273.15) ** 2 / energy}
+    return {
+        "experiment": "isobaric",
+        "files": per_file,
+        "points": int(sum(d.strain.size for d in files)),
+        "residual_strain_model": residual,
+        "parameters": parameters,
+        "covariance": {"parameters": list(fit.wire_names),
+                       "matrix": [[float(v) for v in r] for r in fit.wire_covariance]},
+        "unknowns": unknowns,
+        "unknowns_covariance": {"parameters": list(fit.names),
+                                "matrix": [[float(v) for v in r] for r in fit.covariance]},
+        "hysteresis_centres_degC": _centres(fit, loads),
+        "transition": widths,
+        "fixed_from_base": {name: getattr(params, name) for name in fixed},
+        "residual_rms": fit.residual_rms,
+        "variance_factor": fit.variance_factor,
+        "degrees_of_freedom": fit.dof,
+        "temperature_profile_unknowns": fit.profile_unknowns,
+        "transformation_temperatures": rows,
+        "base_parameter_file": str(base_set.path),
+        "solver": {"converged": fit.converged, "message": fit.message,
+                   "evaluations": fit.evaluations, "seconds": fit.seconds},
+    }
+
+
+def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
+                     reference_length=None, progress=lambda text: None):
+    """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report."""
+    if not files:
+        raise ValueError("no measurement file given")
+    if residual not in RESIDUAL_OPTIONS:
+        raise ValueError(f"--residual-strain must be one of {', '.join(RESIDUAL_OPTIONS)}, "
+                         f"got {residual!r}")
+    check_folder(out_dir)
+    base_set = load_parameter_set(model)
+    base = base_set.params
+    reference = base.x0 if reference_length is None else reference_length
+    per_file = file_loads(files, loads, stresses, base.diameter)
+    data = [read_isobaric(Path(f), load, reference, base.diameter) for f, load in zip(files, per_file)]
+    progress(f"fitting {len(data)} file(s), {sum(d.strain.size for d in data)} points ...")
+    fit = fit_isobaric(data, base, residual)
+    progress("transformation temperatures and figures ...")
+    per_cycle = residual == "per-cycle"
+    rows = [row for d, offsets, profile in zip(data, fit.offsets, fit.profiles)
+            for row in cycle_rows(d, fit.params, offsets, profile, per_cycle)]
+    report = isobaric_report(data, fit, base_set, residual, rows)
+    figures = isobaric_figures(data, fit, per_cycle)
+    stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    names = ", ".join(Path(f).name for f in files)
+    with staged_folder(out_dir) as folder:
+        write_parameter_file(
+            folder / "identified.toml", fit.params, f"{base_set.name}-isobaric",
+            f"isobaric fit of {names}; strain RMS {fit.residual_rms['strain']:.3g}",
+            base_set.meanings,
+            header=[f"Identified by sma-fmu fit isobaric on {stamp}.",
+                    f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}.",
+                    f"Data: {', '.join(str(f) for f in files)} at "
+                    f"{', '.join(f'{d.load:g}' for d in data)} kg"])
+        (folder / "report.json").write_text(json_text(report), encoding="utf-8")
+        (folder / "transformation_temperatures.csv").write_text(rows_csv(rows), encoding="utf-8")
+        (folder / "transformation_temperatures.md").write_text(rows_markdown(rows), encoding="utf-8")
+        for name, png in figures.items():
+            (folder / name).write_bytes(png)
+    return report
+
+
+def format_isobaric_report(report):
+    """A short text summary of an isobaric fit report."""
+    rms = report["residual_rms"]
+    solver = report["solver"]
+    lines = [f"isobaric fit: {report['points']} points in {len(report['files'])} file(s); RMS "
+             f"strain {rms['strain']:.3g}, temperature {rms['temperature_K']:.3g} K"
+             + (f", resistance {rms['resistance_ohm']:.3g} ohm" if rms["resistance_ohm"] else "")
+             + f"; {solver['seconds']:.2f} s ({solver['evaluations']} evaluations)",
+             f"{'parameter':<12}{'value':>14}{'std error':>12}"]
+    for name, row in report["parameters"].items():
+        lines.append(f"{name:<12}{row['value']:>14.6g}{row['std_error']:>12.3g}")
+    for load, centre in report["hysteresis_centres_degC"].items():
+        lines.append(f"centres at {load}: heating {centre['heating']['value']:.2f} +- "
+                     f"{centre['heating']['std_error']:.2f} degC, cooling "
+                     f"{centre['cooling']['value']:.2f} +- {centre['cooling']['std_error']:.2f} degC")
+    return "\n".join(lines)
