@@ -78,8 +78,9 @@ class BatchFeedforward:
         self._own = bool(np.array_equal(self.of_run, np.arange(self.runs.size)))  # one each
         self._tables([scenarios[run] for run in chosen])
         self.split = sum(1 for key in keys if key[2] != "minor-loop")   # first minor column
-        self.minor = (MinorLoopMemory(len(keys) - self.split) if self.split < len(keys)
-                      else None)
+        minor = [scenarios[run].compensator_params for run in chosen[self.split:]]
+        self.minor = (MinorLoopMemory([q.saturation_margin for q in minor],
+                                      [q.memory_depth for q in minor]) if minor else None)
         coefficients = [tustin_coefficients(scenarios[run].controller.alpha,
                                             scenarios[run].controller.beta, inputs.step_s)
                         for run in self.runs]
@@ -188,6 +189,7 @@ class BatchFeedforward:
         np.divide(xi_mf, span, out=xi_mf)
         xi_p = np.subtract(take("cold"), reference)
         np.divide(xi_p, span, out=xi_p)
+        raw = (xi_mf.copy(), xi_p.copy()) if memory is not None else None
         # temperature_of_fractions: clamp into [delta, M - delta] and flag it
         delta, upper = take("delta"), take("upper")
         saturated = clamp_fractions(xi_mf, xi_p, delta, upper)
@@ -197,9 +199,12 @@ class BatchFeedforward:
         sensed, exponent, bad = np.empty(shape), np.empty(shape), np.empty(shape, dtype=bool)
         if memory is None:
             temperature_of_fractions(xi_mf, xi_p, inverse, energy, sensed, exponent, bad)
-        else:                          # the minor-loop inverse, with its reversal memory
-            memory.invert({"mf": xi_mf, "p": xi_p, "delta": delta, "upper": upper,
+        else:                          # the minor-loop inverse, with its reversal stacks
+            memory.invert({"raw_mf": raw[0], "raw_p": raw[1], "mf": xi_mf, "p": xi_p,
+                           "clamped": saturated.copy(), "delta": delta, "upper": upper,
                            "M": take("M"), "energy": energy, "inverse": inverse,
+                           "inv_heating": take("inv_heating"),
+                           "inv_cooling": take("inv_cooling"),
                            "heating": np.broadcast_to(heating, shape)},
                           {"T_ref": sensed, "saturated": saturated, "bad": bad,
                            "exponent": exponent})

@@ -1,34 +1,41 @@
 """The minor-loop inverse of N compensators at once (``FeedforwardStepper(inverse="minor-loop")``).
 
-Each compensator keeps its own reversal memory, taken from the reference direction d_ref:
-when d_ref changes at sample k, the reversal point is what it assumed at sample k - 1,
-(T_ref,k-1, xi_MF,k-1) (the fraction of R_ref(t_k-1), or where that sample was clamped,
-the fraction of its branch at the clamped T_ref,k-1). Before the first reversal it inverts
-the major branch (the batch's major inverse, computed for every column first). After a
-reversal the target fraction is mapped to the major branch at the same temperature
-(:func:`~sma_fmu.runtime.minor_loops.major_equivalent`), clamped into what that branch
-reaches, and inverted; where the branch is flat T_ref is the reversal temperature and
-``saturated`` is set. The branch constants are those of the present load (and direction),
-so a load step re-evaluates the branch and the reversal point stays.
+Each compensator keeps its own stack of reversal points, driven by the reference direction
+d_ref with the plant's rules (spec section 6): when d_ref changes at sample k it pushes what
+it assumed at sample k - 1, (T_ref,k-1, xi_MF,k-1) (the fraction of R_ref(t_k-1), or where
+that sample was saturated, the fraction of its branch at T_ref,k-1), dropping the two oldest
+points beyond ``memory_depth``. Each sample inverts the branch of the stack, walking it
+(:func:`~sma_fmu.runtime.sensing.temperature_on_stack`): a target beyond the branch's end B
+pops A and B for good (the loop it closes is wiped out); on the branch A -> B the major
+value is found in closed form and inverted; a flat branch gives T_A, saturated.
 
-The compensator is open loop, so a chunk of steps is computed at once between the samples
-at which some compensator reverses: per such stretch the reversal memory and each
-column's direction are fixed (so, without a load step in the chunk, the branch's value at
-the reversal point is one row), and at its end the memory of the reversing columns is
-updated from the stretch's last row (the carry holds it across chunks). Results go
-straight into the caller's arrays (``out=``). The operations are those of
-:mod:`~sma_fmu.runtime.sensing` and :mod:`~sma_fmu.runtime.minor_loops`, in their order;
-tests/test_batch.py binds the two.
+The compensator is open loop, so a chunk of samples is computed at once. Between two
+*events* of a compensator (a change of d_ref, or a target beyond B of its top pair) its
+stack and direction are fixed, so every sample is the closed-form inverse of one branch:
+a few numpy calls over (samples, compensators). An event sample is computed with the
+runtime's own functions on that compensator's stack (a list of ReversalPoint, the
+reference state), so every stored point, and so every decision to pop, is the scalar
+path's bit for bit; it then continues from the sample after. The chunk is walked in
+rounds: the first over all its samples and compensators, each later one over a window of
+:data:`WINDOW` samples from the earliest unfinished one, for the compensators whose next
+sample lies in it; a round finishes, per compensator, the samples before its first event
+and the event itself. Events are rare (d_ref reverses a few times a period), so most
+chunks take one round. The operations are those of :mod:`~sma_fmu.runtime.sensing` and
+:mod:`~sma_fmu.runtime.minor_loops`, in their order; tests/test_batch.py binds the two.
 """
+import math
+
 import numpy as np
 
-from sma_fmu.runtime.constants import KELVIN_OFFSET
-from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR
+from sma_fmu.runtime.constant_load import BranchConstants
+from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
+from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, fractions_on_stack, push_reversal
+from sma_fmu.runtime.sensing import temperature_on_stack
 from sma_fmu.studies.batch_plant import major_fractions
 
-__all__ = ["clamp_fractions", "temperature_of_fractions", "MinorLoopMemory"]
+__all__ = ["clamp_fractions", "temperature_of_fractions", "MinorLoopMemory", "WINDOW"]
 
-_CONSTANTS = ("delta", "upper", "M", "energy")   # per load segment: one row without a load step
+WINDOW = 64      # samples per round after the first (which takes the whole chunk)
 
 
 def clamp_fractions(xi_mf, xi_p, delta, upper):
@@ -43,11 +50,11 @@ def clamp_fractions(xi_mf, xi_p, delta, upper):
     np.logical_or(high, low, out=high)
     np.logical_not(high, out=high)                  # not low and not xi_p >= delta
     if low.any():                                   # usually none: R_ref inside the band
-        np.copyto(xi_mf, delta, where=low)
-        np.copyto(xi_p, upper, where=low)
+        np.copyto(xi_mf, np.broadcast_to(delta, xi_mf.shape), where=low)
+        np.copyto(xi_p, np.broadcast_to(upper, xi_p.shape), where=low)
     if high.any():
-        np.copyto(xi_mf, upper, where=high)
-        np.copyto(xi_p, delta, where=high)
+        np.copyto(xi_mf, np.broadcast_to(upper, xi_mf.shape), where=high)
+        np.copyto(xi_p, np.broadcast_to(delta, xi_p.shape), where=high)
     return np.logical_or(low, high, out=low)
 
 
@@ -65,100 +72,198 @@ def temperature_of_fractions(xi_mf, xi_p, inverse, energy, T, exponent, bad):
     np.subtract(T, KELVIN_OFFSET, out=T)
 
 
-def _at_reversal(T_r, M, energy, inverse, heating):
-    """L_h(T_r) heating, M - L_c(T_r) (its xi_P) cooling, at the present branch constants."""
-    xi_mf, xi_p = major_fractions(T_r, M, -energy, inverse)
-    return np.where(heating, xi_mf, xi_p)
-
-
 class MinorLoopMemory:
-    """Reversal memory and inversion of ``count`` minor-loop compensators (inverse columns)."""
+    """Reversal stacks and inversion of ``len(margins)`` minor-loop compensators (columns).
 
-    def __init__(self, count):
-        self.T_r, self.xi_r = np.zeros(count), np.zeros(count)   # [degC], [1]
-        self.has = np.zeros(count, dtype=bool)                   # a reversal is stored
-        self.last_T, self.last_xi = np.zeros(count), np.zeros(count)   # T_ref,k-1, xi_MF,k-1
-        self.last_heating = None                                 # d_ref,k-1 (True: heating)
+    ``margins``: each column's saturation margin delta/M [1]; ``depths``: its memory_depth.
+    :attr:`points` holds each column's stack (a list of ReversalPoint, oldest first), as
+    ``FeedforwardStepper.reversals``.
+    """
+
+    def __init__(self, margins, depths):
+        count = len(margins)
+        self.margins, self.depths = [float(m) for m in margins], [int(d) for d in depths]
+        self.points = [[] for _ in range(count)]
+        # the top pair of each stack: A = the top, B = the point below (if any)
+        self.count = np.zeros(count, dtype=np.int64)
+        self.T_A, self.xi_A = np.zeros(count), np.zeros(count)
+        self.T_B, self.xi_B = np.zeros(count), np.zeros(count)
+        self.last_heating = None       # d_ref of the last sample done (None: none yet)
+        self._carry = None             # that sample's inputs, {name: (columns,)}
+        self._offset = 0               # sample index of the chunk's first row
+        # the sample of each column's last event and what it assumed there (T_ref, xi_MF)
+        self._event_sample = [-2] * count
+        self._event_assumed = [(math.nan, math.nan)] * count
 
     def invert(self, stage, out):
-        """The inverse of a chunk of steps, into ``out``.
+        """The inverse of a chunk of samples, into ``out``.
 
-        ``stage``: (c, k) views: ``mf``, ``p`` (fractions of R_ref after the first clamp),
-        ``inverse`` (1/tau_K of d_ref), ``heating`` (d_ref), and the :data:`_CONSTANTS`
-        (one row when no load step is inside the chunk); ``out``: (c, k) views ``T_ref``,
-        ``saturated`` (holding the first clamp's flag), ``bad``, ``exponent``.
+        ``stage``: (c, k) arrays (one row where the value is the same for every sample):
+        ``raw_mf``, ``raw_p`` (the fractions of R_ref), ``mf``, ``p`` and ``clamped``
+        (after the first clamp into [delta, M - delta], and its flag), ``heating``
+        (d_ref), ``inverse`` (1/tau_K of d_ref), ``inv_heating``, ``inv_cooling``, ``M``,
+        ``energy`` (dH/k_B), ``delta``, ``upper``; ``out``: (c, k) arrays ``T_ref``,
+        ``saturated``, ``bad`` (the inverse diverges), ``exponent`` (Lambda).
         """
         heating = stage["heating"]
-        rows = heating.shape[0]
-        uniform = stage["M"].shape[0] == 1
-        before = heating[0] if self.last_heating is None else self.last_heating  # k = 0: none
-        reversing = np.empty(heating.shape, dtype=bool)
-        np.not_equal(heating[0], before, reversing[0])
+        rows, columns = heating.shape
+        reversing = np.empty((rows, columns), dtype=bool)
+        if self.last_heating is None:                   # the first sample: no reversal
+            reversing[0] = False
+        else:
+            np.not_equal(heating[0], self.last_heating, reversing[0])
         np.not_equal(heating[1:], heating[:-1], reversing[1:])
-        first = 0
-        for last in np.flatnonzero(reversing.any(axis=1)).tolist() + [rows]:
-            if last > first:
-                self._stretch(slice(first, last), stage, out, uniform)
-                self._remember(last - 1, stage, out, uniform)
-            if last < rows:
-                turn = reversing[last]
-                self.T_r[turn], self.xi_r[turn] = self.last_T[turn], self.last_xi[turn]
-                self.has[turn] = True
-            first = last
-        self.last_heating = heating[-1].copy()
+        cursor = np.zeros(columns, dtype=np.int64)      # each column's first sample not done
+        self._round(0, rows, None, cursor, stage, out, reversing)
+        while True:
+            waiting = np.flatnonzero(cursor < rows)
+            if waiting.size == 0:
+                break
+            low = int(cursor[waiting].min())
+            high = min(low + WINDOW, rows)
+            self._round(low, high, waiting[cursor[waiting] < high], cursor, stage, out,
+                        reversing)
+        last = rows - 1
+        self._carry = {name: np.array(np.broadcast_to(stage[name][-1], (columns,)))
+                       for name in ("raw_mf", "raw_p", "M", "energy", "inverse", "heating")}
+        self.last_heating = np.array(heating[last])
+        self._offset += rows
 
-    def _stretch(self, rows, stage, out, uniform):
-        """Rows ``rows`` (no reversal inside): the minor branch's inverse where one is stored."""
-        constant = (lambda name: stage[name]) if uniform else (  # noqa: E731
-            lambda name: stage[name][rows])
-        heating = stage["heating"][rows.start]          # d_ref is fixed in the stretch
-        M, energy = constant("M"), constant("energy")
-        inverse = stage["inverse"][rows]
-        T_r, xi_r, has = self.T_r, self.xi_r, self.has
-        at_reversal = _at_reversal(T_r, M, energy, inverse[:1] if uniform else inverse, heating)
-        remaining = M - xi_r
-        flat = (at_reversal < DENOMINATOR_FLOOR) | np.where(heating, xi_r <= 0.0,
-                                                             remaining <= 0.0)
-        flat &= has
-        # major_equivalent: heating xi_MF = xi_mf L_h(T_r)/xi_r,
-        # cooling xi_P = xi_p xi_P,c(T_r)/(M - xi_r)
-        mf, p = stage["mf"][rows], stage["p"][rows]
-        major_mf = mf * at_reversal
-        major_mf /= xi_r
-        major_p = p * at_reversal
-        major_p /= remaining
-        new_mf = np.where(heating, major_mf, M - major_p)
-        new_p = np.where(heating, M - major_mf, major_p)
-        if not has.all():                               # before the first reversal: major
-            new_mf, new_p = np.where(has, new_mf, mf), np.where(has, new_p, p)
-        clamped = clamp_fractions(new_mf, new_p, constant("delta"), constant("upper"))
-        T_ref, bad, saturated = out["T_ref"][rows], out["bad"][rows], out["saturated"][rows]
-        temperature_of_fractions(new_mf, new_p, inverse, energy, T_ref, out["exponent"][rows],
-                                 bad)
-        np.copyto(T_ref, T_r, where=flat)               # flat: the reversal temperature
-        np.greater(bad, flat, out=bad)                  # bad and not flat
-        np.logical_or(saturated, clamped, out=saturated)
-        np.logical_or(saturated, flat, out=saturated)
+    def _round(self, low, high, chosen, cursor, stage, out, reversing):
+        """Samples ``low`` ... ``high - 1`` of the columns ``chosen`` (None: all): done up to
+        each column's first event, and the event itself; advances ``cursor``."""
+        every = chosen is None
+        columns = slice(None) if every else chosen
 
-    def _remember(self, row, stage, out, uniform):
-        """(T_ref, xi_MF) assumed at ``row``: the fraction of R_ref, or if clamped the branch's."""
-        self.last_T = out["T_ref"][row].copy()
-        self.last_xi = stage["mf"][row].copy()          # = the fraction of R_ref where not clamped
-        chosen = np.flatnonzero(out["saturated"][row])
-        if chosen.size == 0:
-            return
-        at = 0 if uniform else row
-        heating, inverse = stage["heating"][row, chosen], stage["inverse"][row, chosen]
-        M, energy = stage["M"][at, chosen], stage["energy"][at, chosen]
-        T = self.last_T[chosen]
-        branch_mf, branch_p = major_fractions(T, M, -energy, inverse)   # branch_fractions
-        has, T_r, xi_r = self.has[chosen], self.T_r[chosen], self.xi_r[chosen]
-        # minor_branch_fractions: heating xi_MF = clamp(xi_r L_h(T)/L_h(T_r)) (flat: xi_r),
-        # cooling xi_P = clamp((M - xi_r) xi_P,c(T)/xi_P,c(T_r)) (flat: M - xi_r)
-        at_reversal = _at_reversal(T_r, M, energy, inverse, heating)
-        flat = at_reversal < DENOMINATOR_FLOOR
-        base = np.where(heating, xi_r, M - xi_r)
-        value = np.where(flat, base, base * np.where(heating, branch_mf, branch_p) / at_reversal)
-        value = np.where(value < 0.0, 0.0, np.where(value > M, M, value))
-        minor = np.where(heating, value, M - value)
-        self.last_xi[chosen] = np.where(has, minor, branch_mf)
+        def pick(name):
+            values = stage[name]
+            values = values[low:high] if values.shape[0] > 1 else values
+            return values[:, columns]
+
+        # each column's direction at its cursor: its direction until its next event
+        heating = stage["heating"][0] if every else stage["heating"][cursor[chosen], chosen]
+        T, saturated, bad, exponent, pops = self._branches(pick, heating, columns)
+        events = np.logical_or(reversing[low:high, columns], pops)
+        if not every:       # samples before a column's cursor are done already
+            done = np.arange(low, high)[:, None] < cursor[chosen]
+            events &= ~done
+            keep = ~done
+            for name, values in (("T_ref", T), ("saturated", saturated), ("bad", bad),
+                                 ("exponent", exponent)):
+                target = out[name][low:high, chosen]
+                np.copyto(target, values, where=keep)
+                out[name][low:high, chosen] = target
+        else:
+            out["T_ref"][low:high], out["saturated"][low:high] = T, saturated
+            out["bad"][low:high], out["exponent"][low:high] = bad, exponent
+        found = events.any(axis=0)
+        first = np.argmax(events, axis=0) + low
+        indices = np.arange(cursor.size) if every else chosen
+        cursor[indices] = high
+        for column, row in zip(indices[found].tolist(), first[found].tolist()):
+            self._event(column, row, stage, out, bool(reversing[row, column]))
+            cursor[column] = row + 1
+
+    def _branches(self, pick, heating, columns):
+        """(T_ref, saturated, bad, Lambda, pops) of the picked samples with each column's
+        present stack and direction ``heating`` (its direction until its next event).
+
+        temperature_on_stack without the walk: ``pops`` marks where the target lies beyond
+        B of the top pair (an event, computed again there).
+        """
+        count = self.count[columns]
+        has, nested = count > 0, count >= 2
+        mf, p, clamped = pick("mf"), pick("p"), pick("clamped")
+        M, energy, delta, upper = pick("M"), pick("energy"), pick("delta"), pick("upper")
+        inverse = np.where(heating, pick("inv_heating"), pick("inv_cooling"))
+        T_A, xi_A = self.T_A[columns], self.xi_A[columns]
+        T_B, xi_B = self.T_B[columns], self.xi_B[columns]
+        target = np.where(heating, mf, p)
+        value_A = np.where(heating, xi_A, M - xi_A)
+        value_B = np.where(nested, np.where(heating, xi_B, M - xi_B), 0.0)
+        xi_mf, xi_p = major_fractions(T_A, M, -energy, inverse)
+        major_A = np.where(heating, xi_mf, xi_p)
+        xi_mf, xi_p = major_fractions(T_B, M, -energy, inverse)
+        major_B = np.where(nested, np.where(heating, xi_mf, xi_p), 0.0)
+        spread, span = major_A - major_B, value_A - value_B
+        offset = target - value_B
+        pops = np.logical_and(nested, offset * span < 0.0)
+        flat = has & ((np.abs(spread) < DENOMINATOR_FLOOR) | (np.abs(span) < DENOMINATOR_FLOOR))
+        major = major_B + offset * (spread / span)
+        rest = M - major
+        new_mf = np.where(has, np.where(heating, major, rest), mf)
+        new_p = np.where(has, np.where(heating, rest, major), p)
+        second = clamp_fractions(new_mf, new_p, delta, upper)
+        shape = new_mf.shape
+        T, exponent, bad = np.empty(shape), np.empty(shape), np.empty(shape, dtype=bool)
+        temperature_of_fractions(new_mf, new_p, pick("inverse"), energy, T, exponent, bad)
+        if flat.any():                                  # flat: T_A, saturated
+            np.copyto(T, np.broadcast_to(T_A, shape), where=flat)
+            bad &= ~flat
+        saturated = clamped | second | flat
+        return T, saturated, bad, exponent, pops
+
+    def _event(self, column, row, stage, out, reversal):
+        """Sample ``row`` of ``column`` with the runtime's functions (FeedforwardStepper._invert):
+        push on a reversal, walk the stack, invert; the stack and the memory follow."""
+        def at(name, where):
+            values = stage[name]
+            return float(values[where if values.shape[0] > 1 else 0, column])
+
+        points = self.points[column]
+        sample = self._offset + row
+        if reversal:
+            if self._event_sample[column] == sample - 1:      # the previous sample was an event
+                assumed = self._event_assumed[column]
+            elif row > 0:
+                assumed = self._assumed(column, points, *(at(name, row - 1) for name in (
+                    "raw_mf", "raw_p", "M", "energy", "inverse", "heating")))
+            else:                                             # the previous chunk's last sample
+                assumed = self._assumed(column, points, *(float(self._carry[name][column])
+                                                          for name in ("raw_mf", "raw_p", "M",
+                                                                       "energy", "inverse",
+                                                                       "heating")))
+            points = list(points)
+            push_reversal(points, assumed[0], assumed[1], self.depths[column])
+        xi_mf, xi_p = at("raw_mf", row), at("raw_p", row)
+        constants = BranchConstants(at("M", row), None, at("energy", row), at("inverse", row),
+                                    None)
+        direction = HEATING if at("heating", row) else COOLING
+        try:
+            sensed, kept = temperature_on_stack(xi_mf, xi_p, constants, direction, points,
+                                                self.margins[column])
+            points = points[:kept] if kept < len(points) else points
+            fraction = (fractions_on_stack(sensed.temperature, constants, direction, points)[0]
+                        if sensed.saturated else xi_mf)
+            T, saturated, bad = sensed.temperature, sensed.saturated, False
+        except ValueError:                              # diverged: the run goes to the library
+            T, saturated, bad, fraction = math.nan, True, True, math.nan
+        self._keep(column, points)
+        self._event_sample[column] = sample
+        self._event_assumed[column] = (T, fraction)
+        out["T_ref"][row, column], out["saturated"][row, column] = T, saturated
+        out["bad"][row, column], out["exponent"][row, column] = bad, math.nan
+
+    def _assumed(self, column, points, xi_mf, xi_p, M, energy, inverse, heating):
+        """(T_ref, xi_MF) the compensator assumed at a sample that was no event (its stack
+        ``points`` unchanged by it): FeedforwardStepper._invert's state."""
+        constants = BranchConstants(M, None, energy, inverse, None)
+        direction = HEATING if heating else COOLING
+        try:
+            sensed = temperature_on_stack(xi_mf, xi_p, constants, direction, points,
+                                          self.margins[column])[0]
+        except ValueError:
+            return math.nan, math.nan
+        if sensed.saturated:
+            xi_mf = fractions_on_stack(sensed.temperature, constants, direction, points)[0]
+        return sensed.temperature, xi_mf
+
+    def _keep(self, column, points):
+        """Make ``points`` the stack of ``column`` and cache its top pair."""
+        self.points[column] = points
+        count = len(points)
+        self.count[column] = count
+        if count:
+            self.T_A[column], self.xi_A[column] = points[-1]
+        if count >= 2:
+            self.T_B[column], self.xi_B[column] = points[-2]
