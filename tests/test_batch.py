@@ -4,20 +4,34 @@ The sets (sma_fmu.studies.random_set, also the benchmark's) mix every controller
 inverses, with the fixed and the adaptive compensator) in both hysteresis modes with random
 gains, filters, loads, references, wire and model parameters; some runs get a random
 piecewise-linear reference, so the compensators reverse at different samples, on plateaus
-and outside the band the wire can reach.
+and outside the band the wire can reach. Nested minor loops (spec section 6: a stack of
+reversal points with wiping out) come from references of several superimposed frequencies
+with a start inside the transformation and load steps, with the default memory depth and
+with a depth of 4 (the two oldest points dropped), in the plant and in the compensator.
+
+The batch's numpy exp and log may differ from the math module's in the last bit, so the
+series agree to rounding, not bit for bit, and the metrics are compared to rounding too.
 """
 import dataclasses
 import itertools
+import math
 
 import numpy as np
 import pytest
 
-import sma_fmu.runtime.sensing as sensing
+import sma_fmu.runtime.feedforward as runtime_feedforward
+import sma_fmu.runtime.plant as runtime_plant
 import sma_fmu.studies.batch as batch
-from sma_fmu.cosim.loop import run_library
+import sma_fmu.studies.batch_minor_loops as batch_minor_loops
+import sma_fmu.studies.batch_plant as batch_plant
+from sma_fmu.cosim.loop import LibraryCompensator, LibraryPlant, run_library, run_loop
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
+from sma_fmu.runtime.constants import HEATING
+from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, major_value, value_of
+from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.signals import ReferenceSignal
+from sma_fmu.studies.batch_inputs import BatchInputs
 from sma_fmu.studies import BatchUnsupported, StudyError, run_batch, run_many, template
 from sma_fmu.studies.random_set import ALL_CONTROLLERS, gain_grid_scenarios, random_scenarios
 
@@ -32,6 +46,22 @@ def assert_same_series(batch_data, scalar_data, label):
         else:
             np.testing.assert_allclose(batch_data[field], scalar_data[field], rtol=0,
                                        atol=TOLERANCE, equal_nan=True, err_msg=f"{label} {field}")
+
+
+def assert_same_metrics(actual, expected):
+    """scenario_metrics records equal to rounding: numbers to 1e-12 relative, the rest exactly."""
+    assert actual.keys() == expected.keys()
+    for key, value in expected.items():
+        if isinstance(value, dict):
+            assert_same_metrics(actual[key], value)
+        elif isinstance(value, list) and value and isinstance(value[0], dict):
+            assert len(actual[key]) == len(value), key
+            for part, reference in zip(actual[key], value):
+                assert_same_metrics(part, reference)
+        elif isinstance(value, float) and not isinstance(actual[key], bool):
+            assert actual[key] == pytest.approx(value, rel=1e-12, abs=1e-15), key
+        else:
+            assert actual[key] == value, key
 
 
 def random_walk_reference(rng, stop_time_s):
@@ -79,31 +109,239 @@ def test_random_sets_equal_the_library_path(seed, chunk, load_step_s, monkeypatc
         scalar = run_library(scenario).data
         assert_same_series(result.data, scalar, f"{scenario.controller.kind} "
                            f"{scenario.controller.inverse} {scenario.hysteresis_mode}")
-        assert result.metrics == scenario_metrics(scalar, scenario)
+        assert_same_metrics(result.metrics, scenario_metrics(scalar, scenario))
         if scenario.controller.feedforward:
             saturated[scenario.controller.inverse] += int(scalar["saturated"].sum())
     assert min(saturated.values()) > 0    # the clamps and the saturated memory were exercised
 
 
-@pytest.mark.parametrize("values", [[45, 31, 32, 32, 31, 45], [45, 51, 50, 50, 51, 45]])
+def is_flat(points, kept, constants, direction):
+    """Whether temperature_on_stack ended on a flat branch (section 6: a denominator below
+    the floor), recomputed from the stack it kept with the runtime's own helpers."""
+    if not kept:
+        return False
+    heating, total = direction == HEATING, constants.M
+    top = points[kept - 1]
+    value_A, major_A = value_of(top, total, heating), major_value(top.temperature, constants,
+                                                                   heating)
+    value_B = major_B = 0.0
+    if kept >= 2:
+        below = points[kept - 2]
+        value_B = value_of(below, total, heating)
+        major_B = major_value(below.temperature, constants, heating)
+    return abs(major_A - major_B) < DENOMINATOR_FLOOR or abs(value_A - value_B) < DENOMINATOR_FLOOR
+
+
+@pytest.mark.parametrize("values", [[45, 51, 50, 50, 51, 45], [45, 51, 50, 51, 50, 51, 45]])
 def test_minor_loop_inverse_on_flat_branches_equals_the_library_path(values, monkeypatch):
-    """Clamped beyond the band, then reversed: at a margin of 1e-16 the next branch is flat
-    (T_ref stays at the reversal temperature, saturated), on the hot and on the cold side."""
+    """Clamped beyond the cold end of the band, then reversed (once, or back and forth):
+    at a margin of 1e-16 the branch is flat (T_ref stays at the top point's temperature,
+    saturated) for the whole plateau."""
     base = template("load-step-continuous-pi+ff-adaptive-minor-loop").scenario(
         {"scenario.stop_time_s": 3.0})
     model = base.parameter_set
     scenario = dataclasses.replace(
-        base, reference=ReferenceSignal("table", {"times_s": [0, 0.5, 1.0, 1.5, 2.0, 2.5],
+        base, reference=ReferenceSignal("table", {"times_s": [0.5 * i for i in range(len(values))],
                                                   "values_ohm": values}),
         compensator_parameter_set=dataclasses.replace(
             model, params=model.params.replace(saturation_margin=1e-16)))
     flat = []
-    equivalent = sensing.major_equivalent       # None: the branch is flat
-    monkeypatch.setattr(sensing, "major_equivalent",
-                        lambda *args: flat.append(equivalent(*args)) or flat[-1])
+    walk = runtime_feedforward.temperature_on_stack
+
+    def watched(xi_mf, xi_p, constants, direction, points, margin, count=None):
+        sensed, kept = walk(xi_mf, xi_p, constants, direction, points, margin, count)
+        flat.append(is_flat(points, kept, constants, direction))
+        return sensed, kept
+    monkeypatch.setattr(runtime_feedforward, "temperature_on_stack", watched)
     scalar = run_library(scenario).data
-    assert flat.count(None) >= 400     # on the flat branch for the whole plateau
+    assert sum(flat) >= 400     # on a flat branch for a whole plateau
     assert_same_series(run_batch([scenario], "timeseries")[0].data, scalar, str(values))
+
+
+def multi_frequency_reference(stop_time_s):
+    """R_ref of three superimposed frequencies (0.7 Hz decaying, 2.3 Hz, 6.1 Hz) as a table
+    every 10 ms: reversals inside reversals, so the stacks nest."""
+    times = [round(0.01 * i, 2) for i in range(int(round(stop_time_s / 0.01)) + 1)]
+    values = [41.5 + 5.0 * math.exp(-t / 2.5) * math.sin(2.0 * math.pi * 0.7 * t)
+              + 1.2 * math.sin(2.0 * math.pi * 2.3 * t + 1.0)
+              + 0.5 * math.sin(2.0 * math.pi * 6.1 * t) for t in times]
+    return times, values
+
+
+def nested_scenarios(stop_time_s=6.0, depths=(4, 64)):
+    """Every controller in both modes on the multi-frequency reference, starting at 60 degC
+    (inside the transformation), with load steps at 2 s and 4 s, for each memory depth of
+    the wire and of the compensator's model (overrides wire.memory_depth, model.memory_depth)."""
+    times, values = multi_frequency_reference(stop_time_s)
+    base = template("load-step-continuous-pi+ff-adaptive-minor-loop")
+    return [base.scenario({
+        "scenario.stop_time_s": stop_time_s, "reference.kind": "table",
+        "reference.times_s": times, "reference.values_ohm": values,
+        "plant.T_start_degC": 60.0, "plant.hysteresis_mode": mode,
+        "load.times_s": [0.0, 2.0, 4.0], "load.values_kg": [0.01, 0.08, 0.03],
+        "controller.kind": kind, "controller.inverse": inverse,
+        "wire.memory_depth": depth, "model.memory_depth": depth})
+        for (kind, inverse), mode, depth in itertools.product(
+            ALL_CONTROLLERS, HYSTERESIS_MODES, depths)]
+
+
+class PushCounter:
+    """Wraps a module's push_reversal: pushes, pushes that dropped the two oldest points,
+    and the largest stack, per module name."""
+
+    def __init__(self, monkeypatch, **modules):
+        self.counts = {}
+        for name, module in modules.items():
+            monkeypatch.setattr(module, "push_reversal", self._wrap(name, module.push_reversal))
+
+    def _wrap(self, name, push):
+        def counted(points, temperature, xi_mf, depth):
+            pushes, drops, deepest = self.counts.get(name, (0, 0, 0))
+            drops += len(points) + 1 > depth
+            push(points, temperature, xi_mf, depth)
+            self.counts[name] = (pushes + 1, drops, max(deepest, len(points)))
+        return counted
+
+
+@pytest.mark.parametrize("engine", ["default", "vectorized events, small windows and chunks"])
+def test_nested_minor_loops_equal_the_library_path(engine, monkeypatch):
+    """Nested minor loops, wiped-out loops, load steps and a depth of 4 (points dropped), in
+    the plant and in the compensator, both modes, both inverses: every column <= 1e-10.
+
+    The second engine handles every plant event with numpy (no run-by-run path), walks the
+    compensators in windows of 2 samples and cuts the run into chunks of 3 steps, so events
+    fall on chunk boundaries and on the first sample of a chunk."""
+    if engine != "default":
+        monkeypatch.setattr(batch_plant, "FEW_RUNS", 0)
+        monkeypatch.setattr(batch_minor_loops, "WINDOW", 2)
+        monkeypatch.setattr(batch, "CHUNK_ELEMENTS", 60)
+    scenarios = nested_scenarios()
+    results = run_batch(scenarios, "timeseries")
+    counter = PushCounter(monkeypatch, plant=runtime_plant, compensator=runtime_feedforward)
+    seen = {}
+    for scenario, result in zip(scenarios, results):
+        counter.counts.clear()
+        scalar = run_library(scenario).data
+        label = (f"{scenario.controller.kind} {scenario.controller.inverse} "
+                 f"{scenario.hysteresis_mode} depth {scenario.params.memory_depth}")
+        assert result.path == "batch" and result.error is None, label
+        assert_same_series(result.data, scalar, label)
+        assert_same_metrics(result.metrics, scenario_metrics(scalar, scenario))
+        for name, (pushes, drops, deepest) in counter.counts.items():
+            key = (name, scenario.params.memory_depth)
+            total = seen.get(key, (0, 0, 0))
+            seen[key] = (total[0] + pushes, total[1] + drops, max(total[2], deepest))
+    # what the set exercised, on the scalar path: nesting beyond 4 points at depth 64, and
+    # drops at depth 4, in the plant and in the compensator
+    for name in ("plant", "compensator"):
+        assert seen[(name, 64)][1] == 0 and seen[(name, 64)][2] >= 5, (name, seen)
+        assert seen[(name, 4)][1] >= 2 and seen[(name, 4)][2] == 4, (name, seen)
+
+
+def test_the_batch_stacks_are_the_scalar_stacks_and_never_exceed_the_depth(monkeypatch):
+    """After every plant step and every compensator chunk no stack is deeper than its
+    memory_depth, and at the end each run's stacks are the scalar path's (the plant's to
+    1e-10, the compensator's bit for bit: its points come from the runtime's functions)."""
+    scenarios = [s for s in nested_scenarios(stop_time_s=4.0) if s.hysteresis_mode == "continuous"
+                 or s.controller.inverse == "minor-loop"]
+    made = {}
+
+    class CheckedPlant(batch.BatchPlant):
+        def __init__(self, inputs, ordered):
+            super().__init__(inputs, ordered)
+            made["plant"], made["order"], made["deepest"] = self, ordered, 0
+
+        def step(self, power):
+            super().step(power)
+            assert (self.reversal_count <= self.depth).all()
+            made["deepest"] = max(made["deepest"], int(self.reversal_count.max()))
+
+    class CheckedFeedforward(batch.BatchFeedforward):
+        def __init__(self, inputs, ordered):
+            super().__init__(inputs, ordered)
+            made["feedforward"], made["stacked"] = self, 0
+
+        def chunk(self, start, stop):
+            out = super().chunk(start, stop)
+            memory = self.minor
+            assert all(len(points) <= depth for points, depth in zip(memory.points,
+                                                                      memory.depths))
+            made["stacked"] = max([made["stacked"]] + [len(points) for points in memory.points])
+            return out
+    monkeypatch.setattr(batch, "BatchPlant", CheckedPlant)
+    monkeypatch.setattr(batch, "BatchFeedforward", CheckedFeedforward)
+    run_batch(scenarios, "metrics")
+    plant, feedforward, order = made["plant"], made["feedforward"], made["order"]
+    assert made["deepest"] >= 4 and made["stacked"] >= 4
+    position = {id(scenario): run for run, scenario in enumerate(order)}
+    minor_runs = feedforward.runs.tolist()
+    compared = 0
+    for scenario in scenarios:
+        run = position[id(scenario)]
+        library_plant = LibraryPlant(scenario)
+        compensator = LibraryCompensator(scenario) if scenario.controller.feedforward else None
+        run_loop(scenario, library_plant, compensator)
+        expected = library_plant.stepper.reversals
+        got = plant.reversals(run)
+        assert len(got) == len(expected) <= scenario.params.memory_depth, scenario.name
+        if expected:
+            np.testing.assert_allclose(got, expected, rtol=0, atol=TOLERANCE)
+        if scenario.controller.inverse == "minor-loop":
+            column = feedforward.of_run[minor_runs.index(run)] - feedforward.split
+            assert feedforward.minor.points[column] == compensator.stepper.reversals
+            compared += len(compensator.stepper.reversals) > 0
+    assert compared >= 2
+
+
+@pytest.mark.parametrize("few_runs", [0, 1000])
+def test_plant_events_equal_the_scalar_plant_step_by_step(few_runs, monkeypatch):
+    """BatchPlant against PlantStepper, step by step, under a power that chatters every step
+    (a one-on one-off drive) for a third of the runs and swings in decaying nested loops for
+    the others, with depths 2 to 5 and 64 and a load step: R, T and the stacks after every
+    step; every event handled with numpy (0) or run by run (1000)."""
+    monkeypatch.setattr(batch_plant, "FEW_RUNS", few_runs)
+    counter = PushCounter(monkeypatch, plant=runtime_plant)
+    rng = np.random.default_rng(7)
+    depths = [2, 3, 4, 5, 64]
+    scenarios = []
+    for index, scenario in enumerate(random_scenarios(30, 11, 1.5, load_step_s=0.8)):
+        params = scenario.params.replace(memory_depth=depths[index % len(depths)])
+        scenarios.append(dataclasses.replace(
+            scenario, T_start=float(rng.uniform(50.0, 80.0)),
+            hysteresis_mode="switch" if index % 6 == 5 else "continuous",
+            parameter_set=dataclasses.replace(scenario.parameter_set, params=params)))
+    inputs = BatchInputs(scenarios)
+    plant = batch.BatchPlant(inputs, scenarios)
+    steppers = [PlantStepper(s.params, s.T_start, s.hysteresis_mode, s.load.value(0.0))
+                for s in scenarios]
+    hold = np.array([(65.0 - s.params.T_room) / s.params.K_th for s in scenarios])
+    phase = rng.uniform(0.0, 2.0 * math.pi, len(scenarios))
+    chatter = np.arange(len(scenarios)) % 3 == 0
+    changes, h = set(inputs.change_steps), inputs.step_s
+    for k in range(inputs.steps):
+        if k in changes:
+            plant.set_segments(inputs.segment_row(k), inputs.segment_row(k - 1))
+        t = k * h
+        swing = hold * (1.0 + 0.8 * math.exp(-t / 0.6) * np.sin(2.0 * math.pi * 3.0 * t + phase)
+                        + 0.1 * math.sin(2.0 * math.pi * 29.0 * t))
+        power = np.maximum(np.where(chatter, 2.0 * hold * (k % 2), swing), 0.0)
+        plant.step(power)
+        for stepper, scenario, p in zip(steppers, scenarios, power.tolist()):
+            stepper.step(p, scenario.load.value(t), h)
+        expected = np.array([len(s.reversals) for s in steppers])
+        assert np.array_equal(plant.reversal_count, expected), k
+        assert (plant.reversal_count <= plant.depth).all()
+        np.testing.assert_allclose(plant.R, [s.outputs.R for s in steppers], rtol=0,
+                                   atol=TOLERANCE)
+        np.testing.assert_allclose(plant.temperature, [s.temperature for s in steppers],
+                                   rtol=0, atol=TOLERANCE)
+        if k % 50 == 0 or k == inputs.steps - 1:
+            for run, stepper in enumerate(steppers):
+                if stepper.reversals:
+                    np.testing.assert_allclose(plant.reversals(run), stepper.reversals,
+                                               rtol=0, atol=TOLERANCE)
+    pushes, drops, deepest = counter.counts["plant"]
+    assert pushes >= 1000 and drops >= 10 and deepest >= 5
 
 
 def test_compensators_shared_by_a_gain_grid_equal_the_library_path():
