@@ -258,8 +258,9 @@ def _strain(path, quantity, name, unit, values, reference):
             raise _unit_error(path, name, values, "exceed 1: they look like percent; name the "
                                                    "column strain_percent")
         if unit == "percent" and np.ptp(values) < 0.05:
-            raise _unit_error(path, name, values, "span under 0.05 %: they look like a fraction; "
-                                                   "name the column strain")
+            raise _unit_error(path, name, values, "span under 0.05 %: they look like a fraction "
+                                                   "(then name the column strain), or the wire "
+                                                   "never transforms")
         return values / 100.0 if unit == "percent" else values
     metres = values * _SCALE[unit]
     if quantity == "extension":
