@@ -132,7 +132,8 @@ def test_analytic_jacobian_matches_finite_differences(tmp_path, params):
                                (strain - data.strain) / sigma["strain"],
                                (resistance - data.resistance) / sigma["resistance"]])
 
-    analytic = np.vstack(isobaric._jacobian_rows(vector, layout, data, 0, layout.profiles[0], sigma))
+    from sma_fmu.identification.isobaric_jacobian import jacobian_rows
+    analytic = np.vstack(jacobian_rows(vector, layout, data, 0, layout.profiles[0], sigma))
     for column in list(range(len(layout.reported))) + [layout.profiles[0] + 7]:
         step = 1e-6 * max(abs(vector[column]), 1e-3)
         up, down = vector.copy(), vector.copy()
