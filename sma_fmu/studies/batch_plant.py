@@ -20,13 +20,13 @@ sign of each run's direction) is refreshed in the steps in which some direction 
 The reversal memory: the stacks are the rows of an (N, D) array of T and one of xi_MF
 with a count per run (D grows on demand up to the batch's largest ``memory_depth`` + 1).
 Reversals and wipes are rare events per run, so they are handled for the runs concerned
-only (index arrays; a few runs one by one with the runtime's own functions, many at once
-with numpy), in the scalar step's order: push (T_k, xi_MF,k) where the direction changed
+only (index arrays; a few runs one pass each with the runtime's own branch_of, many at
+once with numpy), in the scalar step's order: push (T_k, xi_MF,k) where the direction changed
 (dropping the two oldest points beyond the run's depth), wipe out closed loops, then take
 the :class:`~sma_fmu.runtime.minor_loops.Branch` of the new top (value_B, ratio, major_B).
 Each run's branch is cached until its stack or its load changes, as the scalar plant
-caches it; the per-step check for wiping out is one comparison, sign(d) T+ >= sign(d) T_B,
-against a cached bound (+inf below two points). Per step the minor branches then cost
+caches it; the per-step check for wiping out is a product and a comparison,
+sign(d) T+ >= sign(d) T_B, against a cached bound (+inf below two points). Per step the minor branches then cost
 v = value_B + ratio (L_d(T+) - major_B), the clamp into [0, M] and the selection.
 """
 import numpy as np
