@@ -1,7 +1,7 @@
 """N feedforward compensators (:class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`) at once.
 
 The compensator is open loop: its output at step k depends only on R_ref(t_k), f(t_k) and
-its own memory (d_ref, the minor-loop reversal, the filter), never on the plant. So the
+its own memory (d_ref, the minor-loop reversal stack, the filter), never on the plant. So the
 inverse of :mod:`~sma_fmu.runtime.sensing` (major branch of the reference direction, at the
 measured or the fixed model load, with the saturation clamp; for ``inverse = "minor-loop"``
 the branch of the compensator's own stack of reversal points, :mod:`.batch_minor_loops`) is
