@@ -76,7 +76,8 @@ def temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin, coun
     ``points[:count]`` (default all) is the stack of :class:`~.minor_loops.ReversalPoint`
     (empty: the major branch of ``direction``, as :func:`temperature_of_fractions`). The
     fractions are first clamped into [delta, M - delta] (what the load allows); a target
-    beyond B pops A and B (the loop it closes is wiped out) and the walk repeats; on the
+    at or beyond B pops A and B (the loop it closes is wiped out, as the plant wipes when T
+    reaches or passes T_B) and the walk repeats; on the
     branch A -> B the major value is found in closed form and inverted, clamped again into
     what the major branch reaches. ``saturated`` is set when either clamp acts. Where the
     branch is flat (a denominator below the floor) the result is T_A, saturated. ``kept``
@@ -98,7 +99,8 @@ def temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin, coun
         if count >= 2:
             below = points[count - 2]
             value_B = value_of(below, total, heating)
-            if (target - value_B) * (value_A - value_B) < 0.0:   # beyond B: the outer branch
+            offset = target - value_B
+            if offset * (value_A - value_B) < 0.0 or offset == 0.0:   # at or beyond B: outer
                 count -= 2
                 continue
             major_B = major_value(below.temperature, constants, heating)
@@ -114,7 +116,10 @@ def temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin, coun
         if clamped and not sensed.saturated:
             sensed = _new_tuple(SensedTemperature, (sensed.temperature, True))
         return sensed, count
-    return temperature_of_fractions(xi_mf, xi_p, constants, margin), 0
+    sensed = temperature_of_fractions(xi_mf, xi_p, constants, margin)   # the stack emptied
+    if clamped and not sensed.saturated:
+        sensed = _new_tuple(SensedTemperature, (sensed.temperature, True))
+    return sensed, 0
 
 
 def sense_temperature(resistance, load, direction, params, reversals=()):

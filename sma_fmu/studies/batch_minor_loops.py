@@ -187,7 +187,7 @@ class MinorLoopMemory:
         major_B = np.where(nested, np.where(heating, xi_mf, xi_p), 0.0)
         spread, span = major_A - major_B, value_A - value_B
         offset = target - value_B
-        pops = np.logical_and(nested, offset * span < 0.0)
+        pops = np.logical_and(nested, (offset * span < 0.0) | (offset == 0.0))
         flat = has & ((np.abs(spread) < DENOMINATOR_FLOOR) | (np.abs(span) < DENOMINATOR_FLOOR))
         major = major_B + offset * (spread / span)
         rest = M - major
