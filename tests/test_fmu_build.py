@@ -124,7 +124,7 @@ def test_cli_build_and_validate(tmp_path, capsys):
     assert "SmaActuator: " in capsys.readouterr().out
     assert main(["validate", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert out.count("valid (fmpy: no problems)") == len(FMU_SCRIPTS) == 4
+    assert out.count("valid (fmpy: no problems)") == len(FMU_SCRIPTS) == 5
 
 
 def test_cli_validate_fails_on_a_broken_fmu(tmp_path, fmus, capsys):

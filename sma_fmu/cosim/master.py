@@ -1,8 +1,10 @@
-"""The fmpy co-simulation master: SmaActuator (+ SmaFeedforward) FMUs in the closed loop.
+"""The fmpy co-simulation master: SmaActuator (+ SmaFeedforward, + SmaPwmDriver) FMUs in the closed loop.
 
 Built on fmpy's ``FMU2Slave`` (through :class:`~sma_fmu.fmi.instance.FmuInstance`). The
 loop and the PI block are those of :mod:`sma_fmu.cosim.loop`; the compensator FMU is
-stepped before the plant (Gauss-Seidel), so u_ff,k reaches the plant's step k.
+stepped before the plant (Gauss-Seidel), so u_ff,k reaches the plant's step k. A scenario
+with a PWM drive puts the SmaPwmDriver FMU between the PI and the plant, stepped after the
+PI and before the plant in the same step: the plant gets the wave's mean over that step.
 """
 import time
 from pathlib import Path
@@ -11,7 +13,8 @@ from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
 from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths, read_description
 from sma_fmu.fmi.instance import FmuError, FmuInstance
 
-__all__ = ["FmuPlant", "FmuCompensator", "run_fmus", "MissingFmuError", "model_parameter_values"]
+__all__ = ["FmuPlant", "FmuCompensator", "FmuDriver", "needed_fmus", "run_fmus", "MissingFmuError",
+           "model_parameter_values"]
 
 
 class MissingFmuError(FileNotFoundError):
@@ -83,24 +86,58 @@ class FmuCompensator:
         self.fmu.close()
 
 
+class FmuDriver:
+    """The SmaPwmDriver FMU as the loop's driver (the hook of :func:`~sma_fmu.cosim.loop.run_loop`)."""
+
+    def __init__(self, scenario, fmu_path, instance_name="driver"):
+        drive = scenario.drive
+        self.fmu = FmuInstance(fmu_path, instance_name,
+                               {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W})
+        self._inputs = self.fmu.port(("P_demand",))
+        self._outputs = self.fmu.port(("P_in",))
+
+    def initial(self):
+        """P_in [W] after initialization, before the first step (0 W)."""
+        return self._outputs.get()[0]
+
+    def step(self, time_s, demand, step_size):
+        """Set P_demand [W], doStep, return P_in [W]: the wave's mean over the step."""
+        self._inputs.set((demand,))
+        self.fmu.step(time_s, step_size)
+        return self._outputs.get()[0]
+
+    def close(self):
+        """Free the instance."""
+        self.fmu.close()
+
+
+def needed_fmus(scenario):
+    """Names of the FMUs the FMU path of ``scenario`` runs: the plant, and the compensator
+    and the PWM driver when the scenario has them."""
+    return (["SmaActuator"] + (["SmaFeedforward"] if scenario.controller.feedforward else [])
+            + (["SmaPwmDriver"] if scenario.drive.pwm else []))
+
+
 def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR):
     """Run ``scenario`` through the FMUs in ``fmu_dir``; returns a :class:`LoopResult`."""
     paths = default_fmu_paths(fmu_dir)
-    needed = ["SmaActuator"] + (["SmaFeedforward"] if scenario.controller.feedforward else [])
-    for name in needed:
+    for name in needed_fmus(scenario):
         if not paths[name].is_file():
             raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "
                                   f"sma-fmu build --out {Path(fmu_dir)}")
     start = time.perf_counter()
-    parts = []
+    parts = {}
     try:
-        parts.append(FmuPlant(scenario, paths["SmaActuator"]))
+        parts["plant"] = FmuPlant(scenario, paths["SmaActuator"])
         if scenario.controller.feedforward:
-            parts.append(FmuCompensator(scenario, paths["SmaFeedforward"]))
-        data = run_loop(scenario, parts[0], parts[1] if len(parts) > 1 else None)
+            parts["compensator"] = FmuCompensator(scenario, paths["SmaFeedforward"])
+        if scenario.drive.pwm:
+            parts["driver"] = FmuDriver(scenario, paths["SmaPwmDriver"])
+        data = run_loop(scenario, parts["plant"], parts.get("compensator"),
+                        driver=parts.get("driver"))
     except FmuError as error:
         raise FmuError(f"scenario {scenario.name}: {error}", error.status) from None
     finally:
-        for part in parts:
+        for part in parts.values():
             part.close()
     return LoopResult(scenario, data, "fmu", time.perf_counter() - start)

@@ -40,7 +40,7 @@ __all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "DEFAULT_SIGNALS_SCENARIO", "FmuFil
            "read_description"]
 
 FMU_SCRIPTS = {"SmaActuator": "sma_actuator.py", "SmaFeedforward": "sma_feedforward.py",
-               "SmaPiController": "sma_pi_controller.py",
+               "SmaPiController": "sma_pi_controller.py", "SmaPwmDriver": "sma_pwm_driver.py",
                "SmaScenarioSignals": "sma_scenario_signals.py"}
 DEFAULT_FMU_DIR = Path("fmus")
 DEFAULT_SIGNALS_SCENARIO = "load-step-pi+ff-adaptive"  # the paper's Fig. 10 signals

@@ -7,9 +7,14 @@ from this one description, so they wire and parameterise the loop alike::
     compensator.P_ff --> pi.P_ff     pi.P --> plant.P_in     plant.R --> pi.R
 
 The "pi" controller has no compensator (the PI's P_ff input then keeps its start, 0 W).
+A scenario with ``[drive] kind = "pwm"`` has a PWM driver between the PI and the plant::
+
+    pi.P --> driver.P_demand     driver.P_in --> plant.P_in
+
 Each component's parameter values are the scenario's: every wire parameter its FMU
 exposes (from the scenario's parameter file), the controller's gains and filter, the
-plant's start temperature and hysteresis mode, and the signals as JSON tables.
+driver's frequency and peak power, the plant's start temperature and hysteresis mode, and
+the signals as JSON tables.
 """
 from dataclasses import dataclass
 
@@ -19,11 +24,12 @@ from sma_fmu.runtime.scenario_signals import table_text
 
 __all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "STEP_ORDER"]
 
-# Gauss-Seidel order of a sequential host: the sampled blocks in data-flow order, then the
-# blocks whose outputs hold at the end of their step (plant: the state at t + h; signals:
-# their values at t + h), so every block of step k sees R_k, R_ref(t_k), f(t_k) and the
-# u_ff,k and u_k just computed, as in the library loop
-STEP_ORDER = ("compensator", "pi", "plant", "signals")
+# Gauss-Seidel order of a sequential host: the sampled blocks in data-flow order (the PWM
+# driver's output is the wave's mean over the step it was given), then the blocks whose
+# outputs hold at the end of their step (plant: the state at t + h; signals: their values
+# at t + h), so every block of step k sees R_k, R_ref(t_k), f(t_k) and the u_ff,k, u_k
+# and driver power just computed, as in the library loop
+STEP_ORDER = ("compensator", "pi", "driver", "plant", "signals")
 
 
 @dataclass(frozen=True)
@@ -73,6 +79,7 @@ def _fmu_files(scenario, fmu_dir):
     paths = default_fmu_paths(fmu_dir)
     needed = ["SmaScenarioSignals", "SmaPiController", "SmaActuator"]
     needed += ["SmaFeedforward"] if scenario.controller.feedforward else []
+    needed += ["SmaPwmDriver"] if scenario.drive.pwm else []
     for name in needed:
         if not paths[name].is_file():
             raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "
@@ -100,8 +107,10 @@ def closed_loop(scenario, fmu_dir):
     components = [_component("signals", "SmaScenarioSignals", paths, {
         "reference": table_text(scenario.reference.as_table()),
         "load_profile": table_text(scenario.load.as_table())})]
-    connections = [Connection("signals", "R_ref", "pi", "R_ref"),
-                   Connection("pi", "P", "plant", "P_in"),
+    drive = scenario.drive
+    power = ([Connection("pi", "P", "driver", "P_demand"), Connection("driver", "P_in", "plant", "P_in")]
+             if drive.pwm else [Connection("pi", "P", "plant", "P_in")])
+    connections = [Connection("signals", "R_ref", "pi", "R_ref"), *power,
                    Connection("signals", "load", "plant", "load"),
                    Connection("plant", "R", "pi", "R")]
     if c.feedforward:
@@ -112,6 +121,9 @@ def closed_loop(scenario, fmu_dir):
                             Connection("signals", "load", "compensator", "load"),
                             Connection("compensator", "P_ff", "pi", "P_ff")]
     components.append(_component("pi", "SmaPiController", paths, {"Kp": c.Kp, "Ki": c.Ki}))
+    if drive.pwm:
+        components.append(_component("driver", "SmaPwmDriver", paths, {
+            "frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W}))
     components.append(_component("plant", "SmaActuator", paths, {
         "T_start": scenario.T_start, "hysteresis_mode": scenario.hysteresis_mode}, scenario.params))
     return LoopSystem(scenario, tuple(components), tuple(connections))
