@@ -35,3 +35,12 @@ def test_the_same_scenario_with_sane_values_loads(tmp_path):
     path = tmp_path / "good.toml"
     path.write_text(BASE + "alpha_s = 1.0\n[plant]\nT_start_degC = 40.0\n", encoding="utf-8")
     assert load_scenario(path).T_start == 40.0
+
+
+@pytest.mark.parametrize("frequency", ["5e-324", "1e308"])
+def test_a_pwm_frequency_outside_the_driver_range_names_the_file(tmp_path, frequency):
+    path = tmp_path / "pwm.toml"
+    path.write_text(BASE + f'[drive]\nkind = "pwm"\nfrequency_Hz = {frequency}\npeak_W = 4.0\n',
+                    encoding="utf-8")
+    with pytest.raises(ScenarioError, match=r"\[drive\] frequency_Hz must be in \[1e-06, 1e\+09\] Hz"):
+        load_scenario(path)

@@ -51,7 +51,7 @@ from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.feedforward import INVERSES
 from sma_fmu.runtime.phase_lag import tustin_coefficients
-from sma_fmu.runtime.pwm import DRIVE_KINDS
+from sma_fmu.runtime.pwm import DRIVE_KINDS, PwmDriver
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
 from sma_fmu.toml_files import read_toml
@@ -299,8 +299,13 @@ def _drive(path, table):
         if extra:
             _fail(path, f"[drive] {', '.join(extra)} only apply to kind = 'pwm'")
         return DriveSettings()
-    return DriveSettings("pwm", _number(path, "drive", table, "frequency_Hz", positive=True),
-                         _number(path, "drive", table, "peak_W", positive=True))
+    drive = DriveSettings("pwm", _number(path, "drive", table, "frequency_Hz", positive=True),
+                          _number(path, "drive", table, "peak_W", positive=True))
+    try:
+        PwmDriver(drive.frequency_Hz, drive.peak_W)
+    except ValueError as error:
+        _fail(path, f"[drive] {error}")
+    return drive
 
 
 def check_sections(path, document, sections, required, error=ScenarioError):

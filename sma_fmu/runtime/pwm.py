@@ -18,9 +18,13 @@ import math
 from .checks import fast_finite, fast_positive, require_positive
 from .state_entries import read_entries
 
-__all__ = ["PwmDriver", "PERIOD_TOLERANCE", "DRIVE_KINDS"]
+__all__ = ["PwmDriver", "PERIOD_TOLERANCE", "DRIVE_KINDS", "MIN_FREQUENCY_HZ", "MAX_FREQUENCY_HZ"]
 
 PERIOD_TOLERANCE = 1e-9   # [periods]
+# choice: from one period in ~11.6 days to 1 GHz, far beyond any wire driver either way; the
+# period index t f stays an exact-enough float over the longest run (2e6 steps)
+MIN_FREQUENCY_HZ = 1e-6
+MAX_FREQUENCY_HZ = 1e9
 DRIVE_KINDS = ("power", "pwm")
 
 
@@ -29,6 +33,9 @@ class PwmDriver:
 
     def __init__(self, frequency_Hz, peak_W):
         self.frequency = require_positive("frequency_Hz", frequency_Hz)
+        if not MIN_FREQUENCY_HZ <= self.frequency <= MAX_FREQUENCY_HZ:
+            raise ValueError(f"frequency_Hz must be in [{MIN_FREQUENCY_HZ:g}, {MAX_FREQUENCY_HZ:g}] "
+                             f"Hz, got {frequency_Hz!r}")
         self.peak = require_positive("peak_W", peak_W)
         self.period = 1.0 / self.frequency
         self.held = None      # (index j, duty) of the period in progress at the last step's end
