@@ -20,7 +20,7 @@ from fmpy import read_model_description
 
 from fmi_host import ERROR, OK, WARNING, FmiHost, text, unpack
 from sma_fmu.fmi.build import build_fmu
-from sma_fmu.fmi.front import NativeFrontWarning, compile_front, remove_front
+from sma_fmu.fmi.front import NativeFrontWarning, remove_front
 from sma_fmu.fmi.hosts import CHostError, c_compiler, compile_host
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
@@ -231,19 +231,6 @@ def test_states_in_a_c_host(fmi_host_exe, unpacked):
         assert host.close() == 0
 
 
-def test_missing_libpython_gives_null_and_says_what_to_set(fmi_host_exe, fmus, tmp_path):
-    front = compile_front(libpython=("", "libpython9.99.so.1.0"))
-    assert front.library is not None, front.problem
-    folder = unpack(fmus["SmaActuator"], tmp_path / "unpacked")
-    (folder / "binaries/linux64/SmaActuator.so").write_bytes(front.library)  # pythonfmu's stays
-    with FmiHost(fmi_host_exe, folder) as host:
-        reply = host.call(f"instantiate 0 {text('p')} ok ok 0")
-        assert reply.status == ERROR
-        message = " ".join(reply.logged(ERROR))
-        assert "libpython9.99.so.1.0" in message and "SMA_FMU_LIBPYTHON" in message
-        assert "LD_PRELOAD" in message
-
-
 def test_without_a_compiler_the_build_keeps_pythonfmus_binary_and_says_so(
         fmi_host_exe, tmp_path, monkeypatch, cosim_host):
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
@@ -265,12 +252,17 @@ def test_remove_front_gives_back_pythonfmus_binary(fmus, tmp_path, cosim_host):
     fmu = fmus["SmaActuator"]
     before = remove_front(fmu, tmp_path / "before.fmu")
     with zipfile.ZipFile(fmu) as front, zipfile.ZipFile(before) as plain:
-        binary = "binaries/linux64/SmaActuator.so"
+        binaries = {"binaries/linux64/SmaActuator.so": "binaries/linux64/SmaActuator_pythonfmu.so",
+                    "binaries/win64/SmaActuator.dll": "binaries/win64/SmaActuator_pythonfmu.dll"}
         assert sorted(plain.namelist()) == sorted(
-            n for n in front.namelist() if n != "binaries/linux64/SmaActuator_pythonfmu.so")
-        assert plain.read(binary) == front.read("binaries/linux64/SmaActuator_pythonfmu.so")
-        assert plain.read(binary) != front.read(binary)
-        assert all(plain.read(n) == front.read(n) for n in plain.namelist() if n != binary)
+            n for n in front.namelist() if n not in binaries.values())
+        for binary, backend in binaries.items():
+            assert plain.read(binary) == front.read(backend)
+            assert plain.read(binary) != front.read(binary)
+        assert b"VendorAnnotations" in front.read("modelDescription.xml")
+        assert b"VendorAnnotations" not in plain.read("modelDescription.xml")
+        assert all(plain.read(n) == front.read(n) for n in plain.namelist()
+                   if n not in binaries and n != "modelDescription.xml")
     result, values = _run(cosim_host, before, 1e-3, 10, {}, ["R"])
     assert result.returncode != 0 and not values
     assert "undefined symbol" in result.stdout + result.stderr

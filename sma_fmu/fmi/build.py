@@ -9,9 +9,10 @@ Each FMU ships, in resources/:
 - SmaScenarioSignals only: ``signals.json``, its default signals (those of the shipped
   scenario :data:`DEFAULT_SIGNALS_SCENARIO`).
 
-Its binary is the native front (:mod:`sma_fmu.fmi.front`), compiled with the system C
-compiler, in front of pythonfmu's binary; without a compiler the build keeps pythonfmu's
-binary alone and warns (:class:`~sma_fmu.fmi.front.NativeFrontWarning`).
+Its binaries are the native front (:mod:`sma_fmu.fmi.front`) for linux64 and win64, in front
+of pythonfmu's; without a compiler for a platform the build warns
+(:class:`~sma_fmu.fmi.front.NativeFrontWarning`) and leaves win64 out, or keeps pythonfmu's
+linux64 binary alone, saying so in the model description (:mod:`sma_fmu.fmi.platforms`).
 
 ``<stamp>`` is a hash of all shipped code. pythonfmu FMUs loaded into one process share
 ``sys.modules``: with these names an FMU never runs another FMU type's modules, another
@@ -30,7 +31,7 @@ from importlib import resources
 from pathlib import Path
 
 from sma_fmu import __version__
-from sma_fmu.fmi.front import NativeFrontWarning, compile_front, install_front
+from sma_fmu.fmi.front import NativeFrontWarning, compile_fronts, install_fronts
 from sma_fmu.output_folder import staged_folder
 from sma_fmu.package_data import shipped_file
 from sma_fmu.parameter_file import load_parameter_set
@@ -177,17 +178,13 @@ def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None):
         raise ValueError(f"unknown FMU {unknown[0]!r}; expected one of {', '.join(FMU_SCRIPTS)}")
     parameter_set = load_parameter_set(parameter_file)
     stamp = code_stamp()
-    front = compile_front()
+    fronts = compile_fronts()
     with staged_folder(out_dir) as folder:
         for name in names:
             path = _build_into(name, folder, parameter_set, stamp)
-            if front.library is not None:
-                install_front(path, name, front.library)
-    if front.library is None:
-        warnings.warn(NativeFrontWarning(
-            f"FMUs built without the native front: {front.problem}. They keep pythonfmu's own "
-            "binary: C hosts need libpython in LD_PRELOAD, and refused calls are only logged, "
-            "not returned as fmi2Error (docs/fmus.md, 'Without the native front')"), stacklevel=2)
+            install_fronts(path, name, fronts)
+    for message in fronts.warnings():
+        warnings.warn(NativeFrontWarning(message), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}
 
 

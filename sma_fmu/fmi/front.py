@@ -1,18 +1,25 @@
-"""The native front of the FMUs: compiled by the build with the system C compiler.
+"""The native front of the FMUs: compiled by the build, for Linux and Windows.
 
 pythonfmu's binary needs libpython preloaded in C hosts, crashes on some resource URIs,
 passes log messages to the host as printf formats and cannot report fmi2Error for a
 refused call. The front (C sources in ``sma_fmu/fmi/native/``, shipped with the package)
-fixes that: it becomes ``binaries/linux64/<model>.so`` and forwards every call to
-pythonfmu's binary, renamed ``<model>_pythonfmu.so`` (see ``native/fmi2_exports.c``).
+fixes that: it becomes ``binaries/linux64/<model>.so`` and ``binaries/win64/<model>.dll``
+and forwards every call to pythonfmu's binary, renamed ``<model>_pythonfmu.so`` /
+``.dll`` (see ``native/fmi2_exports.c``).
 
-The compiler is :func:`~sma_fmu.fmi.hosts.c_compiler` (``$CC``, default ``cc``). It
-records the shared libpython of the Python running the build, so a C host finds one
-without any environment variable. Where no
-compiler works the FMU keeps pythonfmu's plain binary and the build says so
-(:class:`NativeFrontWarning`); docs/fmus.md lists what is then lost.
+- linux64: compiled with :func:`~sma_fmu.fmi.hosts.c_compiler` (``$CC``, default ``cc``).
+  It records the shared libpython of the Python running the build, and finds another
+  (3.10 or newer) where that one is absent. Where no compiler works the FMU keeps
+  pythonfmu's plain binary, and its model description says what is degraded.
+- win64: cross-compiled with mingw-w64 (``$SMA_FMU_WIN64_CC``, default
+  ``x86_64-w64-mingw32-gcc``; Debian: ``apt-get install gcc-mingw-w64-x86-64``). Without
+  it the FMU leaves win64 out.
+Either case is a :class:`NativeFrontWarning`; :mod:`sma_fmu.fmi.platforms` writes and
+reads what each FMU says about its platforms.
 """
 import hashlib
+import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -23,20 +30,23 @@ from importlib import resources
 from pathlib import Path
 
 from sma_fmu.fmi.hosts import c_compiler
+from sma_fmu.fmi.platforms import (DEGRADED, HOW_PYTHON_IS_FOUND, PLATFORMS, PlatformEntry,
+                                   annotate, check_build_machine)
 
-__all__ = ["NativeFrontWarning", "FrontBuild", "compile_front", "install_front", "remove_front",
-           "libpython_path"]
+__all__ = ["NativeFrontWarning", "FrontBuild", "Fronts", "compile_front", "compile_windows_front",
+           "compile_fronts", "install_fronts", "remove_front", "libpython_path", "windows_compiler"]
 
-_PLATFORM = "linux64"
-_BACKEND_SUFFIX = "_pythonfmu.so"
-_FLAGS = ["-std=c11", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Wall",
-          "-Wl,-z,nodelete", "-Wl,--no-undefined"]
-_LIBRARIES = ["-ldl", "-lpthread"]
-_compiled = {}  # (compiler, sources digest, libpython) -> bytes of the library
+_BACKEND = "_pythonfmu"
+_COMMON = ["-std=c11", "-O2", "-shared", "-Wall"]
+_LINUX = {"flags": [*_COMMON, "-fPIC", "-fvisibility=hidden", "-Wl,--no-undefined"],
+          "libraries": ["-ldl", "-lpthread"], "output": "front.so"}
+_WINDOWS = {"flags": [*_COMMON, "-s", "-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1"],
+            "libraries": ["-ladvapi32"], "output": "front.dll"}
+_compiled = {}  # (compiler, sources digest, defines) -> FrontBuild
 
 
 class NativeFrontWarning(UserWarning):
-    """The FMUs were built without the native front (no C compiler, or not Linux x86-64)."""
+    """An FMU was built without the native front for a platform (no compiler for it)."""
 
 
 class FrontBuild:
@@ -44,6 +54,31 @@ class FrontBuild:
 
     def __init__(self, library=None, problem=None):
         self.library, self.problem = library, problem
+
+
+class Fronts:
+    """The front of each platform (:class:`FrontBuild` by platform name) and the libpython
+    the linux64 one records."""
+
+    def __init__(self, builds, libpython=("", "")):
+        self.builds, self.libpython = dict(builds), libpython
+
+    def warnings(self):
+        """One message per platform that gets no front: what the FMUs lose there."""
+        messages = []
+        linux, windows = self.builds.get("linux64"), self.builds.get("win64")
+        if linux is not None and linux.library is None:
+            messages.append(
+                f"FMUs built without the native front for linux64: {linux.problem}. They keep "
+                "pythonfmu's own binary there, and their modelDescription.xml says what that "
+                "degrades: C hosts need libpython in LD_PRELOAD, and refused calls are only "
+                "logged, not returned as fmi2Error (docs/fmus.md, 'Without the native front')")
+        if windows is not None and windows.library is None:
+            messages.append(
+                f"FMUs built without win64: {windows.problem}. Install mingw-w64 (Debian: "
+                "apt-get install gcc-mingw-w64-x86-64) or set SMA_FMU_WIN64_CC to build the "
+                "Windows front (docs/fmus.md, 'Platforms')")
+        return messages
 
 
 def libpython_path():
@@ -55,6 +90,11 @@ def libpython_path():
     return (str(path) if path.is_file() else ""), soname
 
 
+def windows_compiler():
+    """The mingw-w64 cross compiler command: ``$SMA_FMU_WIN64_CC`` or ``x86_64-w64-mingw32-gcc``."""
+    return shlex.split(os.environ.get("SMA_FMU_WIN64_CC") or "x86_64-w64-mingw32-gcc")
+
+
 def _sources():
     """{file name: bytes} of the shipped C sources and headers."""
     folder = resources.files("sma_fmu.fmi") / "native"
@@ -62,32 +102,23 @@ def _sources():
             if entry.name.endswith((".c", ".h"))}
 
 
-def compile_front(libpython=None):
-    """Compile the front once per process and compiler; returns a :class:`FrontBuild`.
-
-    ``libpython`` is the (path, soname) the front tries when the host has no Python;
-    default :func:`libpython_path` (the Python running the build).
-    """
-    if not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
-        return FrontBuild(problem=f"the native front is built for Linux x86-64 only (this is {sys.platform})")
-    compiler = c_compiler()
+def _compile_cached(compiler, target, defines):
     sources = _sources()
-    library_path, soname = libpython_path() if libpython is None else libpython
     digest = hashlib.sha256(b"".join(name.encode() + data for name, data in sorted(sources.items())))
-    key = (tuple(compiler), digest.hexdigest(), library_path, soname)
+    key = (tuple(compiler), target["output"], digest.hexdigest(), tuple(defines))
     if key not in _compiled:
-        _compiled[key] = _compile(compiler, sources, library_path, soname)
+        _compiled[key] = _compile(compiler, target, defines, sources)
     return _compiled[key]
 
 
-def _compile(compiler, sources, library_path, soname):
+def _compile(compiler, target, defines, sources):
     with tempfile.TemporaryDirectory(prefix="sma_fmu_front_") as folder:
         for name, data in sources.items():
             (Path(folder) / name).write_bytes(data)
-        output = Path(folder) / "front.so"
-        command = [*compiler, *_FLAGS, f'-DSMA_FRONT_LIBPYTHON="{library_path}"',
-                   f'-DSMA_FRONT_LIBPYTHON_SONAME="{soname}"', "-o", str(output),
-                   *sorted(str(Path(folder) / n) for n in sources if n.endswith(".c")), *_LIBRARIES]
+        output = Path(folder) / target["output"]
+        command = [*compiler, *target["flags"], *defines, "-o", str(output),
+                   *sorted(str(Path(folder) / n) for n in sources if n.endswith(".c")),
+                   *target["libraries"]]
         try:
             result = subprocess.run(command, capture_output=True, text=True, timeout=300)
         except (OSError, subprocess.SubprocessError) as error:
@@ -98,39 +129,90 @@ def _compile(compiler, sources, library_path, soname):
         return FrontBuild(library=output.read_bytes())
 
 
-def _backend(binary):
-    """The name pythonfmu's binary ``binaries/<platform>/<model>.so`` gets behind the front."""
-    return binary[:-len(".so")] + _BACKEND_SUFFIX
+def compile_front(libpython=None):
+    """The linux64 front, compiled once per process and compiler: a :class:`FrontBuild`.
+
+    ``libpython`` is the (path, soname) the front tries first when the host has no Python;
+    default :func:`libpython_path` (the Python running the build).
+    """
+    if not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
+        return FrontBuild(problem=f"the linux64 front is built on 64-bit Linux only (this is {sys.platform})")
+    path, soname = libpython_path() if libpython is None else libpython
+    return _compile_cached(c_compiler(), _LINUX, [f'-DSMA_FRONT_LIBPYTHON="{path}"',
+                                                  f'-DSMA_FRONT_LIBPYTHON_SONAME="{soname}"'])
 
 
-def install_front(fmu_path, model_identifier, library):
-    """Put ``library`` (the front) into the FMU as its binary; pythonfmu's becomes ``*_pythonfmu.so``."""
+def compile_windows_front():
+    """The win64 front, cross-compiled with :func:`windows_compiler`: a :class:`FrontBuild`."""
+    compiler = windows_compiler()
+    if shutil.which(compiler[0]) is None:
+        return FrontBuild(problem=f"no mingw-w64 cross compiler ({compiler[0]} not found)")
+    return _compile_cached(compiler, _WINDOWS, [])
+
+
+def compile_fronts():
+    """Check the build machine (:func:`~sma_fmu.fmi.platforms.check_build_machine`, which
+    raises on one pythonfmu has no binary for), then compile the front of each platform."""
+    check_build_machine()
+    return Fronts({"linux64": compile_front(), "win64": compile_windows_front()}, libpython_path())
+
+
+def _entry(platform, binary, front, libpython):
+    python = HOW_PYTHON_IS_FOUND.get(platform, "")
+    if platform == "linux64" and libpython[0]:
+        python += f" (the build's: {libpython[0]})"
+    return PlatformEntry(platform, binary, front, python, "" if front else DEGRADED)
+
+
+def install_fronts(fmu_path, model_identifier, fronts):
+    """Put each platform's front into the FMU ``fmu_path``, before pythonfmu's binary (renamed
+    ``<model>_pythonfmu.<suffix>``); leave win64 out where it has no front; keep pythonfmu's
+    binary alone elsewhere. The model description then lists each platform (VendorAnnotations)."""
     fmu_path = Path(fmu_path)
-    binary = f"binaries/{_PLATFORM}/{model_identifier}.so"
-    backend = _backend(binary)
     rewritten = fmu_path.with_suffix(".front.tmp")
+    entries = []
     with zipfile.ZipFile(fmu_path) as source, \
             zipfile.ZipFile(rewritten, "w", zipfile.ZIP_DEFLATED) as target:
         names = source.namelist()
-        if binary not in names:
-            raise ValueError(f"{fmu_path}: no {binary} to put the native front before")
+        for platform, suffix in PLATFORMS.items():
+            binary = f"binaries/{platform}/{model_identifier}{suffix}"
+            if binary not in names:
+                continue
+            build = fronts.builds.get(platform)
+            if build is not None and build.library is None and platform == "win64":
+                continue  # left out: no front for it
+            entries.append(_entry(platform, binary, bool(build and build.library), fronts.libpython))
+        kept = {entry.binary: entry for entry in entries}
         for item in source.infolist():
-            data = source.read(item.filename)
-            if item.filename == binary:
-                backend_info = zipfile.ZipInfo(backend, item.date_time)
-                backend_info.external_attr = item.external_attr
-                target.writestr(backend_info, data, zipfile.ZIP_DEFLATED)
-                front_info = zipfile.ZipInfo(binary, item.date_time)
-                front_info.external_attr = item.external_attr
-                target.writestr(front_info, library, zipfile.ZIP_DEFLATED)
-            else:
-                target.writestr(item, data)
+            name = item.filename
+            if name.startswith("binaries/win64/") and not any(e.platform == "win64" for e in entries):
+                continue
+            data = source.read(name)
+            if name == "modelDescription.xml":
+                data = annotate(data.decode("utf-8"), entries).encode("utf-8")
+            entry = kept.get(name)
+            if entry is not None and entry.front:
+                backend = zipfile.ZipInfo(_backend(name), item.date_time)
+                backend.external_attr = item.external_attr
+                target.writestr(backend, data, zipfile.ZIP_DEFLATED)
+                data = fronts.builds[entry.platform].library
+            info = zipfile.ZipInfo(name, item.date_time)
+            info.external_attr = item.external_attr
+            target.writestr(info, data, zipfile.ZIP_DEFLATED)
     shutil.move(str(rewritten), str(fmu_path))
+    return entries
+
+
+def _backend(binary):
+    """The name pythonfmu's binary ``binaries/<platform>/<model>.<suffix>`` gets behind the front."""
+    stem, dot, suffix = binary.rpartition(".")
+    return f"{stem}{_BACKEND}{dot}{suffix}"
 
 
 def remove_front(fmu_path, destination):
     """Write to ``destination`` a copy of the FMU ``fmu_path`` whose binaries are pythonfmu's
-    own again (the inverse of :func:`install_front`: the FMU as it was before the front).
+    own again, and whose model description has no platform annotation (the inverse of
+    :func:`install_fronts`: the FMU as pythonfmu wrote it, with win64 if it was kept).
 
     Returns ``destination``.
     """
@@ -138,8 +220,12 @@ def remove_front(fmu_path, destination):
             zipfile.ZipFile(destination, "w", zipfile.ZIP_DEFLATED) as target:
         names = set(source.namelist())
         for item in source.infolist():
-            if item.filename.endswith(_BACKEND_SUFFIX):
+            name = item.filename
+            if any(name.endswith(f"{_BACKEND}{suffix}") for suffix in PLATFORMS.values()):
                 continue
-            backend = _backend(item.filename) if item.filename.endswith(".so") else None
-            target.writestr(item, source.read(backend if backend in names else item.filename))
+            backend = _backend(name) if name.startswith("binaries/") else None
+            data = source.read(backend if backend in names else name)
+            if name == "modelDescription.xml":
+                data = annotate(data.decode("utf-8"), None).encode("utf-8")
+            target.writestr(item, data)
     return destination

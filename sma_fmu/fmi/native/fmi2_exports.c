@@ -17,10 +17,12 @@
  *  - saved states are wrapped (FrontState, fmi2_states.c) so unknown or freed pointers give fmi2Error;
  *    serialized states carry a checked header (state_bytes.c).
  *  - after fmi2Fatal (pythonfmu released its Python objects) every call is refused and
- *    fmi2FreeInstance leaks the instance instead of freeing it twice.
+ *    fmi2FreeInstance leaks pythonfmu's instance instead of freeing it twice.
+ *  - a pointer that is not a live instance (freed, or never one) is refused, not used
+ *    (instances.c): fmi2FreeInstance twice or any call after it is logged, never a crash.
+ *  - fmi2Instantiate takes pythonfmu's entry for the resources folder off sys.path again.
  */
 #define _GNU_SOURCE
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,13 +43,23 @@ fmi2Status finish(Instance* in, fmi2Status status)
 }
 
 
+/* What `sma-fmu check` finds in a binary that is this front (sma_fmu/fmi/front.py). */
+EXPORT const char sma_fmu_front[] = "sma-fmu native front";
+
 EXPORT const char* fmi2GetTypesPlatform(void) { return "default"; }
 EXPORT const char* fmi2GetVersion(void) { return "2.0"; }
 
-static void free_instance_memory(Instance* in)
+static void free_categories(Instance* in)
 {
     for (size_t i = 0; i < in->n_categories; ++i) free(in->categories[i]);
     free(in->categories);
+    in->categories = NULL;
+    in->n_categories = 0;
+}
+
+void free_instance_memory(Instance* in)
+{
+    free_categories(in);
     free(in->name);
     free(in);
 }
@@ -103,13 +115,18 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     in->callbacks.allocateMemory = functions ? functions->allocateMemory : NULL;
     in->callbacks.freeMemory = functions ? functions->freeMemory : NULL;
     in->callbacks.componentEnvironment = in;
-    in->backend = instantiate_backend_locked(instanceName, fmuType, fmuGUID, uri, &in->callbacks,
-                                             visible);
+    in->backend = instantiate_backend(instanceName, fmuType, fmuGUID, uri, &in->callbacks, visible);
     if (!in->backend) {
         host_log(in, fmi2Error, NULL, "fmi2Instantiate: the Python slave could not be created (see above)");
         goto fail;
     }
     keep_thread_state();
+    forget_resources(path);
+    if (!register_instance(in)) {
+        host_log(in, fmi2Error, NULL, "fmi2Instantiate: out of memory");
+        backend.FreeInstance(in->backend);
+        goto fail;
+    }
     free(uri);
     free(path);
     return in;
@@ -122,12 +139,16 @@ fail:
 
 EXPORT void fmi2FreeInstance(fmi2Component c)
 {
-    Instance* in = (Instance*)c;
-    if (!in || in->dead) return; /* after fmi2Fatal pythonfmu has released it: leak, don't crash */
-    keep_thread_state();
-    while (in->states) drop_state(in, in->states);
-    backend.FreeInstance(in->backend);
-    free_instance_memory(in);
+    if (!c) return;
+    Instance* in = live_instance(c, "fmi2FreeInstance");
+    if (!in || !retire_instance(in)) return; /* refused (logged), or freed meanwhile */
+    if (!in->dead) { /* after fmi2Fatal pythonfmu has released it: leak, don't crash */
+        keep_thread_state();
+        while (in->states) drop_state(in, in->states);
+        backend.FreeInstance(in->backend);
+    }
+    in->backend = NULL;
+    free_categories(in); /* the rest is released when it leaves the freed instances kept */
 }
 
 EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,

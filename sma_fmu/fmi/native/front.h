@@ -1,18 +1,24 @@
 /*
  * front.h - shared declarations of the sma-fmu native front (see fmi2_exports.c).
  *
- * The front is the library a host loads as binaries/linux64/<modelIdentifier>.so. It
- * forwards every FMI call to pythonfmu's binary, shipped beside it as
- * <modelIdentifier>_pythonfmu.so (the "backend"), and fixes what pythonfmu 0.7.0 gets
- * wrong for C hosts: loading libpython, resource URIs, logging, call statuses,
- * fmi2Terminated, serialized states and per-thread Python thread states.
+ * The front is the library a host loads as binaries/linux64/<modelIdentifier>.so or
+ * binaries/win64/<modelIdentifier>.dll. It forwards every FMI call to pythonfmu's binary,
+ * shipped beside it as <modelIdentifier>_pythonfmu.so / .dll (the "backend"), and fixes what
+ * pythonfmu 0.7.0 gets wrong for C hosts: finding and checking a Python, resource URIs,
+ * logging, call statuses, fmi2Terminated, serialized states, calls on freed instances,
+ * per-thread Python thread states and memory kept after an instance is gone.
+ * The operating system is behind platform.h.
  */
 #ifndef SMA_FMU_FRONT_H
 #define SMA_FMU_FRONT_H
 
 #include "fmi2_types.h"
+#include "platform.h"
 
-#define EXPORT __attribute__((visibility("default")))
+/* the oldest Python the FMUs run on (their runtime's syntax and library) */
+#define PYTHON_MIN_MINOR 10
+/* the newest Python 3 minor version looked for when the build's own is absent */
+#define PYTHON_MAX_MINOR 40
 
 /* ---- the backend: pythonfmu's binary, loaded by backend.c ---------------------------- */
 #define BACKEND_FUNCTIONS(X)                                                                     \
@@ -53,21 +59,62 @@ typedef struct {
 
 extern Backend backend;
 
-/* Loads libpython (if the process has none) and the backend once per process; returns 1 on
- * success, else 0 with the reason in load_error. load_info says which libpython is used.
- * Their sizes are given here only: write into them with sizeof. */
+/* ---- the runtime one process shares (backend.c) ------------------------------------------ */
+/* What the owner of the backend does for every copy of the front that shares it. */
+typedef struct {
+    void (*keep_thread_state)(void);
+    fmi2Component (*instantiate)(fmi2String name, fmi2Type type, fmi2String guid, fmi2String uri,
+                                 const fmi2CallbackFunctions* cb, fmi2Boolean visible);
+    void (*forget_resources)(const char* folder);
+} RuntimeCalls;
+
+/*
+ * Hosts unpack an FMU once per instance (fmpy, FmuInstance) and load the front from each
+ * folder: each is another copy of the front in memory. The first copy to load pythonfmu's
+ * binary owns it (and Python) and stays loaded; it exports this record. A later copy whose
+ * backend file has the same build ID takes the owner's backend and runtime calls instead of
+ * loading its own, so it holds nothing the host's unloading of it would leave behind.
+ */
+#define SHARE_MAGIC "SMAFRONT"
+#define SHARE_ABI 1
+typedef struct {
+    char magic[8];
+    unsigned abi;
+    int ready; /* written last, with release order */
+    unsigned char backend_id[64];
+    size_t backend_id_size;
+    Backend backend;
+    RuntimeCalls calls;
+    char python[1024]; /* which Python, for the log */
+    char owner[PATH_SIZE];
+} FrontShare;
+extern FrontShare sma_fmu_front_share; /* this copy's record (filled if it is an owner) */
+
+/* Loads (or shares) Python and the backend, once per copy of the front; returns 1 on success,
+ * else 0 with the reason in load_error. load_info says which Python is used. Their sizes are
+ * given here only: write into them with sizeof. */
 int load_backend(void);
 extern char load_error[2048];
 extern char load_info[1024];
+void keep_thread_state(void); /* the owner's: one parked Python thread state per host thread */
+fmi2Component instantiate_backend(fmi2String name, fmi2Type type, fmi2String guid, fmi2String uri,
+                                  const fmi2CallbackFunctions* cb, fmi2Boolean visible);
+void forget_resources(const char* folder); /* takes pythonfmu's sys.path entry away again */
+/* The GNU build ID of an ELF file (0 elsewhere or without one: then nothing is shared). */
+int backend_build_id(const char* path, unsigned char* id, size_t* size);
+/* An owner's record for a backend with this build ID, or NULL. */
+const FrontShare* find_owner(const unsigned char* id, size_t size);
 
-/* ---- the embedded Python (python_runtime.c) --------------------------------------------- */
-int ensure_libpython(void);          /* 1: the Python C API is in the global scope */
-int resolve_python_api(void);        /* 1: the functions below were found */
-void keep_thread_state(void);        /* one parked Python thread state per host thread */
-int python_is_initialized(void);
-fmi2Component instantiate_backend_locked(fmi2String name, fmi2Type type, fmi2String guid,
-                                         fmi2String uri, const fmi2CallbackFunctions* cb,
-                                         fmi2Boolean visible);
+/* ---- Python (python_runtime.c; finding it: libpython_posix.c, libpython_windows.c) ------- */
+/* Makes a Python of a supported version available: the process's own or a loaded one.
+ * 0 with the reason in load_error (one line, naming what was tried). */
+int load_libpython(void);
+void* python_symbol(const char* name);            /* a C-API function of that Python */
+int python_library_file(char* path, size_t size); /* its library file (for the init lock) */
+/* 1 if `version` (Py_GetVersion's text) is Python 3.PYTHON_MIN_MINOR or newer; else 0 with
+ * the reason in why. */
+int python_version_supported(const char* version, char* why, size_t size);
+int start_python_runtime(RuntimeCalls* calls); /* after load_libpython: 1 if the API is there */
 extern int use_thread_state_keeper;
 
 /* ---- instances --------------------------------------------------------------------------- */
@@ -95,6 +142,7 @@ typedef struct {
     int stepped, terminated, have_discard;
     double discard_time, discard_step;
     int dead; /* the backend returned fmi2Fatal: pythonfmu has freed its objects */
+    int freed; /* fmi2FreeInstance was called: only the name is left */
     FrontState* states; /* the states this instance handed out and that are not freed */
 } Instance;
 
@@ -104,10 +152,20 @@ fmi2Status finish(Instance* in, fmi2Status status); /* the backend's status, or 
 FrontState* find_state(Instance* in, fmi2FMUstate state);
 void drop_state(Instance* in, FrontState* state);
 
-/* Every forwarded call starts with this: refuse after fmi2Fatal, keep the thread's Python
- * thread state, and reset the worst status the slave logged. */
+/* ---- live instances (instances.c) ----------------------------------------------------------- */
+int register_instance(Instance* in); /* 0: out of memory */
+/* `c` if it is a live instance of this front; else NULL, after one line on stderr (a freed
+ * instance's host callbacks may be gone with it). */
+Instance* live_instance(fmi2Component c, const char* function);
+/* fmi2FreeInstance: 1 if `c` was live (it is then a freed instance: its memory is kept for
+ * a while, so a later call with it is recognized and refused). */
+int retire_instance(fmi2Component c);
+void free_instance_memory(Instance* in);
+
+/* Every forwarded call starts with this: refuse an unknown or freed instance, and after
+ * fmi2Fatal; keep the thread's Python thread state; reset the worst status the slave logged. */
 #define ENTER(name)                                                                             \
-    Instance* in = (Instance*)c;                                                                \
+    Instance* in = live_instance(c, "fmi2" #name);                                              \
     if (!in) return fmi2Error;                                                                  \
     if (in->dead) return refuse(in, fmi2Fatal, "fmi2" #name, "refused: an earlier call returned " \
                                 "fmi2Fatal; only fmi2FreeInstance is possible");                \
@@ -116,8 +174,7 @@ void drop_state(Instance* in, FrontState* state);
 
 /* ---- logging (host_log.c) ---------------------------------------------------------------- */
 void host_log(const Instance* in, fmi2Status status, const char* category, const char* message);
-void host_logf(const Instance* in, fmi2Status status, const char* format, ...)
-    __attribute__((format(printf, 3, 4)));
+void host_logf(const Instance* in, fmi2Status status, const char* format, ...) PRINTF_LIKE(3, 4);
 void front_logger(fmi2ComponentEnvironment env, fmi2String instance_name, fmi2Status status,
                   fmi2String category, fmi2String message, ...);
 int set_debug_logging(Instance* in, fmi2Boolean on, size_t n, const fmi2String categories[]);

@@ -6,18 +6,38 @@
  * calls a NULL Python object (SIGSEGV), and a NULL location aborts. The front accepts
  * file:///abs, file:/abs and file://localhost/abs (percent-decoded) and, with a warning, a
  * plain absolute path; it refuses anything else with a logged error, and checks that the
- * folder holds the slave module named in slavemodule.txt. pythonfmu gets "file://" + path.
+ * folder holds the slave module named in slavemodule.txt. pythonfmu gets "file://" + path
+ * (on Windows "file:///" + "C:/...": pythonfmu's Windows build cuts 8 characters).
+ * On Windows the path is a drive path: file:///C:/dir (or, plain, C:\dir), UTF-8.
  */
 #define _GNU_SOURCE
-#include <limits.h>
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "front.h"
+
+#ifdef _WIN32
+#define FORWARD_PREFIX "file:///"
+#else
+#define FORWARD_PREFIX "file://"
+#endif
+
+static int same_text(const char* a, const char* b, size_t n) /* ASCII, ignoring case */
+{
+    for (size_t i = 0; i < n; ++i)
+        if (tolower((unsigned char)a[i]) != tolower((unsigned char)b[i])) return 0;
+    return 1;
+}
+
+#ifdef _WIN32
+/* A drive path, "C:/" or "C:\\". */
+static int drive_path(const char* path)
+{
+    return isalpha((unsigned char)path[0]) && path[1] == ':' && (path[2] == '/' || path[2] == '\\');
+}
+#endif
 
 static int hex_value(char c)
 {
@@ -31,12 +51,17 @@ static int hex_value(char c)
 static const char* uri_path(const char* uri, char* err, size_t errlen, size_t* length,
                             int* plain_path)
 {
-    if (uri[0] == '/') { /* a plain absolute path, not a URI: pythonfmu took it, so do we */
+#ifdef _WIN32
+    int plain = drive_path(uri);
+#else
+    int plain = uri[0] == '/';
+#endif
+    if (plain) { /* a plain absolute path, not a URI: pythonfmu took it, so do we */
         *plain_path = 1;
         *length = strlen(uri);
         return uri;
     }
-    if (strncasecmp(uri, "file:", 5) != 0) {
+    if (!same_text(uri, "file:", 5)) {
         snprintf(err, errlen, "fmuResourceLocation '%s' is not a file: URI", uri);
         return NULL;
     }
@@ -45,7 +70,7 @@ static const char* uri_path(const char* uri, char* err, size_t errlen, size_t* l
         const char* host = p + 2;
         const char* end = strchr(host, '/');
         size_t n = end ? (size_t)(end - host) : strlen(host);
-        if (n != 0 && !(n == 9 && strncasecmp(host, "localhost", 9) == 0)) {
+        if (n != 0 && !(n == 9 && same_text(host, "localhost", 9))) {
             snprintf(err, errlen, "fmuResourceLocation '%s' names host '%.*s'; only local files "
                      "are supported", uri, (int)n, host);
             return NULL;
@@ -60,6 +85,13 @@ static const char* uri_path(const char* uri, char* err, size_t errlen, size_t* l
         snprintf(err, errlen, "fmuResourceLocation '%s' is not an absolute path", uri);
         return NULL;
     }
+#ifdef _WIN32
+    if (!drive_path(p + 1)) {
+        snprintf(err, errlen, "fmuResourceLocation '%s' does not name a drive (file:///C:/...)", uri);
+        return NULL;
+    }
+    ++p; /* "/C:/dir" is the drive path "C:/dir" */
+#endif
     *length = strcspn(p, "?#"); /* query and fragment are not part of the path */
     return p;
 }
@@ -92,15 +124,14 @@ static char* decode(const char* path, size_t length, int percent_escapes)
 /* 0 with err set unless `folder` is the resources folder of a pythonfmu FMU. */
 static int is_resources_folder(const char* folder, const char* uri, char* err, size_t errlen)
 {
-    struct stat info;
-    if (stat(folder, &info) != 0 || !S_ISDIR(info.st_mode)) {
+    if (!is_directory(folder)) {
         snprintf(err, errlen, "resource folder '%s' (from fmuResourceLocation '%s') does not exist",
                  folder, uri);
         return 0;
     }
-    char file[PATH_MAX + 300], module[256] = "";
+    char file[PATH_SIZE + 300], module[256] = "";
     snprintf(file, sizeof file, "%s/slavemodule.txt", folder);
-    FILE* stream = fopen(file, "r");
+    FILE* stream = file_open(file, "r");
     if (!stream || !fgets(module, sizeof module, stream)) {
         if (stream) fclose(stream);
         snprintf(err, errlen, "'%s' is missing or empty: not the resources folder of this FMU", file);
@@ -109,7 +140,7 @@ static int is_resources_folder(const char* folder, const char* uri, char* err, s
     fclose(stream);
     module[strcspn(module, "\r\n")] = '\0';
     snprintf(file, sizeof file, "%s/%s.py", folder, module);
-    if (!*module || access(file, R_OK) != 0) {
+    if (!*module || !is_readable_file(file)) {
         snprintf(err, errlen, "the slave module '%s' named in slavemodule.txt is missing", file);
         return 0;
     }
@@ -131,7 +162,7 @@ char* resource_uri_for_pythonfmu(const char* uri, char* err, size_t errlen, char
         return NULL;
     }
     if (!valid_utf8(folder) || strstr(folder, "%20") || strstr(folder, "file://") ||
-        strlen(folder) >= PATH_MAX) {
+        strlen(folder) >= PATH_SIZE) {
         snprintf(err, errlen, "resource folder '%s' is not UTF-8, too long or contains '%%20' or "
                  "'file://', which pythonfmu cannot handle", folder);
         free(folder);
@@ -141,13 +172,17 @@ char* resource_uri_for_pythonfmu(const char* uri, char* err, size_t errlen, char
         free(folder);
         return NULL;
     }
-    char* forwarded = (char*)malloc(strlen(folder) + 8);
+#ifdef _WIN32
+    for (char* q = folder; *q; ++q)
+        if (*q == '\\') *q = '/';
+#endif
+    char* forwarded = (char*)malloc(strlen(folder) + sizeof FORWARD_PREFIX);
     if (!forwarded) {
         free(folder);
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
-    strcpy(forwarded, "file://");
+    strcpy(forwarded, FORWARD_PREFIX);
     strcat(forwarded, folder);
     *path_out = folder;
     return forwarded;
@@ -155,9 +190,9 @@ char* resource_uri_for_pythonfmu(const char* uri, char* err, size_t errlen, char
 
 int guid_matches(const char* resources, const char* guid, char* err, size_t errlen)
 {
-    char file[PATH_MAX + 64];
+    char file[PATH_SIZE + 64];
     snprintf(file, sizeof file, "%s/../modelDescription.xml", resources);
-    FILE* stream = fopen(file, "r");
+    FILE* stream = file_open(file, "r");
     if (!stream) return 1; /* not unpacked in the standard layout: nothing to compare with */
     char head[8192];
     size_t n = fread(head, 1, sizeof head - 1, stream);

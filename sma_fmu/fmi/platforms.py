@@ -1,0 +1,174 @@
+"""Which platforms an FMU runs on, and what it says about them.
+
+An FMU lists a platform by carrying ``binaries/<platform>/``. Ours list one only where the
+binary is the native front (:mod:`sma_fmu.fmi.front`), or, where the front could not be
+built, say so: the ``sma-fmu`` entry of ``VendorAnnotations`` in ``modelDescription.xml``
+names each platform, its binary, whether it carries the front, how it finds Python, and
+what is degraded without the front. :func:`platform_report` reads it back
+(``sma-fmu check``'s ``platforms`` line), :func:`check_build_machine` refuses a build whose
+architecture pythonfmu's binaries do not match.
+"""
+import platform
+import re
+import struct
+import zipfile
+from dataclasses import dataclass
+from importlib import util
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+__all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", "PlatformEntry",
+           "binary_architecture", "check_build_machine", "annotate", "platform_report"]
+
+FRONT_MARKER = b"sma-fmu native front"  # a string every front binary carries (fmi2_exports.c)
+PLATFORMS = {"linux64": ".so", "win64": ".dll"}
+HOW_PYTHON_IS_FOUND = {
+    "linux64": "the process's own Python, else $SMA_FMU_LIBPYTHON, else the build's libpython, "
+               "else the newest libpython3.X.so.1.0 (3.10 or newer) on the library search path "
+               "and in the standard folders",
+    "win64": "the process's own python3X.dll, else %SMA_FMU_LIBPYTHON%, else the newest Python "
+             "3.10 or newer in the registry (PEP 514), on PATH or in the python.org installer's "
+             "folders",
+}
+DEGRADED = ("pythonfmu's binary without the native front: C hosts need libpython in LD_PRELOAD; "
+            "refused calls return fmi2OK (the log is the only signal); no checks of the resource "
+            "URI, the GUID, strings or state pointers (crashes instead); serialized states "
+            "without checksum; fmi2Terminated true for good after any discard; no check of the "
+            "Python version; each instance keeps its copy of the binary in memory")
+_ELF_MACHINES = {62: "x86-64", 183: "aarch64", 3: "x86", 40: "arm"}
+_PE_MACHINES = {0x8664: "x86-64", 0xAA64: "aarch64", 0x14C: "x86"}
+_MACHINES = {"x86_64": "x86-64", "amd64": "x86-64", "aarch64": "aarch64", "arm64": "aarch64",
+             "i386": "x86", "i686": "x86", "x86": "x86"}
+_TOOL = "sma-fmu"
+
+
+class UnsupportedPlatformError(ValueError):
+    """This machine cannot build FMUs that run on it (pythonfmu has no binary for it)."""
+
+
+@dataclass(frozen=True)
+class PlatformEntry:
+    """One platform of an FMU: its binary, whether that is the front, and what it says."""
+
+    platform: str
+    binary: str
+    front: bool
+    python: str = ""
+    degraded: str = ""
+
+
+def binary_architecture(data):
+    """"x86-64", "aarch64", ... of an ELF or PE binary's bytes; None if neither."""
+    if data[:4] == b"\x7fELF" and len(data) >= 20:
+        return _ELF_MACHINES.get(struct.unpack_from("<H", data, 18)[0], "unknown")
+    if data[:2] == b"MZ" and len(data) >= 64:
+        offset = struct.unpack_from("<I", data, 0x3C)[0]
+        if data[offset:offset + 4] == b"PE\0\0":
+            return _PE_MACHINES.get(struct.unpack_from("<H", data, offset + 4)[0], "unknown")
+    return None
+
+
+def _pythonfmu_binaries():
+    """{platform: path} of the binaries pythonfmu copies into every FMU."""
+    spec = util.find_spec("pythonfmu")
+    folder = Path(spec.origin).parent / "resources" / "binaries"
+    return {entry.name: file for entry in sorted(folder.iterdir()) if entry.is_dir()
+            for file in sorted(entry.iterdir()) if file.suffix in (".so", ".dll", ".dylib")}
+
+
+def check_build_machine(machine=None):
+    """Raise :class:`UnsupportedPlatformError` unless pythonfmu's binaries match ``machine``.
+
+    ``machine`` defaults to this machine (``platform.machine()``). The front is compiled for
+    the build machine and sits before pythonfmu's binary of the same platform, so a machine
+    of another architecture would pair them wrongly and build FMUs that run nowhere.
+    """
+    machine = machine or platform.machine()
+    architecture = _MACHINES.get(machine.lower(), machine)
+    shipped = {name: binary_architecture(path.read_bytes()[:4096])
+               for name, path in _pythonfmu_binaries().items()}
+    if architecture not in shipped.values():
+        listed = ", ".join(f"{name}: {arch}" for name, arch in shipped.items())
+        raise UnsupportedPlatformError(
+            f"this machine is {machine} ({architecture}), but pythonfmu 0.7.0 ships binaries for "
+            f"{listed} only: an FMU built here would pair a {architecture} front with "
+            f"pythonfmu's binary of another architecture and run nowhere. Build the FMUs on an "
+            f"x86-64 machine.")
+
+
+def annotate(model_description, entries):
+    """``model_description`` (XML text) with the sma-fmu VendorAnnotations for ``entries``
+    (a list of :class:`PlatformEntry`), or without them (``entries`` None)."""
+    text = re.sub(rf'\t*<Tool name="{_TOOL}">.*?</Tool>\n', "", model_description, flags=re.S)
+    text = re.sub(r"\t*<VendorAnnotations>\n\t*</VendorAnnotations>\n", "", text)
+    if entries is None:
+        return text
+    lines = [f'\t\t<Tool name="{_TOOL}">', "\t\t\t<Platforms>"]
+    for entry in entries:
+        attributes = (f"name={quoteattr(entry.platform)} binary={quoteattr(entry.binary)} "
+                      f"front=\"{str(entry.front).lower()}\" python={quoteattr(entry.python)}")
+        if entry.degraded:
+            attributes += f" degraded={quoteattr(entry.degraded)}"
+        lines.append(f"\t\t\t\t<Platform {attributes}/>")
+    lines += ["\t\t\t</Platforms>", "\t\t</Tool>"]
+    block = "\n".join(lines) + "\n"
+    if "<VendorAnnotations>" in text:
+        return text.replace("<VendorAnnotations>\n", "<VendorAnnotations>\n" + block, 1)
+    if "<ModelVariables" not in text:
+        raise ValueError("modelDescription.xml has no ModelVariables element")
+    return text.replace("\t<ModelVariables", f"\t<VendorAnnotations>\n{block}\t</VendorAnnotations>\n"
+                        "\t<ModelVariables", 1)
+
+
+def _declared(model_description):
+    """{platform: attributes} from the sma-fmu VendorAnnotations, {} if there are none."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(model_description)
+    return {node.get("name"): dict(node.attrib)
+            for tool in root.iterfind("VendorAnnotations/Tool") if tool.get("name") == _TOOL
+            for node in tool.iterfind("Platforms/Platform")}
+
+
+def platform_report(fmu_path):
+    """[(status, platform, detail)] for each platform the FMU ``fmu_path`` lists.
+
+    status is "ok" (the binary is the front and the model description says so), "degraded"
+    (no front, and the model description says what is lost) or "FAIL" (the binary and what
+    the model description says disagree, or a platform lists nothing).
+    """
+    with zipfile.ZipFile(fmu_path) as archive:
+        names = archive.namelist()
+        description = archive.read("modelDescription.xml").decode("utf-8")
+        import xml.etree.ElementTree as ET
+
+        identifier = ET.fromstring(description).find("CoSimulation").get("modelIdentifier")
+        declared = _declared(description)
+        report = []
+        listed = sorted({name.split("/")[1] for name in names
+                         if name.startswith("binaries/") and name.count("/") >= 2 and name.split("/")[2]})
+        for name in listed:
+            binary = f"binaries/{name}/{identifier}{PLATFORMS.get(name, '')}"
+            said = declared.get(name)
+            if binary not in names:
+                report.append(("FAIL", name, f"lists the platform but has no {binary}"))
+                continue
+            data = archive.read(binary)
+            front = FRONT_MARKER in data
+            arch = binary_architecture(data) or "unknown format"
+            if said is None:
+                report.append(("FAIL", name, f"{binary} ({arch}, {'front' if front else 'no front'}) "
+                                             "is not declared in modelDescription.xml"))
+            elif (said.get("front") == "true") != front:
+                report.append(("FAIL", name, f"modelDescription.xml says front={said.get('front')}, "
+                                             f"but {binary} is {'the front' if front else 'not the front'}"))
+            elif front:
+                report.append(("ok", name, f"{binary} ({arch}): native front; Python: {said.get('python')}"))
+            elif said.get("degraded"):
+                report.append(("degraded", name, f"{binary} ({arch}): {said['degraded']}"))
+            else:
+                report.append(("FAIL", name, f"{binary} has no front and modelDescription.xml "
+                                             "does not say what is degraded"))
+        for name in sorted(set(declared) - set(listed)):
+            report.append(("FAIL", name, "declared in modelDescription.xml but not in binaries/"))
+    return report
