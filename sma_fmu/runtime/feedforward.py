@@ -32,7 +32,8 @@ from .constant_load import BranchCache
 from .constants import COOLING, HEATING, KELVIN_OFFSET
 from .minor_loops import fractions_on_stack, push_reversal, read_points
 from .phase_lag import PhaseLagFilter
-from .state_entries import StateError, read_direction, read_entries, read_optional_number
+from .state_entries import (StateError, check_format,
+                            read_direction, read_entries, read_optional_number)
 from .validity import validity_warning
 from .sensing import (mixed_fractions_of_resistance, temperature_of_fractions,
                       temperature_on_stack)
@@ -184,12 +185,7 @@ class FeedforwardStepper:
         zero; xi_MF in [0, 1]; the stack; the filter's memory): a malformed state, or one
         of an earlier build, raises ``ValueError`` naming the entry and changes nothing.
         """
-        if not isinstance(state, dict) or state.get("format") != STATE_FORMAT:
-            found = state.get("format") if isinstance(state, dict) else None
-            raise StateError(
-                f"the compensator state has format {found!r}, not {STATE_FORMAT!r}: it was "
-                "saved by an earlier sma-fmu build (minor-loop memory of one reversal) and "
-                "cannot be restored by this one")
+        check_format(state, STATE_FORMAT, "compensator state")
         read_entries(state, _STATE_ENTRIES, what="compensator state")
         direction = read_direction(state)
         reference = read_optional_number(state, "previous_reference", 5e-324, unit="ohm")

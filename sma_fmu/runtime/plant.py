@@ -21,7 +21,8 @@ from .constant_load import BranchCache, branch_fractions, require_temperature
 from .constants import COOLING, HEATING, KELVIN_OFFSET
 from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_points,
                           wipe_out)
-from .state_entries import StateError, read_direction, read_entries, read_number
+from .state_entries import (StateError, check_format,
+                            read_direction, read_entries, read_number)
 from .thermal import step_decay, thermal_step
 from .validity import validity_warning
 
@@ -165,17 +166,12 @@ class PlantStepper:
         """Restore a state saved by :meth:`state` and re-evaluate the outputs.
 
         Every entry is checked first (kinds; T above absolute zero and at most
-        ``validity.T_max``, where the model is valid; a load the model covers; fractions in [0, M] with xi_MF + xi_P = M; a well-formed stack of at most
-        ``memory_depth`` points): a malformed state raises ``ValueError`` naming the entry
+        ``validity.T_max``, where the model is valid; a load the model covers; fractions in
+        [0, M] with xi_MF + xi_P = M; a well-formed stack of at most ``memory_depth`` points): a malformed state raises ``ValueError`` naming the entry
         and changes nothing. So does a state of an earlier build (one reversal, no stack),
         which is never misread.
         """
-        if not isinstance(state, dict) or state.get("format") != STATE_FORMAT:
-            found = state.get("format") if isinstance(state, dict) else None
-            raise StateError(
-                f"the plant state has format {found!r}, not {STATE_FORMAT!r}: it was saved by "
-                "an earlier sma-fmu build (minor-loop memory of one reversal) and cannot be "
-                "restored by this one")
+        check_format(state, STATE_FORMAT, "plant state")
         read_entries(state, _STATE_ENTRIES, what="plant state")
         temperature = read_number(state, "temperature", high=self.params.T_max, unit="degC")
         if temperature <= -KELVIN_OFFSET:

@@ -6,11 +6,22 @@ names the entry and the value, so a state is either taken whole or refused whole
 """
 import math
 
-__all__ = ["StateError", "read_entries", "read_number", "read_optional_number", "read_direction"]
+__all__ = ["StateError", "check_format", "read_entries", "read_number", "read_optional_number",
+           "read_direction"]
 
 
 class StateError(ValueError):
     """A saved state is malformed; the message names the entry and what is wrong."""
+
+
+def check_format(state, expected, what):
+    """Refuse a state whose ``format`` entry is not ``expected`` (e.g. one saved by an earlier
+    build, with a one-reversal minor-loop memory): it is never misread."""
+    found = state.get("format") if isinstance(state, dict) else None
+    if found != expected:
+        raise StateError(
+            f"the {what} has format {found!r}, not {expected!r}: it was saved by an earlier "
+            "sma-fmu build (minor-loop memory of one reversal) and cannot be restored by this one")
 
 
 def read_entries(state, required, optional=(), what="state"):
