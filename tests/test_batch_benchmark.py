@@ -13,6 +13,5 @@ def test_batch_section_alone_prints_and_writes_the_table(tmp_path, capsys):
     for rows in results["sets"].values():
         assert [row["N"] for row in rows] == [1, 100, 1000]
         for row in rows:
-            assert row["batch_steps_per_s"] > 0 and row["scalar_steps_per_s"] > 0
             ratio = row["batch_steps_per_s"] / row["scalar_steps_per_s"]
             assert abs(row["ratio"] - ratio) <= 0.05 + 1e-6 * ratio

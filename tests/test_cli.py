@@ -1,5 +1,6 @@
 """The sma-fmu command line: outputs, JSON, and errors on stderr with a non-zero exit."""
 import json
+import math
 
 import pytest
 
@@ -27,9 +28,15 @@ def test_resistance_then_sense_round_trips(capsys):
     assert back["saturated"] is False
 
 
-def test_constant_length_text_output(capsys):
+def test_constant_length_text_output(capsys, params):
     assert main(["constant-length", "--xi-p", "0.4391", "--xi-m", "0.2805", "--xi-f", "0.2805"]) == 0
-    assert "df_dT = 0.00994263 kg/K" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    printed = float(out.split("df_dT = ")[1].split()[0])
+    # spec section 8, computed here: (df/dT)_x = -N k_B (ln xi_F - ln xi_P / 2 - ln xi_M / 2) / (g x_f)
+    slope = (-params.N * 1.380649e-23 * (math.log(0.2805) - 0.5 * math.log(0.4391)
+                                          - 0.5 * math.log(0.2805)) / (9.80665 * params.x_f))
+    assert printed == pytest.approx(slope, rel=1e-6)
+    assert printed == pytest.approx(9.945e-3, rel=2e-3)      # the paper's value
 
 
 @pytest.mark.parametrize("argv,message", [

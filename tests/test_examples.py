@@ -1,5 +1,4 @@
 """The worked examples in sma_fmu/examples/ run, and give what the library gives."""
-import ast
 import csv
 import dataclasses
 import subprocess
@@ -8,19 +7,14 @@ import sys
 import numpy as np
 import pytest
 
+from import_roots import imported_roots
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.package_data import shipped_file
 
 
 def _imports(path):
-    roots = set()
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.Import):
-            roots |= {alias.name.split(".")[0] for alias in node.names}
-        elif isinstance(node, ast.ImportFrom) and node.level == 0:
-            roots.add(node.module.split(".")[0])
-    return roots
+    return imported_roots(path.read_text())
 
 
 def test_fmpy_loop_example_uses_plain_fmpy_and_matches_the_library(tmp_path, fmus):

@@ -43,7 +43,7 @@ def test_tune_improves_and_the_snippet_reproduces_the_rmse(tmp_path, capsys):
 
 @pytest.mark.parametrize("stop, message", [("2.0005", "not a whole number of steps"),
                                            ("0", "must be > 0"),
-                                           ("1e5", "at most 2000000 steps")])
+                                           ("1e5", "at most 4000000 steps")])
 def test_tune_refuses_a_bad_stop_time(tmp_path, capsys, stop, message):
     assert main(["tune", "heavy-pi", "--stop-time", stop, "--out", str(tmp_path / "t")]) == 2
     error = capsys.readouterr().err

@@ -65,5 +65,5 @@ def register(commands):
                       help=f"population size per tuned parameter (scipy's popsize), 1-{MAX_POPULATION}")
     tune.add_argument("--stop-time", type=float, metavar="S",
                       help="tune over the first S seconds, checked as a scenario's stop_time_s "
-                           "(at most 2,000,000 steps) (default: the scenario's duration)")
+                           "(at most 4,000,000 steps) (default: the scenario's duration)")
     tune.set_defaults(handler=_tune)

@@ -65,7 +65,7 @@ __all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "AnalysisWind
 CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")
 PAPER_SET = tuple(f"{profile}-{controller}" for profile in ("load-step", "heavy")
                   for controller in CONTROLLERS)
-MAX_STEPS = 2_000_000  # 33 min at 1 ms; the time series of a run is held in memory
+MAX_STEPS = 4_000_000  # 66 min at 1 ms; the time series (113 B per step) is held in memory
 _SECTIONS = {
     "scenario": {"description", "stop_time_s", "step_s", "model", "group"},
     "reference": None,  # checked by signals.reference_from_table
