@@ -31,7 +31,7 @@ from importlib import resources
 from pathlib import Path
 
 from sma_fmu import __version__
-from sma_fmu.fmi.front import NativeFrontWarning, compile_fronts, install_fronts
+from sma_fmu.fmi.front import NativeFrontWarning, compile_fronts, install_fronts, stage_slave_module
 from sma_fmu.output_folder import staged_folder
 from sma_fmu.package_data import shipped_file
 from sma_fmu.parameter_file import load_parameter_set
@@ -133,8 +133,8 @@ def _stage(script_name, stage, parameter_set, stamp):
     source = shipped_file("slaves", script_name).read_text(encoding="utf-8")
     if "sma_fmu.runtime" not in source:
         raise ValueError(f"{script_name}: slave script does not import sma_fmu.runtime")
-    staged_script = stage / f"{stem}_{stamp}.py"
-    staged_script.write_text(rename(source), encoding="utf-8")
+    staged_script = stage_slave_module(stage, f"{stem}_{stamp}", names["sma_fmu.fmi.slave_support"],
+                                       stem, rename(source))
     document = parameter_set.as_json()
     document.update(source=str(parameter_set.path), sma_fmu_version=__version__, stamp=stamp)
     parameters = stage / "parameters.json"

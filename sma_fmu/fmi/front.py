@@ -12,14 +12,14 @@ and forwards every call to pythonfmu's binary, renamed ``<model>_pythonfmu.so`` 
   (3.10 or newer) where that one is absent. Where no compiler works the FMU keeps
   pythonfmu's plain binary, and its model description says what is degraded.
 - win64: cross-compiled with mingw-w64 (``$SMA_FMU_WIN64_CC``, default
-  ``x86_64-w64-mingw32-gcc``; Debian: ``apt-get install gcc-mingw-w64-x86-64``). Without
+  ``x86_64-w64-mingw32-gcc``, :func:`~sma_fmu.fmi.hosts.windows_compiler`; Debian:
+  ``apt-get install gcc-mingw-w64-x86-64``). Without
   it the FMU leaves win64 out.
 Either case is a :class:`NativeFrontWarning`; :mod:`sma_fmu.fmi.platforms` writes and
 reads what each FMU says about its platforms.
 """
 import hashlib
-import os
-import shlex
+import re
 import shutil
 import subprocess
 import sys
@@ -29,12 +29,12 @@ import zipfile
 from importlib import resources
 from pathlib import Path
 
-from sma_fmu.fmi.hosts import c_compiler
+from sma_fmu.fmi.hosts import c_compiler, windows_compiler
 from sma_fmu.fmi.platforms import (DEGRADED, HOW_PYTHON_IS_FOUND, PLATFORMS, PlatformEntry,
                                    annotate, check_build_machine)
 
 __all__ = ["NativeFrontWarning", "FrontBuild", "Fronts", "compile_front", "compile_windows_front",
-           "compile_fronts", "install_fronts", "remove_front", "libpython_path", "windows_compiler"]
+           "compile_fronts", "install_fronts", "remove_front", "libpython_path", "stage_slave_module"]
 
 _BACKEND = "_pythonfmu"
 _COMMON = ["-std=c11", "-O2", "-shared", "-Wall"]
@@ -88,11 +88,6 @@ def libpython_path():
         soname = f"libpython{sys.version_info[0]}.{sys.version_info[1]}.so.1.0"
     path = Path(sysconfig.get_config_var("LIBDIR") or "/nonexistent") / soname
     return (str(path) if path.is_file() else ""), soname
-
-
-def windows_compiler():
-    """The mingw-w64 cross compiler command: ``$SMA_FMU_WIN64_CC`` or ``x86_64-w64-mingw32-gcc``."""
-    return shlex.split(os.environ.get("SMA_FMU_WIN64_CC") or "x86_64-w64-mingw32-gcc")
 
 
 def _sources():
@@ -229,3 +224,34 @@ def remove_front(fmu_path, destination):
                 data = annotate(data.decode("utf-8"), None).encode("utf-8")
             target.writestr(item, data)
     return destination
+
+
+_STUB = '''"""The module pythonfmu loads: {name} itself is in {package}.{script}.
+
+pythonfmu 0.7.0 (findClass) executes this file again at every fmi2Instantiate, with this
+module's dict as globals, never frees the list it makes of each class's bases (the class
+in it), and releases the dict once too often. A class defined here would stay in memory once
+per instance (about 12 KiB); an imported one is the same class every time, and the entry
+appended per run makes up for the extra release.
+"""
+from {package}.{script} import {name}  # noqa: F401
+
+globals().setdefault("_pythonfmu_runs", []).append(globals())
+'''
+
+
+def stage_slave_module(stage, module, package, script, text):
+    """Write the slave script ``text`` as ``stage/package/script.py`` and, as the module
+    pythonfmu loads, ``stage/module.py``, which imports its one class from there; returns
+    the path of ``module.py`` (pythonfmu's script).
+
+    pythonfmu runs the file it loads again for every instance (see the module written):
+    the class must live elsewhere for an instance to leave no class behind.
+    """
+    classes = re.findall(r"^class (\w+)\(", text, flags=re.M)
+    if len(classes) != 1:
+        raise ValueError(f"{script}: a slave script defines exactly one class, found {classes or 'none'}")
+    (Path(stage) / package / f"{script}.py").write_text(text, encoding="utf-8")
+    stub = Path(stage) / f"{module}.py"
+    stub.write_text(_STUB.format(name=classes[0], package=package, script=script), encoding="utf-8")
+    return stub

@@ -7,7 +7,9 @@
 
 They link no libpython and need no environment variable: what they show is what any C
 host sees. :func:`compile_host` builds either with the system C compiler
-(:func:`c_compiler`), once per source, compiler and library, into a cache folder.
+(:func:`c_compiler`), once per source, compiler and library, into a cache folder; with
+``windows=True`` it cross-builds ``fmi_host.exe`` with mingw-w64 (:func:`windows_compiler`),
+a Windows host for the win64 front (the tests run it under wine).
 """
 import hashlib
 import importlib.util
@@ -19,7 +21,7 @@ import tempfile
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["CHostError", "HOST_PROGRAMS", "c_compiler", "compile_host"]
+__all__ = ["CHostError", "HOST_PROGRAMS", "c_compiler", "windows_compiler", "compile_host"]
 
 HOST_PROGRAMS = ("fmi_host", "cosim_host")
 _FLAGS = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"]
@@ -37,6 +39,12 @@ def c_compiler():
     return ["gcc" if shutil.which("cc") is None and shutil.which("gcc") else "cc"]
 
 
+def windows_compiler():
+    """The mingw-w64 cross compiler as a list: ``$SMA_FMU_WIN64_CC`` split like a shell would,
+    else ``x86_64-w64-mingw32-gcc`` (Debian: ``apt-get install gcc-mingw-w64-x86-64``)."""
+    return shlex.split(os.environ.get("SMA_FMU_WIN64_CC") or "x86_64-w64-mingw32-gcc")
+
+
 def _libcosimc_folder():
     """The folder of libcosimc in the libcosimpy installation."""
     spec = importlib.util.find_spec("libcosimpy")
@@ -48,40 +56,48 @@ def _libcosimc_folder():
     return folder
 
 
-def _link_flags(name):
+def _link_flags(name, windows=False):
+    if windows:
+        if name != "fmi_host":
+            raise CHostError(f"only fmi_host is built for Windows, not {name}")
+        return ["-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1"]
     if name == "fmi_host":
         return ["-ldl"]
     library = _libcosimc_folder()
     return [f"-L{library}", "-lcosimc", f"-Wl,-rpath,{library}"]
 
 
-def compile_host(name, cache=None):
+def compile_host(name, cache=None, windows=False):
     """Build the C host ``name`` (one of :data:`HOST_PROGRAMS`) if needed; returns its path.
 
     The executable is kept in ``cache`` (default: the temporary folder) under a key of the
-    source, the compiler and the flags, so each is compiled once. Raises
+    source, the compiler and the flags, so each is compiled once. ``windows``: cross-build
+    ``<name>.exe`` (fmi_host only) with :func:`windows_compiler`. Raises
     :class:`CHostError` with the compiler's message when it cannot be built.
     """
     if name not in HOST_PROGRAMS:
         raise ValueError(f"C host must be one of {', '.join(HOST_PROGRAMS)}, got {name!r}")
     source = resources.files(__name__).joinpath(f"{name}.c").read_bytes()
-    compiler, link = c_compiler(), _link_flags(name)
+    compiler = windows_compiler() if windows else c_compiler()
+    link = _link_flags(name, windows)
     key = hashlib.sha256(source + "\0".join([*compiler, *_FLAGS, *link]).encode()).hexdigest()[:12]
     folder = Path(cache or tempfile.gettempdir()) / f"sma-fmu-{name}-{key}"
-    executable = folder / name
+    executable = folder / (f"{name}.exe" if windows else name)
     if executable.is_file():
         return executable
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=folder) as stage:
         source_file = Path(stage) / f"{name}.c"
         source_file.write_bytes(source)
-        built = Path(stage) / name
+        built = Path(stage) / executable.name
         command = [*compiler, *_FLAGS, "-o", str(built), str(source_file), *link]
         try:
             result = subprocess.run(command, capture_output=True, text=True, timeout=300)
         except (OSError, subprocess.SubprocessError) as error:
+            hint = ("install gcc-mingw-w64-x86-64 or set SMA_FMU_WIN64_CC" if windows
+                    else "install gcc or set CC")
             raise CHostError(f"C compiler {shlex.join(compiler)!r} could not run to build "
-                             f"{name} ({error}): install gcc or set CC") from None
+                             f"{name} ({error}): {hint}") from None
         if result.returncode != 0:
             raise CHostError(f"C compiler {shlex.join(compiler)!r} could not build {name}: "
                              f"{result.stderr.strip()}")

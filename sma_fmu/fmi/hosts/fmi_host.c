@@ -1,13 +1,16 @@
 /*
  * fmi_host.c - a plain C FMI 2.0 co-simulation host for the tests: no libpython linked,
- * no LD_PRELOAD. It dlopens DIR/binaries/linux64/<modelIdentifier>.so like fmusim does
- * and runs FMI calls read from stdin, one command per line, so the tests (and the fuzz
- * suite) can drive any call sequence in a real non-Python process.
+ * no LD_PRELOAD. It loads DIR/binaries/linux64/<modelIdentifier>.so (built for Windows:
+ * DIR/binaries/win64/<modelIdentifier>.dll) like fmusim does and runs FMI calls read from
+ * stdin, one command per line, so the tests (and the fuzz suite) can drive any call
+ * sequence in a real non-Python process.
  *
  * usage: fmi_host DIR   then commands on stdin; strings are hex-encoded, "-" is NULL:
  *   instantiate S NAME URI GUID LOGGING   URI: ok|one|localhost|plain|empty|null|missing|
  *                                         http|relative|pct or hex text; GUID: ok|wrong|null
  *   free S | setup S T0 STOP(or -) | enter S | exit S | terminate S | reset S
+ *   reuse S (put the pointer "free S" freed back into slot S) | bogus S (a pointer that was
+ *   never an instance) | forget S (empty slot S without freeing)
  *   setreal S N VR V ... | getreal S N VR ... | setbool S N VR B ... | getbool S N VR ...
  *   setint S N VR I ... | getint S N VR ... | setstring S N VR TEXT ... | getstring S N VR ...
  *   step S T H | getstate S K | setstate S K | freestate S K | serialize S K
@@ -18,13 +21,22 @@
  * Library and fmpy's log proxy do: as a printf format (which a '%' must not break).
  */
 #define _GNU_SOURCE
-#include <dlfcn.h>
-#include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#ifdef _WIN32
+#define WIN32_LEAN_AND_MEAN
+#include <windows.h>
+#define PLATFORM "win64"
+#define SUFFIX ".dll"
+#else
+#include <dlfcn.h>
+#define PLATFORM "linux64"
+#define SUFFIX ".so"
+#endif
+#define PATH_SIZE 4096
 
 typedef void* Component;
 typedef struct {
@@ -61,8 +73,9 @@ static struct {
     int (*SetDebugLogging)(Component, int, size_t, const char* const*);
 } F;
 
-static char dir[PATH_MAX], guid[256], model[256];
-static Component slot[SLOTS];
+static char dir[PATH_SIZE], guid[256], model[256];
+static Component slot[SLOTS], freed[SLOTS];
+static char never_an_instance[64];
 static void* states[SLOTS][4];
 
 static void print_hex(const char* text, size_t n)
@@ -96,16 +109,35 @@ static char* unhex(const char* hex, size_t* length)
     return out;
 }
 
+/* The absolute path of the FMU folder, '/'-separated ("C:/dir" on Windows). */
+static int absolute_dir(char* absolute, size_t size)
+{
+#ifdef _WIN32
+    if (!_fullpath(absolute, dir, size)) return 0;
+    for (char* p = absolute; *p; ++p)
+        if (*p == '\\') *p = '/';
+    return 1;
+#else
+    (void)size;
+    return realpath(dir, absolute) != NULL;
+#endif
+}
+
 static const char* resource_uri(const char* mode)
 {
-    static char uri[PATH_MAX + 64];
-    char absolute[PATH_MAX];
-    if (!realpath(dir, absolute)) return NULL;
-    if (!strcmp(mode, "ok")) snprintf(uri, sizeof uri, "file://%s/resources", absolute);
-    else if (!strcmp(mode, "one")) snprintf(uri, sizeof uri, "file:%s/resources", absolute);
-    else if (!strcmp(mode, "localhost")) snprintf(uri, sizeof uri, "file://localhost%s/resources", absolute);
+    static char uri[PATH_SIZE + 64];
+    char absolute[PATH_SIZE];
+#ifdef _WIN32
+    const char* root = "/"; /* file:///C:/dir */
+#else
+    const char* root = "";
+#endif
+    if (!absolute_dir(absolute, sizeof absolute)) return NULL;
+    if (!strcmp(mode, "ok")) snprintf(uri, sizeof uri, "file://%s%s/resources", root, absolute);
+    else if (!strcmp(mode, "one")) snprintf(uri, sizeof uri, "file:%s%s/resources", root, absolute);
+    else if (!strcmp(mode, "localhost")) snprintf(uri, sizeof uri, "file://localhost%s%s/resources", root, absolute);
     else if (!strcmp(mode, "plain")) snprintf(uri, sizeof uri, "%s/resources", absolute);
-    else if (!strcmp(mode, "pct")) snprintf(uri, sizeof uri, "file://%s/re%%73ources", absolute);
+    else if (!strcmp(mode, "pct")) snprintf(uri, sizeof uri, "file://%s%s/re%%73ources", root, absolute);
     else if (!strcmp(mode, "empty")) uri[0] = '\0';
     else if (!strcmp(mode, "null")) return NULL;
     else if (!strcmp(mode, "missing")) snprintf(uri, sizeof uri, "file://%s/nonexistent", absolute);
@@ -117,7 +149,7 @@ static const char* resource_uri(const char* mode)
 
 static void read_model_description(void)
 {
-    char path[PATH_MAX + 32];
+    char path[PATH_SIZE + 32];
     snprintf(path, sizeof path, "%s/modelDescription.xml", dir);
     FILE* file = fopen(path, "r");
     if (!file) { perror(path); exit(2); }
@@ -131,13 +163,32 @@ static void read_model_description(void)
     sscanf(m + 17, "%255[^\"]", model);
 }
 
+#ifdef _WIN32
+static void* symbol(HMODULE library, const char* name)
+{
+    FARPROC address = GetProcAddress(library, name);
+    void* pointer;
+    memcpy(&pointer, &address, sizeof pointer);
+    return pointer;
+}
+#else
+#define symbol dlsym
+#endif
+
 static void load(void)
 {
-    char path[PATH_MAX + 300];
-    snprintf(path, sizeof path, "%s/binaries/linux64/%s.so", dir, model);
+    char path[PATH_SIZE + 300];
+    snprintf(path, sizeof path, "%s/binaries/" PLATFORM "/%s" SUFFIX, dir, model);
+#ifdef _WIN32
+    for (char* p = path; *p; ++p)
+        if (*p == '/') *p = '\\';
+    HMODULE library = LoadLibraryExA(path, NULL, LOAD_WITH_ALTERED_SEARCH_PATH);
+    if (!library) { fprintf(stderr, "fmi_host: LoadLibrary %s: error %lu\n", path, GetLastError()); exit(3); }
+#else
     void* library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!library) { fprintf(stderr, "fmi_host: dlopen: %s\n", dlerror()); exit(3); }
-#define SYM(n) if (!(*(void**)&F.n = dlsym(library, "fmi2" #n))) { fprintf(stderr, "no fmi2" #n "\n"); exit(3); }
+#endif
+#define SYM(n) if (!(*(void**)&F.n = symbol(library, "fmi2" #n))) { fprintf(stderr, "no fmi2" #n "\n"); exit(3); }
     SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
     SYM(ExitInitializationMode) SYM(Terminate) SYM(Reset) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
     SYM(GetInteger) SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(GetString) SYM(DoStep)
@@ -149,9 +200,16 @@ static void load(void)
 
 static double now(void)
 {
+#ifdef _WIN32
+    LARGE_INTEGER count, frequency;
+    QueryPerformanceCounter(&count);
+    QueryPerformanceFrequency(&frequency);
+    return (double)count.QuadPart / (double)frequency.QuadPart;
+#else
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return t.tv_sec + 1e-9 * t.tv_nsec;
+#endif
 }
 
 static int by_value(const void* a, const void* b)
@@ -210,8 +268,21 @@ int main(int argc, char** argv)
             fflush(stdout);
             continue;
         }
+        if (!strcmp(command, "reuse") || !strcmp(command, "bogus") || !strcmp(command, "forget")) {
+            slot[s] = !strcmp(command, "reuse") ? freed[s]
+                      : !strcmp(command, "bogus") ? (Component)never_an_instance : NULL;
+            printf("= 0\n");
+            fflush(stdout);
+            continue;
+        }
         if (!c) { printf("= -2\n"); fflush(stdout); continue; } /* no instance in this slot */
-        if (!strcmp(command, "free")) { F.FreeInstance(c); slot[s] = NULL; memset(states[s], 0, sizeof states[s]); status = 0; }
+        if (!strcmp(command, "free")) {
+            F.FreeInstance(c);
+            freed[s] = c;
+            slot[s] = NULL;
+            memset(states[s], 0, sizeof states[s]);
+            status = 0;
+        }
         else if (!strcmp(command, "setup") && n == 4)
             status = F.SetupExperiment(c, 0, 0.0, strtod(word[2], NULL), strcmp(word[3], "-") != 0,
                                        strtod(word[3], NULL));
