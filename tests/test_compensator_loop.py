@@ -85,13 +85,13 @@ def test_minor_loop_option_reaches_the_system_tools(fmus, tmp_path):
     bound = {(c.get("name"), p.get("name")): p[0].get("value")
              for c in root.iter(f"{{{NAMESPACES['ssd']}}}Component")
              for p in c.iter(f"{{{NAMESPACES['ssv']}}}Parameter")}
-    assert bound[("compensator", "inverse")] == "minor-loop"
+    assert bound[("compensator", "inverse")] == "2"  # the Integer code of minor-loop
     rows = compare_hosts(scenario, fmu_dir, hosts=("fmpy",))
     assert rows[-1]["run"] == "fmpy (container)" and rows[-1]["deviation"] <= 1e-9
 
 
 def test_feedforward_fmu_state_keeps_the_minor_loop_memory(fmus):
-    start = {"inverse": "minor-loop", "R_ref": 45.0, "load": 0.05}
+    start = {"inverse": 2, "R_ref": 45.0, "load": 0.05}  # 2 = minor-loop
     references = [41.85 + 6.05 * math.cos(math.pi * k * 1e-3) for k in range(3000)]
     with FmuInstance(fmus["SmaFeedforward"], "ff-minor", start) as fmu:
         ports = fmu.port(("R_ref", "load")), fmu.port(("P_ff", "T_ref"))

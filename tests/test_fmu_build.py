@@ -52,7 +52,8 @@ def test_plant_interface(fmus, parameter_set):
         assert (variables[name].causality, variables[name].unit) == ("output", unit)
     heating = variables["heating"]
     assert (heating.type, heating.causality, heating.variability) == ("Boolean", "output", "discrete")
-    assert variables["hysteresis_mode"].start == "continuous"
+    mode = variables["hysteresis_mode"]  # an Integer: 1 = continuous, 2 = switch
+    assert (mode.type, mode.start) == ("Integer", "1")
     params = parameter_set.params
     assert float(variables["T_start"].start) == params.T_room
     for name in ("R_P", "a_h", "b_c", "eps_T", "nu", "A_s", "c_p", "h_c", "T_room", "mass"):

@@ -18,6 +18,6 @@ def test_the_table_has_a_row_per_variable_with_unit_and_start(fmus):
     table = markdown_table(fmus["SmaActuator"]).splitlines()
     rows = {line.split(" | ")[0].strip("| `"): line.split(" | ") for line in table[2:]}
     assert rows["P_in"][1:5] == ["input", "continuous", "Real", "W"] and float(rows["P_in"][5]) == 0.0
-    assert rows["hysteresis_mode"][3:6] == ["String", "–", '"continuous"']
+    assert rows["hysteresis_mode"][3:6] == ["Integer", "–", "1"]
     assert rows["R"][1:6] == ["output", "continuous", "Real", "ohm", "(calculated)"]
     assert rows["T_max"][1:5] == ["parameter", "fixed", "Real", "degC"] and float(rows["T_max"][5]) == 300.0

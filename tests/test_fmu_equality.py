@@ -3,6 +3,7 @@ import pytest
 
 from fmu_signals import STEP, plant_load, plant_power, wide_reference as reference
 from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.slave_support.choices import choice_code
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
 
@@ -20,7 +21,8 @@ def _assert_plant_equal(fmu, library_outputs):
 def test_plant_fmu_equals_library_stepper(fmus, params, mode):
     library = PlantStepper(params, mode=mode, load=plant_load(0))
     with FmuInstance(fmus["SmaActuator"], f"plant-{mode}",
-                     {"load": plant_load(0), "hysteresis_mode": mode}) as fmu:
+                     {"load": plant_load(0),
+                      "hysteresis_mode": choice_code("hysteresis_mode", mode)}) as fmu:
         _assert_plant_equal(fmu, library.outputs)
         reversals = 0
         for k in range(STEPS):

@@ -65,8 +65,8 @@ def test_feedforward_discards_bad_input_and_stays_usable(fmus, params, reference
 
 
 @pytest.mark.parametrize("name,start,message", [
-    ("SmaActuator", {"hysteresis_mode": "smooth"},
-     "hysteresis mode must be one of switch, continuous, got 'smooth'"),
+    ("SmaActuator", {"hysteresis_mode": 3},
+     "hysteresis_mode must be 1 (continuous) or 2 (switch), got 3"),
     ("SmaActuator", {"T_start": math.nan}, "T_start must be finite, got nan"),
     ("SmaActuator", {"R_P": -33.0}, "parameter phases.R_P = -33.0 must be > 0 [ohm]"),
     ("SmaActuator", {"load": -1.0}, "load must be >= 0, got -1.0"),

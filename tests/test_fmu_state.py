@@ -30,7 +30,7 @@ def inputs_at(inputs, k):
 
 BOOLEANS = {("P_in", "load"): ["heating"], ("R_ref", "load"): ["saturated"]}
 CASES = {
-    "plant-continuous": ("SmaActuator", {"hysteresis_mode": "continuous"},
+    "plant-continuous": ("SmaActuator", {"hysteresis_mode": 1},  # 1 = continuous
                          ("P_in", "load"), ("R", "T", "xi_P", "xi_M", "xi_F")),
     "plant-switch": ("SmaActuator", {}, ("P_in", "load"), ("R", "T", "x")),
     "feedforward": ("SmaFeedforward", {}, ("R_ref", "load"), ("P_ff", "T_ref")),

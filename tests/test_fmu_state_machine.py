@@ -44,7 +44,7 @@ class Raw:
 
     def set(self, **values):
         for name, value in values.items():
-            setter = self.fmu.setString if isinstance(value, str) else self.fmu.setReal
+            setter = self.fmu.setInteger if isinstance(value, int) else self.fmu.setReal
             setter([self.refs[name]], [value])
 
     def get(self, *names):
@@ -95,7 +95,7 @@ def test_only_inputs_and_parameters_can_be_set_and_fixed_ones_only_before_initia
     R, T = plant.get("R", "T")
     plant.refused(lambda: plant.set(R=1.0), words=["fmi2SetReal", "R (value reference", "output", "1.0"])
     plant.refused(lambda: plant.set(R_P=30.0), words=["R_P", "fixed parameter", "30.0"])
-    plant.refused(lambda: plant.set(hysteresis_mode="switch"), words=["fmi2SetString", "hysteresis_mode"])
+    plant.refused(lambda: plant.set(hysteresis_mode=2), words=["fmi2SetInteger", "hysteresis_mode"])
     plant.refused(plant.fmu.setReal, [plant.refs["P_in"], plant.refs["R"]], [1.0, 2.0],
                   words=["nothing was set"])
     assert plant.get("R", "T", "R_P", "P_in") == [R, T, params.R_P, 0.0]  # nothing changed

@@ -84,7 +84,7 @@ def test_check_fails_on_a_system_that_cannot_run(fmu_dir, tmp_path, capsys):
     scenario = dataclasses.replace(load_scenario(resolve_scenarios(["heavy-pi"])[0]), stop_time_s=1.0)
     system = closed_loop(scenario, fmu_dir)
     plant = system.component("plant")
-    broken = dataclasses.replace(plant, parameters={**plant.parameters, "hysteresis_mode": "bogus"})
+    broken = dataclasses.replace(plant, parameters={**plant.parameters, "hysteresis_mode": 7})
     components = tuple(broken if c is plant else c for c in system.components)
     path = write_ssp(LoopSystem(scenario, components, system.connections), tmp_path / "bogus.ssp")
     (tmp_path / "not-an-fmu.fmu").write_text("plain text")

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
 from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths, read_description
+from sma_fmu.fmi.slave_support.choices import choice_code
 from sma_fmu.fmi.instance import FmuError, FmuInstance
 
 __all__ = ["FmuPlant", "FmuCompensator", "FmuDriver", "needed_fmus", "run_fmus", "MissingFmuError",
@@ -38,7 +39,8 @@ class FmuPlant:
 
     def __init__(self, scenario, fmu_path, instance_name="plant"):
         start = model_parameter_values(fmu_path, scenario.params)
-        start.update(T_start=scenario.T_start, hysteresis_mode=scenario.hysteresis_mode,
+        start.update(T_start=scenario.T_start,
+                     hysteresis_mode=choice_code("hysteresis_mode", scenario.hysteresis_mode),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
         self._inputs = self.fmu.port(("P_in", "load"))
@@ -66,7 +68,7 @@ class FmuCompensator:
         c = scenario.controller
         start = model_parameter_values(fmu_path, scenario.compensator_params)
         start.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
-                     adapt_to_load=c.adapt_to_load, inverse=c.inverse,
+                     adapt_to_load=c.adapt_to_load, inverse=choice_code("inverse", c.inverse),
                      R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)

@@ -20,8 +20,11 @@ from pathlib import Path
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
+# SmaActuator's Integer parameter hysteresis_mode: the code of each mode
+HYSTERESIS_MODES = {"continuous": 1, "switch": 2}
 
-def open_fmu(path, instance_name, reals=None, strings=None, booleans=None):
+
+def open_fmu(path, instance_name, reals=None, integers=None, booleans=None):
     """Instantiate an FMU, set start values in initialization mode, and return (fmu, refs)."""
     description = read_model_description(str(path))
     refs = {v.name: v.valueReference for v in description.modelVariables}
@@ -32,7 +35,7 @@ def open_fmu(path, instance_name, reals=None, strings=None, booleans=None):
     fmu.instantiate()
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
-    for setter, values in ((fmu.setReal, reals), (fmu.setString, strings),
+    for setter, values in ((fmu.setReal, reals), (fmu.setInteger, integers),
                            (fmu.setBoolean, booleans)):
         if values:
             setter([refs[name] for name in values], list(values.values()))
@@ -48,7 +51,8 @@ def reference(t):
 def run(fmu_dir, stop=30.0, step=1e-3, load=0.25, mode="continuous", Kp=0.3, Ki=1.0):
     """Run the loop; returns rows (t, R_ref, R, T, P_ff, P) with one row per sample."""
     plant, p, plant_folder = open_fmu(Path(fmu_dir) / "SmaActuator.fmu", "plant",
-                                      reals={"load": load}, strings={"hysteresis_mode": mode})
+                                      reals={"load": load},
+                                      integers={"hysteresis_mode": HYSTERESIS_MODES[mode]})
     ff, f, ff_folder = open_fmu(Path(fmu_dir) / "SmaFeedforward.fmu", "feedforward",
                                 reals={"R_ref": reference(0.0), "load": load})
     rows, integral = [], 0.0
@@ -91,7 +95,8 @@ def main():
     parser.add_argument("fmus", help="folder with SmaActuator.fmu and SmaFeedforward.fmu")
     parser.add_argument("--stop", type=float, default=30.0, help="duration [s] (30)")
     parser.add_argument("--load", type=float, default=0.25, help="hung mass [kg] (0.25)")
-    parser.add_argument("--mode", default="continuous", help="hysteresis mode (continuous)")
+    parser.add_argument("--mode", default="continuous", choices=sorted(HYSTERESIS_MODES),
+                        help="hysteresis mode (continuous)")
     parser.add_argument("--csv", help="write the run to this CSV file")
     args = parser.parse_args()
     rows = run(args.fmus, args.stop, load=args.load, mode=args.mode)

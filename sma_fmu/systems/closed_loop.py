@@ -14,15 +14,17 @@ A scenario with ``[drive] kind = "pwm"`` has a PWM driver between the PI and the
 Each component's parameter values are the scenario's: every wire parameter its FMU
 exposes (from the scenario's parameter file), the controller's gains and filter, the
 driver's frequency and peak power, the plant's start temperature and hysteresis mode, and
-the signals as JSON tables.
+the signals as JSON tables. Choices (the hysteresis mode, the inverse) are the Integer
+codes of :mod:`sma_fmu.fmi.slave_support.choices`.
 """
 from dataclasses import dataclass
 
 from sma_fmu.cosim.master import MissingFmuError, model_parameter_values
 from sma_fmu.fmi.build import default_fmu_paths, read_description
+from sma_fmu.fmi.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
 
-__all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "STEP_ORDER"]
+__all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "identifier", "STEP_ORDER"]
 
 # Gauss-Seidel order of a sequential host: the sampled blocks in data-flow order (the PWM
 # driver's output is the wave's mean over the step it was given), then the blocks whose
@@ -32,10 +34,19 @@ __all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "STEP_ORDER"]
 STEP_ORDER = ("compensator", "pi", "driver", "plant", "signals")
 
 
+def identifier(name):
+    """``name`` as an identifier (letters, digits, underscores; a letter first), as hosts
+    need for system and model names: every other character becomes "_", and a name that
+    does not start with a letter gets the prefix "sma_"."""
+    text = "".join(character if character.isascii() and character.isalnum() else "_"
+                   for character in name)
+    return text if text[:1].isalpha() else f"sma_{text}"
+
+
 @dataclass(frozen=True)
 class Component:
     """One FMU instance: ``name`` in the system, FMU ``model`` name, its ``fmu`` file,
-    ``parameters`` (name -> float, bool or str) and the FMU's model ``variables`` (name ->
+    ``parameters`` (name -> float, int, bool or str) and the FMU's model ``variables`` (name ->
     fmpy's ScalarVariable, read once here for everything written from the system)."""
 
     name: str
@@ -116,7 +127,8 @@ def closed_loop(scenario, fmu_dir):
     if c.feedforward:
         components.append(_component("compensator", "SmaFeedforward", paths, {
             "alpha": c.alpha, "beta": c.beta, "model_load": c.model_load,
-            "adapt_to_load": c.adapt_to_load, "inverse": c.inverse}, scenario.compensator_params))
+            "adapt_to_load": c.adapt_to_load, "inverse": choice_code("inverse", c.inverse)},
+            scenario.compensator_params))
         connections[1:1] = [Connection("signals", "R_ref", "compensator", "R_ref"),
                             Connection("signals", "load", "compensator", "load"),
                             Connection("compensator", "P_ff", "pi", "P_ff")]
@@ -125,5 +137,6 @@ def closed_loop(scenario, fmu_dir):
         components.append(_component("driver", "SmaPwmDriver", paths, {
             "frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W}))
     components.append(_component("plant", "SmaActuator", paths, {
-        "T_start": scenario.T_start, "hysteresis_mode": scenario.hysteresis_mode}, scenario.params))
+        "T_start": scenario.T_start,
+        "hysteresis_mode": choice_code("hysteresis_mode", scenario.hysteresis_mode)}, scenario.params))
     return LoopSystem(scenario, tuple(components), tuple(connections))

@@ -5,7 +5,10 @@ pythonfmu FMU ships pythonfmu in its resources/. The library path never imports 
 
 The build writes the wire's parameter set to ``resources/parameters.json``; a slave
 exposes some of those parameters as FMI parameters (start values from that file) and
-takes the rest from the file as they are.
+takes the rest from the file as they are. An FMU packed by ``sma-fmu export`` also has
+``resources/start_values.json`` (:mod:`.start_values`): the scenario's values, which
+replace the start values of the parameters it names. Settings that choose among names
+are Integer parameters holding a code (:mod:`.choices`).
 
 Creating a :class:`SlaveInterface` also puts a :class:`~.guards.CallGuard` over the
 slave's pythonfmu callbacks: the FMI state machine, checked arguments and saved states,
@@ -17,10 +20,12 @@ import os
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
+from sma_fmu.fmi.slave_support.choices import CHOICES, choice_text
 from sma_fmu.fmi.slave_support.guards import CallGuard
 from sma_fmu.fmi.slave_support.lifecycle import setting_refusal
 from sma_fmu.fmi.slave_support.model_description import decorate_model_description
 from sma_fmu.fmi.slave_support.saved_state import state_from_bytes, state_to_bytes
+from sma_fmu.fmi.slave_support.start_values import START_VALUES_FILE, read_start_values, start_value
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, WireParameters
 
 __all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
@@ -52,11 +57,16 @@ class SlaveInterface:
         self.defaults = WireParameters.from_values(
             {name: entry["value"] for name, entry in entries.items()},
             source=self.parameter_file.get("source", PARAMETERS_FILE))
+        # the scenario's values packed at export: they replace the parameters' start values
+        self.packed = read_start_values(slave.resources)
 
     def _declare(self, variable, start, unit):
+        kind = next(name for cls, name in _KIND_OF if isinstance(variable, cls))
+        if variable.causality is Fmi2Causality.parameter and variable.name in self.packed:
+            start = start_value(kind, self.packed[variable.name],
+                                f"{START_VALUES_FILE}: {variable.name}")
         setattr(self.slave, variable.name, start)
         self.slave.register_variable(variable)
-        kind = next(name for cls, name in _KIND_OF if isinstance(variable, cls))
         self._variables[variable.value_reference] = (
             variable.name, kind, variable.causality.name, variable.variability.name)
         self._tables.clear()
@@ -141,6 +151,12 @@ class SlaveInterface:
     def string_parameter(self, name, start, description):
         """A fixed String parameter (no unit)."""
         self.parameter(name, start, None, description, kind=String)
+
+    def choice_parameter(self, name, start, description):
+        """A fixed Integer parameter choosing among the names of :data:`~.choices.CHOICES`
+        [``name``]; ``start`` is a name, the description ends with the codes."""
+        code = next(code for code, known in CHOICES[name].items() if known == start)
+        self.parameter(name, code, None, f"{description} ({choice_text(name)})", kind=Integer)
 
     def boolean_parameter(self, name, start, description):
         """A fixed Boolean parameter."""

@@ -9,8 +9,10 @@ the outputs are then the state at t + h with the held load (no direct feedthroug
 outputs reflect T_start and the load set during initialization (in Initialization Mode
 they follow them as they are set). Invalid parameters make exitInitializationMode
 fail with fmi2Error naming the reason; the instance stays in Initialization Mode, where
-they can be corrected (see the guard, ``slave_support/guards.py``).
+they can be corrected (see the guard, ``slave_support/guards.py``). ``hysteresis_mode`` is
+an Integer: 1 = continuous, 2 = switch (``slave_support/choices.py``).
 """
+from sma_fmu.fmi.slave_support.choices import choice_name
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.plant import PlantStepper
@@ -39,9 +41,9 @@ class SmaActuator(StepperSlave):
             fmi.output(name, unit, text)
         fmi.boolean_output("heating", "true while dT/dt > 0 (the last sign is kept when dT/dt = 0)")
         fmi.parameter("T_start", fmi.defaults.T_room, "degC", "initial wire temperature")
-        fmi.string_parameter("hysteresis_mode", "continuous",
-                             "'continuous' (minor loops; holds a set-point) or 'switch' "
-                             "(paper: branch follows sgn dT/dt; limit-cycles at a set-point)")
+        fmi.choice_parameter("hysteresis_mode", "continuous",
+                             "continuous: minor loops, holds a set-point; switch: the paper's, "
+                             "branch follows sgn dT/dt, limit-cycles at a set-point")
         fmi.model_parameters(extra=("T_max", "stress_max"))
         self.stepper = None
 
@@ -50,7 +52,7 @@ class SmaActuator(StepperSlave):
 
     def _start(self):
         stepper = PlantStepper(self.interface.wire_parameters(), self.T_start,
-                               self.hysteresis_mode, self.load)
+                               choice_name("hysteresis_mode", self.hysteresis_mode), self.load)
         return stepper, stepper.outputs
 
     def _advance(self, current_time, step_size):

@@ -9,10 +9,12 @@ call and its outputs then hold u_ff,k for that step; step it before the plant
 initialization the outputs are those of the first sample (filter in steady state); in
 Initialization Mode they follow R_ref, load and the parameters as they are set.
 Invalid parameters make exitInitializationMode fail with fmi2Error naming the reason;
-the instance stays in Initialization Mode, where they can be corrected.
+the instance stays in Initialization Mode, where they can be corrected. ``inverse`` is an
+Integer: 1 = major, 2 = minor-loop (``slave_support/choices.py``).
 """
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.reachable_band import reachable_band
+from sma_fmu.fmi.slave_support.choices import choice_name
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 
@@ -38,15 +40,16 @@ class SmaFeedforward(StepperSlave):
         fmi.boolean_output("saturated", "true when R_ref is outside the transformation (T_ref clamped)")
         fmi.boolean_parameter("adapt_to_load", True,
                               "true: the inverse uses the measured load; false: model_load")
-        fmi.string_parameter("inverse", "major",
-                             "'major' (the paper's: major branches) or 'minor-loop' (the plant's "
-                             "continuous-mode minor branches, reversals taken from R_ref)")
+        fmi.choice_parameter("inverse", "major",
+                             "major: the paper's, major branches; minor-loop: the plant's "
+                             "continuous-mode minor branches, reversals taken from R_ref")
         fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin", "stress_max"))
         self.stepper = None
 
     def _start(self):
         stepper = FeedforwardStepper(self.interface.wire_parameters(),
-                                     adapt_to_load=self.adapt_to_load, inverse=self.inverse)
+                                     adapt_to_load=self.adapt_to_load,
+                                     inverse=choice_name("inverse", self.inverse))
         return stepper, stepper.initial_outputs(self.R_ref, self.load)
 
     def _publish(self, outputs):
