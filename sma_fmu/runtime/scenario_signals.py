@@ -9,6 +9,17 @@ a JSON object with the scenario file's keys (units in the key names)::
 
 The same functions check them as check scenario files (:mod:`.signals`), so a table that
 a scenario file accepts works in the FMU, and the error messages are the same.
+
+**choice** (the time grid): a host that adds up its time (t + h + h + ...) passes
+communication points a few rounding errors off k h, the library loop's t_k. A table
+reference held until t_k and ramped after it then gives, a rounding error after t_k, a
+value 1e-14 ohm off the hold, and a compensator that takes the reference's direction from
+the sign of its change switches branch a step early (16 ohm apart on the set-point
+scenarios). So :class:`SignalSource` samples at start + k h, h the size of its first step,
+whenever the end of a step lies within :data:`GRID_TOLERANCE` steps of that point;
+elsewhere (variable steps) at the host's time. The first step, not each step's size: a
+host that steps from t to t_next passes t_next - t, which differs from h by rounding
+errors too (OMSimulator does).
 """
 import json
 from collections import namedtuple
@@ -17,7 +28,10 @@ from .checks import fast_finite, fast_positive, require_finite
 from .signals import load_from_table, reference_from_table
 from .state_entries import read_entries, read_number
 
-__all__ = ["SignalOutputs", "SignalSource", "table_text", "signals_from_text"]
+__all__ = ["GRID_TOLERANCE", "SignalOutputs", "SignalSource", "table_text", "signals_from_text",
+           "grid_time"]
+
+GRID_TOLERANCE = 1e-6  # [steps]: a time this close to start + k h is taken as that point
 
 SignalOutputs = namedtuple("SignalOutputs", ["R_ref", "load"])
 SignalOutputs.__doc__ = "Reference resistance R_ref [ohm] and load [kg] at one time."
@@ -53,6 +67,16 @@ def signals_from_text(reference_text, load_text):
     return tuple(signals)
 
 
+def grid_time(time_s, start_s, step_s):
+    """``start_s`` + k ``step_s`` [s] for the k nearest ``time_s`` [s] if ``time_s`` lies within
+    :data:`GRID_TOLERANCE` steps of it, else ``time_s``."""
+    steps = (time_s - start_s) / step_s
+    if not abs(steps) < 2.0 ** 52:  # beyond the integers a float holds (or inf, nan)
+        return time_s
+    grid = start_s + round(steps) * step_s
+    return grid if abs(time_s - grid) <= GRID_TOLERANCE * step_s else time_s
+
+
 class SignalSource:
     """R_ref(t) [ohm] and the load f(t) [kg] at the communication points of a co-simulation.
 
@@ -64,13 +88,16 @@ class SignalSource:
         Start time [s]; the outputs before the first step are those at this time.
 
     After :meth:`step` (t, h) the outputs are those at t + h: a plot of them against the
-    communication points shows R_ref(t) and f(t) exactly.
+    communication points shows R_ref(t) and f(t) exactly. t + h is taken on the grid
+    start + k h_0, h_0 the first step's size, when it lies within :data:`GRID_TOLERANCE`
+    steps of it (see the module docstring).
     """
 
     def __init__(self, reference, load, start_time=0.0):
         self.reference = reference
         self.load = load
-        self.time = require_finite("start time", start_time)
+        self.start_time = self.time = require_finite("start time", start_time)
+        self.grid_step = None  # h_0 [s], from the first step (after a restore: the next one)
         self.outputs = self._sample(self.time)
 
     def _sample(self, time_s):
@@ -79,7 +106,11 @@ class SignalSource:
     def step(self, current_time, step_size):
         """Advance from ``current_time`` [s] by ``step_size`` [s]; returns the outputs at the end."""
         end = fast_finite("current time", current_time) + fast_positive("step_size", step_size)
-        self.outputs = self._sample(fast_finite("current time + step_size", end))
+        if self.grid_step is None:
+            self.grid_step = step_size
+        end = grid_time(fast_finite("current time + step_size", end), self.start_time,
+                        self.grid_step)
+        self.outputs = self._sample(end)
         self.time = end
         return self.outputs
 

@@ -5,15 +5,18 @@ signals of ``sma_fmu.runtime.signals``, the code that scenario files use.
 
 Parameters: ``reference`` and ``load_profile``, String parameters holding a scenario's
 ``[reference]`` and ``[load]`` tables as JSON objects (FMI 2.0 has no arrays); their
-defaults, from ``resources/signals.json``, are the paper's load-step scenario.
+defaults, from ``resources/signals.json``, are the paper's load-step scenario, and in an
+FMU packed by ``sma-fmu export`` the exported scenario's (``resources/start_values.json``),
+so a host that binds no String runs that scenario.
 Semantics: a source. After initialization the outputs are the signals at the start
-time; after doStep(t, h) they are the signals at t + h. Invalid tables make
+time; after doStep(t, h) they are the signals at t + h, taken on the step's grid
+start + k h when t + h is within a millionth of a step of it (a host that adds up its
+time samples where the library loop does). Invalid tables make
 exitInitializationMode fail with fmi2Error naming the parameter and the key; the
 instance stays in Initialization Mode, where they can be corrected.
 """
 import json
 import os
-
 
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
