@@ -18,7 +18,8 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 __all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", "PlatformEntry",
-           "binary_architecture", "check_build_machine", "annotate", "platform_report"]
+           "binary_architecture", "check_build_machine", "annotate", "platform_report",
+           "platform_results"]
 
 FRONT_MARKER = b"sma-fmu native front"  # a string every front binary carries (fmi2_exports.c)
 PLATFORMS = {"linux64": ".so", "win64": ".dll"}
@@ -133,42 +134,70 @@ def _declared(model_description):
 def platform_report(fmu_path):
     """[(status, platform, detail)] for each platform the FMU ``fmu_path`` lists.
 
-    status is "ok" (the binary is the front and the model description says so), "degraded"
-    (no front, and the model description says what is lost) or "FAIL" (the binary and what
-    the model description says disagree, or a platform lists nothing).
+    status is "ok" (the binary is the front and the model description says so), "warn" (no
+    front, and the model description says what is degraded), "FAIL" (the binaries and the
+    model description disagree, or an FMU of an earlier ``sma-fmu build`` lists platforms it
+    does not declare), or, once for the whole FMU, "n/a" when ``sma-fmu build`` did not
+    make it (a container, another tool's FMU).
     """
+    import xml.etree.ElementTree as ET
+
     with zipfile.ZipFile(fmu_path) as archive:
         names = archive.namelist()
         description = archive.read("modelDescription.xml").decode("utf-8")
-        import xml.etree.ElementTree as ET
-
-        identifier = ET.fromstring(description).find("CoSimulation").get("modelIdentifier")
         declared = _declared(description)
-        report = []
-        listed = sorted({name.split("/")[1] for name in names
-                         if name.startswith("binaries/") and name.count("/") >= 2 and name.split("/")[2]})
-        for name in listed:
-            binary = f"binaries/{name}/{identifier}{PLATFORMS.get(name, '')}"
-            said = declared.get(name)
-            if binary not in names:
-                report.append(("FAIL", name, f"lists the platform but has no {binary}"))
-                continue
-            data = archive.read(binary)
-            front = FRONT_MARKER in data
-            arch = binary_architecture(data) or "unknown format"
-            if said is None:
-                report.append(("FAIL", name, f"{binary} ({arch}, {'front' if front else 'no front'}) "
-                                             "is not declared in modelDescription.xml"))
-            elif (said.get("front") == "true") != front:
-                report.append(("FAIL", name, f"modelDescription.xml says front={said.get('front')}, "
-                                             f"but {binary} is {'the front' if front else 'not the front'}"))
-            elif front:
-                report.append(("ok", name, f"{binary} ({arch}): native front; Python: {said.get('python')}"))
-            elif said.get("degraded"):
-                report.append(("degraded", name, f"{binary} ({arch}): {said['degraded']}"))
-            else:
-                report.append(("FAIL", name, f"{binary} has no front and modelDescription.xml "
-                                             "does not say what is degraded"))
-        for name in sorted(set(declared) - set(listed)):
-            report.append(("FAIL", name, "declared in modelDescription.xml but not in binaries/"))
-    return report
+        if not declared and not _built_by_sma_fmu(archive, names):
+            return [("n/a", "all", "not built by sma-fmu build (a container, another tool's FMU)")]
+        root = ET.fromstring(description)
+        kinds = [root.find(kind) for kind in ("CoSimulation", "ModelExchange")]
+        identifier = next(kind.get("modelIdentifier") for kind in kinds if kind is not None)
+        listed = sorted({name.split("/")[1] for name in names if name.startswith("binaries/")
+                         and name.count("/") >= 2 and name.split("/")[2]})
+        return [_platform_line(archive, names, identifier, name, declared.get(name))
+                for name in listed] + \
+            [("FAIL", name, "declared in modelDescription.xml but not in binaries/")
+             for name in sorted(set(declared) - set(listed))]
+
+
+def _built_by_sma_fmu(archive, names):
+    """True for an FMU of ``sma-fmu build``, annotated or not (an earlier build)."""
+    return "resources/parameters.json" in names and \
+        b'"sma_fmu_version"' in archive.read("resources/parameters.json")
+
+
+def _platform_line(archive, names, identifier, name, said):
+    binary = f"binaries/{name}/{identifier}{PLATFORMS.get(name, '')}"
+    if binary not in names:
+        return "FAIL", name, f"lists the platform but has no {binary}"
+    data = archive.read(binary)
+    front = FRONT_MARKER in data
+    what = f"{binary} ({binary_architecture(data) or 'unknown format'})"
+    if said is None:
+        return "FAIL", name, f"{what}, {'the front' if front else 'no front'}, is not declared in " \
+                             "modelDescription.xml"
+    if (said.get("front") == "true") != front:
+        return "FAIL", name, f"modelDescription.xml says front={said.get('front')}, but {what} " \
+                             f"is {'the front' if front else 'not the front'}"
+    if front:
+        return "ok", name, f"{what}: native front; Python: {said.get('python')}"
+    if said.get("degraded"):
+        return "warn", name, f"{what}: degraded: {said['degraded']}"
+    return "FAIL", name, f"{what} has no front and modelDescription.xml does not say what is degraded"
+
+
+def platform_results(path):
+    """[(label, status, detail)] of an FMU, or of each FMU in an SSP package (``sma-fmu check``)."""
+    path = Path(path)
+    if not zipfile.is_zipfile(path):
+        return []
+    if path.suffix.lower() != ".ssp":
+        return [(f"platform {name}", status, detail) for status, name, detail in platform_report(path)]
+    import tempfile
+
+    results = []
+    with tempfile.TemporaryDirectory(prefix="sma_fmu_platforms_") as folder, zipfile.ZipFile(path) as ssp:
+        for name in sorted(n for n in ssp.namelist() if n.lower().endswith(".fmu")):
+            inner = ssp.extract(name, folder)
+            results += [(f"[{name}] platform {platform_name}", status, detail)
+                        for status, platform_name, detail in platform_report(inner)]
+    return results

@@ -140,8 +140,8 @@ static const char* resource_uri(const char* mode)
     else if (!strcmp(mode, "pct")) snprintf(uri, sizeof uri, "file://%s%s/re%%73ources", root, absolute);
     else if (!strcmp(mode, "empty")) uri[0] = '\0';
     else if (!strcmp(mode, "null")) return NULL;
-    else if (!strcmp(mode, "missing")) snprintf(uri, sizeof uri, "file://%s/nonexistent", absolute);
-    else if (!strcmp(mode, "http")) snprintf(uri, sizeof uri, "http://example.com%s/resources", absolute);
+    else if (!strcmp(mode, "missing")) snprintf(uri, sizeof uri, "file://%s%s/nonexistent", root, absolute);
+    else if (!strcmp(mode, "http")) snprintf(uri, sizeof uri, "http://example.com%s%s/resources", root, absolute);
     else if (!strcmp(mode, "relative")) snprintf(uri, sizeof uri, "file:resources");
     else { char* text = unhex(mode, NULL); snprintf(uri, sizeof uri, "%s", text ? text : ""); free(text); }
     return uri;
