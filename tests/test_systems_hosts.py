@@ -88,7 +88,7 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
     scenario = load_scenario(tmp_path / "mine-pi.toml")
     assert scenario.params.R_P == 33.5
     path = write_ssp(closed_loop(scenario, fmu_dir), tmp_path / "mine-pi.ssp")
-    assert read_ssd(str(path)).name == "mine-pi"  # valid against the SSP 1.0 schemas
+    assert read_ssd(str(path)).name == "mine_pi"  # valid against the SSP 1.0 schemas
     with zipfile.ZipFile(path) as archive:
         root = ET.fromstring(archive.read(SSD_NAME))
         assert sorted(archive.namelist()) == [SSD_NAME, "resources/SmaActuator.fmu",
@@ -101,7 +101,7 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
     bindings = _bindings(root)
     assert bindings[("plant", "R_P")] == "33.5"
     assert bindings[("plant", "T_start")] == "24.0"
-    assert bindings[("plant", "hysteresis_mode")] == "switch"
+    assert bindings[("plant", "hysteresis_mode")] == "2"  # switch
     assert bindings[("pi", "Kp")] == repr(scenario.controller.Kp)
     assert bindings[("signals", "load_profile")] == '{"times_s":[0.0],"values_kg":[0.25]}'
     inputs = {c.get("name") for c in root.iter(f"{{{NAMESPACES['ssd']}}}Connector")

@@ -4,12 +4,11 @@ Built with fmu-manipulation-toolbox's container builder in sequential mode: insi
 doStep the embedded FMUs step one after another in :data:`~.closed_loop.STEP_ORDER`
 (compensator, PI, plant, signals), each with the outputs just computed by the ones before
 it (Gauss-Seidel), so the container computes exactly what the library loop computes.
-Every embedded FMU is named as in the SSP, and its parameters are set to the scenario's
-values as start values. The container has no inputs; its outputs are :data:`OUTPUTS`, with
+Every embedded FMU is named as in the SSP, packed with the scenario's values as its
+defaults (:mod:`.packed`), and its parameters are also set to them as start values. The container has no inputs; its outputs are :data:`OUTPUTS`, with
 the units of the embedded FMUs (added to the builder's modelDescription.xml, which has none).
 """
 import io
-import shutil
 import tempfile
 import xml.etree.ElementTree as ET
 import zipfile
@@ -18,7 +17,8 @@ from pathlib import Path
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.slave_support.model_description import set_units
 from sma_fmu.output_folder import OutputError, write_file
-from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.closed_loop import closed_loop, identifier
+from sma_fmu.systems.packed import packed_fmu
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
 __all__ = ["OUTPUTS", "loop_outputs", "build_container", "export_container"]
@@ -119,8 +119,8 @@ def build_container(system, out, step_size=None, argument="--out"):
         with toolbox_messages() as messages, \
                 tempfile.TemporaryDirectory(prefix="sma_fmu_container_") as folder:
             for component in system.components:
-                shutil.copy(component.fmu, folder)
-            container = FMUContainer(_identifier(scenario.name), folder, fmi_version=2)
+                (Path(folder) / Path(component.fmu).name).write_bytes(packed_fmu(component, scenario))
+            container = FMUContainer(identifier(scenario.name), folder, fmi_version=2)
             container.start_time, container.stop_time = 0.0, scenario.stop_time_s
             _configure(container, system)
             built = Path(folder) / "container.fmu"
@@ -133,12 +133,6 @@ def build_container(system, out, step_size=None, argument="--out"):
     except FMUContainerError as error:
         raise ValueError(f"{out}: cannot build the container: {error}") from None
     return Path(out)
-
-
-def _identifier(name):
-    """A C identifier for the container's modelIdentifier, from a scenario name."""
-    text = "".join(character if character.isalnum() else "_" for character in name)
-    return text if text[:1].isalpha() else f"sma_{text}"
 
 
 def export_container(scenario_path, out, fmu_dir):

@@ -1,26 +1,37 @@
 """SSP 1.0 packages of a scenario's closed loop: SystemStructure.ssd + the FMUs under resources/.
 
-The SSD follows what the hosts need (see docs/systems.md):
-- the literal prefixes ``ssd:``, ``ssc:``, ``ssv:`` (libcosim and Ecos match prefixes);
+The SSD follows what the hosts need (see docs/systems.md and :mod:`.host_needs`):
+- the literal prefixes ``ssd:``, ``ssc:``, ``ssv:``, ``oms:`` (libcosim, Ecos and
+  OMSimulator match prefixes, not namespaces);
+- identifiers as the SSD's and the system's names (OMSimulator refuses others): the
+  scenario's name with every other character made "_"; the scenario's own name is in the
+  SSD's description;
 - a connector, with its type and unit, for every connection end, and no unconnected inputs
   (fmpy's resolver breaks on them);
 - one ParameterBinding per component, inline, in a parameter set named :data:`PARAMETER_SET`
   (libcosim applies only the first binding of a component; Ecos applies a set only when
   its name is given to ``init``);
-- a DefaultExperiment with the OSP annotation of the step size (libcosim reads it).
+- OpenModelica's annotation of the system (``oms:FixedStepMaster`` with the scenario's
+  step: without it OMSimulator makes no system) and a DefaultExperiment with start, stop
+  and the OSP annotation of the step size (libcosim reads it);
+- the FMUs packed with the scenario's values as their defaults (:mod:`.packed`), so a host
+  that binds nothing, or no Strings, runs the same scenario.
 """
 import io
 import zipfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from sma_fmu import __version__
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
+from sma_fmu.fmi.slave_support.start_values import start_value_text
 from sma_fmu.output_folder import OutputError, check_folder, staged_folder, write_file
-from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.closed_loop import closed_loop, identifier
+from sma_fmu.systems.packed import packed_fmu
 
-__all__ = ["PARAMETER_SET", "SSD_NAME", "NAMESPACES", "ssd_document", "ssp_bytes", "write_ssp",
-           "ssp_targets", "export_ssp"]
+__all__ = ["PARAMETER_SET", "SSD_NAME", "NAMESPACES", "OMS_MASTER", "ssd_document", "ssp_bytes",
+           "write_ssp", "ssp_targets", "export_ssp"]
 
 PARAMETER_SET = "initial"
 SSD_NAME = "SystemStructure.ssd"
@@ -29,7 +40,10 @@ NAMESPACES = {
     "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
     "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
     "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
+    "oms": "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd",
 }
+OMS_MASTER = "oms-ma"  # OMSimulator's fixed-step co-simulation master
+_OMS_TOLERANCE = "0.0001"  # its tolerances (algebraic loops; the loop here has none)
 _FMU_MIME = "application/x-fmu-sharedlibrary"
 
 for _prefix, _uri in NAMESPACES.items():
@@ -43,17 +57,6 @@ def _tag(name):
 
 def _add(parent, tag, **attributes):
     return ET.SubElement(parent, _tag(tag), {k: v for k, v in attributes.items() if v is not None})
-
-
-def _text(value, kind):
-    """A value as the SSP attribute text for an FMU variable of type ``kind``."""
-    if kind == "Boolean":
-        return "true" if value else "false"
-    if kind == "Real":
-        return repr(float(value))
-    if kind == "Integer":
-        return str(int(value))
-    return str(value)
 
 
 def _connectors(system):
@@ -88,7 +91,7 @@ def _component(elements, component, connectors, units):
             variable = variables[name]
             entry = _add(parameters, "ssv:Parameter", name=name)
             unit = variable.unit if variable.type == "Real" else None
-            _add(entry, f"ssv:{variable.type}", value=_text(value, variable.type), unit=unit)
+            _add(entry, f"ssv:{variable.type}", value=start_value_text(variable.type, value), unit=unit)
             if unit:
                 units.add(unit)
 
@@ -96,9 +99,11 @@ def _component(elements, component, connectors, units):
 def ssd_document(system):
     """SystemStructure.ssd of ``system`` (a :class:`~.closed_loop.LoopSystem`) as bytes."""
     scenario = system.scenario
-    root = ET.Element(_tag("ssd:SystemStructureDescription"), version="1.0", name=scenario.name)
-    top = _add(root, "ssd:System", name=scenario.name,
-               description=scenario.description or None)
+    name = identifier(scenario.name)
+    root = ET.Element(_tag("ssd:SystemStructureDescription"), version="1.0", name=name,
+                      description=f"sma-fmu scenario {scenario.name}",
+                      generationTool=f"sma-fmu {__version__}")
+    top = _add(root, "ssd:System", name=name, description=scenario.description or None)
     elements = _add(top, "ssd:Elements")
     ends, units = _connectors(system), set()
     for component in system.components:
@@ -107,6 +112,11 @@ def ssd_document(system):
     for c in system.connections:
         _add(connections, "ssd:Connection", startElement=c.source, startConnector=c.output,
              endElement=c.target, endConnector=c.input)
+    oms = _add(_add(_add(top, "ssd:Annotations"), "ssc:Annotation", type="org.openmodelica"),
+               "oms:Annotations")
+    _add(_add(oms, "oms:SimulationInformation"), "oms:FixedStepMaster", description=OMS_MASTER,
+         stepSize=repr(scenario.step_s), absoluteTolerance=_OMS_TOLERANCE,
+         relativeTolerance=_OMS_TOLERANCE)
     unit_group = _add(root, "ssd:Units")
     for name in sorted(units):
         unit = _add(unit_group, "ssc:Unit", name=name)
@@ -122,12 +132,14 @@ def ssd_document(system):
 
 
 def ssp_bytes(system):
-    """The .ssp archive of ``system``: SystemStructure.ssd at the root, FMUs under resources/."""
+    """The .ssp archive of ``system``: SystemStructure.ssd at the root, FMUs under resources/,
+    each packed with the scenario's values as its defaults (:func:`~.packed.packed_fmu`)."""
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.writestr(SSD_NAME, ssd_document(system))
         for component in system.components:
-            archive.write(component.fmu, f"resources/{component.model}.fmu")
+            archive.writestr(f"resources/{component.model}.fmu",
+                             packed_fmu(component, system.scenario))
     return buffer.getvalue()
 
 
