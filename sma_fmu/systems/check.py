@@ -7,7 +7,13 @@ Per FMU (a container is an FMU; the FMUs inside an SSP are checked one by one):
 - ``state round trip``: save the state, step, restore, step again: the same outputs, bit
   for bit (serialized and read back when the FMU can); "n/a" when it does not declare it.
 Per SSP also ``SSD schema``: SystemStructure.ssd against the SSP 1.0 schemas (fmpy's
-copy), and the C-host run is of the whole system, with its parameter bindings.
+copy); ``packed defaults``: the FMUs' packed start values agree with their model
+descriptions and the SSD's bindings; one ``host ...`` line per known host
+(:mod:`.host_needs`: libcosim, Ecos, OMSimulator, fmpy's ``simulate_ssp``): what it needs
+and applies, failing where it would run something other than what the SSD binds (a
+binding it does not apply whose value the FMU's default does not hold, a missing
+annotation, a name that is no identifier); and the C-host run is of the whole system,
+with its parameter bindings.
 Each check gives a :class:`CheckResult`; an exception inside a check is its failure.
 """
 import functools
@@ -19,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.systems.c_host import run_c_host
+from sma_fmu.systems.host_needs import KNOWN_HOSTS, host_check, packed_defaults_check, read_ssp
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
@@ -149,8 +156,20 @@ def _ssp_step(path):
     return float(algorithm.get("baseStepSize")) if algorithm is not None else _DEFAULT_STEP_S
 
 
+def _host_results(path):
+    """The ``packed defaults`` and ``host ...`` lines of an SSP."""
+    try:
+        contents = read_ssp(path)
+    except Exception as error:  # noqa: BLE001 - an unreadable SSD fails these checks
+        return [CheckResult(str(path), "hosts", "FAIL", f"{type(error).__name__}: {error}")]
+    results = [_run(path, "packed defaults", lambda: packed_defaults_check(contents))]
+    for host in KNOWN_HOSTS:
+        results.append(_run(path, f"host {host.name}", lambda host=host: host_check(host, contents)))
+    return results
+
+
 def _ssp_checks(path):
-    results = [_run(path, "SSD schema", lambda: _ssd_schema(path)),
+    results = [_run(path, "SSD schema", lambda: _ssd_schema(path)), *_host_results(path),
                _run(path, "C host (libcosim)", lambda: _short_run("ssp", path, _ssp_step(path)))]
     with tempfile.TemporaryDirectory(prefix="sma_fmu_check_") as folder, \
             zipfile.ZipFile(path) as archive:
