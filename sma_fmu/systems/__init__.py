@@ -2,7 +2,10 @@
 
 - :mod:`.closed_loop`: a scenario's loop as components, parameter values and connections;
 - :mod:`.ssp`: the SSP 1.0 package (SystemStructure.ssd + the FMUs);
+- :mod:`.packed`: the FMUs packed with the scenario's values as their defaults;
 - :mod:`.container`: the whole loop as one FMI 2.0 FMU (fmu-manipulation-toolbox);
 - :mod:`.hosts`: running them in libcosim, Ecos and fmpy, results as loop time series;
+  :mod:`.omsimulator` and :mod:`.fmpy_ssp`: the SSP in OMSimulator and fmpy's ``simulate_ssp``;
+- :mod:`.host_needs`: what each known SSP host needs and applies;
 - :mod:`.check`: the compliance check behind ``sma-fmu check``.
 """

@@ -14,7 +14,7 @@ import numpy as np
 from sma_fmu.cosim.loop import COLUMNS, COUPLINGS, run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.systems.closed_loop import closed_loop
-from sma_fmu.systems.runs import HOSTS, run_host, write_artifact
+from sma_fmu.systems.runs import DEFAULT_HOSTS, HOSTS, run_host, write_artifact
 
 __all__ = ["deviation", "compare_hosts", "rmse_table"]
 
@@ -36,8 +36,11 @@ def _rmse(data, scenario):
     return scenario_metrics(data, scenario)["overall"]["rmse_ohm"]
 
 
-def compare_hosts(scenario, fmu_dir, hosts=tuple(HOSTS), artifacts=None):
+def compare_hosts(scenario, fmu_dir, hosts=DEFAULT_HOSTS, artifacts=None):
     """Rows {scenario, run, coupling, rmse_ohm, deviation, wall_time_s} for ``scenario``.
+
+    ``hosts``: keys of :data:`~.runs.HOSTS` (default :data:`~.runs.DEFAULT_HOSTS`; add
+    "omsimulator" when SMA_FMU_OMSIMULATOR names its executable).
 
     ``artifacts``: optional {"ssp": path, "container": path} already written for the
     scenario; a kind the ``hosts`` need and that is not given is built once, from the FMUs

@@ -14,9 +14,10 @@ from sma_fmu.cosim.loop import LoopResult
 from sma_fmu.systems import hosts
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.container import build_container, loop_outputs
+from sma_fmu.systems.omsimulator import run_ssp_omsimulator
 from sma_fmu.systems.ssp import write_ssp
 
-__all__ = ["HOSTS", "write_artifact", "run_host", "run_ssp", "run_container"]
+__all__ = ["HOSTS", "DEFAULT_HOSTS", "write_artifact", "run_host", "run_ssp", "run_container"]
 
 # host -> (artifact, coupling the host applies,
 #          function(artifact path, scenario, the loop's outputs) -> samples)
@@ -27,7 +28,12 @@ HOSTS = {
              lambda path, s, out: hosts.run_container_fmpy(path, s.step_s, s.steps, out)),
     "libcosim-container": ("container", "gauss-seidel", lambda path, s, out:
                            hosts.run_container_libcosim(path, s.step_s, s.steps, out)),
+    # not on any package registry: runs when SMA_FMU_OMSIMULATOR names its executable
+    "omsimulator": ("ssp", "jacobi",
+                    lambda path, s, out: run_ssp_omsimulator(path, s.step_s, s.steps, out)[0]),
 }
+# the hosts the package's dependencies bring (pip installs them): what the tests run
+DEFAULT_HOSTS = ("libcosim", "ecos", "fmpy", "libcosim-container")
 _BUILDERS = {"ssp": write_ssp, "container": build_container}
 
 
