@@ -173,8 +173,8 @@ def _platform_line(archive, names, identifier, name, said):
     front = FRONT_MARKER in data
     what = f"{binary} ({binary_architecture(data) or 'unknown format'})"
     if said is None:
-        return "FAIL", name, f"{what}, {'the front' if front else 'no front'}, is not declared in " \
-                             "modelDescription.xml"
+        return "FAIL", name, f"{what}, {'the front' if front else 'without this front'}, is not " \
+                             "declared in modelDescription.xml"
     if (said.get("front") == "true") != front:
         return "FAIL", name, f"modelDescription.xml says front={said.get('front')}, but {what} " \
                              f"is {'the front' if front else 'not the front'}"
