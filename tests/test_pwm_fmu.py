@@ -4,8 +4,8 @@ The driver FMU is checked against the runtime :class:`PwmDriver` it wraps (exact
 same Python runs in it) and against an independent reference, the mean of the PWM wave
 sampled finely over each step. A PWM scenario (the paper's adaptive loop, 2.2 s, load step
 at 0.6 s, 50 Hz PWM at 8 W peak) runs on the FMU path equal to the library path (both
-hysteresis modes), in libcosim and Ecos as an SSP equal to the library's Jacobi loop (Ecos:
-its power within what its summed time explains), and as a container in fmpy and libcosim
+hysteresis modes), in libcosim and Ecos as an SSP equal to the library's Jacobi loop, and
+as a container in fmpy and libcosim
 equal to the library's Gauss-Seidel loop, all to 1e-9; so do the shipped PWM scenarios on
 the FMU path and in libcosim, and a PWM scenario file exported and checked by the CLI.
 """
@@ -229,8 +229,8 @@ def test_fmu_path_equals_library_path_with_pwm(fmu_dir, name):
 @pytest.mark.parametrize("name", ["setpoints-pwm-pi+ff-adaptive", "setpoints-pwm-continuous-pi+ff-adaptive"])
 def test_shipped_pwm_scenarios_on_the_fmu_path_and_in_libcosim(fmu_dir, name):
     """The first 5 s (a hold, a ramp at 4 s, the next hold): FMU path = library, SSP in
-    libcosim = library Jacobi. (Containers and Ecos part from the library at a later ramp:
-    docs/systems.md, 'Known limitation'.)"""
+    libcosim = library Jacobi. (Containers and Ecos through the end of a hold at 7 s:
+    tests/test_ssp_hosts_grid.py.)"""
     scenario = dataclasses.replace(load_scenario(resolve_scenarios([name])[0]), stop_time_s=5.0)
     assert scenario.drive.pwm
     assert deviation(run_fmus(scenario, fmu_dir).data, run_library(scenario).data) <= TOLERANCE
@@ -257,7 +257,7 @@ def test_ssp_and_container_put_the_driver_between_the_pi_and_the_plant(fmu_dir, 
     system = closed_loop(scenario, fmu_dir)
     assert [c.name for c in system.in_step_order()] == ["pi", "driver", "plant", "signals"]
     path = write_ssp(system, tmp_path / "pwm.ssp")
-    assert read_ssd(str(path)).name == "heavy-pi"  # valid against the SSP 1.0 schemas
+    assert read_ssd(str(path)).name == "heavy_pi"  # valid against the SSP 1.0 schemas
     with zipfile.ZipFile(path) as archive:
         assert "resources/SmaPwmDriver.fmu" in archive.namelist()
         root = ET.fromstring(archive.read(SSD_NAME))
@@ -301,19 +301,13 @@ def test_ssp_in_libcosim_and_container_equal_the_library_loop_of_their_coupling(
 
 
 def test_ssp_in_ecos_equals_the_library_jacobi_loop(adaptive_pwm, fmu_dir):
-    """Ecos adds up its time (t = t + h), 1.3e-13 s off k h within 2.2 s: every column within
-    1e-9, except the power, which moves with the host's time by peak / h per second of shift
-    for each edge of the wave inside a step (docs/systems.md)."""
+    """Ecos adds up its time (t = t + h), 1.3e-13 s off k h within 2.2 s; the driver and the
+    signals take their time on the step grid k h, so every column is within 1e-9 (the power
+    moved with Ecos's time by peak / h per second of shift before: docs/systems.md)."""
     scenario, artifacts = adaptive_pwm
     ecos = run_host("ecos", scenario, fmu_dir, artifacts["ssp"]).data
     library = run_library(scenario, "jacobi").data
     largest = {name: _largest_difference(ecos[name], library[name]) for name, _ in COLUMNS}
-    time, time_error = 0.0, 0.0  # [s]: Ecos's time, its largest distance from k h
-    for k in range(scenario.steps + 1):
-        time_error = max(time_error, abs(time - k * STEP))
-        time += STEP
-    edges = 2  # per step at 50 Hz and 1-ms steps: at most one on and one off edge
-    assert largest.pop("P") <= edges * PEAK * time_error / STEP
     assert max(largest.values()) <= TOLERANCE, largest
 
 

@@ -72,3 +72,24 @@ def test_hosts_that_add_up_their_time_follow_the_library_through_a_set_point_hol
         if name != "saturated":
             assert np.nanmax(np.abs(ecos[name] - library[name])) <= 1e-6, name
     assert np.array_equal(ecos["saturated"], library["saturated"])
+
+
+def test_the_pwm_driver_takes_a_summed_time_on_the_grid(fmus):
+    """Stepped with t + h + h + ... (as Ecos and OMSimulator do), the driver FMU gives the
+    runtime driver's wave at k h, to the last bit (off the grid, the edges move by the
+    rounding: peak / h per second)."""
+    from sma_fmu.fmi.instance import FmuInstance
+    from sma_fmu.runtime.pwm import PwmDriver
+
+    h, peak = 1e-3, 8.0
+    library = PwmDriver(50.0, peak)
+    summed, drifted = 0.0, 0.0
+    with FmuInstance(fmus["SmaPwmDriver"], "driver", {"frequency_Hz": 50.0, "peak_W": peak}) as fmu:
+        for k in range(3000):
+            demand = 4.0 + 3.0 * math.sin(k * 1e-3)
+            fmu.set_real(("P_demand",), (demand,))
+            fmu.step(summed, h)
+            assert fmu.get_real(("P_in",)) == [library.step(demand, k * h, h)], k
+            drifted = max(drifted, abs(summed - k * h))
+            summed += h
+    assert drifted > 1e-13  # the summed time did leave the grid

@@ -29,7 +29,7 @@ from .signals import load_from_table, reference_from_table
 from .state_entries import read_entries, read_number
 
 __all__ = ["GRID_TOLERANCE", "SignalOutputs", "SignalSource", "table_text", "signals_from_text",
-           "grid_time"]
+           "grid_point", "grid_time"]
 
 GRID_TOLERANCE = 1e-6  # [steps]: a time this close to start + k h is taken as that point
 
@@ -67,14 +67,20 @@ def signals_from_text(reference_text, load_text):
     return tuple(signals)
 
 
-def grid_time(time_s, start_s, step_s):
+def grid_point(time_s, start_s, step_s):
     """``start_s`` + k ``step_s`` [s] for the k nearest ``time_s`` [s] if ``time_s`` lies within
-    :data:`GRID_TOLERANCE` steps of it, else ``time_s``."""
+    :data:`GRID_TOLERANCE` steps of it, else None."""
     steps = (time_s - start_s) / step_s
     if not abs(steps) < 2.0 ** 52:  # beyond the integers a float holds (or inf, nan)
-        return time_s
+        return None
     grid = start_s + round(steps) * step_s
-    return grid if abs(time_s - grid) <= GRID_TOLERANCE * step_s else time_s
+    return grid if abs(time_s - grid) <= GRID_TOLERANCE * step_s else None
+
+
+def grid_time(time_s, start_s, step_s):
+    """:func:`grid_point` of ``time_s`` [s], or ``time_s`` itself when it is off the grid."""
+    grid = grid_point(time_s, start_s, step_s)
+    return time_s if grid is None else grid
 
 
 class SignalSource:

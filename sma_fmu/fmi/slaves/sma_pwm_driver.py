@@ -12,10 +12,16 @@ no wave has been switched yet. Non-finite P_demand discards the step. Invalid pa
 (frequency_Hz or peak_W not finite and > 0) make exitInitializationMode fail with
 fmi2Error naming the reason; the instance stays in Initialization Mode, where they can be
 corrected.
+
+Time: like SmaScenarioSignals, the wave is taken on the step grid start + k h_0 (h_0 the
+first step's size): a step that starts within a millionth of a step of a grid point and is
+h_0 long within as much is [t_k, t_k + h_0) exactly, so a host that adds up its time
+(Ecos, OMSimulator) gets the library's wave, not one moved by its rounding errors.
 """
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.pwm import PwmDriver
+from sma_fmu.runtime.scenario_signals import GRID_TOLERANCE, grid_point
 
 FREQUENCY_HZ = 50.0   # default switching frequency [Hz]
 PEAK_W = 10.0         # default power while on [W]: above what the paper's loops demand
@@ -34,7 +40,12 @@ class SmaPwmDriver(StepperSlave):
         fmi.parameter("frequency_Hz", FREQUENCY_HZ, "Hz",
                       "switching frequency (> 0); periods start at t = j / frequency_Hz")
         fmi.parameter("peak_W", PEAK_W, "W", "power while the switch is on (> 0)")
+        self.start_time = 0.0
+        self.grid_step = None  # h_0 [s], the first step's size
         self.stepper = None
+
+    def setup_experiment(self, start_time, stop_time, tolerance):
+        self.start_time = start_time
 
     def _start(self):
         return PwmDriver(self.frequency_Hz, self.peak_W), 0.0
@@ -43,4 +54,10 @@ class SmaPwmDriver(StepperSlave):
         self.P_in = outputs
 
     def _advance(self, current_time, step_size):
+        if self.grid_step is None:
+            self.grid_step = step_size
+        grid = self.grid_step
+        start = grid_point(current_time, self.start_time, grid)
+        if start is not None and abs(step_size - grid) <= GRID_TOLERANCE * grid:
+            current_time, step_size = start, grid
         return self.stepper.step(self.P_demand, current_time, step_size)
