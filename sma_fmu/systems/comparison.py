@@ -3,20 +3,28 @@
 :func:`compare_hosts` runs a scenario on the library path (Gauss-Seidel and Jacobi) and
 in the hosts of :data:`~.runs.HOSTS`, and reports per run the RMSE of R - R_ref (the
 metric of :mod:`sma_fmu.cosim.metrics`) and the largest deviation of any time-series
-column from the library run of the same coupling. :func:`rmse_table` formats the rows
-(``benchmarks/hosts.py`` prints it for the paper scenarios; docs/systems.md shows it).
+column from the library run of the same coupling. The host "fmpy-ssp" is fmpy's
+``simulate_ssp``, which records only the connectors (:mod:`.fmpy_ssp`): its deviation
+covers R_ref, load, R, P and P_ff, its RMSE R - R_ref; a loop it cannot run gets a row
+with a ``note`` and no numbers. :func:`rmse_table` and :func:`host_table` format the rows
+(``benchmarks/hosts.py`` prints them; docs/systems.md shows them).
 """
 import math
 import tempfile
+import time
 
 import numpy as np
 
 from sma_fmu.cosim.loop import COLUMNS, COUPLINGS, run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.fmpy_ssp import fmpy_ssp_deviation, fmpy_ssp_series, run_ssp_fmpy
+from sma_fmu.systems.hosts import HostError
 from sma_fmu.systems.runs import DEFAULT_HOSTS, HOSTS, run_host, write_artifact
 
-__all__ = ["deviation", "compare_hosts", "rmse_table"]
+__all__ = ["deviation", "compare_hosts", "rmse_table", "host_table", "FMPY_SSP"]
+
+FMPY_SSP = "fmpy-ssp"  # fmpy's simulate_ssp: the SSP, Jacobi, its connectors only
 
 
 def deviation(data, reference):
@@ -36,11 +44,27 @@ def _rmse(data, scenario):
     return scenario_metrics(data, scenario)["overall"]["rmse_ohm"]
 
 
+def _fmpy_ssp_row(scenario, ssp_path, library):
+    """The row of fmpy's simulate_ssp: its recorded columns against the library's Jacobi loop."""
+    row = {"scenario": scenario.name, "run": "fmpy simulate_ssp (ssp)", "coupling": "jacobi"}
+    start = time.perf_counter()
+    try:
+        series = fmpy_ssp_series(run_ssp_fmpy(ssp_path, scenario.step_s, scenario.steps), scenario)
+    except HostError as error:
+        return {**row, "rmse_ohm": None, "deviation": None, "wall_time_s": time.perf_counter() - start,
+                "note": str(error).replace(f"{ssp_path}: ", "")}
+    data = library.data.copy()  # the library's row 0, then what fmpy recorded at t_1 ... t_n
+    data["R_ref"][1:], data["R"][1:] = series["R_ref"], series["R"]
+    return {**row, "rmse_ohm": _rmse(data, scenario),
+            "deviation": fmpy_ssp_deviation(series, library.data),
+            "wall_time_s": time.perf_counter() - start}
+
+
 def compare_hosts(scenario, fmu_dir, hosts=DEFAULT_HOSTS, artifacts=None):
     """Rows {scenario, run, coupling, rmse_ohm, deviation, wall_time_s} for ``scenario``.
 
     ``hosts``: keys of :data:`~.runs.HOSTS` (default :data:`~.runs.DEFAULT_HOSTS`; add
-    "omsimulator" when SMA_FMU_OMSIMULATOR names its executable).
+    "omsimulator" when SMA_FMU_OMSIMULATOR names its executable) or :data:`FMPY_SSP`.
 
     ``artifacts``: optional {"ssp": path, "container": path} already written for the
     scenario; a kind the ``hosts`` need and that is not given is built once, from the FMUs
@@ -54,12 +78,16 @@ def compare_hosts(scenario, fmu_dir, hosts=DEFAULT_HOSTS, artifacts=None):
              "rmse_ohm": _rmse(result.data, scenario), "deviation": 0.0,
              "wall_time_s": result.wall_time_s}
             for coupling, result in library.items()]
-    missing = sorted({HOSTS[host][0] for host in hosts} - set(artifacts))
+    missing = sorted({"ssp" if host == FMPY_SSP else HOSTS[host][0] for host in hosts}
+                     - set(artifacts))
     with tempfile.TemporaryDirectory(prefix="sma_fmu_compare_") as folder:
         if missing:
             system = closed_loop(scenario, fmu_dir)
             artifacts.update({kind: write_artifact(kind, system, folder) for kind in missing})
         for host in hosts:
+            if host == FMPY_SSP:
+                rows.append(_fmpy_ssp_row(scenario, artifacts["ssp"], library["jacobi"]))
+                continue
             kind, coupling, _ = HOSTS[host]
             result = run_host(host, scenario, fmu_dir, artifacts[kind])
             rows.append({"scenario": scenario.name, "run": f"{host} ({kind})",
@@ -77,10 +105,36 @@ def rmse_table(rows):
     lines = ["| scenario | " + " | ".join(f"{run}, {coupling}" for run, coupling in runs) + " |",
              "|---|" + "---:|" * len(runs)]
     for name in scenarios:
-        cells = [f"{value[(name, *run)]['rmse_ohm']:.3f}" if (name, *run) in value else ""
-                 for run in runs]
+        cells = [_number(value.get((name, *run), {}).get("rmse_ohm"), ".3f") for run in runs]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    worst = max((row["deviation"] for row in rows), default=0.0)
+    worst = max((row["deviation"] for row in rows if row["deviation"] is not None), default=0.0)
     lines += ["", f"Largest deviation of a host run from the library run of its coupling, over "
                   f"all time-series columns: {worst:.2g}"]
     return "\n".join(lines)
+
+
+def _number(value, spec):
+    return "–" if value is None else format(value, spec)
+
+
+def host_table(rows):
+    """Markdown: one line per scenario, one column per run, each cell "RMSE [ohm] / largest
+    deviation from the library run of its coupling" ("–" where a host cannot run it)."""
+    runs = list(dict.fromkeys((row["run"], row["coupling"]) for row in rows))
+    scenarios = list(dict.fromkeys(row["scenario"] for row in rows))
+    value = {(row["scenario"], row["run"], row["coupling"]): row for row in rows}
+    lines = ["| scenario | " + " | ".join(f"{run}, {coupling}" for run, coupling in runs) + " |",
+             "|---|" + "---:|" * len(runs)]
+    for name in scenarios:
+        cells = []
+        for run in runs:
+            row = value.get((name, *run))
+            if row is None or row["rmse_ohm"] is None:
+                cells.append("–")
+            elif row["run"] == "library":
+                cells.append(f"{row['rmse_ohm']:.3f}")
+            else:
+                cells.append(f"{row['rmse_ohm']:.3f} / {row['deviation']:.1e}")
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    notes = sorted({f"{row['run']}: {row['note']}" for row in rows if row.get("note")})
+    return "\n".join(lines + ([""] + notes if notes else []))

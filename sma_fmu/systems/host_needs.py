@@ -39,7 +39,7 @@ __all__ = ["SspHost", "KNOWN_HOSTS", "IDENTIFIER", "SspContents", "read_ssp", "h
 IDENTIFIER = re.compile(r"[a-zA-Z][a-zA-Z0-9_]*")
 _ALL_TYPES = frozenset(("Real", "Integer", "Boolean", "String"))
 # FMUs whose input refuses the 0.0 fmpy's simulate_ssp gives every input at the first step
-_REFUSE_ZERO = {"SmaFeedforward": ("R_ref", "R_ref = 0 ohm is no reference resistance")}
+_REFUSE_ZERO = {"SmaFeedforward": ("R_ref", "ohm", "no reference resistance")}
 
 
 @dataclass(frozen=True)
@@ -168,7 +168,9 @@ def host_check(host, contents):
             problems.append(f"{component}.{parameter} would be {differs[0]!r} (the FMU's default), "
                             f"not the bound {differs[1]!r}: {why}")
     bound = len(contents.bindings) - len(skipped)
-    if skipped:
+    if skipped and not bound:
+        notes.append(f"binds none of the {len(skipped)} values: all from the FMUs' defaults")
+    elif skipped:
         notes.append(f"binds {bound} of {len(contents.bindings)} values; "
                      f"{', '.join(skipped) if len(skipped) <= 4 else f'{len(skipped)} others'} "
                      "from the FMUs' defaults")
@@ -181,9 +183,10 @@ def host_check(host, contents):
     refusing = [(name, _REFUSE_ZERO[model]) for name, model in contents.components.items()
                 if model in _REFUSE_ZERO]
     if host.zero_inputs and refusing:
-        name, (variable, why) = refusing[0]
+        name, (variable, unit, why) = refusing[0]
         return "n/a", (f"cannot run this system: every input is 0.0 before the first step, and "
-                       f"{name}.{variable}: {why} (the step at t = 0 is discarded, the run stops)")
+                       f"{name}.{variable} = 0 {unit} is refused ({why}): the step at t = 0 is "
+                       "discarded and the run stops")
     if host.zero_inputs:
         notes.append("its first step gets 0.0 on every input, not the outputs after "
                      "initialization")
