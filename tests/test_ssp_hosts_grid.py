@@ -93,3 +93,28 @@ def test_the_pwm_driver_takes_a_summed_time_on_the_grid(fmus):
             drifted = max(drifted, abs(summed - k * h))
             summed += h
     assert drifted > 1e-13  # the summed time did leave the grid
+
+
+def test_a_step_a_rounding_error_off_the_first_is_taken_as_the_first(fmus, params):
+    """OMSimulator steps from t to t_next = t + h passing t_next - t, a few rounding errors
+    off h: the plant integrates with h, as the library loop does (a step further off, such
+    as a last short step, is taken as it is)."""
+    from sma_fmu.fmi.instance import FmuInstance
+    from sma_fmu.runtime.plant import PlantStepper
+
+    h = 1e-3
+    library = PlantStepper(params, params.T_room, "continuous", 0.05)
+    with FmuInstance(fmus["SmaActuator"], "plant", {"load": 0.05}) as fmu:
+        time, uneven = 0.0, 0
+        for k in range(2000):
+            following = time + h
+            uneven += (following - time) != h
+            fmu.set_real(("P_in", "load"), (2.5, 0.05))
+            fmu.step(time, following - time)
+            out = library.step(2.5, 0.05, h)
+            time = following
+        assert uneven > 100  # the host's steps were not h
+        assert fmu.get_real(("R", "T")) == [out.R, out.T]
+        fmu.step(time, 0.4 * h)  # a short last step: its own size
+        out = library.step(2.5, 0.05, 0.4 * h)
+        assert fmu.get_real(("R", "T")) == [out.R, out.T]

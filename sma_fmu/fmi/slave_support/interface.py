@@ -27,6 +27,7 @@ from sma_fmu.fmi.slave_support.model_description import decorate_model_descripti
 from sma_fmu.fmi.slave_support.saved_state import state_from_bytes, state_to_bytes
 from sma_fmu.fmi.slave_support.start_values import START_VALUES_FILE, read_start_values, start_value
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, WireParameters
+from sma_fmu.runtime.scenario_signals import GRID_TOLERANCE
 
 __all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
 
@@ -59,6 +60,7 @@ class SlaveInterface:
             source=self.parameter_file.get("source", PARAMETERS_FILE))
         # the scenario's values packed at export: they replace the parameters' start values
         self.packed = read_start_values(slave.resources)
+        self.first_step = None  # h0 [s]: the size of the first step (see nominal_step)
 
     def _declare(self, variable, start, unit):
         kind = next(name for cls, name in _KIND_OF if isinstance(variable, cls))
@@ -181,6 +183,16 @@ class SlaveInterface:
                               variability=Fmi2Variability.discrete,
                               initial=Fmi2Initial.calculated, description=description),
                       False, None)
+
+    def nominal_step(self, step_size):
+        """h0, the first step's size [s], when ``step_size`` [s] is within GRID_TOLERANCE
+        steps of it, else ``step_size``: a host that steps from t to t_next passes
+        t_next - t, a few rounding errors off h (OMSimulator), and the slave then steps by
+        the h the library loop uses (docs/systems.md, the time grid)."""
+        first = self.first_step
+        if first is None:
+            self.first_step = first = step_size
+        return first if abs(step_size - first) <= GRID_TOLERANCE * first else step_size
 
     def wire_parameters(self):
         """WireParameters from the file, with the exposed parameters' present values."""

@@ -10,7 +10,8 @@ outputs reflect T_start and the load set during initialization (in Initializatio
 they follow them as they are set). Invalid parameters make exitInitializationMode
 fail with fmi2Error naming the reason; the instance stays in Initialization Mode, where
 they can be corrected (see the guard, ``slave_support/guards.py``). ``hysteresis_mode`` is
-an Integer: 1 = continuous, 2 = switch (``slave_support/choices.py``).
+an Integer: 1 = continuous, 2 = switch (``slave_support/choices.py``). A step within a
+millionth of the first step's size is taken as that size (the time grid, docs/systems.md).
 """
 from sma_fmu.fmi.slave_support.choices import choice_name
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
@@ -56,4 +57,4 @@ class SmaActuator(StepperSlave):
         return stepper, stepper.outputs
 
     def _advance(self, current_time, step_size):
-        return self.stepper.step(self.P_in, self.load, step_size)
+        return self.stepper.step(self.P_in, self.load, self.interface.nominal_step(step_size))

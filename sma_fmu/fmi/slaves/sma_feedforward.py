@@ -10,7 +10,8 @@ initialization the outputs are those of the first sample (filter in steady state
 Initialization Mode they follow R_ref, load and the parameters as they are set.
 Invalid parameters make exitInitializationMode fail with fmi2Error naming the reason;
 the instance stays in Initialization Mode, where they can be corrected. ``inverse`` is an
-Integer: 1 = major, 2 = minor-loop (``slave_support/choices.py``).
+Integer: 1 = major, 2 = minor-loop (``slave_support/choices.py``). A step within a
+millionth of the first step's size is taken as that size (the time grid, docs/systems.md).
 """
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.reachable_band import reachable_band
@@ -56,4 +57,4 @@ class SmaFeedforward(StepperSlave):
         self.P_ff, self.T_ref, self.saturated = outputs
 
     def _advance(self, current_time, step_size):
-        return self.stepper.step(self.R_ref, self.load, step_size)
+        return self.stepper.step(self.R_ref, self.load, self.interface.nominal_step(step_size))

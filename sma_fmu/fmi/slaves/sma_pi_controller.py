@@ -9,7 +9,8 @@ e_k = R - R_ref for that step, and the integrator advances. Before the first ste
 in Initialization Mode) the outputs are those the first step will give: the present
 inputs with I = 0. Non-finite inputs discard the step. Invalid gains make
 exitInitializationMode fail with fmi2Error naming the reason; the instance stays in
-Initialization Mode, where they can be corrected.
+Initialization Mode, where they can be corrected. A step within a millionth of the first
+step's size is taken as that size (the time grid, docs/systems.md).
 """
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
@@ -41,4 +42,5 @@ class SmaPiController(StepperSlave):
         self.P, self.P_fb = outputs
 
     def _advance(self, current_time, step_size):
-        return self.stepper.sample(self.R, self.R_ref, self.P_ff, step_size)
+        return self.stepper.sample(self.R, self.R_ref, self.P_ff,
+                                   self.interface.nominal_step(step_size))

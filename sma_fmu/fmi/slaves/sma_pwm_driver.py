@@ -21,7 +21,7 @@ h_0 long within as much is [t_k, t_k + h_0) exactly, so a host that adds up its 
 from sma_fmu.fmi.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.slave_support.stepper_slave import StepperSlave
 from sma_fmu.runtime.pwm import PwmDriver
-from sma_fmu.runtime.scenario_signals import GRID_TOLERANCE, grid_point
+from sma_fmu.runtime.scenario_signals import grid_point
 
 FREQUENCY_HZ = 50.0   # default switching frequency [Hz]
 PEAK_W = 10.0         # default power while on [W]: above what the paper's loops demand
@@ -41,7 +41,6 @@ class SmaPwmDriver(StepperSlave):
                       "switching frequency (> 0); periods start at t = j / frequency_Hz")
         fmi.parameter("peak_W", PEAK_W, "W", "power while the switch is on (> 0)")
         self.start_time = 0.0
-        self.grid_step = None  # h_0 [s], the first step's size
         self.stepper = None
 
     def setup_experiment(self, start_time, stop_time, tolerance):
@@ -54,10 +53,8 @@ class SmaPwmDriver(StepperSlave):
         self.P_in = outputs
 
     def _advance(self, current_time, step_size):
-        if self.grid_step is None:
-            self.grid_step = step_size
-        grid = self.grid_step
-        start = grid_point(current_time, self.start_time, grid)
-        if start is not None and abs(step_size - grid) <= GRID_TOLERANCE * grid:
-            current_time, step_size = start, grid
+        step = self.interface.nominal_step(step_size)
+        start = grid_point(current_time, self.start_time, self.interface.first_step)
+        if start is not None and step == self.interface.first_step:
+            current_time, step_size = start, step
         return self.stepper.step(self.P_demand, current_time, step_size)
