@@ -208,7 +208,13 @@ def test_analysis_window_outside_the_run(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv,parts", [
-    (["synth", "constant-load", "--t-step", "0"], ["--t-step", "expected a number > 0, got '0'"]),
+    (["synth", "constant-load", "--t-step", "0"], ["--t-step", "expected a number in (0, 100] K, got '0'"]),
+    (["synth", "constant-load", "--noise-ohm", "1e308"], ["--noise-ohm", "in [0, 10] ohm"]),
+    (["synth", "constant-load", "--t-step", "1e-9"], ["--t-step 1e-09 K", "at most 1,000,000"]),
+    (["synth", "constant-temperature", "--loads", "0,1e300"], ["--loads 1e+300 kg", "validity"]),
+    (["synth", "constant-temperature", "--load-step", "1e-9"], ["--load-step 1e-09 kg", "rows"]),
+    (["synth", "constant-load", "--t-max", "1e6"], ["--t-max 1000000.0 degC", "(-273.15, 300]"]),
+    (["synth", "isobaric", "--points", "1e9"], ["--points", "in [10, 1000000]"]),
     (["synth", "constant-temperature", "--load-step", "0"], ["--load-step", "got '0'"]),
     (["bench", "--runs", "0"], ["--runs", "expected a whole number in [1, 1000], got '0'"]),
     (["bench", "--runs", "1001"], ["--runs", "expected a whole number in [1, 1000], got '1001'"]),

@@ -95,11 +95,14 @@ def bounded_integer(low, high):
     return convert
 
 
-def bounded_number(low, high, unit=""):
-    """argparse type factory: a finite number in (low, high] [unit]."""
+def bounded_number(low, high, unit="", closed=False):
+    """argparse type factory: a finite number in (low, high] [unit], or [low, high] if ``closed``."""
+    interval = f"{'[' if closed else '('}{low:g}, {high:g}]"
+
     def convert(text):
-        return _number(text, lambda v: low < v <= high, f"in ({low:g}, {high:g}] {unit}".rstrip())
-    convert.__name__ = f"number in ({low:g}, {high:g}]"
+        return _number(text, lambda v: (low <= v if closed else low < v) and v <= high,
+                       f"in {interval} {unit}".rstrip())
+    convert.__name__ = f"number in {interval}"
     return convert
 
 

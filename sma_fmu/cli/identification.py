@@ -5,8 +5,7 @@ Experiments: constant-load, constant-temperature (resistance, the paper's two) a
 import dataclasses
 from pathlib import Path
 
-from .arguments import (finite_number, nonnegative_number, number_list, positive_integer,
-                        positive_number)
+from .arguments import bounded_integer, bounded_number, finite_number, number_list, positive_number
 
 __all__ = ["register"]
 
@@ -14,6 +13,9 @@ EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
 _ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length")
 _SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
+# choice: synth's limits, wide for any real test file and checked before anything is made
+MAX_ROWS = 1_000_000          # rows (or samples) one synth call may write
+MAX_NOISE_OHM, MAX_NOISE_K, MAX_NOISE_STRAIN = 10.0, 50.0, 0.1
 
 
 def _only_for(args, names, experiment, command):
@@ -87,6 +89,30 @@ def _synth_isobaric(args, params, t_min, t_max):
     return 0
 
 
+def _check_synth_size(args, params, t_min, t_max):
+    """Loads inside the model's validity, temperatures above absolute zero and up to T_max,
+    and at most MAX_ROWS rows, all before anything is computed."""
+    for load in args.loads or []:
+        if not 0.0 <= load <= params.load_max:
+            raise ValueError(f"synth: --loads {load!r} kg is outside [0, {params.load_max:.4g}] kg, "
+                             "the model's validity range (validity.stress_max)")
+    for name, value in (("--t-min", t_min), ("--t-max", t_max), ("--temperature", args.temperature)):
+        if not -273.15 < value <= params.T_max:
+            raise ValueError(f"synth: {name} {value!r} degC is outside (-273.15, {params.T_max:g}] degC")
+    if args.experiment == "isobaric":
+        rows = len(args.loads or [0]) * (args.points or 3000)
+        what = f"--points {args.points or 3000} per load"
+    elif args.experiment == "constant-load":
+        rows = len(args.loads or [0] * 4) * 2 * (abs(t_max - t_min) / args.t_step + 1)
+        what = f"--t-step {args.t_step!r} K over {t_min!r}..{t_max!r} degC"
+    else:
+        path = args.loads or [0.0, 0.1, 0.03, 0.2, 0.03, 0.3]
+        rows = sum(abs(b - a) for a, b in zip(path, path[1:])) / args.load_step + len(path)
+        what = f"--load-step {args.load_step!r} kg along the load path"
+    if rows > MAX_ROWS:
+        raise ValueError(f"synth: {what} would make about {rows:.3g} rows; at most {MAX_ROWS:,}")
+
+
 def _synth(args):
     from sma_fmu.identification.synthetic import (constant_load_rows, constant_temperature_rows,
                                                   write_rows)
@@ -95,6 +121,7 @@ def _synth(args):
     t_min, t_max = _T_RANGE.get(args.experiment, (10.0, 110.0))
     t_min = t_min if args.t_min is None else args.t_min
     t_max = t_max if args.t_max is None else args.t_max
+    _check_synth_size(args, params, t_min, t_max)
     if args.experiment == "isobaric":
         return _synth_isobaric(args, params, t_min, t_max)
     _only_for(args, _SYNTH_ISOBARIC_ONLY + ("no_time", "resistance"), "isobaric", "synth")
@@ -147,24 +174,24 @@ def register(commands):
                        help="sweep start [degC] (default: 10; isobaric 15)")
     synth.add_argument("--t-max", type=finite_number,
                        help="sweep end [degC] (default: 110; isobaric 130)")
-    synth.add_argument("--t-step", type=positive_number, default=1.0, help="sweep step [K]")
+    synth.add_argument("--t-step", type=bounded_number(0.0, 100.0, "K"), default=1.0, help="sweep step [K]")
     synth.add_argument("--temperature", type=finite_number, default=20.0,
                        help="constant-temperature: the temperature [degC]")
-    synth.add_argument("--load-step", type=positive_number, default=0.005,
+    synth.add_argument("--load-step", type=bounded_number(0.0, 1.0, "kg"), default=0.005,
                        help="constant-temperature: load sampling step [kg]")
-    synth.add_argument("--noise-ohm", type=nonnegative_number,
+    synth.add_argument("--noise-ohm", type=bounded_number(0.0, MAX_NOISE_OHM, "ohm", closed=True),
                        help="resistance noise sigma [ohm] (default: 0; isobaric 0.05)")
-    synth.add_argument("--noise-K", type=nonnegative_number,
+    synth.add_argument("--noise-K", type=bounded_number(0.0, MAX_NOISE_K, "K", closed=True),
                        help="temperature noise sigma [K] (default: 0; isobaric 3)")
-    synth.add_argument("--noise-strain", type=nonnegative_number,
+    synth.add_argument("--noise-strain", type=bounded_number(0.0, MAX_NOISE_STRAIN, closed=True),
                        help="isobaric: strain noise sigma [1] (default: 1e-4)")
-    synth.add_argument("--points", type=positive_integer,
+    synth.add_argument("--points", type=bounded_integer(10, MAX_ROWS),
                        help="isobaric: samples per file, evenly spaced in time (default: 3000)")
-    synth.add_argument("--cycles", type=positive_integer, help="isobaric: thermal cycles (default: 3)")
-    synth.add_argument("--rate", type=positive_number, help="isobaric: ramp rate [K/min] (default: 10)")
-    synth.add_argument("--dwell", type=nonnegative_number,
+    synth.add_argument("--cycles", type=bounded_integer(1, 1000), help="isobaric: thermal cycles (default: 3)")
+    synth.add_argument("--rate", type=bounded_number(0.0, 1e4, "K/min"), help="isobaric: ramp rate [K/min] (default: 10)")
+    synth.add_argument("--dwell", type=bounded_number(0.0, 1e5, "s", closed=True),
                        help="isobaric: hold at each end [s] (default: 60)")
-    synth.add_argument("--drift", type=nonnegative_number,
+    synth.add_argument("--drift", type=bounded_number(0.0, 0.1, closed=True),
                        help="isobaric: residual strain of the first cycle [1], halving each "
                             "cycle (default: 1.5e-3)")
     synth.add_argument("--strain-unit", choices=("percent", "fraction", "length"),
@@ -172,7 +199,7 @@ def register(commands):
     synth.add_argument("--no-time", action="store_true", help="isobaric: leave out the time column")
     synth.add_argument("--resistance", action="store_true",
                        help="isobaric: add a resistance_ohm column")
-    synth.add_argument("--seed", type=int, default=0, help="random seed")
+    synth.add_argument("--seed", type=bounded_integer(0, 2 ** 32 - 1), default=0, help="random seed")
     synth.add_argument("--no-direction", action="store_true",
                        help="constant-load: leave out the direction column")
     synth.set_defaults(handler=_synth)
