@@ -5,7 +5,7 @@ Experiments: constant-load, constant-temperature (resistance, the paper's two) a
 import dataclasses
 from pathlib import Path
 
-from .arguments import bounded_integer, bounded_number, finite_number, number_list, positive_number
+from .arguments import bounded_integer, bounded_number, finite_number, number_list
 
 __all__ = ["register"]
 
@@ -16,6 +16,7 @@ _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
 # choice: synth's limits, wide for any real test file and checked before anything is made
 MAX_ROWS = 1_000_000          # rows (or samples) one synth call may write
 MAX_NOISE_OHM, MAX_NOISE_K, MAX_NOISE_STRAIN = 10.0, 50.0, 0.1
+MAX_FIT_LOAD_KG, MAX_FIT_STRESS_MPA = 10.0, 2000.0   # beyond any Ti-Ni wire's breaking load
 
 
 def _only_for(args, names, experiment, command):
@@ -25,8 +26,20 @@ def _only_for(args, names, experiment, command):
             raise ValueError(f"{command}: --{name.replace('_', '-')} applies to {experiment} only")
 
 
+def _check_fit_loads(args):
+    """--load in [0, MAX_FIT_LOAD_KG] kg, --stress in (0, MAX_FIT_STRESS_MPA] MPa."""
+    for name, values, low_open, high, unit in (("--load", args.load, False, MAX_FIT_LOAD_KG, "kg"),
+                                               ("--stress", args.stress, True, MAX_FIT_STRESS_MPA,
+                                                "MPa")):
+        for value in values or []:
+            if not ((value > 0.0) if low_open else (value >= 0.0)) or value > high:
+                raise ValueError(f"fit: {name} {value!r} {unit} is outside "
+                                 f"{'(' if low_open else '['}0, {high:g}] {unit}")
+
+
 def _fit_isobaric(args, out):
     from sma_fmu.identification.isobaric_runner import format_isobaric_report, run_isobaric_fit
+    _check_fit_loads(args)
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
                               args.residual_strain or "per-cycle", args.reference_length,
                               progress=lambda text: print(text, flush=True))
@@ -150,14 +163,15 @@ def register(commands):
     fit.add_argument("--model", metavar="FILE",
                      help="base parameter file for everything not fitted (default: reference wire)")
     fit.add_argument("--load", type=number_list, metavar="KG[,KG...]",
-                     help="isobaric: the hung mass [kg], one for all files or one per file "
-                          "(default: the file header's 'load: ... kg')")
+                     help="isobaric: the hung mass [kg] in [0, 10], one for all files or one "
+                          "per file (default: the file header's 'load: ... kg')")
     fit.add_argument("--stress", type=number_list, metavar="MPA[,MPA...]",
-                     help="isobaric: the stress [MPa] instead of --load (uses the wire diameter)")
+                     help="isobaric: the stress [MPa] in (0, 2000] instead of --load (uses the "
+                          "wire diameter)")
     fit.add_argument("--residual-strain", choices=("per-cycle", "none"),
                      help="isobaric: a strain offset per residual-strain level (each cycle may "
                           "leave strain behind), or one per file (default: per-cycle)")
-    fit.add_argument("--reference-length", type=positive_number, metavar="M",
+    fit.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
                      help="isobaric: length the strain is measured from [m] (default: the base "
                           "file's x0)")
     fit.set_defaults(handler=_fit)
