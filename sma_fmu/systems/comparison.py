@@ -52,7 +52,7 @@ def _fmpy_ssp_row(scenario, ssp_path, library):
         series = fmpy_ssp_series(run_ssp_fmpy(ssp_path, scenario.step_s, scenario.steps), scenario)
     except HostError as error:
         return {**row, "rmse_ohm": None, "deviation": None, "wall_time_s": time.perf_counter() - start,
-                "note": str(error).replace(f"{ssp_path}: ", "")}
+                "note": str(error).replace(f"fmpy simulate_ssp: {ssp_path}: ", "")}
     data = library.data.copy()  # the library's row 0, then what fmpy recorded at t_1 ... t_n
     data["R_ref"][1:], data["R"][1:] = series["R_ref"], series["R"]
     return {**row, "rmse_ohm": _rmse(data, scenario),
