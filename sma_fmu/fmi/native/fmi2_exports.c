@@ -21,6 +21,10 @@
  *  - a pointer that is not a live instance (freed, or never one) is refused, not used
  *    (instances.c): fmi2FreeInstance twice or any call after it is logged, never a crash.
  *  - fmi2Instantiate takes pythonfmu's entry for the resources folder off sys.path again.
+ *  - in stepComplete, fmi2Set/GetReal, Integer and Boolean are served from values the front
+ *    holds (fast_path.c): Python runs in fmi2DoStep, which hands the inputs over and takes
+ *    the outputs back. Every other call, and every call the front would refuse, goes to the
+ *    slave (after the pending inputs), so the guard's rules and messages stay as they are.
  */
 #define _GNU_SOURCE
 #include <stdio.h>
@@ -59,6 +63,7 @@ static void free_categories(Instance* in)
 
 void free_instance_memory(Instance* in)
 {
+    fast_free(&in->fast);
     free_categories(in);
     free(in->name);
     free(in);
@@ -122,6 +127,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     }
     keep_thread_state();
     forget_resources(path);
+    fast_attach(in);
     if (!register_instance(in)) {
         host_log(in, fmi2Error, NULL, "fmi2Instantiate: out of memory");
         backend.FreeInstance(in->backend);
@@ -166,14 +172,15 @@ EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefi
                                       fmi2Boolean stopTimeDefined, fmi2Real stopTime)
 {
     ENTER(SetupExperiment);
-    return finish(in, backend.SetupExperiment(in->backend, toleranceDefined, tolerance, startTime,
-                                              stopTimeDefined, stopTime));
+    FORWARD(in, 0, backend.SetupExperiment(in->backend, toleranceDefined, tolerance, startTime,
+                                           stopTimeDefined, stopTime));
+    return status;
 }
 
 EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
     ENTER(EnterInitializationMode);
-    fmi2Status status = finish(in, backend.EnterInitializationMode(in->backend));
+    FORWARD(in, 0, backend.EnterInitializationMode(in->backend));
     if (status <= fmi2Warning) in->stepped = in->terminated = in->have_discard = 0;
     return status;
 }
@@ -181,24 +188,28 @@ EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 {
     ENTER(ExitInitializationMode);
-    return finish(in, backend.ExitInitializationMode(in->backend));
+    FORWARD(in, 1, backend.ExitInitializationMode(in->backend));
+    return status;
 }
 
 EXPORT fmi2Status fmi2Terminate(fmi2Component c)
 {
     ENTER(Terminate);
-    return finish(in, backend.Terminate(in->backend));
+    FORWARD(in, 0, backend.Terminate(in->backend));
+    return status;
 }
 
 EXPORT fmi2Status fmi2Reset(fmi2Component c)
 {
     ENTER(Reset);
-    fmi2Status status = finish(in, backend.Reset(in->backend));
+    FORWARD(in, 0, backend.Reset(in->backend));
+    if (!in->dead) fast_attach(in); /* pythonfmu made a new slave: its table and buffer */
     if (status <= fmi2Warning) in->stepped = in->terminated = in->have_discard = 0;
     return status;
 }
 
-#define FORWARD_ARRAY(name, T)                                                                  \
+/* served: fast_get / fast_set with kind 'R', 'I' or 'B'; none: (0) */
+#define FORWARD_ARRAY(name, T, served)                                                          \
     EXPORT fmi2Status fmi2##name(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,    \
                                  T value[])                                                     \
     {                                                                                           \
@@ -206,15 +217,17 @@ EXPORT fmi2Status fmi2Reset(fmi2Component c)
         if (nvr == 0) return fmi2OK;                                                            \
         if (!vr || !value) return refuse(in, fmi2Error, "fmi2" #name, "vr[] or value[] is NULL"); \
         if (nvr > 1000000) return refuse(in, fmi2Error, "fmi2" #name, "nvr is implausibly large"); \
-        return finish(in, backend.name(in->backend, vr, nvr, value));                           \
+        if (served) return fmi2OK;                                                              \
+        FORWARD(in, 0, backend.name(in->backend, vr, nvr, value));                              \
+        return status;                                                                          \
     }
-FORWARD_ARRAY(GetReal, fmi2Real)
-FORWARD_ARRAY(GetInteger, fmi2Integer)
-FORWARD_ARRAY(GetBoolean, fmi2Boolean)
-FORWARD_ARRAY(GetString, fmi2String)
-FORWARD_ARRAY(SetReal, const fmi2Real)
-FORWARD_ARRAY(SetInteger, const fmi2Integer)
-FORWARD_ARRAY(SetBoolean, const fmi2Boolean)
+FORWARD_ARRAY(GetReal, fmi2Real, fast_ready(in) && fast_get(in, 'R', vr, nvr, value))
+FORWARD_ARRAY(GetInteger, fmi2Integer, fast_ready(in) && fast_get(in, 'I', vr, nvr, value))
+FORWARD_ARRAY(GetBoolean, fmi2Boolean, fast_ready(in) && fast_get(in, 'B', vr, nvr, value))
+FORWARD_ARRAY(GetString, fmi2String, 0)
+FORWARD_ARRAY(SetReal, const fmi2Real, fast_ready(in) && fast_set(in, 'R', vr, nvr, value))
+FORWARD_ARRAY(SetInteger, const fmi2Integer, fast_ready(in) && fast_set(in, 'I', vr, nvr, value))
+FORWARD_ARRAY(SetBoolean, const fmi2Boolean, fast_ready(in) && fast_set(in, 'B', vr, nvr, value))
 
 EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                 const fmi2String value[])
@@ -230,7 +243,8 @@ EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], 
             return fmi2Error;
         }
     }
-    return finish(in, backend.SetString(in->backend, vr, nvr, value));
+    FORWARD(in, 0, backend.SetString(in->backend, vr, nvr, value));
+    return status;
 }
 
 EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[],
@@ -267,9 +281,11 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint
                              fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
 {
     ENTER(DoStep);
+    fast_before_step(in); /* the slave takes the pending inputs and writes the outputs */
     fmi2Status status = finish(in, backend.DoStep(in->backend, currentCommunicationPoint,
                                                   communicationStepSize,
                                                   noSetFMUStatePriorToCurrentPoint));
+    fast_after_step(in);
     if (status > fmi2Discard) return status; /* refused (illegal call): nothing was stepped */
     in->stepped = 1;
     if (status != fmi2Discard) {
@@ -315,7 +331,8 @@ EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi
     if (!value) return refuse(in, fmi2Error, "fmi2GetRealStatus", "value is NULL");
     if (s != fmi2LastSuccessfulTime)
         return refuse(in, fmi2Discard, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is defined");
-    return finish(in, backend.GetRealStatus(in->backend, s, value));
+    FORWARD(in, 0, backend.GetRealStatus(in->backend, s, value));
+    return status;
 }
 
 EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer* value)

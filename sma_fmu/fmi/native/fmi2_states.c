@@ -60,7 +60,7 @@ EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state)
         return refuse(in, fmi2Error, "fmi2GetFMUstate", "*FMUstate is neither NULL nor a state of "
                       "this instance");
     fmi2FMUstate saved = NULL;
-    fmi2Status status = finish(in, backend.GetFMUstate(in->backend, &saved));
+    FORWARD(in, 0, backend.GetFMUstate(in->backend, &saved)); /* with the pending inputs */
     if (status > fmi2Warning) {
         if (saved && !in->dead) backend.FreeFMUstate(in->backend, &saved);
         return status;
@@ -75,7 +75,7 @@ EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
     FrontState* wrapper = find_state(in, state);
     if (!wrapper) return refuse(in, fmi2Error, "fmi2SetFMUstate", "not a state of this instance "
                                 "(NULL, freed, or made by another instance)");
-    fmi2Status status = finish(in, backend.SetFMUstate(in->backend, wrapper->saved));
+    FORWARD(in, 1, backend.SetFMUstate(in->backend, wrapper->saved));
     if (status <= fmi2Warning) in->terminated = in->have_discard = 0;
     return status;
 }

@@ -125,6 +125,22 @@ typedef struct FrontState {
     fmi2FMUstate saved; /* pythonfmu's state (a Python object) */
 } FrontState;
 
+/* Values the front holds for the slave, so that fmi2Set/Get need no Python (fast_path.c). */
+#define FAST_HEADER 6
+#define FAST_DESCRIBE_VR 0xFFFFFA51u /* fmi2GetString: the slave's variable table */
+#define FAST_ATTACH_VR 0xFFFFFA52u   /* fmi2SetString: the buffer's address */
+#define FAST_SYNC_VR 0xFFFFFA53u     /* fmi2GetString: take pending inputs, write every value */
+typedef struct {
+    int attached;            /* the slave writes its values into buffer */
+    int stale;               /* a call went to the slave since it last wrote them all */
+    int maybe_step_complete; /* the slave may be in stepComplete (else nothing is served) */
+    size_t n;                /* slots */
+    double* buffer;          /* FAST_HEADER + 2 n doubles: header, values, pending flags */
+    unsigned char* settable; /* per slot: settable in stepComplete */
+    int* slot_of[3];         /* Real, Integer, Boolean: value reference -> slot or -1 */
+    unsigned table_size[3];
+} FastPath;
+
 typedef struct {
     fmi2Component backend;
     fmi2CallbackFunctions callbacks; /* what pythonfmu gets; it keeps the pointer */
@@ -144,7 +160,20 @@ typedef struct {
     int dead; /* the backend returned fmi2Fatal: pythonfmu has freed its objects */
     int freed; /* fmi2FreeInstance was called: only the name is left */
     FrontState* states; /* the states this instance handed out and that are not freed */
+    FastPath fast;
 } Instance;
+
+/* ---- the fast path (fast_path.c) ------------------------------------------------------------ */
+void fast_attach(Instance* in); /* after the slave is created: table and buffer, or nothing */
+void fast_free(FastPath* fast);
+int fast_ready(Instance* in);   /* 1: serve fmi2Set/Get from the buffer now (may sync first) */
+void fast_flush(Instance* in);  /* before a call goes to the slave: hand pending inputs over */
+void fast_forwarded(Instance* in, int may_enter_step_complete); /* after it went */
+/* 1 if served (every reference known, for fast_set settable now); 0: ask the slave */
+int fast_get(Instance* in, char kind, const fmi2ValueReference vr[], size_t nvr, void* value);
+int fast_set(Instance* in, char kind, const fmi2ValueReference vr[], size_t nvr, const void* value);
+void fast_before_step(Instance* in);
+void fast_after_step(Instance* in);
 
 /* ---- forwarding (fmi2_exports.c) and saved states (fmi2_states.c) ----------------------- */
 fmi2Status refuse(Instance* in, fmi2Status status, const char* function, const char* why);
@@ -171,6 +200,14 @@ void free_instance_memory(Instance* in);
                                 "fmi2Fatal; only fmi2FreeInstance is possible");                \
     keep_thread_state();                                                                        \
     in->logged_status = fmi2OK
+
+/* A call that goes to the slave: pending inputs first (fast_flush), then the call; declares
+ * `status`. may_enter: the call can bring the slave into stepComplete. */
+#define FORWARD(in, may_enter, call)                                                            \
+    fast_flush(in);                                                                             \
+    if (in->dead) return refuse(in, fmi2Fatal, __func__, "refused: the slave failed (fmi2Fatal)"); \
+    fmi2Status status = finish(in, call);                                                       \
+    fast_forwarded(in, may_enter)
 
 /* ---- logging (host_log.c) ---------------------------------------------------------------- */
 void host_log(const Instance* in, fmi2Status status, const char* category, const char* message);

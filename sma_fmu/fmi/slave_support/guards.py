@@ -10,6 +10,10 @@ returns the worst status the slave logged during a call as that call's status. W
 the front (an FMU built where no C compiler was found) the message is the only signal:
 the call still returns fmi2OK (doStep: fmi2Discard). See docs/fmus.md.
 
+With the front, fmi2Set/Get in stepComplete never reach Python: the front serves them from
+values it holds, with the same rules, and passes everything it would refuse on to the guard
+(:mod:`.fast_path`). fmi2DoStep takes the inputs from it and gives the outputs back.
+
 :class:`CallGuard` installs itself over the slave's callbacks (instance attributes shadow
 the class's methods, so a slave written in the usual style gets it by creating its
 :class:`~.interface.SlaveInterface`).
@@ -19,6 +23,7 @@ from operator import attrgetter
 
 from pythonfmu.enums import Fmi2Status
 
+from .fast_path import ATTACH, DESCRIBE, FastPath
 from .lifecycle import ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED
 from .saved_state import SavedStates
 
@@ -53,8 +58,10 @@ class CallGuard:
         self.time = None            # the next communication point [s]
         self.outputs_current = False  # Initialization Mode: outputs reflect what was set
         self.initial_error = None   # why the outputs cannot be computed from what was set
+        self.last_outputs = None    # the Real outputs outputs_finite read last
         self.describing = False     # inside to_xml (the build reads start values)
         self.states = SavedStates(self)
+        self.fast = FastPath(self)  # the front's values (attached by the front, if there is one)
         self._model = {name: getattr(slave, name) for name in (
             "setup_experiment", "enter_initialization_mode", "exit_initialization_mode",
             "do_step", "terminate", "to_xml", "_get_fmu_state", "_set_fmu_state")}
@@ -101,6 +108,7 @@ class CallGuard:
         values = self._real_outputs(self.slave)
         if not isinstance(values, tuple):
             values = (values,)
+        self.last_outputs = values  # what fmi2DoStep gives the front
         try:
             return all(map(math.isfinite, values))
         except TypeError:  # not even a number
@@ -180,10 +188,17 @@ class CallGuard:
                 self.refuse("fmi2Terminate", f"{type(error).__name__}: {error}")
 
     def do_step(self, current_time, step_size):
+        fast = self.fast.view
+        self.last_outputs = None
         try:
+            if fast is not None and fast[2]:  # inputs the front accepted since the last step
+                self.fast.take_inputs()
             return self._do_step(current_time, step_size)
         except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
             return self.internal("fmi2DoStep", error, False)
+        finally:
+            if fast is not None:
+                self.fast.write_step(self.last_outputs)
 
     def _do_step(self, current_time, step_size):
         function = "fmi2DoStep"
@@ -302,6 +317,11 @@ class CallGuard:
         return self._get("fmi2GetBoolean", "Boolean", references, bool, False)
 
     def get_string(self, references):
+        special = self.fast.reference(references)
+        if special == DESCRIBE and self.fast.view is None:
+            return [self.fast.describe()]
+        if special is not None and self.fast.sync():
+            return [""]
         return self._get("fmi2GetString", "String", references, str, "")
 
     def get_integer(self, references):
@@ -328,6 +348,12 @@ class CallGuard:
         self._set("fmi2SetBoolean", "Boolean", references, values, _check_boolean)
 
     def set_string(self, references, values):
+        if self.fast.reference(references) == ATTACH and self.fast.view is None:
+            try:
+                return self.fast.attach(values[0])
+            except Exception:  # noqa: BLE001 - not attached: every call takes the guard's path
+                self.fast.view = None
+                return None
         self._set("fmi2SetString", "String", references, values, _check_string)
 
     def set_integer(self, references, values):

@@ -1,0 +1,160 @@
+"""The slave's side of the native front's fast path (``fmi/native/fast_path.c``).
+
+In stepComplete the front serves fmi2Set/GetReal, Integer and Boolean from a buffer of
+doubles it holds; Python runs only in fmi2DoStep (and in the calls that need the model).
+The slave writes its state and values into that buffer; the front writes the inputs it
+accepted there and marks them pending; the slave takes them at the next step, or when the
+front asks (before any other call reaches the slave).
+
+The front talks to the slave through three value references no variable has, each used
+only as the only reference of a call:
+
+- fmi2GetString(``DESCRIBE``): the variable table, ``"SMAFAST1 <n> (<kind> <vr> <settable>)*n"``
+  (kind R, I or B; settable: 1 if the variable may be set in stepComplete, as the guard's
+  tables say). Answered until the buffer is attached.
+- fmi2SetString(``ATTACH``, ``"<address> <n>"``): the buffer. The slave writes every value.
+- fmi2GetString(``SYNC``): take the pending inputs, write every value. Answered only when the
+  front has set the buffer's request flag, so a host calling with it is refused as before.
+
+Slot order: the variables a step changes (outputs, locals) first, then inputs and parameters.
+Buffer: header (``_HEADER`` doubles: stepComplete, written, pending, sync request, write all
+at the next step), the n values, the n pending flags. Without the front (or with
+``SMA_FMU_NO_FAST_PATH=1``) nothing is attached and every call takes the guard's path.
+"""
+import ctypes
+import struct
+
+from .lifecycle import INSTANTIATED, STEP_COMPLETE
+
+__all__ = ["FastPath", "DESCRIBE", "ATTACH", "SYNC"]
+
+DESCRIBE, ATTACH, SYNC = 0xFFFFFA51, 0xFFFFFA52, 0xFFFFFA53
+_HEADER = 6
+_STEP_COMPLETE, _WRITTEN, _PENDING, _SYNC, _FULL = range(5)
+_KINDS = (("Real", "R", float), ("Integer", "I", int), ("Boolean", "B", bool))
+
+
+def _as_double(kind):
+    if kind == "B":
+        return lambda value: 1.0 if value else 0.0
+    if kind == "I":
+        return lambda value: float(int(value))
+    return float
+
+
+class FastPath:
+    """The buffer one slave shares with the front (see the module docstring)."""
+
+    def __init__(self, guard):
+        self.guard = guard
+        self.view = None  # memoryview of doubles once attached
+        self.slots = None
+
+    def reference(self, references):
+        """The fast-path reference of a one-reference call (unsigned), or None."""
+        if len(references) != 1:
+            return None
+        reference = references[0] & 0xFFFFFFFF
+        return reference if reference in (DESCRIBE, ATTACH, SYNC) else None
+
+    # ---- the table -------------------------------------------------------------------------
+    def _table(self):
+        """(slots, number of slots a step changes): those first, the Real outputs leading in
+        the guard's order (:meth:`~.guards.CallGuard.outputs_finite`)."""
+        interface = self.guard.interface
+        outputs = {name: i for i, name in enumerate(interface.real_output_names())}
+        changing, fixed = [], []
+        for kind, code, convert in _KINDS:
+            names = interface.names(kind)
+            settable = interface.settable(kind, STEP_COMPLETE)
+            free = interface.settable(kind, INSTANTIATED)  # inputs and parameters
+            for reference, name in sorted(names.items()):
+                entry = (code, reference, name, reference in settable, convert)
+                (fixed if reference in free else changing).append(entry)
+        changing.sort(key=lambda e: (e[0] != "R" or e[2] not in outputs, outputs.get(e[2], 0)))
+        return changing + fixed, len(changing)
+
+    def describe(self):
+        """fmi2GetString(DESCRIBE): the table text ("" once attached)."""
+        if self.view is not None:
+            return ""
+        slots, _ = self._table()
+        return f"SMAFAST1 {len(slots)} " + " ".join(
+            f"{code} {reference} {int(settable)}" for code, reference, _, settable, _ in slots)
+
+    def attach(self, text):
+        """fmi2SetString(ATTACH, "<address> <n>"): use the front's buffer; write every value."""
+        if self.view is not None:
+            return
+        address, count = (int(word) for word in text.split())
+        slots, n_changing = self._table()
+        if count != len(slots):
+            return
+        array = (ctypes.c_double * (_HEADER + 2 * count)).from_address(address)
+        self.view = memoryview(array).cast("B").cast("d")
+        self.slots = slots
+        self._names = [name for _, _, name, _, _ in slots]
+        self._to_double = [_as_double(code) for code, _, _, _, _ in slots]
+        self._inputs = [(i, name, convert) for i, (_, _, name, settable, convert) in enumerate(slots)
+                        if settable]
+        n_outputs = len(self.guard.interface.real_output_names())
+        self._n_outputs = n_outputs
+        self._outputs = struct.Struct(f"{n_outputs}d")  # the Real outputs: slots 0 ... n_outputs-1
+        self._raw = memoryview(array).cast("B")
+        self._other = [(i, name, self._to_double[i])
+                       for i, name in enumerate(self._names[n_outputs:n_changing], n_outputs)]
+        self.write_all()
+
+    # ---- values ------------------------------------------------------------------------------
+    def take_inputs(self):
+        """Set the inputs the front marked pending (stepComplete: it checked them)."""
+        view, slave, pending = self.view, self.guard.slave, _HEADER + len(self.slots)
+        for index, name, convert in self._inputs:
+            if view[pending + index]:
+                setattr(slave, name, convert(view[_HEADER + index]))
+                view[pending + index] = 0.0
+        view[_PENDING] = 0.0
+
+    def write_all(self):
+        """Every value and the state into the buffer (a value that is no number: the fast
+        path is off until the next write)."""
+        view, slave = self.view, self.guard.slave
+        try:
+            for index, (name, to_double) in enumerate(zip(self._names, self._to_double)):
+                view[_HEADER + index] = to_double(getattr(slave, name))
+            view[_STEP_COMPLETE] = 1.0 if self.guard.state is STEP_COMPLETE else 0.0
+        except Exception:  # noqa: BLE001 - then every call goes to the guard
+            view[_STEP_COMPLETE] = 0.0
+        view[_WRITTEN] = 1.0
+
+    def write_step(self, outputs=None):
+        """After fmi2DoStep: the outputs (``outputs``: the Real outputs' values the guard read
+        in this step, or None) and the state; every value if the front asked."""
+        view = self.view
+        if view[_FULL]:
+            view[_FULL] = 0.0
+            return self.write_all()
+        slave = self.guard.slave
+        try:
+            if outputs is None:
+                outputs = [getattr(slave, name) for name in self._names[:self._n_outputs]]
+            self._outputs.pack_into(self._raw, 8 * _HEADER, *outputs)
+            for index, name, to_double in self._other:
+                view[_HEADER + index] = to_double(getattr(slave, name))
+            view[_STEP_COMPLETE] = 1.0 if self.guard.state is STEP_COMPLETE else 0.0
+        except Exception:  # noqa: BLE001
+            view[_STEP_COMPLETE] = 0.0
+        view[_WRITTEN] = 1.0
+
+    def sync(self):
+        """fmi2GetString(SYNC) from the front: take the pending inputs, write every value.
+        False if the front did not ask (a host's call: refused as an unknown reference)."""
+        view = self.view
+        if view is None or not view[_SYNC]:
+            return False
+        view[_SYNC] = 0.0
+        if view[_PENDING]:
+            self.take_inputs()
+        self.write_all()
+        return True
+
