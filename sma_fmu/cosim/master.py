@@ -5,8 +5,15 @@ loop and the PI block are those of :mod:`sma_fmu.cosim.loop`; the compensator FM
 stepped before the plant (Gauss-Seidel), so u_ff,k reaches the plant's step k. A scenario
 with a PWM drive puts the SmaPwmDriver FMU between the PI and the plant, stepped after the
 PI and before the plant in the same step: the plant gets the wave's mean over that step.
+
+Each step is one fmi2SetReal, one fmi2DoStep and one fmi2GetReal per FMU (the compensator
+also one fmi2GetBoolean), called through ctypes with argument objects built once
+(:class:`LeanStep`): no argument conversion per call, values written into and read from
+the same C arrays every step.
 """
 import time
+from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
+from functools import partial
 from pathlib import Path
 
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
@@ -14,8 +21,8 @@ from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths, read_descripti
 from sma_fmu.fmi.slave_support.choices import choice_code
 from sma_fmu.fmi.instance import FmuError, FmuInstance
 
-__all__ = ["FmuPlant", "FmuCompensator", "FmuDriver", "needed_fmus", "run_fmus", "MissingFmuError",
-           "model_parameter_values"]
+__all__ = ["FmuPlant", "FmuCompensator", "FmuDriver", "LeanStep", "needed_fmus", "run_fmus",
+           "MissingFmuError", "model_parameter_values"]
 
 
 class MissingFmuError(FileNotFoundError):
@@ -34,6 +41,56 @@ def model_parameter_values(fmu_path, params, variables=None):
             if v.causality == "parameter" and v.name in values}
 
 
+class LeanStep:
+    """set inputs + doStep + get outputs of one FMU instance, with prebuilt ctypes arguments.
+
+    Parameters
+    ----------
+    fmu : FmuInstance
+        An initialized instance.
+    inputs, outputs : tuple of str
+        Real inputs set and Real outputs read at every step.
+    flags : tuple of str
+        Boolean outputs read at every step (one fmi2GetBoolean), or none.
+    """
+
+    def __init__(self, fmu, inputs, outputs, flags=()):
+        self.fmu = fmu
+        component = c_void_p(fmu.component)
+        library = fmu.library
+
+        def bound(function, names, ctype):
+            references = [fmu.variables[name].valueReference for name in names]
+            values = (ctype * len(names))()
+            raw = library[function]  # a function object of its own: no argtypes, int result
+            raw.restype = c_int
+            return partial(raw, component, (c_uint * len(names))(*references),
+                           c_size_t(len(names)), values), values
+
+        self._set, self.inputs = bound("fmi2SetReal", inputs, c_double)
+        self._get, self.outputs = bound("fmi2GetReal", outputs, c_double)
+        self._get_flags, self.flags = bound("fmi2GetBoolean", flags, c_int) if flags else (None, None)
+        do_step = library["fmi2DoStep"]
+        do_step.argtypes, do_step.restype = [c_void_p, c_double, c_double, c_int], c_int
+        self._do_step = partial(do_step, component)
+        self._names = (inputs, outputs, flags)
+
+    def step(self, time_s, step_size):
+        """Set :attr:`inputs` (write them first), doStep, read :attr:`outputs` (and
+        :attr:`flags`); raises :class:`~sma_fmu.fmi.instance.FmuError` above fmi2Warning."""
+        status = self._set()
+        if status > 1:
+            raise self.fmu.failure(f"set {', '.join(self._names[0])}", status)
+        status = self._do_step(time_s, step_size, 1)
+        if status > 1:
+            raise self.fmu.failure("fmi2DoStep", status)
+        status = self._get()
+        if status <= 1 and self._get_flags is not None:
+            status = self._get_flags()
+        if status > 1:
+            raise self.fmu.failure(f"get {', '.join(self._names[1] + self._names[2])}", status)
+
+
 class FmuPlant:
     """The SmaActuator FMU as a loop plant."""
 
@@ -43,8 +100,9 @@ class FmuPlant:
                      hysteresis_mode=choice_code("hysteresis_mode", scenario.hysteresis_mode),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
-        self._inputs = self.fmu.port(("P_in", "load"))
         self._outputs = self.fmu.port(PLANT_OUTPUTS)
+        self._step = LeanStep(self.fmu, ("P_in", "load"), PLANT_OUTPUTS)
+        self._inputs, self._values = self._step.inputs, self._step.outputs
 
     def outputs(self):
         """The loop's :data:`~sma_fmu.cosim.loop.PLANT_OUTPUTS` now."""
@@ -52,9 +110,11 @@ class FmuPlant:
 
     def step(self, time_s, power, load, step_size):
         """Set P_in and load, doStep, return the PLANT_OUTPUTS at the end of the step."""
-        self._inputs.set((power, load))
-        self.fmu.step(time_s, step_size)
-        return self._outputs.get()
+        inputs = self._inputs
+        inputs[0] = power
+        inputs[1] = load
+        self._step.step(time_s, step_size)
+        return self._values[:]
 
     def close(self):
         """Free the instance."""
@@ -72,16 +132,18 @@ class FmuCompensator:
                      R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
-        self._inputs = self.fmu.port(("R_ref", "load"))
-        self._outputs = self.fmu.port(("P_ff", "T_ref"))
-        self._saturated = self.fmu.port(("saturated",))
+        self._step = LeanStep(self.fmu, ("R_ref", "load"), ("P_ff", "T_ref"), ("saturated",))
+        self._inputs, self._outputs, self._saturated = (self._step.inputs, self._step.outputs,
+                                                        self._step.flags)
 
     def step(self, time_s, reference, load, step_size):
         """Set R_ref and load, doStep, return (P_ff, T_ref, saturated) for this sample."""
-        self._inputs.set((reference, load))
-        self.fmu.step(time_s, step_size)
-        p_ff, t_ref = self._outputs.get()
-        return p_ff, t_ref, self._saturated.get()[0] != 0
+        inputs = self._inputs
+        inputs[0] = reference
+        inputs[1] = load
+        self._step.step(time_s, step_size)
+        outputs = self._outputs
+        return outputs[0], outputs[1], self._saturated[0] != 0
 
     def close(self):
         """Free the instance."""
@@ -95,18 +157,19 @@ class FmuDriver:
         drive = scenario.drive
         self.fmu = FmuInstance(fmu_path, instance_name,
                                {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W})
-        self._inputs = self.fmu.port(("P_demand",))
-        self._outputs = self.fmu.port(("P_in",))
+        self._initial = self.fmu.port(("P_in",))
+        self._step = LeanStep(self.fmu, ("P_demand",), ("P_in",))
+        self._inputs, self._outputs = self._step.inputs, self._step.outputs
 
     def initial(self):
         """P_in [W] after initialization, before the first step (0 W)."""
-        return self._outputs.get()[0]
+        return self._initial.get()[0]
 
     def step(self, time_s, demand, step_size):
         """Set P_demand [W], doStep, return P_in [W]: the wave's mean over the step."""
-        self._inputs.set((demand,))
-        self.fmu.step(time_s, step_size)
-        return self._outputs.get()[0]
+        self._inputs[0] = demand
+        self._step.step(time_s, step_size)
+        return self._outputs[0]
 
     def close(self):
         """Free the instance."""

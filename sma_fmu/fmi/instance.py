@@ -107,6 +107,7 @@ class FmuInstance:
         # the library fmpy loaded, called without releasing the GIL: pythonfmu's C++ takes it
         # back at once anyway (PyGILState_Ensure), so keeping it saves a hand-off per call
         library = PyDLL(self._fmu.dll._name, handle=self._fmu.dll._handle)
+        self.library = library  # library["fmi2..."]: a function of its own (no argtypes set)
         reals = [c_void_p, POINTER(c_uint), c_size_t, POINTER(c_double)]
         booleans = [c_void_p, POINTER(c_uint), c_size_t, POINTER(c_int)]
         self._raw = {
