@@ -13,7 +13,7 @@ def test_two_plants_with_different_loads_side_by_side(fmus, params):
     loads = {"light": 0.01, "heavy": 0.25}
     libraries = {key: PlantStepper(params, mode="continuous", load=f) for key, f in loads.items()}
     instances = {key: FmuInstance(fmus["SmaActuator"], key,
-                                  {"load": f, "hysteresis_mode": "continuous"})
+                                  {"load": f, "hysteresis_mode": 1})  # 1 = continuous
                  for key, f in loads.items()}
     feedforward = FmuInstance(fmus["SmaFeedforward"], "ff", {"R_ref": reference(0), "load": 0.25})
     ff_library = FeedforwardStepper(params)
