@@ -164,16 +164,17 @@ def test_unusable_resource_uris_give_null_and_a_message(fmi_host_exe, unpacked, 
 
 def test_format_characters_are_logged_literally(fmi_host_exe, unpacked):
     """'%' in an instance name or a String parameter reaches a printf-style logger as text."""
-    mode_ref = {v.name: v.valueReference for v in read_model_description(
-        str(unpacked["SmaActuator"] / "modelDescription.xml")).modelVariables}["hysteresis_mode"]
-    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+    # the signals' reference table: hysteresis_mode, the plant's String once, is an Integer
+    table_ref = {v.name: v.valueReference for v in read_model_description(
+        str(unpacked["SmaScenarioSignals"] / "modelDescription.xml")).modelVariables}["reference"]
+    with FmiHost(fmi_host_exe, unpacked["SmaScenarioSignals"]) as host:
         assert host.call(f"instantiate 0 {text('valve 50%s%n')} ok ok 1").status == OK
         assert host.call("setup 0 0 -").status == OK
-        assert host.call(f"setstring 0 1 {mode_ref} {text('%s%s%n%x')}").status == OK
+        assert host.call(f"setstring 0 1 {table_ref} {text('%s%s%n%x')}").status == OK
         assert host.call("enter 0").status == OK
         reply = host.call("exit 0")
         assert reply.status == ERROR
-        assert any("'valve 50%s%n'" in m and "got '%s%s%n%x'" in m for m in reply.logged(ERROR))
+        assert any("'valve 50%s%n'" in m and "'%s%s%n%x'" in m for m in reply.logged(ERROR))
         assert host.close() == 0
 
 
