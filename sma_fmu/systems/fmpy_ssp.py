@@ -21,7 +21,7 @@ records, aligned with the rows of the library loop.
 """
 import numpy as np
 
-__all__ = ["run_ssp_fmpy", "fmpy_ssp_series", "FMPY_SSP_COLUMNS"]
+__all__ = ["run_ssp_fmpy", "fmpy_ssp_series", "fmpy_ssp_deviation", "FMPY_SSP_COLUMNS"]
 
 # loop column -> the connector fmpy records, and whether it is a state (value at t_k+1 after
 # step k) or a step output (the block's output of step k)

@@ -2,7 +2,9 @@
 
 - :func:`run_ssp_libcosim`: libcosim (Open Simulation Platform) through libcosimpy;
 - :func:`run_ssp_ecos`: Ecos through ecospy (its library needs libtbb, from the ``tbb`` wheel);
-- :func:`run_container_fmpy`, :func:`run_container_libcosim`: the container FMU alone.
+- :func:`run_container_fmpy`, :func:`run_container_libcosim`: the container FMU alone;
+- OMSimulator and fmpy's ``simulate_ssp``: :mod:`.omsimulator` (its samples in this form
+  too) and :mod:`.fmpy_ssp` (the connectors it records).
 
 Each takes the ``outputs`` the system has ({column: (component, variable)}, from
 :func:`~.container.loop_outputs`): a missing one is an error. Each returns their samples
