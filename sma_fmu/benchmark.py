@@ -13,7 +13,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from sma_fmu.benchmark_c_hosts import C_HOST_STEPS, c_host_step_costs
+from sma_fmu.benchmark_c_hosts import C_HOST_STEPS, c_host_step_costs, floor_costs
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.fmi.build import build_fmus
 from sma_fmu.fmi.instance import FmuInstance
@@ -32,6 +32,10 @@ TARGETS = {  # issue 6, on a 2-core machine
     "library_real_time_factor": 150.0,         # per scenario
     "identification_s": 2.0,                   # the 4-load constant-load fit
     "c_host_vs_fmpy": 2.0,                     # issue 10: SmaActuator step in a C host / fmpy master
+}
+RATIO_TARGETS = {  # issue 22: (target, stretch or None)
+    "FMU closed loop / library path": (3.0, 2.0),
+    "SmaActuator in the C host / library plant step": (1.5, None),
 }
 _TRIVIAL_SLAVE = '''
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
@@ -109,18 +113,37 @@ def fmu_step_costs(paths, runs, steps=3000):
 
 
 def closed_loop_times(fmu_dir, runs):
-    """load-step, 30 s at 1 ms, per controller and path: median wall [s] and real-time factor."""
+    """load-step, 30 s at 1 ms, per controller and path: median wall [s], real-time factor and
+    every run's wall [s] (``walls_s``; the two paths alternate, so run i of each compare)."""
     results = {}
     for controller in CONTROLLERS:
         scenario = load_scenario(shipped_file("scenarios", f"load-step-{controller}.toml"))
-        for path, run in (("fmu", lambda: run_fmus(scenario, fmu_dir)),
-                          ("library", lambda: run_library(scenario))):
-            walls = [run().wall_time_s for _ in range(runs)]
-            wall = _median(walls)
+        runners = {"fmu": lambda: run_fmus(scenario, fmu_dir), "library": lambda: run_library(scenario)}
+        walls = {path: [] for path in runners}
+        for _ in range(runs):
+            for path, run in runners.items():
+                walls[path].append(run().wall_time_s)
+        for path, samples in walls.items():
+            wall = round(_median(samples), 4)  # the factor from the wall as printed
             results[f"{controller} ({path})"] = {
-                "wall_s": round(wall, 4), "min_s": round(min(walls), 4), "max_s": round(max(walls), 4),
-                "real_time_factor": round(scenario.stop_time_s / wall, 1)}
+                "wall_s": round(wall, 4), "min_s": round(min(samples), 4),
+                "max_s": round(max(samples), 4), "real_time_factor": round(scenario.stop_time_s / wall, 1),
+                "walls_s": [round(w, 5) for w in samples]}
     return results
+
+
+def ratio_table(loops, floor):
+    """{ratio name: {median, min, max, runs}}: each FMU closed loop over the library run next to
+    it, and the C-host / fmpy-master / native-FMU ratios of :func:`floor_costs`."""
+    samples = {}
+    for controller in CONTROLLERS:
+        fmu, library = loops[f"{controller} (fmu)"], loops[f"{controller} (library)"]
+        samples[f"FMU closed loop / library path, {controller}"] = [
+            a / b for a, b in zip(fmu["walls_s"], library["walls_s"])]
+    samples.update(floor["ratios"])
+    return {name: {"median": round(_median(values), 3), "min": round(min(values), 3),
+                   "max": round(max(values), 3), "runs": len(values)}
+            for name, values in samples.items()}
 
 
 def _library_run(path):
@@ -203,13 +226,18 @@ def run_benchmarks(out_dir, runs=5, progress=print):
         c_hosts = c_host_step_costs(fmu_paths["SmaActuator"], runs, folder)
         machine = {"python": platform.python_version(), "system": platform.platform(),
                    "python_loop_ns_per_iteration": python_loop_ns()}
-        progress(f"closed loops, load-step 30 s ({runs} runs per controller and path) ...")
+        progress(f"native C FMU floor, C host and fmpy master ({runs} alternating runs) ...")
+        from sma_fmu.parameter_file import load_parameters
+        floor = floor_costs(fmu_paths, load_parameters(), runs, folder)
+        progress(f"closed loops, load-step 30 s ({runs} alternating runs per controller and path) ...")
         loops = closed_loop_times(stage / "fmus", runs)
         progress("library throughput over the shipped scenarios ...")
         throughput = library_throughput()
         progress("identification ...")
         results = {
             "machine": machine, "runs": runs, "fmu_step": steps, "c_host_step": c_hosts,
+            "floor": {"samples_us": floor["samples"], "not_built": floor["floor"]},
+            "ratios": ratio_table(loops, floor),
             "closed_loop_load_step_30s": loops, "library_throughput": throughput,
             "identification_4_loads_s": identification_time(runs), "targets": TARGETS,
             # --runs 1 or 2 is a smoke run: 1 s batch runs, where the setup weighs more
@@ -242,6 +270,7 @@ def format_table(results):
     lines += [f"SmaFeedforward step: {ff:.2f} us = {ff / trivial:.2f} x trivial FMU; "
               f"{_verdict(ff, TARGETS['feedforward_step_us'])} us", ""]
     lines += _c_host_lines(results)
+    lines += [""] + _ratio_lines(results)
     lines += ["",
               "load-step, 30 s at 1 ms          wall [s]   x real time   (min ... max of runs)"]
     for name, row in results["closed_loop_load_step_30s"].items():
@@ -273,6 +302,25 @@ def _c_host_lines(results):
     ratio = after / fmpy
     lines.append(f"plain C host (front) {after:.2f} us = {ratio:.2f} x the fmpy master's {fmpy:.2f} us: "
                  f"{_verdict(ratio, TARGETS['c_host_vs_fmpy'])}")
+    return lines
+
+
+def _ratio_lines(results):
+    """The ratios of issue 22, with the spread of the alternating runs and their targets."""
+    lines = [f"Ratios (median of {results['runs']} alternating runs, min ... max)"]
+    for name, row in results["ratios"].items():
+        target = next((t for key, t in RATIO_TARGETS.items() if name.startswith(key)), None)
+        verdict = ""
+        if target is not None:
+            verdict = f"  {_verdict(row['median'], target[0])}"
+            if target[1] is not None:
+                verdict += f" (stretch {target[1]:g}: {'met' if row['median'] <= target[1] else 'not met'})"
+        lines.append(f"{name:<58}{row['median']:>8.2f} x  ({row['min']:.2f} ... {row['max']:.2f}){verdict}")
+    samples = results["floor"]["samples_us"]
+    lines.append("per step [us, median]: " + "; ".join(
+        f"{name} {_median(values):.3f}" for name, values in samples.items()))
+    if results["floor"]["not_built"]:
+        lines.append(f"native C FMU (the floor) not built: {results['floor']['not_built']}")
     return lines
 
 

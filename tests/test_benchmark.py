@@ -12,7 +12,13 @@ def test_benchmark_runs_and_reports_every_section(tmp_path, capsys):
     for text in ("FMU per step", "Trivial (baseline)", "load-step, 30 s at 1 ms",
                  "pi+ff-adaptive (fmu)", "pi+ff-adaptive (library)", "library batch",
                  "identification, 4 loads", "target", "SmaActuator in C hosts",
-                 "plain C host, front (after)", "libcosim step, front (after)"):
+                 "plain C host, front (after)", "libcosim step, front (after)",
+                 "plain C host, front without fast path", "Ratios (median of 1 alternating runs",
+                 "FMU closed loop / library path, pi+ff-adaptive",
+                 "SmaActuator in the C host / library plant step",
+                 "SmaActuator in the fmpy master / library plant step",
+                 "native C FMU in the C host / library plant step",   # a C compiler is there
+                 "SmaActuator / native C FMU, C host", "SmaActuator / native C FMU, fmpy master"):
         assert text in out
     results = json.loads((tmp_path / "benchmark.json").read_text())
     assert set(results["fmu_step"]) == {"SmaActuator", "SmaFeedforward", "Trivial (baseline)"}
@@ -20,6 +26,10 @@ def test_benchmark_runs_and_reports_every_section(tmp_path, capsys):
     for row in results["closed_loop_load_step_30s"].values():   # the table is consistent
         assert row["min_s"] <= row["wall_s"] <= row["max_s"]
         assert row["real_time_factor"] == pytest.approx(30.0 / row["wall_s"], abs=0.051)
+        assert len(row["walls_s"]) == 1
+    for row in results["ratios"].values():   # every ratio with its spread
+        assert row["min"] <= row["median"] <= row["max"] and row["runs"] == 1
+    assert results["floor"]["not_built"] is None
     assert results["identification_4_loads_s"] < 60.0   # a finished fit, not a placeholder
     c_hosts = results["c_host_step"]
-    assert len(c_hosts) == 5 and all(0 < row["p50_us"] <= row["p99_9_us"] for row in c_hosts.values())
+    assert len(c_hosts) == 6 and all(0 < row["p50_us"] <= row["p99_9_us"] for row in c_hosts.values())
