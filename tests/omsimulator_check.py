@@ -1,0 +1,42 @@
+"""OMSimulator runs the exported SSP as the library's Jacobi loop: by hand, not in CI.
+
+OMSimulator is in no package registry, so CI cannot have it, and pytest does not collect this
+file by default (it does not match test_*.py). Build OMSimulator v3.0.0 (docs/systems.md),
+then:
+
+    SMA_FMU_OMSIMULATOR=/path/to/OMSimulator python -m pytest tests/omsimulator_check.py
+
+Without SMA_FMU_OMSIMULATOR the check fails (it never skips).
+"""
+import os
+
+import pytest
+
+from test_ssp_hosts import LOAD_STEP, TOLERANCE, _scenario, fmu_dir  # noqa: F401 (fixture)
+from sma_fmu.cosim.loop import run_library
+from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.container import loop_outputs
+from sma_fmu.systems.hosts import loop_series
+from sma_fmu.systems.ssp import write_ssp
+
+
+@pytest.fixture(scope="module", autouse=True)
+def omsimulator():
+    """The executable SMA_FMU_OMSIMULATOR names; a missing one fails the check."""
+    path = os.environ.get("SMA_FMU_OMSIMULATOR")
+    assert path and os.access(path, os.X_OK), (
+        "set SMA_FMU_OMSIMULATOR to an OMSimulator v3.0.0 executable (docs/systems.md)")
+    return path
+
+
+def test_omsimulator_runs_the_ssp_as_the_library_jacobi_loop(fmu_dir, tmp_path):
+    from sma_fmu.systems.comparison import deviation
+    from sma_fmu.systems.omsimulator import run_ssp_omsimulator
+
+    scenario = _scenario("heavy-pi+ff-adaptive", stop_time_s=2.2, load=LOAD_STEP)
+    path = write_ssp(closed_loop(scenario, fmu_dir), tmp_path / "loop.ssp")
+    samples, log = run_ssp_omsimulator(path, scenario.step_s, scenario.steps, loop_outputs(scenario))
+    data = loop_series(scenario, samples, scenario.steps)
+    assert deviation(data, run_library(scenario, "jacobi").data) <= TOLERANCE
+    # it binds no String: it says so, and the FMUs' defaults hold the same tables
+    assert sum("Unknown ParameterBinding-type" in line for line in log) == 2
