@@ -3,7 +3,7 @@ and 50 Hz PWM (peak = 2 x mean), R [ohm] over the last 5 s of a 60-s run, load 0
 
 Run: python benchmarks/pwm_table.py  (prints Markdown rows; about 10 s)
 """
-from sma_fmu.parameter_file import load_parameters
+from sma_fmu.wire.parameter_file import load_parameters
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.pwm import PwmDriver
 p = load_parameters(); load = 0.05; h = 1e-3

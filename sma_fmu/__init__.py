@@ -1,17 +1,21 @@
 """sma-fmu: SMA wire actuator model, feedforward hysteresis compensator and FMI co-simulation units.
 
-Subpackages, by concern:
+Subpackages, by concern, lowest layer first (each imports only from those before it;
+tests/test_layout.py checks it):
 - :mod:`sma_fmu.runtime`: the physics and steppers (standard library only, shipped in the FMUs);
+- :mod:`sma_fmu.files`: shipped data, TOML and JSON files, output folders never left half-written;
+- :mod:`sma_fmu.wire`: parameter files and the parameters derived from a wire's geometry;
 - :mod:`sma_fmu.fmi`: building FMUs, the FMI glue they ship, driving FMUs from Python;
-- :mod:`sma_fmu.cosim`: scenarios, the closed loop, the fmpy master, metrics, results, figures;
-- :mod:`sma_fmu.identification`: parameter identification from measurements;
-- :mod:`sma_fmu.analysis`: the best tracking any controller can reach (lower bound, benchmark);
+- :mod:`sma_fmu.cosim`: scenarios, the closed loop, the fmpy master, metrics, reports, figures;
+- :mod:`sma_fmu.systems`: the loop in system tools (SSP, container, hosts) and the runner
+  that writes a scenario's results on any path;
+- :mod:`sma_fmu.studies`, :mod:`sma_fmu.analysis`, :mod:`sma_fmu.identification`: design
+  studies on the batch engine, the best possible tracking, parameter identification;
+- :mod:`sma_fmu.bench`: ``sma-fmu bench``;
 - :mod:`sma_fmu.cli`: the ``sma-fmu`` command line.
-Parameter files are read by :mod:`sma_fmu.parameter_file`; the shipped data (``models/``,
-``scenarios/``, ``examples/``, ``fmi/slaves/``) is found by :mod:`sma_fmu.package_data`.
 """
 __version__ = "0.1.0"
 
-from sma_fmu.parameter_file import load_parameters, load_parameter_set  # noqa: E402
+from sma_fmu.wire.parameter_file import load_parameters, load_parameter_set  # noqa: E402
 
 __all__ = ["__version__", "load_parameters", "load_parameter_set"]

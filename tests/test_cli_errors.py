@@ -10,7 +10,7 @@ import zipfile
 import pytest
 
 from sma_fmu.cli import main
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 
 
 def _fails(capsys, argv, *parts):

@@ -5,7 +5,7 @@ import pytest
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.master import run_fmus
 from sma_fmu.cosim.metrics import scenario_metrics
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
 
 

@@ -10,7 +10,7 @@ import pytest
 from import_roots import imported_roots
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 
 
 def _imports(path):

@@ -7,7 +7,7 @@ from fmpy import read_model_description
 from import_roots import imported_roots
 from sma_fmu.cli import main
 from sma_fmu.fmi.build import FMU_SCRIPTS, build_fmu, code_stamp, validate_fmus
-from sma_fmu.parameter_file import write_parameter_file
+from sma_fmu.wire.parameter_file import write_parameter_file
 from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
 

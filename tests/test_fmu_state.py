@@ -7,7 +7,7 @@ import pytest
 
 from fmu_signals import STEP, plant_load, plant_power, reference
 from sma_fmu.fmi.instance import FmuError, FmuInstance
-from sma_fmu.parameter_file import load_parameters
+from sma_fmu.wire.parameter_file import load_parameters
 from sma_fmu.runtime.plant import PlantStepper
 
 SAVE_AT, RUN_TO = 5000, 8000  # steps: 5 s and 8 s

@@ -8,7 +8,7 @@ from sma_fmu.cli import main
 from sma_fmu.identification.constant_load import FITTED, fit_constant_load, starting_parameters
 from sma_fmu.identification.constant_temperature import fit_constant_temperature
 from sma_fmu.identification.measurements import MeasurementError, read_constant_load, read_constant_temperature
-from sma_fmu.parameter_file import load_parameter_set, write_parameter_file
+from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file
 from sma_fmu.identification.synthetic import constant_load_rows, constant_temperature_rows, write_rows
 
 LOADS = [3.2e-3, 0.05, 0.15, 0.25]

@@ -9,8 +9,8 @@ from sma_fmu.cli import main
 from sma_fmu.identification.isobaric_files import read_isobaric
 from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
                                                        isobaric_text)
-from sma_fmu.package_data import shipped_file
-from sma_fmu.parameter_file import load_parameter_set
+from sma_fmu.files.package_data import shipped_file
+from sma_fmu.wire.parameter_file import load_parameter_set
 
 
 def _columns(params, load=0.15, **settings):

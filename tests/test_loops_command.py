@@ -9,7 +9,7 @@ import pytest
 
 from sma_fmu.analysis.minor_loop_figure import power_to_reach
 from sma_fmu.cli import main
-from sma_fmu.parameter_file import write_parameter_file
+from sma_fmu.wire.parameter_file import write_parameter_file
 from sma_fmu.runtime.constant_load import constant_load_resistance
 from sma_fmu.runtime.thermal import step_decay, thermal_step
 

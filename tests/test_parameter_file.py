@@ -3,8 +3,8 @@ from dataclasses import fields
 
 import pytest
 
-from sma_fmu.parameter_file import load_parameter_set, write_parameter_file
-from sma_fmu.package_data import default_parameter_file
+from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file
+from sma_fmu.files.package_data import default_parameter_file
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
 
 

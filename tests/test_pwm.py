@@ -11,7 +11,7 @@ from sma_fmu.cosim.loop import (LibraryCompensator, LibraryDriver, LibraryPlant,
                                 run_loop)
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import DriveSettings, ScenarioError, load_scenario
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.pwm import PwmDriver
 from sma_fmu.runtime.reachable_band import reachable_band

@@ -8,8 +8,8 @@ import pytest
 
 from sma_fmu.cli import main
 from sma_fmu.cosim.scenario import default_analysis, load_scenario
-from sma_fmu.json_output import json_text
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.package_data import shipped_file
 
 
 def _copy(folder, name, text_changes=()):
@@ -101,7 +101,7 @@ def test_json_never_holds_nan_or_infinity():
 
 def test_importing_the_library_leaves_the_matplotlib_backend_alone():
     code = ("import matplotlib; matplotlib.use('svg')\n"
-            "import sma_fmu.cosim.runner, sma_fmu.identification.runner, sma_fmu.cli\n"
+            "import sma_fmu.systems.runner, sma_fmu.identification.runner, sma_fmu.cli\n"
             "print(matplotlib.get_backend())\n")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "svg"
@@ -111,7 +111,7 @@ def test_outputs_get_the_usual_permissions(tmp_path):
     """Staged outputs are not left private (mkdtemp/mkstemp make 0700/0600)."""
     import os
     import stat
-    from sma_fmu.output_folder import staged_folder, write_file
+    from sma_fmu.files.output_folder import staged_folder, write_file
     mask = os.umask(0o022)
     try:
         with staged_folder(tmp_path / "out") as folder:

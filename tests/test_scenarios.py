@@ -2,7 +2,7 @@
 
 import pytest
 
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.cosim.scenario import (CONTROLLERS, PAPER_SET, ScenarioError, load_scenario,
                               resolve_scenarios, scenario_names)
 from sma_fmu.runtime.signals import load_from_table, reference_from_table

@@ -80,7 +80,7 @@ def test_run_many_groups_by_duration_and_keeps_the_order():
 
 def test_scenario_model_override_loads_that_parameter_file(tmp_path):
     """An override of scenario.model is not ignored: the plant and the compensator use that file."""
-    from sma_fmu.package_data import shipped_file
+    from sma_fmu.files.package_data import shipped_file
     from sma_fmu.studies import scenario as study_scenario
     text = shipped_file("models", "reference_wire.toml").read_text().replace(
         "a_h = { value = 68.0", "a_h = { value = 71.0")

@@ -14,7 +14,7 @@ import pytest
 from sma_fmu.cli import main
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.studies import StudyError, template
 from sma_fmu.studies.design import monte_carlo_draws
 from sma_fmu.studies.spec import StudyRunSpec, load_spec

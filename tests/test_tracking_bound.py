@@ -12,7 +12,7 @@ from sma_fmu.cli import main
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.runtime.thermal import thermal_step
 
 CONTROLLERS = ('kind = "pi"', 'kind = "pi+ff-fixed"', 'kind = "pi+ff-adaptive"',

@@ -5,8 +5,8 @@ import math
 import pytest
 
 from sma_fmu.cli import main
-from sma_fmu.parameter_file import load_parameter_set
-from sma_fmu.package_data import shipped_file
+from sma_fmu.wire.parameter_file import load_parameter_set
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.runtime.parameters import ParameterError
 
 NITI_DENSITY = 6450.0  # kg/m3

@@ -10,8 +10,8 @@ import hashlib
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import staged_folder
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import staged_folder
 
 from .tracking_bound import SMOOTH_REVERSALS_PER_S, tracking_bound
 from .tracking_problem import TrackingProblem

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from sma_fmu.output_folder import staged_folder
+from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.runtime.checks import direction_name
 from sma_fmu.runtime.constant_load import (branch_constants, constant_load_resistance,
                                            require_temperature)

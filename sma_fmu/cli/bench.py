@@ -9,7 +9,7 @@ __all__ = ["register"]
 
 
 def _bench(args):
-    from sma_fmu.benchmark import main as bench_main
+    from sma_fmu.bench.benchmark import main as bench_main
     return bench_main(args.out, args.runs, args.only, args.quick)
 
 

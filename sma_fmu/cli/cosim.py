@@ -7,7 +7,7 @@ __all__ = ["register"]
 
 
 def _run(args):
-    from sma_fmu.cosim.runner import timed_run
+    from sma_fmu.systems.runner import timed_run
     timed_run(scenario_paths(args), args.out, args.path, args.fmus)
     return 0
 

@@ -2,7 +2,7 @@
 import shutil
 from pathlib import Path
 
-from sma_fmu.package_data import shipped_file, shipped_files
+from sma_fmu.files.package_data import shipped_file, shipped_files
 
 __all__ = ["register"]
 
@@ -13,7 +13,7 @@ def _examples(args):
         for name in names:
             print(shipped_file("examples", name))
         return 0
-    from sma_fmu.output_folder import staged_folder
+    from sma_fmu.files.output_folder import staged_folder
     with staged_folder(args.out, "--out") as folder:
         for name in names:
             shutil.copyfile(shipped_file("examples", name), folder / name)

@@ -65,7 +65,7 @@ def _fit(args):
 def _synth_isobaric(args, params, t_min, t_max):
     from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
                                                            isobaric_text, stress_of_load)
-    from sma_fmu.output_folder import staged_folder, write_file
+    from sma_fmu.files.output_folder import staged_folder, write_file
     loads = args.loads or [0.15]
     programme = IsobaricProgramme(
         t_low=t_min, t_high=t_max, rate=args.rate or 10.0, cycles=args.cycles or 3,
@@ -129,7 +129,7 @@ def _check_synth_size(args, params, t_min, t_max):
 def _synth(args):
     from sma_fmu.identification.synthetic import (constant_load_rows, constant_temperature_rows,
                                                   write_rows)
-    from sma_fmu.parameter_file import load_parameter_set
+    from sma_fmu.wire.parameter_file import load_parameter_set
     params = load_parameter_set(args.model).params
     t_min, t_max = _T_RANGE.get(args.experiment, (10.0, 110.0))
     t_min = t_min if args.t_min is None else args.t_min

@@ -28,8 +28,8 @@ def _loops(args):
     from sma_fmu.analysis.minor_loop_figure import (check_history, check_load, check_step,
                                                     closure_rows, reversal_rows, trace_history,
                                                     write_loops)
-    from sma_fmu.output_folder import check_folder
-    from sma_fmu.parameter_file import load_parameter_set
+    from sma_fmu.files.output_folder import check_folder
+    from sma_fmu.wire.parameter_file import load_parameter_set
 
     check_folder(args.out)
     model = "the reference wire" if args.model is None else str(Path(args.model))

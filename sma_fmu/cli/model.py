@@ -2,7 +2,7 @@
 import json
 import math
 
-from sma_fmu.parameter_file import load_parameter_set
+from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.runtime.checks import direction_name
 from sma_fmu.runtime.constant_length import load_temperature_slope
 from sma_fmu.runtime.constant_load import constant_load_fractions

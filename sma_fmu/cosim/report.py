@@ -1,6 +1,6 @@
 """Text reports of a set of runs: the summary table and the Markdown ranking per group.
 
-A row is the dict :func:`sma_fmu.cosim.runner.run_scenarios` returns per run: ``scenario``
+A row is the dict :func:`sma_fmu.systems.runner.run_scenarios` returns per run: ``scenario``
 (its result folder name), ``label`` (its name in the comparisons), ``group``, ``metrics``,
 ``wall_time_s``, ``real_time_factor``. A metric that could not be computed (no sample in
 its window) is None and shows as "n/a".

@@ -44,8 +44,8 @@ from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
-from sma_fmu.parameter_file import load_parameter_set
-from sma_fmu.package_data import shipped_file, shipped_files
+from sma_fmu.wire.parameter_file import load_parameter_set
+from sma_fmu.files.package_data import shipped_file, shipped_files
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
@@ -54,7 +54,7 @@ from sma_fmu.runtime.phase_lag import tustin_coefficients
 from sma_fmu.runtime.pwm import DRIVE_KINDS, PwmDriver
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
-from sma_fmu.toml_files import read_toml
+from sma_fmu.files.toml_files import read_toml
 
 __all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "AnalysisWindow", "Scenario",
            "CONTROLLERS",

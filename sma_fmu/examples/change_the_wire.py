@@ -16,8 +16,8 @@ import argparse
 import tempfile
 from pathlib import Path
 
-from sma_fmu.package_data import shipped_file
-from sma_fmu.parameter_file import load_parameter_set
+from sma_fmu.files.package_data import shipped_file
+from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.studies import run
 
 NITI_DENSITY = 6450.0  # kg/m3

@@ -18,7 +18,7 @@ from pathlib import Path
 import pandas as pd
 from matplotlib.figure import Figure
 
-from sma_fmu.json_output import json_text
+from sma_fmu.files.json_output import json_text
 from sma_fmu.studies import run_many, scenario
 
 CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")

@@ -32,9 +32,11 @@ from pathlib import Path
 
 from sma_fmu import __version__
 from sma_fmu.fmi.front import NativeFrontWarning, compile_fronts, install_fronts, stage_slave_module
-from sma_fmu.output_folder import staged_folder
-from sma_fmu.package_data import shipped_file
-from sma_fmu.parameter_file import load_parameter_set
+from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.files.package_data import shipped_file
+from sma_fmu.files.toml_files import read_toml
+from sma_fmu.runtime.signals import load_from_table, reference_from_table
+from sma_fmu.wire.parameter_file import load_parameter_set
 
 __all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "DEFAULT_SIGNALS_SCENARIO", "FmuFileError",
            "code_stamp", "build_fmu", "build_fmus", "validate_fmus", "default_fmu_paths",
@@ -106,12 +108,13 @@ def _renamer(stem, stamp):
 
 def _default_signals(stage):
     """Write SmaScenarioSignals' ``signals.json``; returns [its path]."""
-    from sma_fmu.cosim.scenario import load_scenario  # cosim imports this module
-
-    scenario = load_scenario(shipped_file("scenarios", f"{DEFAULT_SIGNALS_SCENARIO}.toml"))
+    # the shipped scenario's signal tables, read at the runtime's level (fmi is below cosim)
+    document = read_toml(shipped_file("scenarios", f"{DEFAULT_SIGNALS_SCENARIO}.toml"),
+                         ValueError, "scenario file")
+    reference, load = reference_from_table(document["reference"]), load_from_table(document["load"])
     path = stage / "signals.json"
-    path.write_text(json.dumps({"scenario": scenario.name, "reference": scenario.reference.as_table(),
-                                "load": scenario.load.as_table()}, indent=2), encoding="utf-8")
+    path.write_text(json.dumps({"scenario": DEFAULT_SIGNALS_SCENARIO, "reference": reference.as_table(),
+                                "load": load.as_table()}, indent=2), encoding="utf-8")
     return [path]
 
 

@@ -17,9 +17,9 @@ from sma_fmu.identification.isobaric_figures import isobaric_figures
 from sma_fmu.identification.isobaric_files import read_isobaric
 from sma_fmu.identification.isobaric_synthetic import load_of_stress, stress_of_load
 from sma_fmu.identification.isobaric_tables import cycle_rows, rows_csv, rows_markdown
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import check_folder, staged_folder
-from sma_fmu.parameter_file import load_parameter_set, write_parameter_file
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import check_folder, staged_folder
+from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file
 from sma_fmu.runtime.constants import BOLTZMANN, STANDARD_GRAVITY
 
 __all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report"]

@@ -11,9 +11,9 @@ from sma_fmu.identification import constant_load as fit_constant_load
 from sma_fmu.identification import constant_temperature as fit_constant_temperature
 from sma_fmu.identification.figures import constant_load_figures, constant_temperature_figures
 from sma_fmu.identification.measurements import read_constant_load, read_constant_temperature
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import staged_folder
-from sma_fmu.parameter_file import load_parameter_set, parameter_file_text
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.wire.parameter_file import load_parameter_set, parameter_file_text
 
 __all__ = ["EXPERIMENTS", "run_fit", "format_report"]
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sma_fmu.output_folder import write_file
+from sma_fmu.files.output_folder import write_file
 from sma_fmu.runtime.checks import direction_name
 from sma_fmu.runtime.constant_load import constant_load_resistance
 from sma_fmu.runtime.constant_temperature import ConstantTemperatureModel

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.scenario import (Scenario, ScenarioError, read_scenario_document,
                                     resolve_scenarios, scenario_from_document)
-from sma_fmu.parameter_file import load_parameter_set
+from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError
 
 __all__ = ["StudyError", "SECTIONS", "ScenarioTemplate", "template", "with_overrides"]

@@ -14,7 +14,7 @@ import itertools
 import numpy as np
 
 from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.signals import LoadProfile, ReferenceSignal
 

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import staged_folder
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.studies.figures import distribution_figure, heat_map_figure, line_figure
 
 __all__ = ["PARTS", "read_parts", "summary", "summary_markdown", "write_results"]

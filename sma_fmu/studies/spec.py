@@ -38,7 +38,7 @@ from pathlib import Path
 from sma_fmu.cosim.scenario import ScenarioError, check_sections
 from sma_fmu.studies.design import MAX_POINTS, axis_points, monte_carlo_draws
 from sma_fmu.studies.overrides import StudyError, template
-from sma_fmu.toml_files import read_toml
+from sma_fmu.files.toml_files import read_toml
 
 __all__ = ["AXIS_KINDS", "StudyRunSpec", "StudySpec", "load_spec"]
 

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import check_folder, write_file
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import check_folder, write_file
 from sma_fmu.studies.overrides import StudyError
 from sma_fmu.studies.results import PARTS, read_parts, write_results
 from sma_fmu.studies.spec import load_spec

@@ -21,8 +21,8 @@ from scipy.optimize import differential_evolution
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import staged_folder
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.studies.batch import run_batch, unsupported_reason
 from sma_fmu.studies.overrides import StudyError, template
 

@@ -19,8 +19,8 @@ from sma_fmu.cosim.plots import plot_comparison, plot_run
 from sma_fmu.cosim.report import comparison_markdown, groups, summary_table
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.build import DEFAULT_FMU_DIR
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import staged_folder
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.systems.runs import run_container, run_ssp
 
 __all__ = ["PATHS", "run_scenarios", "timed_run", "write_timeseries", "result_names",

@@ -13,14 +13,14 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from sma_fmu.benchmark_c_hosts import C_HOST_STEPS, c_host_step_costs, floor_costs
+from sma_fmu.bench.c_hosts import C_HOST_STEPS, c_host_step_costs, floor_costs
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.fmi.build import build_fmus
 from sma_fmu.fmi.instance import FmuInstance
 from sma_fmu.cosim.master import run_fmus
-from sma_fmu.json_output import json_text
-from sma_fmu.output_folder import staged_folder
-from sma_fmu.package_data import shipped_file
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.files.package_data import shipped_file
 from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario, resolve_scenarios
 
 __all__ = ["TARGETS", "run_benchmarks", "run_batch_benchmark", "format_table", "main"]
@@ -170,7 +170,7 @@ def identification_time(runs):
     """Median time [s] of the 4-load constant-load fit (808 noisy points, seeded)."""
     from sma_fmu.identification.constant_load import fit_constant_load
     from sma_fmu.identification.measurements import read_constant_load
-    from sma_fmu.parameter_file import load_parameters
+    from sma_fmu.wire.parameter_file import load_parameters
     from sma_fmu.identification.synthetic import constant_load_rows, write_rows
 
     params = load_parameters()
@@ -227,7 +227,7 @@ def run_benchmarks(out_dir, runs=5, progress=print):
         machine = {"python": platform.python_version(), "system": platform.platform(),
                    "python_loop_ns_per_iteration": python_loop_ns()}
         progress(f"native C FMU floor, C host and fmpy master ({runs} alternating runs) ...")
-        from sma_fmu.parameter_file import load_parameters
+        from sma_fmu.wire.parameter_file import load_parameters
         floor = floor_costs(fmu_paths, load_parameters(), runs, folder)
         progress(f"closed loops, load-step 30 s ({runs} alternating runs per controller and path) ...")
         loops = closed_loop_times(stage / "fmus", runs)

@@ -17,10 +17,10 @@ import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from sma_fmu.package_data import default_parameter_file
+from sma_fmu.files.package_data import default_parameter_file
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
-from sma_fmu.toml_files import read_toml
-from sma_fmu.wire_geometry import DERIVABLE, GEOMETRY_INPUTS, complete_from_geometry
+from sma_fmu.files.toml_files import read_toml
+from sma_fmu.wire.geometry import DERIVABLE, GEOMETRY_INPUTS, complete_from_geometry
 
 __all__ = ["ParameterSet", "load_parameter_set", "load_parameters", "parse_parameter_document",
            "parameter_file_text", "write_parameter_file", "ParameterError"]
