@@ -97,13 +97,19 @@ def compare_hosts(scenario, fmu_dir, hosts=DEFAULT_HOSTS, artifacts=None):
     return rows
 
 
-def rmse_table(rows):
-    """Markdown: one line per scenario, one column per run (RMSE [ohm], coupling in the head)."""
+def _table_frame(rows):
+    """(runs, scenarios, {(scenario, run, coupling): row}, the Markdown head) of host rows."""
     runs = list(dict.fromkeys((row["run"], row["coupling"]) for row in rows))
     scenarios = list(dict.fromkeys(row["scenario"] for row in rows))
     value = {(row["scenario"], row["run"], row["coupling"]): row for row in rows}
     lines = ["| scenario | " + " | ".join(f"{run}, {coupling}" for run, coupling in runs) + " |",
              "|---|" + "---:|" * len(runs)]
+    return runs, scenarios, value, lines
+
+
+def rmse_table(rows):
+    """Markdown: one line per scenario, one column per run (RMSE [ohm], coupling in the head)."""
+    runs, scenarios, value, lines = _table_frame(rows)
     for name in scenarios:
         cells = [_number(value.get((name, *run), {}).get("rmse_ohm"), ".3f") for run in runs]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
@@ -120,11 +126,7 @@ def _number(value, spec):
 def host_table(rows):
     """Markdown: one line per scenario, one column per run, each cell "RMSE [ohm] / largest
     deviation from the library run of its coupling" ("–" where a host cannot run it)."""
-    runs = list(dict.fromkeys((row["run"], row["coupling"]) for row in rows))
-    scenarios = list(dict.fromkeys(row["scenario"] for row in rows))
-    value = {(row["scenario"], row["run"], row["coupling"]): row for row in rows}
-    lines = ["| scenario | " + " | ".join(f"{run}, {coupling}" for run, coupling in runs) + " |",
-             "|---|" + "---:|" * len(runs)]
+    runs, scenarios, value, lines = _table_frame(rows)
     for name in scenarios:
         cells = []
         for run in runs:
