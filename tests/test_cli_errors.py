@@ -9,23 +9,9 @@ import zipfile
 
 import pytest
 
+from cli_failure import fails as _fails
 from sma_fmu.cli import main
 from sma_fmu.files.package_data import shipped_file
-
-
-def _fails(capsys, argv, *parts):
-    """Run the CLI; assert exit 2, one stderr line starting 'sma-fmu: error:' containing parts."""
-    try:
-        status = main(argv)
-    except SystemExit as stop:  # argparse errors
-        status = stop.code
-    err = capsys.readouterr().err
-    assert status == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("sma-fmu: error: "), err
-    for part in parts:
-        assert part in lines[0], lines[0]
-    return lines[0]
 
 
 def _scenario(tmp_path, name="heavy-pi", **replace):

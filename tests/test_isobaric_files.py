@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 
+from cli_failure import fails as _fails
 from sma_fmu.cli import main
 from sma_fmu.identification.isobaric_files import read_isobaric
 from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
@@ -57,15 +58,6 @@ def test_columns_and_units_are_detected(tmp_path, params):
     assert data.load == pytest.approx(0.15, rel=1e-3)     # from the stress and the 0.15 mm wire
     np.testing.assert_allclose(data.temperature, c["temperature_C"], atol=1e-5)
     np.testing.assert_allclose(data.strain, c["strain_percent"] / 100.0, atol=1e-8)
-
-
-def _fails(capsys, argv, *parts):
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and err.startswith("sma-fmu: error: "), err
-    for part in parts:
-        assert part in err, (part, err)
-    return err
 
 
 def _bad(tmp_path, params, kind):

@@ -7,6 +7,7 @@ import csv
 
 import pytest
 
+from cli_failure import fails
 from sma_fmu.analysis.minor_loop_figure import power_to_reach
 from sma_fmu.cli import main
 from sma_fmu.wire.parameter_file import write_parameter_file
@@ -149,16 +150,7 @@ def test_bad_input_fails_in_one_line_and_leaves_out_alone(case, existing, tmp_pa
         (out / "loops.csv").write_text("kept\n")
     before = sorted((p.relative_to(work), p.read_bytes() if p.is_file() else None)
                     for p in work.rglob("*"))
-    try:
-        status = main([*argv, "--out", str(out)])
-    except SystemExit as stop:  # argparse
-        status = stop.code
-    err = capsys.readouterr().err
-    assert status == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("sma-fmu: error: "), err
-    for part in parts:
-        assert part in lines[0], lines[0]
+    fails(capsys, [*argv, "--out", str(out)], *parts)
     after = sorted((p.relative_to(work), p.read_bytes() if p.is_file() else None)
                    for p in work.rglob("*"))
     assert after == before
