@@ -29,14 +29,14 @@ from collections import namedtuple
 
 from .checks import fast_nonnegative, fast_positive, require_nonnegative, require_positive
 from .constant_load import BranchCache
-from .constants import COOLING, HEATING, KELVIN_OFFSET
+from .constants import COOLING, HEATING
 from .minor_loops import fractions_on_stack, push_reversal, read_points
 from .phase_lag import PhaseLagFilter
-from .state_entries import (StateError, check_format,
-                            read_direction, read_entries, read_optional_number)
-from .validity import validity_warning
 from .sensing import (mixed_fractions_of_resistance, temperature_of_fractions,
                       temperature_on_stack)
+from .state_entries import (StateError, check_format, read_direction, read_entries,
+                            read_optional_number, read_temperature)
+from .validity import validity_warning
 
 __all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStepper",
            "STATE_FORMAT"]
@@ -189,10 +189,7 @@ class FeedforwardStepper:
         read_entries(state, _STATE_ENTRIES, what="compensator state")
         direction = read_direction(state)
         reference = read_optional_number(state, "previous_reference", 5e-324, unit="ohm")
-        temperature = read_optional_number(state, "previous_temperature", -KELVIN_OFFSET,
-                                           unit="degC")
-        if temperature == -KELVIN_OFFSET:
-            raise StateError("state entry previous_temperature must be above -273.15 degC")
+        temperature = read_temperature(state, "previous_temperature", optional=True)
         fraction = read_optional_number(state, "previous_fraction", 0.0, 1.0)
         if (temperature is None) != (fraction is None):
             raise StateError("state entries previous_temperature and previous_fraction must "

@@ -6,10 +6,10 @@ The direction is sgn(T+ - T) (unchanged when T+ = T). In mode "continuous" (the
 default) a reversal found in a step pushes (T_k, xi_MF_k) onto the stack of reversal
 points, closed loops are wiped out, and the branch of the top point follows (section 6,
 :mod:`.minor_loops`: return-point memory); in mode "switch" (the paper's) the fractions
-follow the major branch of that direction. A power of 0 W or less is applied as 0 W (the paper's rule), so a
-compensator output wired straight to the plant is valid; non-finite power is rejected,
-and so is a finite power so large that the temperature would leave the floating-point
-range. Leaving the validity range (T above ``validity.T_max``, or a load above the one
+follow the major branch of that direction. A power of 0 W or less is applied as 0 W (the
+paper's rule), so a compensator output wired straight to the plant is valid; non-finite
+power is rejected, and so is a finite power so large that the temperature would leave the
+floating-point range. Leaving the validity range (T above ``validity.T_max``, or a load above the one
 ``validity.stress_max`` gives) sets :attr:`PlantStepper.warning` for that one step, so the
 FMU can warn once per excursion.
 """
@@ -18,11 +18,11 @@ from collections import namedtuple
 
 from .checks import fast_finite, fast_nonnegative, fast_positive, require_mode, require_nonnegative
 from .constant_load import BranchCache, branch_fractions, require_temperature
-from .constants import COOLING, HEATING, KELVIN_OFFSET
+from .constants import COOLING, HEATING
 from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_points,
                           wipe_out)
-from .state_entries import (StateError, check_format,
-                            read_direction, read_entries, read_number)
+from .state_entries import (StateError, check_format, read_direction, read_entries, read_number,
+                            read_temperature)
 from .thermal import step_decay, thermal_step
 from .validity import validity_warning
 
@@ -57,8 +57,9 @@ class PlantStepper:
         Load during initialization [kg]; the initial outputs reflect it.
 
     The wire starts heating, on the major branch, with an empty reversal memory
-    (:attr:`reversals`, at most ``params.memory_depth`` points). ``warning`` is a message for the one
-    step (or the start) in which the temperature rises above ``params.T_max``, else None.
+    (:attr:`reversals`, at most ``params.memory_depth`` points). ``warning`` is a message for
+    the one step (or the start) in which the temperature rises above ``params.T_max`` or the
+    load above ``params.load_max``, else None.
     """
 
     def __init__(self, params, T_start=None, mode="continuous", load=0.0):
@@ -167,15 +168,13 @@ class PlantStepper:
 
         Every entry is checked first (kinds; T above absolute zero and at most
         ``validity.T_max``, where the model is valid; a load the model covers; fractions in
-        [0, M] with xi_MF + xi_P = M; a well-formed stack of at most ``memory_depth`` points): a malformed state raises ``ValueError`` naming the entry
-        and changes nothing. So does a state of an earlier build (one reversal, no stack),
+        [0, M] with xi_MF + xi_P = M; a well-formed stack of at most ``memory_depth``
+        points): a malformed state raises ``ValueError`` naming the entry and changes nothing. So does a state of an earlier build (one reversal, no stack),
         which is never misread.
         """
         check_format(state, STATE_FORMAT, "plant state")
         read_entries(state, _STATE_ENTRIES, what="plant state")
-        temperature = read_number(state, "temperature", high=self.params.T_max, unit="degC")
-        if temperature <= -KELVIN_OFFSET:
-            raise StateError(f"state entry temperature = {temperature!r} degC is not above -273.15 degC")
+        temperature = read_temperature(state, "temperature", high=self.params.T_max)
         direction = read_direction(state)
         load = read_number(state, "load", 0.0, unit="kg")
         try:

@@ -6,8 +6,10 @@ names the entry and the value, so a state is either taken whole or refused whole
 """
 import math
 
+from .constants import KELVIN_OFFSET
+
 __all__ = ["StateError", "check_format", "read_entries", "read_number", "read_optional_number",
-           "read_direction"]
+           "read_temperature", "read_direction"]
 
 
 class StateError(ValueError):
@@ -56,6 +58,17 @@ def read_number(state, key, low=-math.inf, high=math.inf, unit=""):
 def read_optional_number(state, key, low=-math.inf, high=math.inf, unit=""):
     """:func:`read_number`, or None where the entry is None (a memory not yet filled)."""
     return None if state[key] is None else read_number(state, key, low, high, unit)
+
+
+def read_temperature(state, key, high=math.inf, optional=False):
+    """``state[key]`` as a temperature [degC] above absolute zero and at most ``high``
+    (None where ``optional`` and the entry is None), else StateError."""
+    if optional and state[key] is None:
+        return None
+    temperature = read_number(state, key, -KELVIN_OFFSET, high, "degC")
+    if temperature == -KELVIN_OFFSET:
+        raise StateError(f"state entry {key} = {temperature!r} degC must be above -273.15 degC")
+    return temperature
 
 
 def read_direction(state, key="direction"):
