@@ -114,6 +114,11 @@ int python_library_file(char* path, size_t size); /* its library file (for the i
 /* 1 if `version` (Py_GetVersion's text) is Python 3.PYTHON_MIN_MINOR or newer; else 0 with
  * the reason in why. */
 int python_version_supported(const char* version, char* why, size_t size);
+/* Append printf-style text to the string `text` of `size` bytes (truncating, never past it). */
+void text_append(char* text, size_t size, const char* format, ...) PRINTF_LIKE(3, 4);
+/* The version ("3.11.7") of the Python whose Py_GetVersion is `get_version`, into version
+ * (32 bytes); "" when there is none. */
+void python_version(void* get_version, char* version);
 int start_python_runtime(RuntimeCalls* calls); /* after load_libpython: 1 if the API is there */
 extern int use_thread_state_keeper;
 

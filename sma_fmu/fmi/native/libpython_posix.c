@@ -44,17 +44,6 @@ static const char* const STANDARD_FOLDERS[] = {
     "/usr/local/lib", "/usr/local/lib64", "/usr/lib/" MULTIARCH, "/lib/" MULTIARCH,
     "/usr/lib64", "/lib64", "/usr/lib", "/lib", NULL};
 
-static void append(char* text, size_t size, const char* format, ...) PRINTF_LIKE(3, 4);
-static void append(char* text, size_t size, const char* format, ...)
-{
-    size_t used = strlen(text);
-    if (used + 1 >= size) return;
-    va_list args;
-    va_start(args, format);
-    vsnprintf(text + used, size - used, format, args);
-    va_end(args);
-}
-
 void* python_symbol(const char* name) { return dlsym(RTLD_DEFAULT, name); }
 
 int python_library_file(char* path, size_t size)
@@ -65,16 +54,6 @@ int python_library_file(char* path, size_t size)
         return 0;
     snprintf(path, size, "%s", info.dli_fname);
     return 1;
-}
-
-/* The version of the Python whose Py_GetVersion is `get` ("3.11.7"), into version. */
-static void version_of(void* get, char* version)
-{
-    const char* (*function)(void);
-    *(void**)&function = get;
-    const char* text = function ? function() : NULL;
-    version[0] = '\0';
-    if (text) sscanf(text, "%31s", version);
 }
 
 /* dl_iterate_phdr callback: the first mapped libpython, if any. */
@@ -95,7 +74,7 @@ static int find_mapped_libpython(struct dl_phdr_info* info, size_t size, void* f
 static int check_process_python(const char* how)
 {
     char version[32], why[256];
-    version_of(dlsym(RTLD_DEFAULT, "Py_GetVersion"), version);
+    python_version(python_symbol("Py_GetVersion"), version);
     if (!python_version_supported(version, why, sizeof why)) {
         snprintf(load_error, sizeof load_error, "the Python in this process: %s", why);
         return 0;
@@ -118,19 +97,19 @@ static int try_libpython(const char* path, const char* label, char* tried, size_
     if (!handle) {
         int missing = strstr(reason, "No such file") != NULL;
         if (!(quiet && missing))
-            append(tried, size, "; %s%s%s%s", label, name, colon, missing ? "not found" : reason);
+            text_append(tried, size, "; %s%s%s%s", label, name, colon, missing ? "not found" : reason);
         return 0;
     }
     char version[32], why[256];
     void* get_version = dlsym(handle, "Py_GetVersion");
-    version_of(get_version, version);
+    python_version(get_version, version);
     if (!dlsym(handle, "Py_IsInitialized") || !get_version) {
-        append(tried, size, "; %s%s%snot a libpython (no Py_IsInitialized)", label, name, colon);
+        text_append(tried, size, "; %s%s%snot a libpython (no Py_IsInitialized)", label, name, colon);
         dlclose(handle);
         return 0;
     }
     if (!python_version_supported(version, why, sizeof why)) {
-        append(tried, size, "; %s%s%s%s", label, name, colon, why);
+        text_append(tried, size, "; %s%s%s%s", label, name, colon, why);
         dlclose(handle);
         return 0;
     }
@@ -170,12 +149,12 @@ static int try_any_libpython(char* tried, size_t size)
     if (environment("LD_LIBRARY_PATH", library_path, sizeof library_path)) {
         for (char* folder = strtok(library_path, ":"); folder; folder = strtok(NULL, ":")) {
             scan_folder(folder, found, minors, &count, MAX_FOUND);
-            append(folders, sizeof folders, "%s, ", folder);
+            text_append(folders, sizeof folders, "%s, ", folder);
         }
     }
     for (int i = 0; STANDARD_FOLDERS[i]; ++i) {
         scan_folder(STANDARD_FOLDERS[i], found, minors, &count, MAX_FOUND);
-        append(folders, sizeof folders, "%s%s", STANDARD_FOLDERS[i], STANDARD_FOLDERS[i + 1] ? ", " : "");
+        text_append(folders, sizeof folders, "%s%s", STANDARD_FOLDERS[i], STANDARD_FOLDERS[i + 1] ? ", " : "");
     }
     for (int minor = PYTHON_MAX_MINOR; minor >= PYTHON_MIN_MINOR; --minor) {
         char soname[64];
@@ -184,7 +163,7 @@ static int try_any_libpython(char* tried, size_t size)
         for (int i = 0; i < count; ++i)
             if (minors[i] == minor && try_libpython(found[i], "", tried, size, 1)) return 1;
     }
-    append(tried, size, "; libpython3.%d.so.1.0 to libpython3.%d.so.1.0 through the library "
+    text_append(tried, size, "; libpython3.%d.so.1.0 to libpython3.%d.so.1.0 through the library "
            "search path and in %s: none", PYTHON_MAX_MINOR, PYTHON_MIN_MINOR, folders);
     return 0;
 }
@@ -215,7 +194,7 @@ int load_libpython(void)
                  tried + 2, PYTHON_MIN_MINOR);
         return 0;
     }
-    append(tried, sizeof tried, "; SMA_FMU_LIBPYTHON: not set");
+    text_append(tried, sizeof tried, "; SMA_FMU_LIBPYTHON: not set");
     if (try_libpython(SMA_FRONT_LIBPYTHON, "the build's ", tried, sizeof tried, 0) ||
         try_libpython(SMA_FRONT_LIBPYTHON_SONAME, "", tried, sizeof tried, 0) ||
         try_any_libpython(tried, sizeof tried))

@@ -27,17 +27,6 @@
 
 static HMODULE python; /* the python3X.dll in use */
 
-static void append(char* text, size_t size, const char* format, ...) PRINTF_LIKE(3, 4);
-static void append(char* text, size_t size, const char* format, ...)
-{
-    size_t used = strlen(text);
-    if (used + 1 >= size) return;
-    va_list args;
-    va_start(args, format);
-    vsnprintf(text + used, size - used, format, args);
-    va_end(args);
-}
-
 void* python_symbol(const char* name) { return python ? library_symbol(python, name) : NULL; }
 
 static int module_file(HMODULE module, char* path, size_t size)
@@ -50,20 +39,11 @@ static int module_file(HMODULE module, char* path, size_t size)
 
 int python_library_file(char* path, size_t size) { return python && module_file(python, path, size); }
 
-static void version_of(HMODULE module, char* version)
-{
-    const char* (*get)(void);
-    *(void**)&get = library_symbol(module, "Py_GetVersion");
-    const char* text = get ? get() : NULL;
-    version[0] = '\0';
-    if (text) sscanf(text, "%31s", version);
-}
-
 /* Use `module` (a loaded python3X.dll) if its version is supported; else 0, reason in why. */
 static int accept(HMODULE module, const char* how, char* why, size_t size)
 {
     char version[32], file[PATH_SIZE] = "?";
-    version_of(module, version);
+    python_version(library_symbol(module, "Py_GetVersion"), version);
     module_file(module, file, sizeof file);
     if (!library_symbol(module, "Py_IsInitialized")) {
         snprintf(why, size, "%s is not a Python DLL (no Py_IsInitialized)", file);
@@ -82,12 +62,12 @@ static int try_dll(const char* path, const char* label, char* tried, size_t size
     Library module = library_open(path, 1, 0, reason, sizeof reason);
     if (!module) {
         int missing = strncmp(reason, "error 126", 9) == 0 || strncmp(reason, "error 2:", 8) == 0;
-        if (!(quiet && missing)) append(tried, size, "; %s%s: %s", label, path, reason);
+        if (!(quiet && missing)) text_append(tried, size, "; %s%s: %s", label, path, reason);
         return 0;
     }
     char why[512];
     if (!accept((HMODULE)module, "loaded", why, sizeof why)) {
-        append(tried, size, "; %s%s: %s", label, path, why);
+        text_append(tried, size, "; %s%s: %s", label, path, why);
         library_close(module);
         return 0;
     }
@@ -124,7 +104,7 @@ static int try_folder(const char* folder, int minor, const char* label, char* tr
     const char* sep = n && (folder[n - 1] == '\\' || folder[n - 1] == '/') ? "" : "\\";
     snprintf(path, sizeof path, "%s%spython3%d.dll", folder, sep, minor);
     if (!is_readable_file(path)) {
-        if (registered) append(tried, size, "; %s%s: not found", label, path);
+        if (registered) text_append(tried, size, "; %s%s: not found", label, path);
         return 0;
     }
     return try_dll(path, label, tried, size, 0);
@@ -133,7 +113,7 @@ static int try_folder(const char* folder, int minor, const char* label, char* tr
 int load_libpython(void)
 {
     char why[512];
-    for (int minor = 40; minor >= 0; --minor) { /* 1: a Python host's own */
+    for (int minor = PYTHON_MAX_MINOR; minor >= 0; --minor) { /* 1: a Python host's own */
         wchar_t name[32];
         _snwprintf(name, 32, L"python3%d.dll", minor);
         name[31] = L'\0';
@@ -157,7 +137,7 @@ int load_libpython(void)
                  PYTHON_MIN_MINOR);
         return 0;
     }
-    append(tried, sizeof tried, "; SMA_FMU_LIBPYTHON: not set");
+    text_append(tried, sizeof tried, "; SMA_FMU_LIBPYTHON: not set");
     char local[PATH_SIZE] = "", programs[PATH_SIZE] = "";
     environment("LOCALAPPDATA", local, sizeof local);
     environment("ProgramFiles", programs, sizeof programs);
@@ -180,7 +160,7 @@ int load_libpython(void)
             if (try_folder(folder, minor, "", tried, sizeof tried, 0)) return 1;
         }
     }
-    append(tried, sizeof tried, "; Python 3.%d to 3.%d in the registry (HKCU and HKLM "
+    text_append(tried, sizeof tried, "; Python 3.%d to 3.%d in the registry (HKCU and HKLM "
            "Software\\Python\\PythonCore\\3.X\\InstallPath), python3X.dll on the DLL search "
            "path (PATH) and in %s\\Programs\\Python\\Python3X and %s\\Python3X: none",
            PYTHON_MAX_MINOR, PYTHON_MIN_MINOR, *local ? local : "%LOCALAPPDATA%",

@@ -13,6 +13,7 @@
  * No Python header is needed: the few C-API functions used are looked up by name.
  */
 #define _GNU_SOURCE
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -46,6 +47,25 @@ static struct {
 
 #define PY_EQ 2
 #define PYTHON_THREAD ((void*)1) /* the thread slot's mark: a thread with its own Python state */
+
+void text_append(char* text, size_t size, const char* format, ...)
+{
+    size_t used = strlen(text);
+    if (used + 1 >= size) return;
+    va_list args;
+    va_start(args, format);
+    vsnprintf(text + used, size - used, format, args);
+    va_end(args);
+}
+
+void python_version(void* get_version, char* version)
+{
+    const char* (*function)(void);
+    *(void**)&function = get_version;
+    const char* text = function ? function() : NULL;
+    version[0] = '\0';
+    if (text) sscanf(text, "%31s", version);
+}
 
 int python_version_supported(const char* version, char* why, size_t size)
 {
