@@ -178,7 +178,7 @@ def _simulate_ssp_reference(scenario):
 def test_fmpy_simulate_ssp_runs_the_pi_loops_scenario(fmu_dir, tmp_path, name):
     scenario = _scenario(name, stop_time_s=2.2, load=LOAD_STEP)
     path = write_ssp(closed_loop(scenario, fmu_dir), tmp_path / f"{name}.ssp")
-    series = fmpy_ssp_series(run_ssp_fmpy(path, scenario.step_s, scenario.steps), scenario)
+    series = fmpy_ssp_series(run_ssp_fmpy(path, scenario.step_s, scenario.steps))
     expected = _simulate_ssp_reference(scenario)
     for column, values in expected.items():
         assert np.max(np.abs(series[column] - values)) <= TOLERANCE, column

@@ -70,9 +70,7 @@ class LeanStep:
         self._set, self.inputs = bound("fmi2SetReal", inputs, c_double)
         self._get, self.outputs = bound("fmi2GetReal", outputs, c_double)
         self._get_flags, self.flags = bound("fmi2GetBoolean", flags, c_int) if flags else (None, None)
-        do_step = library["fmi2DoStep"]
-        do_step.argtypes, do_step.restype = [c_void_p, c_double, c_double, c_int], c_int
-        self._do_step = partial(do_step, component)
+        self._do_step = partial(fmu._do_step_c, component)
         self._names = (inputs, outputs, flags)
 
     def step(self, time_s, step_size):

@@ -19,7 +19,7 @@ codes of :mod:`sma_fmu.fmi.slave_support.choices`.
 """
 from dataclasses import dataclass
 
-from sma_fmu.cosim.master import MissingFmuError, model_parameter_values
+from sma_fmu.cosim.master import MissingFmuError, model_parameter_values, needed_fmus
 from sma_fmu.fmi.build import default_fmu_paths, read_description
 from sma_fmu.fmi.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
@@ -88,9 +88,7 @@ class LoopSystem:
 
 def _fmu_files(scenario, fmu_dir):
     paths = default_fmu_paths(fmu_dir)
-    needed = ["SmaScenarioSignals", "SmaPiController", "SmaActuator"]
-    needed += ["SmaFeedforward"] if scenario.controller.feedforward else []
-    needed += ["SmaPwmDriver"] if scenario.drive.pwm else []
+    needed = ["SmaScenarioSignals", "SmaPiController", *needed_fmus(scenario)]
     for name in needed:
         if not paths[name].is_file():
             raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "

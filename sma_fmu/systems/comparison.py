@@ -49,7 +49,7 @@ def _fmpy_ssp_row(scenario, ssp_path, library):
     row = {"scenario": scenario.name, "run": "fmpy simulate_ssp (ssp)", "coupling": "jacobi"}
     start = time.perf_counter()
     try:
-        series = fmpy_ssp_series(run_ssp_fmpy(ssp_path, scenario.step_s, scenario.steps), scenario)
+        series = fmpy_ssp_series(run_ssp_fmpy(ssp_path, scenario.step_s, scenario.steps))
     except HostError as error:
         return {**row, "rmse_ohm": None, "deviation": None, "wall_time_s": time.perf_counter() - start,
                 "note": str(error).replace(f"fmpy simulate_ssp: {ssp_path}: ", "")}

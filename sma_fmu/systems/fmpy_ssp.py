@@ -48,7 +48,7 @@ def run_ssp_fmpy(ssp_path, step_size, steps):
     return result[:steps]  # its sum of steps may fall short of the stop time: one more step
 
 
-def fmpy_ssp_series(result, scenario):
+def fmpy_ssp_series(result):
     """{column: values} of a :func:`run_ssp_fmpy` result, each aligned with rows of the library
     loop: states (R_ref, load, R) at t_1 ... t_n, the library's rows 1 ... n; step outputs
     (P_ff, and P, the power the plant applied) of steps 0 ... n-1, its rows 0 ... n-1.
@@ -61,8 +61,6 @@ def fmpy_ssp_series(result, scenario):
               for column, (connector, _) in FMPY_SSP_COLUMNS.items() if connector in names}
     power = np.concatenate(([0.0], np.asarray(result["plant.P_in"], dtype=float)[:-1]))
     series["P"] = np.maximum(0.0, power)
-    if not scenario.controller.feedforward:
-        series.pop("P_ff", None)
     return series
 
 

@@ -111,8 +111,7 @@ def read_ssp(path):
             names.append(("component name", name))
             with zipfile.ZipFile(io.BytesIO(archive.read(component.get("source")))) as fmu:
                 defaults[name] = fmu_defaults(fmu)
-                model = ET.fromstring(fmu.read("modelDescription.xml")).get("modelName")
-            components[name] = model
+            components[name] = defaults[name].model
             for index, binding in enumerate(component.iter(_tag("ssd:ParameterBinding"))):
                 for parameter in _binding_parameters(binding, archive):
                     value = parameter[0]

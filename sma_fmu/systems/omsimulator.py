@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from sma_fmu.runtime.scenario_signals import GRID_TOLERANCE
+
 __all__ = ["ENVIRONMENT", "omsimulator_executable", "omsimulator_command", "read_mat_results",
            "run_ssp_omsimulator"]
 
@@ -80,7 +82,7 @@ def run_ssp_omsimulator(ssp_path, step_size, steps, outputs, executable=None):
     index = np.rint(times / step_size).astype(int)
     first = {}
     for row, k in enumerate(index):
-        if abs(times[row] - k * step_size) <= 1e-6 * step_size:
+        if abs(times[row] - k * step_size) <= GRID_TOLERANCE * step_size:
             first.setdefault(int(k), row)
     missing = [k for k in range(steps + 1) if k not in first]
     if missing:

@@ -92,11 +92,13 @@ def packed_fmu(component, scenario):
 
 class FmuDefaults:
     """The defaults an FMU carries: ``starts`` {parameter: (FMI type, start value)} from its
-    modelDescription.xml and ``packed`` {name: value} from its start_values.json ({} if none)."""
+    modelDescription.xml, ``packed`` {name: value} from its start_values.json ({} if none) and
+    ``model`` its modelName."""
 
-    def __init__(self, starts, packed):
+    def __init__(self, starts, packed, model=None):
         self.starts = starts
         self.packed = packed
+        self.model = model
 
     def problems(self):
         """Texts naming each packed value that is not a parameter or differs from its start."""
@@ -138,4 +140,4 @@ def fmu_defaults(archive):
     if START_VALUES_ENTRY in archive.namelist():
         document = json.loads(archive.read(START_VALUES_ENTRY))
         packed = document.get("values", {}) if isinstance(document, dict) else {}
-    return FmuDefaults(starts, packed)
+    return FmuDefaults(starts, packed, root.get("modelName"))

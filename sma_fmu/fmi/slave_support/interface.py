@@ -20,7 +20,7 @@ import os
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Variability, Integer, Real, String
 from pythonfmu.enums import Fmi2Status
 
-from sma_fmu.fmi.slave_support.choices import CHOICES, choice_text
+from sma_fmu.fmi.slave_support.choices import choice_code, choice_text
 from sma_fmu.fmi.slave_support.guards import CallGuard
 from sma_fmu.fmi.slave_support.lifecycle import setting_refusal
 from sma_fmu.fmi.slave_support.model_description import decorate_model_description
@@ -157,7 +157,7 @@ class SlaveInterface:
     def choice_parameter(self, name, start, description):
         """A fixed Integer parameter choosing among the names of :data:`~.choices.CHOICES`
         [``name``]; ``start`` is a name, the description ends with the codes."""
-        code = next(code for code, known in CHOICES[name].items() if known == start)
+        code = choice_code(name, start)
         self.parameter(name, code, None, f"{description} ({choice_text(name)})", kind=Integer)
 
     def boolean_parameter(self, name, start, description):

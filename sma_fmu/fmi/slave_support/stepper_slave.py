@@ -28,6 +28,9 @@ class StepperSlave(Fmi2Slave):
     # modelDescription.xml attributes every sma-fmu FMU shares (pythonfmu reads the class's)
     author = "sma-fmu"
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
+    # a step within GRID_TOLERANCE of the first step's size is taken as that size
+    # (SlaveInterface.nominal_step); slaves that put their time on the grid themselves say no
+    snaps_step = True
 
     def exit_initialization_mode(self):
         self.stepper = None  # a failed start leaves none (and a saved state says so)
@@ -35,6 +38,8 @@ class StepperSlave(Fmi2Slave):
         self._publish(outputs)
 
     def do_step(self, current_time, step_size):
+        if self.snaps_step:
+            step_size = self.interface.nominal_step(step_size)
         self._publish(self._advance(current_time, step_size))
         return True
 

@@ -57,4 +57,4 @@ class SmaActuator(StepperSlave):
         return stepper, stepper.outputs
 
     def _advance(self, current_time, step_size):
-        return self.stepper.step(self.P_in, self.load, self.interface.nominal_step(step_size))
+        return self.stepper.step(self.P_in, self.load, step_size)

@@ -57,4 +57,4 @@ class SmaFeedforward(StepperSlave):
         self.P_ff, self.T_ref, self.saturated = outputs
 
     def _advance(self, current_time, step_size):
-        return self.stepper.step(self.R_ref, self.load, self.interface.nominal_step(step_size))
+        return self.stepper.step(self.R_ref, self.load, step_size)

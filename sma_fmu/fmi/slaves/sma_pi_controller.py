@@ -42,5 +42,4 @@ class SmaPiController(StepperSlave):
         self.P, self.P_fb = outputs
 
     def _advance(self, current_time, step_size):
-        return self.stepper.sample(self.R, self.R_ref, self.P_ff,
-                                   self.interface.nominal_step(step_size))
+        return self.stepper.sample(self.R, self.R_ref, self.P_ff, step_size)

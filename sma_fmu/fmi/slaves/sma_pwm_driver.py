@@ -30,6 +30,7 @@ PEAK_W = 10.0         # default power while on [W]: above what the paper's loops
 class SmaPwmDriver(StepperSlave):
 
     description = "PWM driver of the SMA wire: demanded power in, mean power of the PWM wave over the step out"
+    snaps_step = False   # puts its time on the step grid itself (see the module docstring)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)

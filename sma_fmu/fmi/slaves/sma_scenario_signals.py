@@ -28,6 +28,7 @@ DEFAULTS_FILE = "signals.json"
 class SmaScenarioSignals(StepperSlave):
 
     description = "Scenario signals of the SMA wire loop: reference resistance R_ref(t) and load f(t)"
+    snaps_step = False   # puts its time on the step grid itself (see the module docstring)
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
