@@ -21,6 +21,7 @@ import pytest
 
 import sma_fmu.runtime.feedforward as runtime_feedforward
 import sma_fmu.runtime.plant as runtime_plant
+import sma_fmu.runtime.sensing as runtime_sensing
 import sma_fmu.studies.batch as batch
 import sma_fmu.studies.batch_minor_loops as batch_minor_loops
 import sma_fmu.studies.batch_plant as batch_plant
@@ -146,13 +147,13 @@ def test_minor_loop_inverse_on_flat_branches_equals_the_library_path(values, mon
         compensator_parameter_set=dataclasses.replace(
             model, params=model.params.replace(saturation_margin=1e-16)))
     flat = []
-    walk = runtime_feedforward.temperature_on_stack
+    walk = runtime_sensing.temperature_on_stack       # the stepper's walk (invert_on_stack)
 
     def watched(xi_mf, xi_p, constants, direction, points, margin, count=None):
         sensed, kept = walk(xi_mf, xi_p, constants, direction, points, margin, count)
         flat.append(is_flat(points, kept, constants, direction))
         return sensed, kept
-    monkeypatch.setattr(runtime_feedforward, "temperature_on_stack", watched)
+    monkeypatch.setattr(runtime_sensing, "temperature_on_stack", watched)
     scalar = run_library(scenario).data
     assert sum(flat) >= 400     # on a flat branch for a whole plateau
     assert_same_series(run_batch([scenario], "timeseries")[0].data, scalar, str(values))

@@ -30,10 +30,9 @@ from collections import namedtuple
 from .checks import fast_nonnegative, fast_positive, require_nonnegative, require_positive
 from .constant_load import BranchCache
 from .constants import COOLING, HEATING
-from .minor_loops import fractions_on_stack, push_reversal, read_points
+from .minor_loops import push_reversal, read_points
 from .phase_lag import PhaseLagFilter
-from .sensing import (mixed_fractions_of_resistance, temperature_of_fractions,
-                      temperature_on_stack)
+from .sensing import invert_on_stack, mixed_fractions_of_resistance, temperature_of_fractions
 from .state_entries import (StateError, check_format, read_direction, read_entries,
                             read_optional_number, read_temperature)
 from .validity import validity_warning
@@ -118,13 +117,7 @@ class FeedforwardStepper:
             points = list(points)
             push_reversal(points, self.previous_temperature, self.previous_fraction,
                           params.memory_depth)
-        sensed, kept = temperature_on_stack(xi_mf, xi_p, constants, direction, points,
-                                            params.saturation_margin)
-        if kept < len(points):
-            points = points[:kept]
-        if sensed.saturated:  # the state assumed is on the branch's edge
-            xi_mf = fractions_on_stack(sensed.temperature, constants, direction, points)[0]
-        return sensed, points, xi_mf
+        return invert_on_stack(xi_mf, xi_p, constants, direction, points, params.saturation_margin)
 
     def _direction_for(self, reference):
         previous = self.previous_reference

@@ -23,11 +23,12 @@ from .checks import direction_sign, require_positive
 from .constant_load import branch_constants
 from .constants import KELVIN_OFFSET
 from .constants import HEATING
-from .minor_loops import DENOMINATOR_FLOOR, fractions_of_value, major_value, value_of
+from .minor_loops import (DENOMINATOR_FLOOR, fractions_of_value, fractions_on_stack, major_value,
+                          value_of)
 from .reachable_band import band_of_branch
 
 __all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of_fractions",
-           "temperature_on_stack", "sense_temperature"]
+           "temperature_on_stack", "invert_on_stack", "sense_temperature"]
 
 SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
 SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
@@ -120,6 +121,22 @@ def temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin, coun
     if clamped and not sensed.saturated:
         sensed = _new_tuple(SensedTemperature, (sensed.temperature, True))
     return sensed, 0
+
+
+def invert_on_stack(xi_mf, xi_p, constants, direction, points, margin):
+    """The minor-loop compensator's inversion of one sample: (SensedTemperature, the stack
+    after the walk, xi_MF it assumes) [degC], [points], [1].
+
+    :func:`temperature_on_stack`, the stack cut to the points it kept (a copy only when it
+    shrank), and the fraction the state is assumed at: the target's, or where the clamp
+    acted, the branch's at the clamped temperature.
+    """
+    sensed, kept = temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin)
+    if kept < len(points):
+        points = points[:kept]
+    if sensed.saturated:
+        xi_mf = fractions_on_stack(sensed.temperature, constants, direction, points)[0]
+    return sensed, points, xi_mf
 
 
 def sense_temperature(resistance, load, direction, params, reversals=()):

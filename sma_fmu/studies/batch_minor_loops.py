@@ -29,8 +29,8 @@ import numpy as np
 
 from sma_fmu.runtime.constant_load import BranchConstants
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
-from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, fractions_on_stack, push_reversal
-from sma_fmu.runtime.sensing import temperature_on_stack
+from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, push_reversal
+from sma_fmu.runtime.sensing import invert_on_stack
 from sma_fmu.studies.batch_plant import major_fractions
 
 __all__ = ["clamp_fractions", "temperature_of_fractions", "MinorLoopMemory", "WINDOW"]
@@ -230,11 +230,8 @@ class MinorLoopMemory:
                                     None)
         direction = HEATING if at("heating", row) else COOLING
         try:
-            sensed, kept = temperature_on_stack(xi_mf, xi_p, constants, direction, points,
-                                                self.margins[column])
-            points = points[:kept] if kept < len(points) else points
-            fraction = (fractions_on_stack(sensed.temperature, constants, direction, points)[0]
-                        if sensed.saturated else xi_mf)
+            sensed, points, fraction = invert_on_stack(xi_mf, xi_p, constants, direction, points,
+                                                       self.margins[column])
             T, saturated, bad = sensed.temperature, sensed.saturated, False
         except ValueError:                              # diverged: the run goes to the library
             T, saturated, bad, fraction = math.nan, True, True, math.nan
@@ -250,12 +247,10 @@ class MinorLoopMemory:
         constants = BranchConstants(M, None, energy, inverse, None)
         direction = HEATING if heating else COOLING
         try:
-            sensed = temperature_on_stack(xi_mf, xi_p, constants, direction, points,
-                                          self.margins[column])[0]
+            sensed, _, xi_mf = invert_on_stack(xi_mf, xi_p, constants, direction, points,
+                                               self.margins[column])
         except ValueError:
             return math.nan, math.nan
-        if sensed.saturated:
-            xi_mf = fractions_on_stack(sensed.temperature, constants, direction, points)[0]
         return sensed.temperature, xi_mf
 
     def _keep(self, column, points):

@@ -33,7 +33,8 @@ import numpy as np
 
 from sma_fmu.runtime.constant_load import BranchConstants
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
-from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, ReversalPoint, branch_of
+from sma_fmu.runtime.minor_loops import (DENOMINATOR_FLOOR, ReversalPoint, branch_of, push_reversal,
+                                         wipe_out)
 
 __all__ = ["BatchPlant", "major_fractions", "FEW_RUNS"]
 
@@ -125,9 +126,10 @@ class BatchPlant:
     xi_M = property(lambda self: self._state[2], doc="Martensite fraction xi_M [1] per run.")
 
     def reversals(self, run):
-        """The reversal stack of ``run``: [(T [degC], xi_MF [1])], oldest first."""
+        """The reversal stack of ``run``: [ReversalPoint(T [degC], xi_MF [1])], oldest first."""
         count = int(self.reversal_count[run])
-        return list(zip(self._stack_T[run, :count].tolist(), self._stack_xi[run, :count].tolist()))
+        return [ReversalPoint(T, xi) for T, xi in zip(self._stack_T[run, :count].tolist(),
+                                                        self._stack_xi[run, :count].tolist())]
 
     def _set(self, segments, runs):
         at, rows = self.inputs.constants, segments[runs]
@@ -268,26 +270,18 @@ class BatchPlant:
         """One run's event with the runtime's own functions: push (T_k = ``before``,
         xi_MF,k) if given, wipe out at T+, then the Branch of the new top (branch_of), the
         wipe-out bound and the selectors."""
-        stack_T, stack_xi, count = self._stack_T, self._stack_xi, self.reversal_count
-        c = int(count[run])
+        count = self.reversal_count
         heating = bool(self.heating[run])
-        if before is not None:                          # push_reversal
-            if c + 1 > self._capacity:
-                self._grow(c + 1)
-                stack_T, stack_xi = self._stack_T, self._stack_xi
-            stack_T[run, c], stack_xi[run, c] = before, self._state[0, run]
-            c += 1
-            if c > self.depth[run]:                     # del points[:2]
-                stack_T[run, :c - 2] = stack_T[run, 2:c].copy()
-                stack_xi[run, :c - 2] = stack_xi[run, 2:c].copy()
-                c -= 2
-        temperature = after[run]                        # wipe_out
-        while c >= 2:
-            bound = stack_T[run, c - 2]
-            if (temperature >= bound) if heating else (temperature <= bound):
-                c -= 2
-            else:
-                break
+        points = self.reversals(run)
+        if before is not None:
+            push_reversal(points, float(before), float(self._state[0, run]), int(self.depth[run]))
+        wipe_out(points, after[run], HEATING if heating else COOLING)
+        c = len(points)
+        if c > self._capacity:
+            self._grow(c)
+        stack_T, stack_xi = self._stack_T, self._stack_xi
+        stack_T[run, :c] = [point.temperature for point in points]
+        stack_xi[run, :c] = [point.xi_MF for point in points]
         nested = int(count[run] >= 2)
         count[run] = c
         self._nested += int(c >= 2) - nested
@@ -301,10 +295,7 @@ class BatchPlant:
         constants = BranchConstants(
             float(self.M[run]), None, -float(self.minus_energy[run]),
             float(self.inv_heating[run] if heating else self.inv_cooling[run]), None)
-        first = max(c - 2, 0)
-        points = [ReversalPoint(T, xi) for T, xi in zip(
-            stack_T[run, first:c].tolist(), stack_xi[run, first:c].tolist())]
-        branch = branch_of(points, len(points), constants, HEATING if heating else COOLING)
+        branch = branch_of(points, c, constants, HEATING if heating else COOLING)
         self._value_B[run], self._ratio[run], self._major_B[run] = branch
 
     def _grow(self, needed):
