@@ -8,7 +8,7 @@ import csv
 import pytest
 
 from cli_failure import fails
-from sma_fmu.analysis.minor_loop_figure import power_to_reach
+from sma_fmu.runtime.thermal import power_to_reach
 from sma_fmu.cli import main
 from sma_fmu.wire.parameter_file import write_parameter_file
 from sma_fmu.runtime.constant_load import constant_load_resistance

@@ -4,7 +4,7 @@
 "continuous", spec section 6) through a list of temperature turning points at one load. The
 sweep is quasi-static: each step holds its power for :data:`HOLD_TIME_CONSTANTS` thermal time
 constants, with the power that lands the thermal model of section 9 on the next temperature
-(:func:`power_to_reach`). The section 6 hysteresis depends on the temperature path only, not
+(:func:`~sma_fmu.runtime.thermal.power_to_reach`). The section 6 hysteresis depends on the temperature path only, not
 on its speed, so the curve is the one any slow enough sweep gives. Each segment is cut into
 equal steps of at most ``step_K`` and also lands on every earlier turning point it passes,
 so the sample where a minor loop closes is a row of the trace.
@@ -27,9 +27,9 @@ from sma_fmu.runtime.constant_load import (branch_constants, constant_load_resis
                                            require_temperature)
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.plant import PlantStepper
-from sma_fmu.runtime.thermal import step_decay
+from sma_fmu.runtime.thermal import power_to_reach, step_decay
 
-__all__ = ["HOLD_TIME_CONSTANTS", "MAX_STEPS", "MIN_STEP_K", "LoopTrace", "power_to_reach",
+__all__ = ["HOLD_TIME_CONSTANTS", "MAX_STEPS", "MIN_STEP_K", "LoopTrace",
            "check_load", "check_history", "check_step", "trace_history", "reversal_rows",
            "closure_rows", "loops_csv", "loops_figure", "write_loops"]
 
@@ -48,17 +48,6 @@ history : the turning points [degC]; load : the load [kg].
 
 def _degC(value):
     return f"{value:.15g}"
-
-
-def power_to_reach(temperature, target, T_room, gain, decay):
-    """The power u [W] that takes the thermal model from ``temperature`` to ``target`` [degC].
-
-    Inverts :func:`sma_fmu.runtime.thermal.thermal_step`,
-    T+ = T_room + (T - T_room) e^(-h/tau) + K_th u (1 - e^(-h/tau)), for u, with
-    ``T_room`` [degC], ``gain`` K_th [K/W] and ``decay`` e^(-h/tau) [1] < 1. A negative
-    result means the target lies below where passive cooling gets in that step.
-    """
-    return (target - T_room - (temperature - T_room) * decay) / (gain * (1.0 - decay))
 
 
 def check_load(load, params):

@@ -47,6 +47,7 @@ from sma_fmu.identification.isobaric_files import noise_level
 from sma_fmu.identification.isobaric_jacobian import jacobian_rows
 from sma_fmu.identification.isobaric_model import branch_levels, branch_share
 from sma_fmu.identification.measurements import MeasurementError
+from sma_fmu.runtime.constant_load import residual_f_fraction
 from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 
 __all__ = ["RESIDUAL_OPTIONS", "IsobaricFit", "fit_isobaric", "file_model", "KNOTS_PER_BRANCH"]
@@ -221,7 +222,7 @@ def _starts(files, layout, base):
         vector[column:column + data.knot_count] = profile_start
         profiles.append(basis @ profile_start)
     centres = {HEATING: [], COOLING: []}
-    widths, spans, hots, colds, r_levels = [], [], [], [], []
+    widths, spans, r_levels = [], [], []
     for data, profile in zip(files, profiles):
         marks = _crossings(data, profile)
         for d in (HEATING, COOLING):
@@ -242,7 +243,6 @@ def _starts(files, layout, base):
                                    f"{'heating' if d == HEATING else 'cooling'} branch crosses "
                                    f"the transformation")
     start = {}
-    loads = sorted({f.load for f in files})
     for d, a, b in ((HEATING, "a_h", "b_h"), (COOLING, "a_c", "b_c")):
         f, tau = np.array(centres[d]).T
         if b in layout.phys:
@@ -260,7 +260,7 @@ def _starts(files, layout, base):
         raise MeasurementError(f"{files[0].path}: the strain is lower when cold than when hot; the "
                                f"model needs the wire to contract on heating (actuation strain > 0)")
     data0 = spans[0][0]
-    xi_f_min = base.xi_F_inf * (1.0 - math.exp(-data0.load / base.f_F))
+    xi_f_min = residual_f_fraction(data0.load, base)
     reference = data0.reference_length
     if "x_min" in layout.phys:
         cold_length = reference * (1 + float(np.median([c for _, _, c, _ in spans])))
@@ -271,7 +271,7 @@ def _starts(files, layout, base):
         start["l_MF"] = base.x_min + span * reference / (1.0 - xi_f_min)
     if r_levels:
         data, r_hot, r_cold = r_levels[0]
-        xi = base.xi_F_inf * (1.0 - math.exp(-data.load / base.f_F))
+        xi = residual_f_fraction(data.load, base)
         start["R_MF"] = r_cold - xi * layout.half_r
         start["R_P"] = (r_hot - xi * (start["R_MF"] + layout.half_r)) / (1.0 - xi)
     lower = np.full(layout.size, -np.inf)

@@ -45,7 +45,6 @@ def jacobian_rows(x, layout, data, index, column, s):
                     "E": c.inv_centre_K - 1.0 / t_k}
         level = data.row_level[rows]
         gain = np.full(rows.size, lv.strain_span)     # d eps / dq
-        offset_weight = {}
         if d == COOLING and data.per_cycle:
             gain = gain + levels[level + 1] - levels[level]
             offset_weight = {0: 1.0 - q, 1: q}

@@ -20,7 +20,8 @@ from sma_fmu.identification.isobaric_tables import cycle_rows, rows_csv, rows_ma
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import check_folder, staged_folder
 from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file
-from sma_fmu.runtime.constants import BOLTZMANN, STANDARD_GRAVITY
+from sma_fmu.runtime.constant_load import domain_energy, hysteresis_centre
+from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
 
 __all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report"]
 
@@ -89,9 +90,10 @@ def isobaric_report(files, fit, base_set, residual, rows):
             "residual_strain_per_cycle": list(np.diff(offsets)) if residual == "per-cycle" else []})
     widths = {}
     for load in loads:
-        energy = params.nu * (params.eps_T - STANDARD_GRAVITY * load * params.x_T / params.N)
+        energy = domain_energy(load, params)
+        centre_K = hysteresis_centre(load, HEATING, params) + KELVIN_OFFSET
         widths[f"{load:g} kg"] = {"dH_J": energy, "width_25_75_K_heating": 2 * np.log(3) * BOLTZMANN
-                                  * (params.a_h + params.b_h * load + 273.15) ** 2 / energy}
+                                  * centre_K ** 2 / energy}
     return {
         "experiment": "isobaric",
         "files": per_file,

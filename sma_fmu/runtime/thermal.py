@@ -4,7 +4,7 @@
 """
 import math
 
-__all__ = ["thermal_gain", "thermal_time_constant", "step_decay", "thermal_step"]
+__all__ = ["thermal_gain", "thermal_time_constant", "step_decay", "thermal_step", "power_to_reach"]
 
 
 def thermal_gain(h_c, A_s):
@@ -30,3 +30,14 @@ def thermal_step(temperature, power, T_room, gain, decay):
     ``decay`` = e^(-h/tau) from :func:`step_decay`.
     """
     return T_room + (temperature - T_room) * decay + gain * power * (1.0 - decay)
+
+
+def power_to_reach(temperature, target, T_room, gain, decay):
+    """The power u [W] that takes the thermal model from ``temperature`` to ``target`` [degC].
+
+    Inverts :func:`thermal_step`,
+    T+ = T_room + (T - T_room) e^(-h/tau) + K_th u (1 - e^(-h/tau)), for u, with
+    ``T_room`` [degC], ``gain`` K_th [K/W] and ``decay`` e^(-h/tau) [1] < 1. A negative
+    result means the target lies below where passive cooling gets in that step.
+    """
+    return (target - T_room - (temperature - T_room) * decay) / (gain * (1.0 - decay))

@@ -55,7 +55,6 @@ class BatchPwm:
         self.period = 1.0 / self.frequency
         self.held_index = np.full(self.runs.size, np.nan)   # no period held yet
         self.held_duty = np.zeros(self.runs.size)
-        self.power = np.zeros(self.runs.size)                # mean power of the last step [W]
 
     def step(self, demand, time_s, step_size):
         """Mean power [W] of each run's wave over [time_s, time_s + step_size) for ``demand`` [W].
@@ -83,5 +82,4 @@ class BatchPwm:
             self.held_duty = np.where(several, duty, first_duty)
         else:
             self.held_index, self.held_duty = first, first_duty
-        self.power = peak * np.minimum(1.0, on / step_size)
-        return self.power
+        return peak * np.minimum(1.0, on / step_size)
