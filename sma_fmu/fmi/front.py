@@ -178,9 +178,10 @@ def install_fronts(fmu_path, model_identifier, fronts):
                 continue  # left out: no front for it
             entries.append(_entry(platform, binary, bool(build and build.library), fronts.libpython))
         kept = {entry.binary: entry for entry in entries}
+        keep_win64 = any(entry.platform == "win64" for entry in entries)
         for item in source.infolist():
             name = item.filename
-            if name.startswith("binaries/win64/") and not any(e.platform == "win64" for e in entries):
+            if name.startswith("binaries/win64/") and not keep_win64:
                 continue
             data = source.read(name)
             if name == "modelDescription.xml":

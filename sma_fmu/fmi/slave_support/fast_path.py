@@ -26,11 +26,11 @@ import struct
 
 from .lifecycle import INSTANTIATED, STEP_COMPLETE
 
-__all__ = ["FastPath", "DESCRIBE", "ATTACH", "SYNC"]
+__all__ = ["FastPath", "DESCRIBE", "ATTACH", "SYNC", "PENDING"]
 
 DESCRIBE, ATTACH, SYNC = 0xFFFFFA51, 0xFFFFFA52, 0xFFFFFA53
 _HEADER = 6
-_STEP_COMPLETE, _WRITTEN, _PENDING, _SYNC, _FULL = range(5)
+_STEP_COMPLETE, _WRITTEN, PENDING, _SYNC, _FULL = range(5)  # PENDING: inputs set in C since the last step
 _KINDS = (("Real", "R", float), ("Integer", "I", int), ("Boolean", "B", bool))
 
 
@@ -113,7 +113,7 @@ class FastPath:
             if view[pending + index]:
                 setattr(slave, name, convert(view[_HEADER + index]))
                 view[pending + index] = 0.0
-        view[_PENDING] = 0.0
+        view[PENDING] = 0.0
 
     def write_all(self):
         """Every value and the state into the buffer (a value that is no number: the fast
@@ -153,7 +153,7 @@ class FastPath:
         if view is None or not view[_SYNC]:
             return False
         view[_SYNC] = 0.0
-        if view[_PENDING]:
+        if view[PENDING]:
             self.take_inputs()
         self.write_all()
         return True

@@ -23,7 +23,7 @@ from operator import attrgetter
 
 from pythonfmu.enums import Fmi2Status
 
-from .fast_path import ATTACH, DESCRIBE, FastPath
+from .fast_path import ATTACH, DESCRIBE, PENDING, FastPath
 from .lifecycle import ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED
 from .saved_state import SavedStates
 
@@ -191,7 +191,7 @@ class CallGuard:
         fast = self.fast.view
         self.last_outputs = None
         try:
-            if fast is not None and fast[2]:  # inputs the front accepted since the last step
+            if fast is not None and fast[PENDING]:  # inputs the front accepted since the last step
                 self.fast.take_inputs()
             return self._do_step(current_time, step_size)
         except Exception as error:  # noqa: BLE001 - nothing may reach pythonfmu
