@@ -173,9 +173,9 @@ class WireParameters:
         key = f"{spec.section}.{spec.name}"
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self._fail(f"parameter {key} must be a number [{spec.unit}], got {value!r}")
-        value = float(value)
-        if not _rule_holds(spec.rule, value):
+        if not _rule_holds(spec.rule, float(value)):  # the value as given: an Integer stays one
             self._fail(f"parameter {key} = {value!r} {_RULE_TEXT[spec.rule]} [{spec.unit}]")
+        value = float(value)
         object.__setattr__(self, spec.name, int(value) if spec.rule == "depth" else value)
 
     def _derived(self, what, unit, keys, compute):
