@@ -14,6 +14,9 @@ and applies, failing where it would run something other than what the SSD binds 
 binding it does not apply whose value the FMU's default does not hold, a missing
 annotation, a name that is no identifier); and the C-host run is of the whole system,
 with its parameter bindings.
+Before any of these, ``archive``: the archive's entries (:mod:`sma_fmu.files.archives`:
+no path leaving the tree, no link, no duplicate, no bomb, nested FMUs too); an unsafe
+archive gets one FAIL line per unsafe entry and no other check.
 Each check gives a :class:`CheckResult`; an exception inside a check is its failure.
 """
 import functools
@@ -24,6 +27,7 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from sma_fmu.files.archives import inspect_archive
 from sma_fmu.systems.c_host import run_c_host
 from sma_fmu.systems.host_needs import KNOWN_HOSTS, host_check, packed_defaults_check, read_ssp
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
@@ -186,6 +190,10 @@ def check_file(path):
         raise ValueError(f"{path}: no such file")
     if not zipfile.is_zipfile(path):
         return [CheckResult(str(path), "archive", "FAIL", "not a zip archive (an FMU or SSP is one)")]
+    problems = inspect_archive(path)
+    if problems:  # no host, library or unpacking ever sees an unsafe archive
+        return [CheckResult(str(path), "archive", "FAIL", f"unsafe entry {problem.entry!r}: {problem.rule}")
+                for problem in problems]
     if path.suffix.lower() == ".ssp":
         return _ssp_checks(path)
     return _fmu_checks(path, str(path))
