@@ -33,3 +33,18 @@ def test_benchmark_runs_and_reports_every_section(tmp_path, capsys):
     assert results["identification_4_loads_s"] < 60.0   # a finished fit, not a placeholder
     c_hosts = results["c_host_step"]
     assert len(c_hosts) == 6 and all(0 < row["p50_us"] <= row["p99_9_us"] for row in c_hosts.values())
+
+
+def test_the_c_host_bench_steps_the_plant_at_the_library_steps_load(fmi_host_exe, unpacked, fmus):
+    """Issue 27: the C host's SmaActuator ran at load 0 against a library step at 0.05 kg."""
+    from fmi_host import FmiHost
+    from sma_fmu.bench.c_hosts import BENCH_LOAD_KG, _references, plain_host_commands
+    refs = _references(fmus["SmaActuator"])
+    commands = plain_host_commands(refs, steps=10)
+    timed = [line for line in commands if line.startswith("bench ")]
+    assert len(timed) == 1
+    with FmiHost(fmi_host_exe, unpacked["SmaActuator"]) as host:
+        for line in commands[:commands.index(timed[0])]:  # up to the timed steps
+            assert host.call(line).status == 0, line
+        assert [float(v) for v in host.call(f"getreal 0 1 {refs['load']}").values] == [BENCH_LOAD_KG]
+        assert BENCH_LOAD_KG > 0

@@ -1,6 +1,8 @@
 """What a SmaActuator step costs in C hosts, before and after the native front.
 
-Each host runs 30,000 steps of 1 ms (P_in = 2.6 W, load = 0.05 kg) and times every step:
+Each host runs 30,000 steps of 1 ms (P_in = 2.6 W, load = 0.05 kg: :data:`BENCH_P_IN_W`,
+:data:`BENCH_LOAD_KG`, as the library plant step and the fmpy master it is compared with) and
+times every step:
 - the plain ``dlopen`` C host (``sma_fmu/fmi/hosts/fmi_host.c``): set P_in + doStep + get T;
 - libcosim (sma-fmu's C host ``hosts/cosim_host.c --timing``, if libcosimpy is installed):
   one ``cosim_execution_step`` (libcosim sets, steps and reads the FMU's variables itself).
@@ -29,8 +31,8 @@ from sma_fmu.fmi.front import libpython_path, remove_front
 from sma_fmu.fmi.hosts import c_compiler, compile_host
 from sma_fmu.systems.c_host import host_environment
 
-__all__ = ["C_HOST_STEPS", "c_host_step_costs", "build_thermal_lag", "plain_host_step_us",
-           "THERMAL_LAG_REFERENCES"]
+__all__ = ["BENCH_LOAD_KG", "BENCH_P_IN_W", "C_HOST_STEPS", "c_host_step_costs",
+           "build_thermal_lag", "plain_host_commands", "plain_host_step_us", "THERMAL_LAG_REFERENCES"]
 
 THERMAL_LAG_REFERENCES = {"P_in": 0, "T": 1, "T_room": 2, "K_th": 3, "tau": 4, "T_start": 5}
 _LAG_XML = """<?xml version="1.0" encoding="UTF-8"?>
@@ -53,6 +55,8 @@ _LAG_XML = """<?xml version="1.0" encoding="UTF-8"?>
 
 C_HOST_STEPS = 30_000
 _STEP = 1e-3
+BENCH_P_IN_W = 2.6     # W, every SmaActuator step of the bench
+BENCH_LOAD_KG = 0.05   # kg, every SmaActuator step of the bench (C hosts, fmpy, library)
 
 
 def _references(fmu):
@@ -96,21 +100,28 @@ def build_thermal_lag(folder, params):
     return path, None
 
 
-def plain_host_step_us(fmu, runs, folder, refs, init=()):
+def plain_host_step_us(fmu, runs, folder, refs, init=None):
     """Median over ``runs`` of the mean [us] of set P_in + doStep + get T in fmi_host, for any
-    FMU with those variables (``init``: fmi_host commands in Initialization Mode); a list."""
+    FMU with those variables (``init``: fmi_host commands in Initialization Mode, default: the
+    load set to :data:`BENCH_LOAD_KG`); a list."""
     unpacked = Path(folder) / f"unpacked-{Path(fmu).stem}"
     shutil.unpack_archive(str(fmu), str(unpacked), "zip")
     host = compile_host("fmi_host", folder)
     return [_plain_host(host, unpacked, refs, {}, init)[0] for _ in range(runs)]
 
 
+def plain_host_commands(refs, init=None, steps=C_HOST_STEPS):
+    """The fmi_host commands of one timed run: instantiate, initialize (``init``, default: the
+    load ``refs["load"]`` set to :data:`BENCH_LOAD_KG`), then ``steps`` timed steps at
+    :data:`BENCH_P_IN_W`; a list of lines."""
+    init = [f"setreal 0 1 {refs['load']} {BENCH_LOAD_KG!r}"] if init is None else list(init)
+    return [f"instantiate 0 {b'bench'.hex()} ok ok 0", "setup 0 0 -", "enter 0", *init, "exit 0",
+            f"bench 0 {steps} {_STEP} {refs['P_in']} {BENCH_P_IN_W!r} {refs['T']} 0", "end"]
+
+
 def _plain_host(exe, folder, refs, env, init=None):
     """(mean, p50, p99, p99.9) [us] of set + doStep + get in fmi_host."""
-    init = [f"setreal 0 1 {refs['load']} 0.05"] if init is None else list(init)
-    commands = "\n".join([
-        f"instantiate 0 {b'bench'.hex()} ok ok 0", "setup 0 0 -", "enter 0", *init, "exit 0",
-        f"bench 0 {C_HOST_STEPS} {_STEP} {refs['P_in']} 2.6 {refs['T']} 0", "end", ""])
+    commands = "\n".join([*plain_host_commands(refs, init), ""])
     result = subprocess.run([str(exe), str(folder)], input=commands, capture_output=True, text=True,
                             env=_environment(env), timeout=600, check=True)
     words = [line.split() for line in result.stdout.splitlines() if line.startswith("= ")][-1]
@@ -123,8 +134,8 @@ def _plain_host(exe, folder, refs, env, init=None):
 def _libcosim(exe, fmu, env):
     """(mean, p50, p99, p99.9) [us] of one libcosim step."""
     result = subprocess.run(
-        [str(exe), "--timing", "fmu", str(fmu), repr(_STEP), str(C_HOST_STEPS), "P_in=2.6",
-         "load=0.05"], capture_output=True, text=True, env=_environment(env), timeout=600)
+        [str(exe), "--timing", "fmu", str(fmu), repr(_STEP), str(C_HOST_STEPS),
+         f"P_in={BENCH_P_IN_W!r}", f"load={BENCH_LOAD_KG!r}"], capture_output=True, text=True, env=_environment(env), timeout=600)
     timing = [line.split() for line in result.stdout.splitlines() if line.startswith("timing ")]
     if result.returncode != 0 or not timing:
         raise RuntimeError(f"libcosim run failed: {(result.stdout + result.stderr)[-500:]}")
@@ -164,14 +175,14 @@ def c_host_step_costs(fmu, runs, folder):
 
 
 def _library_plant_step_us(params, steps=C_HOST_STEPS):
-    """Mean [us] of the library's plant step (PlantStepper.step, P_in = 2.6 W, load = 0.05 kg)."""
+    """Mean [us] of the library's plant step (PlantStepper.step at BENCH_P_IN_W, BENCH_LOAD_KG)."""
     import time
     from sma_fmu.runtime.plant import PlantStepper
-    stepper = PlantStepper(params, load=0.05)
+    stepper = PlantStepper(params, load=BENCH_LOAD_KG)
     step = stepper.step
     start = time.perf_counter()
     for _ in range(steps):
-        step(2.6, 0.05, _STEP)
+        step(BENCH_P_IN_W, BENCH_LOAD_KG, _STEP)
     return (time.perf_counter() - start) / steps * 1e6
 
 
@@ -185,7 +196,7 @@ def _master_step_us(fmu, start_values, steps=C_HOST_STEPS):
         inputs, step, t = lean.inputs, lean.step, 0.0
         begin = time.perf_counter()
         for _ in range(steps):
-            inputs[0] = 2.6
+            inputs[0] = BENCH_P_IN_W
             step(t, _STEP)
             t += _STEP
         return (time.perf_counter() - begin) / steps * 1e6
@@ -201,7 +212,7 @@ def floor_costs(fmu_paths, params, runs, folder):
     cases = {
         "library plant step": lambda: _library_plant_step_us(params),
         "SmaActuator, C host": lambda: plain_host_step_us(actuator, 1, folder, refs)[0],
-        "SmaActuator, fmpy master": lambda: _master_step_us(actuator, {"load": 0.05}),
+        "SmaActuator, fmpy master": lambda: _master_step_us(actuator, {"load": BENCH_LOAD_KG}),
     }
     if lag is not None:
         cases["ThermalLag (native C), C host"] = lambda: plain_host_step_us(
