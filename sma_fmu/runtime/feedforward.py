@@ -23,6 +23,13 @@ Two inverses (``inverse``):
 In both, a reference outside what the branch can reach at the present load gives the
 temperature of the nearest reachable edge (xi_MF clamped to delta or M - delta of the
 section 5 clamp) and ``saturated`` = True.
+
+No reference yet: R_ref <= 0 ohm before the first R_ref > 0 (a host that steps before its
+inputs are connected, as fmpy's ``simulate_ssp`` gives every input 0.0 at t = 0) is an
+unconnected start, not an error. That step outputs P_ff = 0 W, T_ref = T_room and
+``saturated`` = True, sets one warning (the first such step only) and changes no state:
+the first R_ref > 0 is the compensator's first sample (filter started in steady state).
+After a reference has arrived, R_ref <= 0 is refused (``ValueError``) as before.
 """
 import math
 from collections import namedtuple
@@ -100,6 +107,7 @@ class FeedforwardStepper:
         self._branches = BranchCache(params)
         self.warning = None               # validity warning of the last step (the load)
         self._load_before = -math.inf     # load of the last step [kg]
+        self._unconnected_warned = False  # the no-reference-yet warning was given
 
     def _invert(self, reference, load, direction):
         """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
@@ -125,13 +133,27 @@ class FeedforwardStepper:
             return self.direction
         return HEATING if reference < previous else COOLING
 
+    def _no_reference_yet(self, reference):
+        """True for R_ref <= 0 [ohm] before the first R_ref > 0 (see the module docstring)."""
+        try:
+            return self.previous_reference is None and reference <= 0.0
+        except TypeError:  # not a number: the checks name it
+            return False
+
+    def _unconnected(self):
+        """The outputs of a sample without a reference: P_ff = 0 W, T_ref = T_room, saturated."""
+        return _new_tuple(FeedforwardOutputs, (0.0, self.params.T_room, True))
+
     def initial_outputs(self, reference, load):
         """Outputs before the first step (filter in steady state); the state is unchanged.
 
-        ``reference`` R_ref [ohm], ``load`` [kg].
+        ``reference`` R_ref [ohm], ``load`` [kg]; R_ref <= 0 gives the unconnected outputs.
         """
         if self.filter.previous_input is not None:
             raise RuntimeError("initial_outputs is only defined before the first step")
+        if self._no_reference_yet(reference):
+            require_nonnegative("load", load)
+            return self._unconnected()
         reference = require_positive("R_ref", reference)
         load = require_nonnegative("load", load)
         sensed = self._invert(reference, load, self._direction_for(reference))[0]
@@ -140,8 +162,18 @@ class FeedforwardStepper:
     def step(self, reference, load, step_size):
         """Compensate one sample: R_ref [ohm] and load [kg] at t_k, step h [s] -> outputs.
 
-        Invalid inputs raise ``ValueError`` before any state changes.
+        Invalid inputs raise ``ValueError`` before any state changes. R_ref <= 0 before the
+        first R_ref > 0 gives the unconnected outputs and one warning (module docstring).
         """
+        if self.previous_reference is None and self._no_reference_yet(reference):
+            fast_nonnegative("load", load)
+            fast_positive("step_size", step_size)
+            self.warning = None if self._unconnected_warned else (
+                f"R_ref = {reference!r} ohm before any reference (an unconnected input): "
+                f"P_ff = 0 W, T_ref = T_room, saturated; the compensator starts at the first "
+                f"R_ref > 0")
+            self._unconnected_warned = True
+            return self._unconnected()
         reference = fast_positive("R_ref", reference)
         load = fast_nonnegative("load", load)
         step_size = fast_positive("step_size", step_size)
