@@ -72,8 +72,8 @@ def _kind_problem(info):
     if info.create_system != 3:  # 3: Unix; others carry no file type
         return None
     mode = info.external_attr >> 16
-    if mode == 0 or stat.S_ISREG(mode) or stat.S_ISDIR(mode):
-        return None
+    if stat.S_IFMT(mode) == 0 or stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return None  # no type recorded (permission bits alone), a file or a folder
     if stat.S_ISLNK(mode):
         return "symbolic link"
     return f"not a regular file (mode {oct(stat.S_IFMT(mode))})"

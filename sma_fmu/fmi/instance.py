@@ -15,6 +15,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2CallbackFunctions,
                        fmi2CallbackLoggerTYPE)
 
+from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.build import read_description
 
 __all__ = ["FmuError", "FmuInstance"]
@@ -86,6 +87,7 @@ class FmuInstance:
     def __init__(self, path, instance_name, start_values=None, start_time=0.0):
         self.path = str(path)
         self.instance_name = instance_name
+        require_safe_archive(self.path)  # fmpy unpacks it: never an archive that leaves its folder
         description = read_description(path)
         self.variables = {v.name: v for v in description.modelVariables}
         self.messages = []

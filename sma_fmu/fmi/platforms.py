@@ -194,6 +194,9 @@ def platform_results(path):
         return [(f"platform {name}", status, detail) for status, name, detail in platform_report(path)]
     import tempfile
 
+    from sma_fmu.files.archives import require_safe_archive
+
+    require_safe_archive(path)  # its FMUs are unpacked below
     results = []
     with tempfile.TemporaryDirectory(prefix="sma_fmu_platforms_") as folder, zipfile.ZipFile(path) as ssp:
         for name in sorted(n for n in ssp.namelist() if n.lower().endswith(".fmu")):

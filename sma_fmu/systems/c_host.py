@@ -14,6 +14,7 @@ import os
 import re
 import subprocess
 
+from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.hosts import CHostError, compile_host
 
 __all__ = ["CHostError", "host_environment", "run_c_host"]
@@ -40,6 +41,7 @@ def run_c_host(kind, path, step_size, steps, timeout=600):
     ``step_size`` [s], ``steps``: the fixed steps to take. Raises :class:`CHostError` with
     the host's message when it fails.
     """
+    require_safe_archive(path)  # libcosim unpacks it: never one that leaves its folder
     executable = compile_host("cosim_host")
     result = subprocess.run([str(executable), kind, str(path), repr(float(step_size)), str(steps)],
                             capture_output=True, text=True, env=host_environment(),

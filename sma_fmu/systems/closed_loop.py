@@ -20,6 +20,7 @@ codes of :mod:`sma_fmu.fmi.slave_support.choices`.
 from dataclasses import dataclass
 
 from sma_fmu.cosim.master import MissingFmuError, model_parameter_values, needed_fmus
+from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.build import default_fmu_paths, read_description
 from sma_fmu.fmi.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
@@ -93,6 +94,7 @@ def _fmu_files(scenario, fmu_dir):
         if not paths[name].is_file():
             raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "
                                   f"sma-fmu build --out {fmu_dir}")
+        require_safe_archive(paths[name])  # an export packs it for hosts that unpack it
     return paths
 
 

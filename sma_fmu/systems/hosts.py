@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from sma_fmu.cosim.loop import COLUMNS
+from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.systems.container import loop_outputs
 from sma_fmu.systems.ssp import PARAMETER_SET
 
@@ -121,6 +122,7 @@ def run_ssp_libcosim(ssp_path, steps, outputs):
 
     The step size comes from the SSD's OSP annotation. libcosim couples by Jacobi.
     """
+    require_safe_archive(ssp_path)
     from libcosimpy.CosimExecution import CosimExecution
 
     _quiet_libcosim()
@@ -133,6 +135,7 @@ def run_ssp_libcosim(ssp_path, steps, outputs):
 
 def run_container_libcosim(fmu_path, step_size, steps, outputs):
     """Run the container FMU alone in libcosim, ``steps`` steps of ``step_size`` [s]."""
+    require_safe_archive(fmu_path)
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimSlave import CosimLocalSlave
 
@@ -163,6 +166,7 @@ def load_tbb():
 
 def run_ssp_ecos(ssp_path, step_size, steps, outputs):
     """Run an SSP of :mod:`.ssp` in Ecos, ``steps`` steps of ``step_size`` [s] (Jacobi)."""
+    require_safe_archive(ssp_path)
     load_tbb()
     from ecospy import EcosLib, EcosSimulation
 
@@ -202,6 +206,7 @@ def _ecos_readers(simulation, outputs, ssp_path):
 # ------------------------------------------------------------------------------ fmpy
 def run_container_fmpy(fmu_path, step_size, steps, outputs):
     """Run the container FMU in fmpy's ``simulate_fmu``; returns {column: samples}."""
+    require_safe_archive(fmu_path)
     from fmpy import read_model_description, simulate_fmu
 
     names = {v.name for v in read_model_description(str(fmu_path)).modelVariables
