@@ -9,6 +9,7 @@
 #define MOLAR_MASS_NI 58.6934e-3      /* kg/mol */
 #define STANDARD_GRAVITY 9.80665      /* m/s^2: a hung mass f [kg] pulls with g*f [N] */
 #define KELVIN_OFFSET 273.15          /* K: T_K = T_degC + KELVIN_OFFSET */
+#define SMA_PI 3.141592653589793      /* Python's math.pi (C99 has no M_PI) */
 
 #define HEATING 1                     /* direction d = sgn(dT/dt) while heating */
 #define COOLING (-1)                  /* direction d while cooling */

@@ -1,0 +1,69 @@
+/* Constant-load model with a direction-switched hysteresis centre (spec sections 3-4);
+ * runtime/constant_load.py.
+ *   tau(f, d) = a_h + b_h f (heating), a_c + b_c f (cooling)   [degC]
+ *   xi_Fmin(f) = xi_F_inf (1 - exp(-f/f_F)),  dH(f) = nu (eps_T - g f x_T / N)  [J]
+ *   Lambda = (dH/k_B)(1/tau_K - 1/T_K),  xi_MF = M/(1 + e^Lambda),  xi_P = M - xi_MF */
+#ifndef SMA_CONSTANT_LOAD_H
+#define SMA_CONSTANT_LOAD_H
+
+#include "parameters.h"
+#include "phases.h"
+#include "sma_message.h"
+
+/* Constants of one major branch at one load: M = 1 - xi_Fmin [1], xi_F_min [1],
+ * energy_over_kB = dH/k_B [K], inv_centre_K = 1/tau_K [1/K], centre = tau [degC]. */
+typedef struct BranchConstants {
+    double M;
+    double xi_F_min;
+    double energy_over_kB;
+    double inv_centre_K;
+    double centre;
+} BranchConstants;
+
+/* `value` [degC] finite and above absolute zero, else refused naming `name`. */
+int require_temperature(const char *name, double value, SmaMessage *message);
+/* Hysteresis centre tau [degC] for a load [kg] and direction (+1 heating, -1 cooling). */
+double hysteresis_centre(double load, int direction, const WireParameters *params);
+/* Residual F fraction xi_Fmin(f) [1]. */
+double residual_f_fraction(double load, const WireParameters *params);
+/* dH(f) [J] -> *energy; refused when it overflows or is <= 0 (load beyond the model). */
+int domain_energy(double load, const WireParameters *params, double *energy,
+                  SmaMessage *message);
+/* The BranchConstants for `load` [kg] and `direction`; refused as Python's ValueError. */
+int branch_constants(double load, int direction, const WireParameters *params,
+                     BranchConstants *out, SmaMessage *message);
+/* Split `total` into (total/(1+e^z), total e^z/(1+e^z)) without overflow. */
+void logistic_split(double total, double exponent, double *first, double *second);
+/* (xi_MF, xi_P) [1] on a major branch at `temperature` [degC] (no argument checks). */
+void branch_fractions(double temperature, const BranchConstants *constants, double *xi_mf,
+                      double *xi_p);
+/* PhaseFractions from xi_MF, xi_P and the residual F (xi_M = xi_F'). */
+PhaseFractions phase_fractions(double xi_mf, double xi_p, double xi_f_min);
+int constant_load_fractions(double temperature, double load, int direction,
+                            const WireParameters *params, PhaseFractions *out,
+                            SmaMessage *message);
+int constant_load_resistance(double temperature, double load, int direction,
+                             const WireParameters *params, double *out, SmaMessage *message);
+
+/* Memo of branch_constants per (load, direction) for steppers (Python's BranchCache, same
+ * numbers): the last entry is checked first; the memo is emptied when it holds
+ * BRANCH_CACHE_SIZE entries. No heap memory and no pointers (a stepper may be copied): the
+ * caller passes the parameters at each get. */
+#define BRANCH_CACHE_SIZE 64
+typedef struct BranchCacheEntry {
+    double load;
+    int direction;
+    BranchConstants constants;
+} BranchCacheEntry;
+typedef struct BranchCache {
+    int count;
+    int last;                         /* index of the last entry returned, -1: none */
+    BranchCacheEntry entries[BRANCH_CACHE_SIZE];
+} BranchCache;
+
+void branch_cache_init(BranchCache *cache);
+/* The constants for `load` [kg] and `direction` (+1/-1) -> *out (a copy). */
+int branch_cache_get(BranchCache *cache, const WireParameters *params, double load, int direction,
+                     BranchConstants *out, SmaMessage *message);
+
+#endif
