@@ -1,6 +1,7 @@
 """Model commands: lattice, wire, resistance, sense, constant-length (``name = value unit`` or JSON)."""
 import json
 import math
+import sys
 
 from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.runtime.checks import direction_name
@@ -9,6 +10,7 @@ from sma_fmu.runtime.constant_load import constant_load_fractions
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.phases import length_of, resistance_of
 from sma_fmu.runtime.sensing import sense_temperature
+from sma_fmu.runtime.validity import validity_warning
 
 from .arguments import Parser, direction, finite_number
 
@@ -78,10 +80,22 @@ def _constant_length(args, parameter_set):
             ("df_dT", slope, "kg/K")]
 
 
+def _warn_load(args, params):
+    """One ``sma-fmu: warning:`` line on stderr for a --load above the validity limit, as the
+    FMUs warn (runtime/validity.py)."""
+    load = getattr(args, "load", None)
+    message = None if load is None else validity_warning(params, -math.inf, -math.inf, load, -math.inf)
+    if message:
+        print(f"sma-fmu: warning: --load: {message}", file=sys.stderr)
+
+
 def _handler(compute):
     """Handler that loads the parameter file, computes rows and prints them."""
     def handler(args):
-        _report(compute(args, load_parameter_set(args.model)), args.json)
+        parameter_set = load_parameter_set(args.model)
+        rows = compute(args, parameter_set)
+        _warn_load(args, parameter_set.params)
+        _report(rows, args.json)
         return 0
     return handler
 

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from sma_fmu.files.package_data import default_parameter_file
+from sma_fmu.runtime.constant_load import branch_constants
+from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
 from sma_fmu.files.toml_files import read_toml
 from sma_fmu.wire.geometry import DERIVABLE, GEOMETRY_INPUTS, complete_from_geometry
@@ -84,8 +86,32 @@ def parse_parameter_document(document, source):
         raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
     values, derived = complete_from_geometry(values, source)
     params = WireParameters.from_values(values, source=str(source))
+    check_load_range(params, source)
     return ParameterSet(params, str(wire.get("name", Path(str(source)).stem)),
                         str(wire.get("description", "")), meanings, derived=derived)
+
+
+def check_load_range(params, source):
+    """Raise :class:`ParameterError` naming ``source`` and the parameters behind it when the
+    major branches cannot be evaluated at load 0 or at the validity limit ``load_max``.
+
+    Each value may pass its own rule while together they put the model out of the
+    floating-point range (``geometry.mass = 5e-324`` makes N tiny and dH(f) overflow at any
+    load): say so when the file is read, not at the first step of a run.
+    """
+    for load in (0.0, params.load_max):
+        for direction in (HEATING, COOLING):
+            try:
+                branch_constants(load, direction, params)
+            except ValueError as error:
+                raise ParameterError(
+                    f"{source}: the model cannot be evaluated at load {load!r} kg, within its "
+                    f"validity range [0, {params.load_max!r}] kg: {error}. It follows from "
+                    f"dH(f) = nu (eps_T - g f x_T / N) with constant_load.nu = {params.nu!r}, "
+                    f"constant_load.eps_T = {params.eps_T!r} J, x_T = {params.x_T!r} m "
+                    f"(phases.l_M, phases.l_F, geometry.x_min) and N = {params.N!r} "
+                    f"(geometry.mass = {params.mass!r} kg, x0, diameter, theta), and the "
+                    f"centres hysteresis.a_h + b_h f, a_c + b_c f") from None
 
 
 def _parse_entry(entry, spec, source):
