@@ -1,0 +1,150 @@
+/* Temperature-sensing inverse; runtime/sensing.py (see sensing.h). */
+#include "sensing.h"
+
+#include <math.h>
+
+#include "checks.h"
+#include "constants.h"
+#include "reachable_band.h"
+
+void mixed_fractions_of_resistance(double resistance, const BranchConstants *constants,
+                                   const WireParameters *params, double *xi_mf, double *xi_p)
+{
+    double span = params->R_MF - params->R_P;
+    ResistanceBand band = band_of_branch(constants, params);
+    *xi_mf = (resistance - band.hot) / span;
+    *xi_p = (band.cold - resistance) / span;
+}
+
+/* (xi_MF, xi_P) moved to the nearer end of [delta, total - delta] (one is outside). */
+static void clamped(double *xi_mf, double *xi_p, double total, double delta)
+{
+    if (!(*xi_mf >= delta)) {   /* also NaN */
+        *xi_mf = delta;
+        *xi_p = total - delta;
+        return;
+    }
+    *xi_mf = total - delta;
+    *xi_p = delta;
+}
+
+int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *constants,
+                             double margin, SensedTemperature *sensed, SmaMessage *message)
+{
+    double delta = margin * constants->M, exponent, inverse_kelvin;
+    int saturated = 0;
+    if (!(xi_mf >= delta && xi_p >= delta)) {
+        clamped(&xi_mf, &xi_p, constants->M, delta);
+        saturated = 1;
+    }
+    exponent = log(xi_p / xi_mf);
+    inverse_kelvin = constants->inv_centre_K - exponent / constants->energy_over_kB;
+    if (!(inverse_kelvin > 0.0)) {
+        return sma_message_set(message, "temperature-sensing inverse diverges at Lambda = %.17g: "
+                               "dH(f)/k_B = %.17g K is too small for the hysteresis centre",
+                               exponent, constants->energy_over_kB);
+    }
+    sensed->temperature = 1.0 / inverse_kelvin - KELVIN_OFFSET;
+    sensed->saturated = saturated;
+    return 0;
+}
+
+int temperature_on_stack(double xi_mf, double xi_p, const BranchConstants *constants,
+                         int direction, const ReversalPoint *points, size_t count, double margin,
+                         SensedTemperature *sensed, size_t *kept, SmaMessage *message)
+{
+    double total, delta, target;
+    int is_clamped = 0, heating;
+    if (count == 0) {
+        *kept = 0;
+        return temperature_of_fractions(xi_mf, xi_p, constants, margin, sensed, message);
+    }
+    total = constants->M;
+    delta = margin * total;
+    if (!(xi_mf >= delta && xi_p >= delta)) {
+        clamped(&xi_mf, &xi_p, total, delta);
+        is_clamped = 1;
+    }
+    heating = direction == HEATING;
+    target = heating ? xi_mf : xi_p;
+    while (count) {
+        const ReversalPoint *top = &points[count - 1];
+        double value_A = value_of(top, total, heating), value_B, major_A, major_B, span, major;
+        double major_mf, major_p;
+        if (count >= 2) {
+            const ReversalPoint *below = &points[count - 2];
+            double offset;
+            value_B = value_of(below, total, heating);
+            offset = target - value_B;
+            if (offset * (value_A - value_B) < 0.0 || offset == 0.0) {   /* at or beyond B: outer */
+                count -= 2;
+                continue;
+            }
+            major_B = major_value(below->temperature, constants, heating);
+        } else {
+            value_B = major_B = 0.0;
+        }
+        major_A = major_value(top->temperature, constants, heating);
+        span = value_A - value_B;
+        if (fabs(major_A - major_B) < DENOMINATOR_FLOOR || fabs(span) < DENOMINATOR_FLOOR) {
+            sensed->temperature = top->temperature;
+            sensed->saturated = 1;
+            *kept = count;
+            return 0;
+        }
+        major = major_B + (target - value_B) * ((major_A - major_B) / span);
+        fractions_of_value(major, total, heating, &major_mf, &major_p);
+        if (temperature_of_fractions(major_mf, major_p, constants, margin, sensed, message)) {
+            return 1;
+        }
+        if (is_clamped) {
+            sensed->saturated = 1;
+        }
+        *kept = count;
+        return 0;
+    }
+    if (temperature_of_fractions(xi_mf, xi_p, constants, margin, sensed, message)) {
+        return 1;   /* the stack emptied */
+    }
+    if (is_clamped) {
+        sensed->saturated = 1;
+    }
+    *kept = 0;
+    return 0;
+}
+
+int invert_on_stack(double xi_mf, double xi_p, const BranchConstants *constants, int direction,
+                    const ReversalPoint *points, size_t count, double margin,
+                    SensedTemperature *sensed, size_t *kept, double *assumed,
+                    SmaMessage *message)
+{
+    if (temperature_on_stack(xi_mf, xi_p, constants, direction, points, count, margin, sensed,
+                             kept, message)) {
+        return 1;
+    }
+    if (sensed->saturated) {
+        double branch_p;
+        fractions_on_stack(sensed->temperature, constants, direction, points, *kept, &xi_mf,
+                           &branch_p);
+    }
+    *assumed = xi_mf;
+    return 0;
+}
+
+int sense_temperature(double resistance, double load, int direction,
+                      const WireParameters *params, const ReversalPoint *reversals,
+                      size_t count, SensedTemperature *sensed, SmaMessage *message)
+{
+    BranchConstants constants;
+    double xi_mf, xi_p;
+    size_t kept;
+    int sign;
+    if (require_positive("resistance", resistance, message)
+        || direction_sign(direction, NULL, &sign, message)
+        || branch_constants(load, sign, params, &constants, message)) {
+        return 1;
+    }
+    mixed_fractions_of_resistance(resistance, &constants, params, &xi_mf, &xi_p);
+    return temperature_on_stack(xi_mf, xi_p, &constants, sign, reversals, count,
+                                params->saturation_margin, sensed, &kept, message);
+}
