@@ -2,8 +2,9 @@
 
 Pinned here: the SSD's identifiers, both vendor annotations (OSP for libcosim,
 OpenModelica for OMSimulator) and the DefaultExperiment; no setting that lives only in a
-String binding (choices are Integers, and every FMU carries the bound values as its
-defaults); fmpy's ``simulate_ssp``, which binds nothing, running the scenario; and
+String binding (choices are Integers, no String is bound: OMSimulator logs an error for
+one, and every FMU carries all values as its defaults); fmpy's ``simulate_ssp``, which
+binds nothing, running the scenario, compensator loops too; and
 ``sma-fmu check`` failing, per host, a package that a host would run differently.
 OMSimulator is on no registry: its test runs only when SMA_FMU_OMSIMULATOR names the
 executable (docs/systems.md); benchmarks/hosts.py gives its per-host table.
@@ -21,6 +22,7 @@ from sma_fmu.cli import main
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios
 from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.signals import load_from_table
@@ -106,9 +108,11 @@ def test_the_ssd_names_are_identifiers_and_it_carries_both_annotations(exported,
 
 
 @pytest.mark.parametrize("name", SCENARIOS)
-def test_no_setting_lives_only_in_a_string_binding(exported, name):
-    """Choices are Integers; every binding, String or not, is also the FMU's default."""
+def test_the_ssd_binds_no_string_and_the_fmus_hold_every_value(exported, fmu_dir, name):
+    """Choices are Integers; the SSD binds what every host reads (no String: OMSimulator
+    logs an error per String binding), and every value, bound or not, is the FMU's default."""
     scenario = _scenario(name)
+    system = closed_loop(scenario, fmu_dir)
     with zipfile.ZipFile(exported[name]) as archive:
         root = ET.fromstring(archive.read(SSD_NAME))
         checked = 0
@@ -119,14 +123,14 @@ def test_no_setting_lives_only_in_a_string_binding(exported, name):
             assert not defaults.problems()
             for parameter in component.iter(_tag("ssv:Parameter")):
                 kind = parameter[0].tag.rsplit("}", 1)[1]
-                value = parameter[0].get("value")
-                if kind == "String":  # only the signal tables, which no Integer can hold
-                    assert (component.get("name"), parameter.get("name")) in {
-                        ("signals", "reference"), ("signals", "load_profile")}
-                    assert defaults.value(parameter.get("name")) == value
-                else:
-                    assert defaults.starts[parameter.get("name")][0] == kind
+                assert kind in ("Real", "Integer", "Boolean"), parameter.get("name")
+                assert defaults.starts[parameter.get("name")][0] == kind
                 checked += 1
+            if component.get("name") == "signals":   # its tables: Strings, packed only
+                parameters = system.component("signals").parameters
+                assert {"reference", "load_profile"} <= set(parameters)
+                for table in ("reference", "load_profile"):
+                    assert defaults.value(table) == parameters[table]
     bindings = {(c.get("name"), p.get("name")): (p[0].tag.rsplit("}", 1)[1], p[0].get("value"))
                 for c in root.iter(_tag("ssd:Component")) for p in c.iter(_tag("ssv:Parameter"))}
     mode = {"continuous": "1", "switch": "2"}[scenario.hysteresis_mode]
@@ -156,22 +160,28 @@ def test_a_packed_fmu_runs_the_scenario_with_nothing_set(exported, tmp_path, par
 
 # ------------------------------------------------------------------------- fmpy simulate_ssp
 def _simulate_ssp_reference(scenario):
-    """What fmpy 0.3.32's simulate_ssp computes for a "pi" loop, from the runtime steppers:
-    Jacobi, with every input 0.0 in the first step (the plant's load too, from its start
-    value), the PI's P_ff at its start value (no connector), the signals on the grid."""
-    h, n = scenario.step_s, scenario.steps
+    """What fmpy 0.3.32's simulate_ssp computes, from the runtime steppers: Jacobi, with
+    every input 0.0 in the first step (the plant's load too, from its start value; the
+    compensator's R_ref, which it takes as no reference yet), the PI's P_ff at its start
+    value 0 W without a compensator, the signals on the grid."""
+    h, n, c = scenario.step_s, scenario.steps, scenario.controller
     plant = PlantStepper(scenario.params, scenario.T_start, scenario.hysteresis_mode, 0.0)
-    pi = PIController(scenario.controller.Kp, scenario.controller.Ki)
-    resistance = reference = load = power = 0.0
+    pi = PIController(c.Kp, c.Ki)
+    compensator = (FeedforwardStepper(scenario.compensator_params, c.alpha, c.beta, c.model_load,
+                                      c.adapt_to_load, c.inverse) if c.feedforward else None)
+    resistance = reference = load = power = feedforward = 0.0
     rows = []
     for k in range(n):
-        command, _ = pi.sample(resistance, reference, 0.0, h)
+        command, _ = pi.sample(resistance, reference, feedforward, h)
         out = plant.step(power, load, h)
+        step_ff = compensator.step(reference, load, h).P_ff if compensator else 0.0
         t = (k + 1) * h
-        resistance, reference, load, power = out.R, scenario.reference.value(t), \
-            scenario.load.value(t), command
-        rows.append((reference, load, resistance, out.P))
-    return {column: np.array(values) for column, values in zip(("R_ref", "load", "R", "P"), zip(*rows))}
+        resistance, reference, load, power, feedforward = out.R, scenario.reference.value(t), \
+            scenario.load.value(t), command, step_ff
+        rows.append((reference, load, resistance, out.P, step_ff))
+    columns = ("R_ref", "load", "R", "P", "P_ff")
+    return {column: np.array(values) for column, values in zip(columns, zip(*rows))
+            if column != "P_ff" or compensator}
 
 
 @pytest.mark.parametrize("name", ["heavy-pi", "load-step-pi"])
@@ -191,10 +201,25 @@ def test_fmpy_simulate_ssp_runs_the_pi_loops_scenario(fmu_dir, tmp_path, name):
     assert np.max(np.abs(series["R"][-500:] - library["R"][-500:])) < 0.01
 
 
-def test_fmpy_simulate_ssp_stops_on_a_loop_with_a_compensator(exported):
-    """Its zero first inputs give the compensator R_ref = 0 ohm: a discard at t = 0."""
-    with pytest.raises(HostError, match=r"fmpy simulate_ssp: .*fmi2DoStep failed with status 2"):
-        run_ssp_fmpy(exported["load-step-pi+ff-adaptive"], 1e-3, 10)
+@pytest.mark.parametrize("name", ["load-step-pi+ff-adaptive", "heavy-continuous-pi+ff-adaptive-minor-loop"])
+def test_fmpy_simulate_ssp_runs_a_compensator_loop(fmu_dir, tmp_path, name):
+    """Its zero first inputs give the compensator R_ref = 0 ohm: no reference yet (P_ff =
+    0 W), and the loop goes on; it ends where the library's Jacobi loop does."""
+    scenario = _scenario(name, stop_time_s=2.2, load=LOAD_STEP)
+    path = write_ssp(closed_loop(scenario, fmu_dir), tmp_path / f"{name}.ssp")
+    series = fmpy_ssp_series(run_ssp_fmpy(path, scenario.step_s, scenario.steps))
+    expected = _simulate_ssp_reference(scenario)
+    assert set(expected) == {"R_ref", "load", "R", "P", "P_ff"}
+    for column, values in expected.items():
+        assert np.max(np.abs(series[column] - values)) <= TOLERANCE, column
+    # the library's Jacobi loop, but for the first step: the compensator's P_ff is 0 W
+    # there, its filter starts at the second sample, the PI and the plant carry that on
+    library = run_library(scenario, "jacobi").data
+    assert series["P_ff"][0] == 0.0 < library["P_ff"][0]
+    assert np.array_equal(series["R_ref"], library["R_ref"][1:])
+    apart = np.abs(series["R"] - library["R"][1:])
+    assert 1e-6 < apart.max() < 0.5
+    assert np.max(np.abs(series["P_ff"][1000:] - library["P_ff"][1000:-1])) < 1e-6
 
 
 # ------------------------------------------------------------------------------ sma-fmu check
@@ -209,20 +234,46 @@ def test_check_reports_what_each_host_needs(exported):
         assert lines[f"host {host}"][0] == "ok", lines[f"host {host}"]
     oms = lines["host OMSimulator 3.0.0"][1]
     assert "step 0.001 s from the org.openmodelica annotation" in oms
-    assert "signals.reference, signals.load_profile from the FMUs' defaults" in oms
-    assert "--stopTime" in oms
+    assert "binds all" in oms and "--stopTime" in oms
     status, detail = lines["host fmpy 0.3.32 simulate_ssp"]
-    assert status == "n/a" and "compensator.R_ref" in detail
+    assert status == "ok" and "compensator: R_ref = 0 ohm: P_ff = 0 W" in detail
     pi = _lines(check_file(exported["heavy-pi"]))["host fmpy 0.3.32 simulate_ssp"]
     assert pi[0] == "ok" and "0.0 on every input" in pi[1]
+
+
+def _with_string_binding(source, target, value):
+    """``source`` with the signals' load table bound as an ssv:String of ``value`` (JSON)."""
+    binding = ('<ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>'
+               f'<ssv:ParameterSet version="1.0" name="initial"><ssv:Parameters>'
+               f'<ssv:Parameter name="load_profile"><ssv:String value="{value}" />'
+               '</ssv:Parameter></ssv:Parameters></ssv:ParameterSet></ssd:ParameterValues>'
+               '</ssd:ParameterBinding></ssd:ParameterBindings></ssd:Component>')
+    return _rewrite_ssd(source, target, lambda text: re.sub(
+        r"(<ssd:Component name=\"signals\".*?)</ssd:Component>",
+        lambda match: match.group(1) + binding, text, count=1, flags=re.S))
+
+
+def test_check_fails_a_string_binding_omsimulator_would_log_as_an_error(exported, tmp_path):
+    """The packed table, bound again as a String: libcosim, Ecos and fmpy run it; OMSimulator
+    would too, but logs "Unknown ParameterBinding-type" (an error line) for it."""
+    table = "{&quot;times_s&quot;:[0.0],&quot;values_kg&quot;:[0.25]}"
+    path = _with_string_binding(exported["heavy-pi"], tmp_path / "string.ssp", table)
+    lines = _lines(check_file(path))
+    assert lines["packed defaults"][0] == "ok"
+    for host in ("libcosim 0.11", "Ecos 0.7.2", "fmpy 0.3.32 simulate_ssp"):
+        assert lines[f"host {host}"][0] == "ok", lines[f"host {host}"]
+    status, detail = lines["host OMSimulator 3.0.0"]
+    assert status == "FAIL" and "would log 1 error line(s)" in detail
+    assert "Unknown ParameterBinding-type" in detail and "signals.load_profile (ssv:String)" in detail
+    assert "would not run" not in detail
+    assert main(["check", str(path)]) == 1
 
 
 def test_check_fails_a_string_only_setting_and_names_the_hosts_it_breaks(exported, tmp_path):
     """A load table bound as a String, but not the FMU's default: OMSimulator and fmpy
     would run the FMU's table."""
-    path = _rewrite_ssd(exported["heavy-pi"], tmp_path / "edited.ssp", lambda text: text.replace(
-        "{&quot;times_s&quot;:[0.0],&quot;values_kg&quot;:[0.25]}",
-        "{&quot;times_s&quot;:[0.0],&quot;values_kg&quot;:[0.2]}"))
+    table = "{&quot;times_s&quot;:[0.0],&quot;values_kg&quot;:[0.2]}"
+    path = _with_string_binding(exported["heavy-pi"], tmp_path / "edited.ssp", table)
     lines = _lines(check_file(path))
     assert lines["host libcosim 0.11"][0] == lines["host Ecos 0.7.2"][0] == "ok"
     for host in ("OMSimulator 3.0.0", "fmpy 0.3.32 simulate_ssp"):

@@ -8,6 +8,7 @@ time-series column. The scenarios are shortened to 2.2 s (RMSE from 2 s on), wit
 step at 0.6 s.
 """
 import dataclasses
+import io
 import json
 import math
 import xml.etree.ElementTree as ET
@@ -21,7 +22,7 @@ from fmpy.ssp.ssd import read_ssd
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
-from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.fmi.instance import FmuInstance
 from sma_fmu.files.package_data import default_parameter_file
 from sma_fmu.runtime.signals import load_from_table
 from sma_fmu.systems.c_host import run_c_host
@@ -29,6 +30,7 @@ from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.comparison import compare_hosts, deviation, rmse_table
 from sma_fmu.systems.container import build_container
 from sma_fmu.systems.hosts import STATE_COLUMNS
+from sma_fmu.systems.packed import fmu_defaults
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME, write_ssp
 
 TOLERANCE = 1e-9
@@ -103,7 +105,10 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
     assert bindings[("plant", "T_start")] == "24.0"
     assert bindings[("plant", "hysteresis_mode")] == "2"  # switch
     assert bindings[("pi", "Kp")] == repr(scenario.controller.Kp)
-    assert bindings[("signals", "load_profile")] == '{"times_s":[0.0],"values_kg":[0.25]}'
+    assert ("signals", "load_profile") not in bindings  # a String: only the packed default
+    with zipfile.ZipFile(path) as archive, \
+            zipfile.ZipFile(io.BytesIO(archive.read("resources/SmaScenarioSignals.fmu"))) as fmu:
+        assert fmu_defaults(fmu).value("load_profile") == '{"times_s":[0.0],"values_kg":[0.25]}'
     inputs = {c.get("name") for c in root.iter(f"{{{NAMESPACES['ssd']}}}Connector")
               if c.get("kind") == "input"}
     assert "P_ff" not in inputs  # no compensator, and no unconnected input connector
@@ -163,17 +168,19 @@ def test_every_host_fails_on_a_feedforward_system_without_its_compensator(fmu_di
             run()
 
 
-def test_fmpy_simulate_ssp_cannot_run_the_loop(adaptive, fmu_dir):
-    """As docs/systems.md says: fmpy's simulate_ssp feeds 0.0 into every input at t = 0."""
+def test_fmpy_simulate_ssp_runs_the_loop_from_zero_inputs(adaptive, fmu_dir):
+    """As docs/systems.md says: fmpy's simulate_ssp feeds 0.0 into every input at t = 0;
+    the compensator takes R_ref = 0 ohm as no reference yet, with one warning."""
     from fmpy.ssp.simulation import simulate_ssp
 
-    with pytest.raises(Exception, match=r"fmi2DoStep failed with status 2 \(discard\)"):
-        simulate_ssp(str(adaptive[1]["ssp"]), stop_time=0.01, step_size=1e-3)
-    # the discard is the compensator's: R_ref = 0 ohm is no reference
+    result = simulate_ssp(str(adaptive[1]["ssp"]), stop_time=0.01, step_size=1e-3)
+    assert result["compensator.P_ff"][0] == 0.0 and result["compensator.P_ff"][1] > 0.0
     with FmuInstance(closed_loop(adaptive[0], fmu_dir).component("compensator").fmu, "ff") as fmu:
-        fmu.set_real(("R_ref",), (0.0,))
-        with pytest.raises(FmuError, match="R_ref must be > 0, got 0.0"):
-            fmu.step(0.0, 1e-3)
+        for k in range(2):
+            fmu.set_real(("R_ref",), (0.0,))
+            fmu.step(k * 1e-3, 1e-3)
+        assert fmu.get_real(("P_ff",)) == [0.0]
+        assert [status for status, _ in fmu.messages if status != "ok"] == ["warning"]
 
 
 def test_container_and_ssp_run_in_the_c_host(adaptive):

@@ -12,7 +12,8 @@ descriptions and the SSD's bindings; one ``host ...`` line per known host
 (:mod:`.host_needs`: libcosim, Ecos, OMSimulator, fmpy's ``simulate_ssp``): what it needs
 and applies, failing where it would run something other than what the SSD binds (a
 binding it does not apply whose value the FMU's default does not hold, a missing
-annotation, a name that is no identifier); and the C-host run is of the whole system,
+annotation, a name that is no identifier) or would log an error line (OMSimulator: a
+String binding); and the C-host run is of the whole system,
 with its parameter bindings.
 Before any of these, ``archive``: the archive's entries (:mod:`sma_fmu.files.archives`:
 no path leaving the tree, no link, no duplicate, no bomb, nested FMUs too); an unsafe

@@ -9,11 +9,12 @@ What fmpy 0.3.32's ``simulate_ssp`` does (``fmpy/ssp/simulation.py``):
 - it couples by Jacobi: every FMU steps with the outputs the others had after the step
   before, passed along the connections after all have stepped;
 - before the first step every connector holds **0.0**, not the outputs after
-  initialization: at t = 0 every input is 0. The compensator refuses R_ref = 0 ohm (no
-  reference resistance) and discards the step, and fmpy stops with an exception: a loop
-  with a compensator does not run. The "pi" loops run, their first step with the PI
-  seeing R = R_ref = 0 ohm and the plant P_in = 0 W and load = 0 kg, so they differ from
-  the library's Jacobi loop by that first step;
+  initialization: at t = 0 every input is 0. The compensator takes R_ref = 0 ohm as no
+  reference yet (P_ff = 0 W, saturated, one warning; :mod:`sma_fmu.runtime.feedforward`),
+  the PI sees R = R_ref = 0 ohm and the plant P_in = 0 W and load = 0 kg. So every loop
+  runs, and differs from the library's Jacobi loop by that first step (the compensator's
+  filter then starts at the second sample, the PI's integral and the plant carry the
+  first step on);
 - it adds up its time (t + h + h + ...) and records only the connectors, after each step.
 
 :func:`run_ssp_fmpy` runs it; :func:`fmpy_ssp_series` takes the columns of the loop it

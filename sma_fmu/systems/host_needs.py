@@ -11,17 +11,21 @@ Found by running them on this project's SSPs (docs/systems.md):
 - **OMSimulator** 3.0.0: the SSD's, the system's and the components' names must be
   identifiers (``[a-zA-Z][a-zA-Z0-9_]*``: "is not a valid ident", and it stops); the
   system needs OpenModelica's annotation with ``oms:FixedStepMaster`` (else "internal
-  error", no system); binds Real, Integer and Boolean, **no String** (it logs "Unknown
-  ParameterBinding-type" and goes on with the FMU's default); its command line takes the
-  stop time only from ``--stopTime``.
+  error", no system); binds Real, Integer and Boolean, **no String**: its
+  ``Values::importStartValuesHelper`` logs an **error line** for any other ssv type
+  ("Failed to import ssv:Parameter:Unknown ParameterBinding-type") and goes on with the
+  FMU's default; its command line takes the stop time only from ``--stopTime``.
 - **fmpy** 0.3.32 ``simulate_ssp``: binds **nothing** and reads neither DefaultExperiment
   nor annotations; every input is 0.0 before the first step (:mod:`.fmpy_ssp`).
 
 A host runs something other than what the SSD binds when it does not apply a binding and
 the FMU's default (its packed start value, :mod:`.packed`) differs: :func:`host_check`
-fails that host, naming the variable and both values, and likewise a missing annotation
-or a name that is no identifier. fmpy's zero inputs make a loop with the SmaFeedforward
-compensator stop at t = 0 (R_ref = 0 ohm is refused): that host is then "n/a".
+fails that host, naming the variable and both values, and likewise a missing annotation,
+a name that is no identifier, or a binding that makes the host log an error line (a
+String for OMSimulator, even when the FMU's default holds its value: a user who reads
+"2 errors" cannot tell that the run is right; :mod:`.ssp` binds no String). fmpy's zero
+first inputs give SmaFeedforward R_ref = 0 ohm, which it takes as no reference yet
+(P_ff = 0 W, one warning; :mod:`sma_fmu.runtime.feedforward`): the loop runs.
 """
 import io
 import re
@@ -33,13 +37,14 @@ from sma_fmu.fmi.slave_support.start_values import parse_start_value
 from sma_fmu.systems.packed import fmu_defaults
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
 
-__all__ = ["SspHost", "KNOWN_HOSTS", "IDENTIFIER", "SspContents", "read_ssp", "host_check",
+__all__ = ["SspHost", "KNOWN_HOSTS", "IDENTIFIER", "UNREAD_BINDING_ERROR", "SspContents", "read_ssp", "host_check",
            "packed_defaults_check"]
 
 IDENTIFIER = re.compile(r"[a-zA-Z][a-zA-Z0-9_]*")
 _ALL_TYPES = frozenset(("Real", "Integer", "Boolean", "String"))
-# FMUs whose input refuses the 0.0 fmpy's simulate_ssp gives every input at the first step
-_REFUSE_ZERO = {"SmaFeedforward": ("R_ref", "ohm", "no reference resistance")}
+# FMUs that take the 0.0 fmpy's simulate_ssp gives every input at the first step as no input yet
+_ZERO_AS_UNCONNECTED = {"SmaFeedforward": "R_ref = 0 ohm: P_ff = 0 W until a reference arrives"}
+UNREAD_BINDING_ERROR = "Failed to import ssv:Parameter:Unknown ParameterBinding-type"
 
 
 @dataclass(frozen=True)
@@ -52,6 +57,7 @@ class SspHost:
     identifiers: bool = False          # SSD, system and component names must be identifiers
     annotation: str = None             # "osp" or "oms": where it reads the step
     zero_inputs: bool = False          # every input is 0.0 before the first step
+    logs_unread: str = None            # the error line it logs per binding it cannot read
     how: str = ""                      # how it is run (stop time, step, parameter set)
 
 
@@ -60,7 +66,8 @@ KNOWN_HOSTS = (
             how="stopTime is not applied: step it n times"),
     SspHost("Ecos 0.7.2", how="pass step_size and init(parameter_set=\"initial\")"),
     SspHost("OMSimulator 3.0.0", binds=frozenset(("Real", "Integer", "Boolean")), identifiers=True,
-            annotation="oms", how="pass --stopTime (its command line ignores the DefaultExperiment)"),
+            annotation="oms", logs_unread=UNREAD_BINDING_ERROR,
+            how="pass --stopTime (its command line ignores the DefaultExperiment)"),
     SspHost("fmpy 0.3.32 simulate_ssp", binds=frozenset(), zero_inputs=True,
             how="pass stop_time and step_size"),
 )
@@ -154,12 +161,14 @@ def host_check(host, contents):
     others = {s for key, s in contents.steps.items() if s is not None}
     if len(others) > 1:
         problems.append(f"the annotations give different steps: {sorted(others)}")
-    skipped = []
+    skipped, unread = [], []
     for component, index, parameter, kind, text in contents.bindings:
         applied = kind in host.binds and not (host.first_binding_only and index > 0)
         if applied:
             continue
         skipped.append(f"{component}.{parameter}")
+        if host.logs_unread and kind not in host.binds:
+            unread.append(f"{component}.{parameter} (ssv:{kind})")
         differs = _differs(contents, component, parameter, kind, text)
         if differs:
             why = (f"it binds no {kind}" if kind not in host.binds
@@ -177,18 +186,16 @@ def host_check(host, contents):
         notes.append(f"binds all {bound} values")
     if host.how:
         notes.append(host.how)
-    if problems:
-        return "FAIL", f"would not run what the SSD binds: {'; '.join(problems)}"
-    refusing = [(name, _REFUSE_ZERO[model]) for name, model in contents.components.items()
-                if model in _REFUSE_ZERO]
-    if host.zero_inputs and refusing:
-        name, (variable, unit, why) = refusing[0]
-        return "n/a", (f"cannot run this system: every input is 0.0 before the first step, and "
-                       f"{name}.{variable} = 0 {unit} is refused ({why}): the step at t = 0 is "
-                       "discarded and the run stops")
+    errors = ([f"would log {len(unread)} error line(s) {host.logs_unread!r}, one per binding "
+               f"of a type it cannot read: {', '.join(unread)}"] if unread else [])
+    if problems or errors:
+        return "FAIL", "; ".join(errors + ([f"would not run what the SSD binds: "
+                                            f"{'; '.join(problems)}"] if problems else []))
     if host.zero_inputs:
+        unconnected = [f"{name}: {_ZERO_AS_UNCONNECTED[model]}"
+                       for name, model in contents.components.items() if model in _ZERO_AS_UNCONNECTED]
         notes.append("its first step gets 0.0 on every input, not the outputs after "
-                     "initialization")
+                     "initialization" + (f" ({'; '.join(unconnected)})" if unconnected else ""))
     return "ok", "; ".join(notes)
 
 

@@ -10,7 +10,10 @@ The SSD follows what the hosts need (see docs/systems.md and :mod:`.host_needs`)
   (fmpy's resolver breaks on them);
 - one ParameterBinding per component, inline, in a parameter set named :data:`PARAMETER_SET`
   (libcosim applies only the first binding of a component; Ecos applies a set only when
-  its name is given to ``init``);
+  its name is given to ``init``), of the Real, Integer and Boolean parameters only: a
+  String ssv:Parameter makes OMSimulator log an error ("Unknown ParameterBinding-type",
+  its ``Values::importStartValuesHelper`` reads only these three), and the packed FMU
+  holds every bound value as its default anyway (:data:`BOUND_TYPES`);
 - OpenModelica's annotation of the system (``oms:FixedStepMaster`` with the scenario's
   step: without it OMSimulator makes no system) and a DefaultExperiment with start, stop
   and the OSP annotation of the step size (libcosim reads it);
@@ -30,8 +33,8 @@ from sma_fmu.files.output_folder import OutputError, check_folder, staged_folder
 from sma_fmu.systems.closed_loop import closed_loop, identifier
 from sma_fmu.systems.packed import packed_fmu
 
-__all__ = ["PARAMETER_SET", "SSD_NAME", "NAMESPACES", "OMS_MASTER", "ssd_document", "ssp_bytes",
-           "write_ssp", "ssp_targets", "export_ssp"]
+__all__ = ["PARAMETER_SET", "SSD_NAME", "NAMESPACES", "OMS_MASTER", "BOUND_TYPES", "ssd_document",
+           "ssp_bytes", "write_ssp", "ssp_targets", "export_ssp"]
 
 PARAMETER_SET = "initial"
 SSD_NAME = "SystemStructure.ssd"
@@ -45,6 +48,8 @@ NAMESPACES = {
 OMS_MASTER = "oms-ma"  # OMSimulator's fixed-step co-simulation master
 _OMS_TOLERANCE = "0.0001"  # its tolerances (algebraic loops; the loop here has none)
 _FMU_MIME = "application/x-fmu-sharedlibrary"
+# the ssv types the SSD binds: those every known host reads (a String is only packed)
+BOUND_TYPES = ("Real", "Integer", "Boolean")
 
 for _prefix, _uri in NAMESPACES.items():
     ET.register_namespace(_prefix, _uri)
@@ -80,14 +85,17 @@ def _component(elements, component, connectors, units):
             _add(connector, f"ssc:{variable.type}", unit=variable.unit)
             if variable.unit:
                 units.add(variable.unit)
-    if component.parameters:
+    missing = [name for name in component.parameters if name not in variables]
+    if missing:
+        raise ValueError(f"{component.fmu}: has no variable {missing[0]!r} to bind")
+    bound = {name: value for name, value in component.parameters.items()
+             if variables[name].type in BOUND_TYPES}   # the rest only as packed defaults
+    if bound:
         binding = _add(_add(node, "ssd:ParameterBindings"), "ssd:ParameterBinding")
         values = _add(binding, "ssd:ParameterValues")
         parameters = _add(_add(values, "ssv:ParameterSet", version="1.0", name=PARAMETER_SET),
                           "ssv:Parameters")
-        for name, value in component.parameters.items():
-            if name not in variables:
-                raise ValueError(f"{component.fmu}: has no variable {name!r} to bind")
+        for name, value in bound.items():
             variable = variables[name]
             entry = _add(parameters, "ssv:Parameter", name=name)
             unit = variable.unit if variable.type == "Real" else None
