@@ -120,6 +120,7 @@ class CPlant:
                                      None if mode is None else mode.encode(), load, error)
         if not self.pointer:
             raise ValueError(error.value.decode())
+        self._read()
 
     def __del__(self):
         if getattr(self, "pointer", None):
@@ -326,3 +327,156 @@ def test_the_c_plant_equals_the_python_one(lib, params, seed, mode, depth, T_sta
           f"|C - Python| per output: {TALLY.worst}")
     assert all(value == 0.0 for value in TALLY.worst.values())
 
+
+
+# ---------------------------------------------------------------- refusals
+
+def walked_pair(lib, params, steps=300, seed=11):
+    """A Python and a C plant (memory of 6) walked alike to a state with a reversal stack."""
+    params = params.replace(memory_depth=6)
+    python, c = PlantStepper(params), CPlant(lib, params)
+    plan = power_walk(random.Random(seed), params, steps)
+    for instruction in plan:
+        compare(python, c, power_of(instruction, python))
+    assert python.reversals
+    return python, c, params
+
+
+@pytest.mark.parametrize("power, load, step_size", [
+    (math.nan, 0.05, 0.02), (math.inf, 0.05, 0.02), (-math.inf, 0.05, 0.02),
+    (1.0, -1.0, 0.02), (1.0, math.nan, 0.02), (1.0, math.inf, 0.02), (1.0, 1.7e308, 0.02),
+    (1.0, 0.05, 0.0), (1.0, 0.05, -0.02), (1.0, 0.05, math.nan), (1.0, 0.05, math.inf),
+    (1.7e308, 0.05, 0.02),
+])
+def test_bad_inputs_are_refused_alike_and_change_nothing(lib, params, power, load, step_size):
+    python, c, _ = walked_pair(lib, params)
+    before = c.state()
+    message = refusal(lambda: python.step(power, load, step_size))
+    assert normalized(refusal(lambda: c.step(power, load, step_size))) == normalized(message)
+    assert same(c.state(), before) and same(c.state(), doubles_of(python.state()))
+    for instruction in power_walk(random.Random(12), python.params, 300):
+        compare(python, c, power_of(instruction, python))
+
+
+def test_bad_arguments_at_the_start_are_refused_alike(lib, params):
+    for T_start, mode, load in ((math.nan, "continuous", 0.0), (-273.15, "continuous", 0.0),
+                                (-300.0, "switch", 0.0), (math.inf, "switch", 0.0),
+                                (None, "Continuous", 0.0), (None, "50%s%n", 0.0),
+                                (None, None, 0.0), (None, "switch", -1.0),
+                                (None, "switch", math.nan), (None, "continuous", 1.7e308)):
+        message = refusal(lambda: PlantStepper(params, T_start, mode, load))
+        got = refusal(lambda: CPlant(lib, params, T_start, mode, load))
+        assert normalized(got) == normalized(message), (T_start, mode, load)
+
+
+def _bad_states(state, params):
+    """(a Python state dict, its C doubles, what both messages name)."""
+    def changed(**entries):
+        new = {**state, **entries}
+        return new, doubles_of(new)
+    point = list(state["reversals"][0])
+    yield changed(temperature=math.nan) + ("temperature",)
+    yield changed(temperature=-273.15) + ("temperature",)
+    yield changed(temperature=-300.0) + ("temperature",)
+    yield changed(temperature=params.T_max + 1.0) + ("temperature",)
+    yield changed(direction=0) + ("direction",)
+    yield changed(direction=2) + ("direction",)
+    yield changed(direction=0.5) + ("direction",)
+    yield changed(load=-0.1) + ("load",)
+    yield changed(load=math.inf) + ("load",)
+    yield changed(load=1.7e308) + ("state entry load:",)
+    yield changed(xi_MF=-0.1) + ("xi_MF",)
+    yield changed(xi_MF=1.5) + ("xi_MF",)
+    yield changed(xi_P=math.nan) + ("xi_P",)
+    yield changed(xi_MF=state["xi_MF"] * 0.5) + ("xi_MF = ",)
+    yield changed(power=-1.0) + ("power",)
+    yield changed(power=math.inf) + ("power",)
+    yield changed(reversals=state["reversals"] + [[-274.0, 0.5]]) + ("reversals[",)
+    yield changed(reversals=[[point[0], 1.5]] + state["reversals"][1:]) + ("reversals[0]",)
+    yield changed(reversals=[[math.inf, 0.5]]) + ("reversals[0]",)
+    yield changed(reversals=[[math.nan, 0.5]]) + ("reversals[0]",)
+
+
+def test_bad_states_are_refused_alike_and_change_nothing(lib, params):
+    python, c, params = walked_pair(lib, params)
+    state = python.state()
+    before = c.state()
+    cases = list(_bad_states(state, params))
+    for bad_state, values, name in cases:
+        message = refusal(lambda: PlantStepper(params).restore(bad_state))
+        got = refusal(lambda: c.restore(values))
+        assert name in got and normalized(got) == normalized(message), (name, got, message)
+        assert same(c.state(), before)
+    # too many points: Python prints the list, C the count; both name "reversals must be"
+    values = doubles_of({**state, "reversals": [list(state["reversals"][0])] * 7})
+    message = refusal(lambda: PlantStepper(params).restore(state_of(values)))
+    got = refusal(lambda: c.restore(values))
+    assert got.split(" got ")[0] == message.split(" got ")[0] and same(c.state(), before)
+    # C's own layout: too short, a count that is not a whole number or does not fit
+    for values, name in ((before[:6], "plant state"), (before[:7] + [1.0], "reversals"),
+                         (before[:6] + [0.5], "reversals"), (before[:6] + [-2.0], "reversals"),
+                         (before + [20.0], "reversals"), (before[:-2], "reversals")):
+        assert name in refusal(lambda: c.restore(values))
+        assert same(c.state(), before)
+    for instruction in power_walk(random.Random(13), params, 300):
+        compare(python, c, power_of(instruction, python))
+
+
+def _bad_parameters(values):
+    """Parameter sets both must refuse: each rule broken, derived constants out of range,
+    the consistency checks."""
+    bad = {"positive": (0.0, -1.0, math.inf, math.nan), "nonnegative": (-1e-9, math.inf),
+           "fraction": (1.0, -0.1, math.nan), "finite": (math.inf, -math.inf, math.nan),
+           "margin": (0.0, 0.5), "depth": (1.0, 2.5, 100001.0, math.inf)}
+    for spec in PARAMETER_SPECS:
+        for value in bad[spec.rule]:
+            if spec.required or not math.isnan(value):   # C: NaN = an optional one not given
+                yield {**values, spec.name: value}
+    yield {**values, "diameter": 1e200}                     # diameter**2 overflows
+    yield {**values, "h_c": 1e-200, "A_s": 1e-200}          # 1/(h_c A_s): division by zero
+    yield {**values, "mass": 1e-320, "x0": 1e10}            # line density underflows to 0
+    yield {**values, "x0": 1e300, "mass": 1e300}            # lattice: N overflows
+    yield {**values, "nu": 1e300, "eps_T": 1e300}           # nu eps_T / k_B overflows
+    yield {**values, "stress_max": 1e306}                   # load_max overflows
+    yield {**values, "R_M": 20.0, "R_F": 20.0}              # R_MF <= R_P
+    yield {**values, "l_F": 0.7}                            # x_f <= 0
+    yield {**values, "T_room": -300.0}
+    yield {**values, "T_max": values["T_room"]}
+
+
+def test_bad_parameters_are_refused_alike(lib, params):
+    values = params.values()
+    count = 0
+    for bad in _bad_parameters(values):
+        for source in ("<parameters>", "SmaActuator instance 'a%s'"):
+            message = refusal(lambda: WireParameters.from_values(bad, source=source))
+            got = refusal(lambda: CParameters(lib, bad, source))
+            assert normalized(got) == normalized(message), (bad, got, message)
+            count += 1
+    assert count > 100
+
+
+def test_good_parameters_derive_the_same_constants(lib, params):
+    """alpha given or not, memory_depth and stress_max given or defaulted: the C plant made
+    from them runs like the Python one (so the derived constants are the same)."""
+    values = params.values()
+    for changes in ({}, {"alpha": 0.3}, {"memory_depth": 2}, {"stress_max": 150.0},
+                    {"diameter": 2e-4, "mass": 1.2e-4, "T_room": 25.0}):
+        changed = params.replace(**changes)
+        python, c = PlantStepper(changed, mode="continuous", load=0.3), CPlant(lib, changed,
+                                                                              load=0.3)
+        assert same(c.outputs, tuple(python.outputs)) and c.warning == python.warning
+        for instruction in power_walk(random.Random(len(changes)), changed, 500):
+            compare(python, c, power_of(instruction, python))
+    defaults = {k: v for k, v in values.items() if k not in ("memory_depth", "stress_max")}
+    python = PlantStepper(WireParameters.from_values(defaults), load=0.6)
+    c = CPlant(lib, WireParameters.from_values(defaults), load=0.6)
+    assert c.warning == python.warning is not None
+
+
+def test_the_runtime_compiles_clean_for_win64(tmp_path):
+    """x86_64-w64-mingw32-gcc -std=c99 -Wall -Wextra -Wpedantic -Werror -ffp-contract=off."""
+    objects = compile_win64(RUNTIME, tmp_path)
+    if objects is None:
+        pytest.skip("x86_64-w64-mingw32-gcc is not installed")
+    assert all(path.stat().st_size > 0 for path in objects)
