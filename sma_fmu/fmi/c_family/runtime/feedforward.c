@@ -14,8 +14,6 @@
 
 const char *const INVERSES[INVERSE_COUNT] = {"major", "minor-loop"};
 
-#define STATE_HEADER 7   /* doubles before the reversal points */
-
 int require_inverse(const char *inverse, FeedforwardInverse *out, SmaMessage *message)
 {
     int index;
@@ -225,7 +223,7 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
 
 size_t feedforward_stepper_state_size(const FeedforwardStepper *self)
 {
-    return STATE_HEADER + 2 * self->reversal_count;
+    return FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count;
 }
 
 void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out)
@@ -238,8 +236,8 @@ void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out
     phase_lag_filter_state_write(&self->filter, out + 4);
     out[6] = (double)self->reversal_count;
     for (i = 0; i < self->reversal_count; i++) {
-        out[STATE_HEADER + 2 * i] = self->reversals[i].temperature;
-        out[STATE_HEADER + 2 * i + 1] = self->reversals[i].xi_MF;
+        out[FEEDFORWARD_STATE_FIXED + 2 * i] = self->reversals[i].temperature;
+        out[FEEDFORWARD_STATE_FIXED + 2 * i + 1] = self->reversals[i].xi_MF;
     }
 }
 
@@ -249,8 +247,8 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
     int direction, reference_present, temperature_present, fraction_present;
     double points_given;
     size_t depth = (size_t)self->params.memory_depth, points;
-    if (count < STATE_HEADER) {
-        return read_entries(count, STATE_HEADER, "compensator state", message);
+    if (count < FEEDFORWARD_STATE_FIXED) {
+        return read_entries(count, FEEDFORWARD_STATE_FIXED, "compensator state", message);
     }
     if (read_direction(in[0], NULL, &direction, message)
         || read_optional_number(in[1], "previous_reference", 5e-324, HUGE_VAL, "ohm",
@@ -272,13 +270,14 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
                                "pairs, got a count of %.17g", (unsigned long)depth, points_given);
     }
     points = (size_t)points_given;
-    if (count != STATE_HEADER + 2 * points) {
+    if (count != FEEDFORWARD_STATE_FIXED + 2 * points) {
         return sma_message_set(message, "reversals: the compensator state holds %lu numbers, "
                                "not %d + 2 x %lu for its %lu reversal points",
-                               (unsigned long)count, STATE_HEADER, (unsigned long)points,
-                               (unsigned long)points);
+                               (unsigned long)count, FEEDFORWARD_STATE_FIXED,
+                               (unsigned long)points, (unsigned long)points);
     }
-    if (read_points(in + STATE_HEADER, points, depth, "reversals", NULL, message)) {
+    if (read_points(in + FEEDFORWARD_STATE_FIXED, points, depth, "reversals", NULL,
+                    message)) {
         return 1;
     }
     if (phase_lag_filter_state_read(&self->filter, in + 4, message)) {   /* the last check */
@@ -288,7 +287,8 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
     self->previous_reference = in[1];
     self->previous_temperature = in[2];
     self->previous_fraction = in[3];
-    read_points(in + STATE_HEADER, points, depth, "reversals", self->reversals, NULL);
+    read_points(in + FEEDFORWARD_STATE_FIXED, points, depth, "reversals", self->reversals,
+                NULL);
     self->reversal_count = points;
     return 0;
 }

@@ -37,6 +37,10 @@
 #include "phase_lag.h"
 #include "sma_message.h"
 
+#define FEEDFORWARD_STATE_FIXED 7   /* doubles before the reversal points */
+/* Python's STATE_FORMAT: the FMI layer's header names it, the doubles follow. */
+#define FEEDFORWARD_STATE_FORMAT "sma-fmu compensator state 2: reversal stack"
+
 /* INVERSES = ("major", "minor-loop"): an inverse is its index in that tuple. */
 typedef enum {
     INVERSE_MAJOR = 0,
