@@ -1,0 +1,485 @@
+/* The FMI 2.0 co-simulation functions of the native models: the calling sequence.
+ *
+ * The states, refusals and messages are the pythonfmu FMUs' (slave_support/guards.py and
+ * the front in fmi/native/fmi2_exports.c), so the two families answer every call alike:
+ *  - a call in a state where it is illegal: fmi2Error, "illegal call in state '<state>'";
+ *  - fmi2ExitInitializationMode with parameters the model refuses: fmi2Error naming the
+ *    reason, the instance stays in Initialization Mode (fix them and call it again);
+ *  - fmi2DoStep with a bad t or h, or not following the last step: fmi2Error, nothing done;
+ *    an input the model refuses: fmi2Discard naming the input and value (never fmi2Fatal);
+ *    the instance stays in stepComplete, so the master may fix its inputs and retry; the
+ *    very same step discarded twice in a row reports fmi2Terminated;
+ *  - a step that leaves the model's validity range: fmi2Warning with the model's warning
+ *    (once per excursion: the runtime says when).
+ * A pointer that is not a live instance gives fmi2Error (checked by a magic number). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2_layer.h"
+
+/* What `sma-fmu check` finds in a native binary (c_family/native_build.py). */
+static const char NATIVE_MARKER[] = "sma-fmu native C FMU";
+
+const char *const STATE_NAMES[STATE_COUNT] = {
+    "instantiated", "Initialization Mode", "stepComplete", "terminated", "error"};
+
+static Instance *live(fmi2Component c)
+{
+    Instance *in = (Instance *)c;
+    if (!in || in->magic != INSTANCE_MAGIC) return NULL;
+    in->worst = fmi2OK;
+    return in;
+}
+
+#define ENTER                                                                                 \
+    Instance *in = live(c);                                                                   \
+    if (!in) return fmi2Error
+
+/* The call's status: `status`, or worse if the call logged worse. */
+static fmi2Status finish(const Instance *in, fmi2Status status)
+{
+    return in->worst > status ? in->worst : status;
+}
+
+/* guard.allowed: 1 if the present state is one of the `mask` bits, else refused. */
+static int allowed(Instance *in, const char *function, unsigned int mask)
+{
+    char why[80];
+    if (mask & (1u << in->state)) return 1;
+    snprintf(why, sizeof why, "illegal call in state '%s'", STATE_NAMES[in->state]);
+    layer_refuse(in, fmi2Error, function, why);
+    return 0;
+}
+#define IN(state) (1u << (state))
+
+/* guards._close: communication points equal up to rounding. */
+static int close_to(double a, double b, double step)
+{
+    double scale = fabs(a) > fabs(b) ? fabs(a) : fabs(b);
+    if (step > scale) scale = step;
+    return fabs(a - b) <= 1e-9 * scale;
+}
+
+static void validity(Instance *in, const char *function)
+{
+    const char *warning = in->model->warning && in->stepper ? in->model->warning(in->stepper) : "";
+    if (warning && *warning) layer_log(in, fmi2Warning, "%s: %s", function, warning);
+}
+
+FMI2_Export const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+FMI2_Export const char *fmi2GetVersion(void) { return fmi2Version; }
+
+FMI2_Export fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn,
+                                           size_t nCategories, const fmi2String categories[])
+{
+    ENTER;
+    if (!layer_set_debug_logging(in, loggingOn, nCategories, categories))
+        return layer_refuse(in, fmi2Error, "fmi2SetDebugLogging", "categories[] is NULL or holds "
+                            "a NULL or non-UTF-8 category");
+    return fmi2OK;
+}
+
+static void free_instance(Instance *in)
+{
+    if (!in) return;
+    in->magic = 0;
+    layer_free_states(in);
+    layer_drop_stepper(in);
+    layer_values_free(in->model, in->values);
+    free(in->categories);
+    free(in->resources);
+    free(in->guid);
+    free(in->name);
+    free(in);
+}
+
+/* Back to the state of a new instance (fmi2Instantiate, fmi2Reset): 0 with `why` if the
+ * packed start values cannot be read. */
+static int initial_state(Instance *in, char *why, size_t size)
+{
+    layer_drop_stepper(in);
+    layer_values_free(in->model, in->values);
+    in->values = NULL;
+    in->state = STATE_INSTANTIATED;
+    in->run.start_time = 0.0;
+    in->run.first_step = 0.0;
+    in->stop_defined = in->time_defined = 0;
+    in->outputs_current = 0;
+    in->initial_error[0] = '\0';
+    in->stepped = in->terminated = in->have_discard = 0;
+    if (!layer_values_init(in)) {
+        snprintf(why, size, "out of memory");
+        return 0;
+    }
+    return !layer_packed_start_values(in, why, size);
+}
+
+static char *copy_text(const char *text)
+{
+    char *copy = (char *)malloc(strlen(text) + 1);
+    if (copy) strcpy(copy, text);
+    return copy;
+}
+
+FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType,
+                                          fmi2String fmuGUID, fmi2String fmuResourceLocation,
+                                          const fmi2CallbackFunctions *functions,
+                                          fmi2Boolean visible, fmi2Boolean loggingOn)
+{
+    char why[1200];
+    int plain = 0;
+    int good_name = instanceName && *instanceName && layer_valid_utf8(instanceName);
+    Instance *in = (Instance *)calloc(1, sizeof *in);
+    (void)visible;
+    if (!in) return NULL;
+    in->model = &SMA_MODEL;
+    in->logger = functions ? functions->logger : NULL;
+    in->environment = functions ? functions->componentEnvironment : NULL;
+    in->log_all = loggingOn ? 1 : 0;
+    in->log_problems = 1;
+    in->name = copy_text(good_name ? instanceName : "?");
+    if (!in->name) goto fail;
+    in->run.model_name = in->model->name;
+    in->run.instance_name = in->name;
+    if (!good_name) {
+        layer_refuse(in, fmi2Error, "fmi2Instantiate", "instanceName must be a non-empty UTF-8 string");
+        goto fail;
+    }
+    if (fmuType != fmi2CoSimulation) {
+        layer_refuse(in, fmi2Error, "fmi2Instantiate", "this FMU supports co-simulation only");
+        goto fail;
+    }
+    if (!fmuGUID || !layer_valid_utf8(fmuGUID)) {
+        layer_refuse(in, fmi2Error, "fmi2Instantiate", "fmuGUID is NULL or not UTF-8");
+        goto fail;
+    }
+    if (strcmp(fmuGUID, in->model->guid) != 0) {
+        layer_log(in, fmi2Error, "fmi2Instantiate: fmuGUID '%s' does not match the guid '%s' of "
+                  "this FMU", fmuGUID, in->model->guid);
+        goto fail;
+    }
+    in->guid = copy_text(fmuGUID);
+    if (!in->guid) goto fail;
+    if (!layer_resource_folder(fmuResourceLocation, &in->resources, &plain, why, sizeof why)) {
+        layer_log(in, fmi2Error, "fmi2Instantiate: %s", why);
+        goto fail;
+    }
+    if (plain)
+        layer_log(in, fmi2Warning, "fmi2Instantiate: fmuResourceLocation '%s' is a path, not a "
+                  "file: URI (FMI 2.0 section 2.1.6); accepted", fmuResourceLocation);
+    if (!initial_state(in, why, sizeof why)) {
+        layer_log(in, fmi2Error, "fmi2Instantiate: %s", why);
+        goto fail;
+    }
+    layer_log(in, fmi2OK, "fmi2Instantiate: %s (%s)", NATIVE_MARKER, in->resources);
+    in->magic = INSTANCE_MAGIC;
+    return in;
+fail:
+    free_instance(in);
+    return NULL;
+}
+
+FMI2_Export void fmi2FreeInstance(fmi2Component c)
+{
+    Instance *in = live(c);
+    if (in) free_instance(in);
+}
+
+FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined,
+                                           fmi2Real tolerance, fmi2Real startTime,
+                                           fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+{
+    const char *function = "fmi2SetupExperiment";
+    char a[32], b[32];
+    ENTER;
+    (void)toleranceDefined;
+    (void)tolerance;
+    if (!allowed(in, function, IN(STATE_INSTANTIATED))) return fmi2Error;
+    layer_repr(startTime, a);
+    layer_repr(stopTime, b);
+    if (!isfinite(startTime)) {
+        layer_log(in, fmi2Error, "%s: startTime = %s s is not finite", function, a);
+        return fmi2Error;
+    }
+    if (stopTimeDefined && !(startTime <= stopTime && stopTime < HUGE_VAL)) {
+        layer_log(in, fmi2Error, "%s: stopTime = %s s is not finite and >= startTime = %s s",
+                  function, b, a);
+        return fmi2Error;
+    }
+    in->run.start_time = startTime;
+    in->time_defined = 1;
+    in->stop_defined = stopTimeDefined ? 1 : 0;
+    in->stop_time = stopTime;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+{
+    ENTER;
+    if (!allowed(in, "fmi2EnterInitializationMode", IN(STATE_INSTANTIATED))) return fmi2Error;
+    in->state = STATE_INITIALIZATION;
+    in->outputs_current = 0;
+    in->stepped = in->terminated = in->have_discard = 0;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+    const char *function = "fmi2ExitInitializationMode";
+    char why[sizeof ((Instance *)0)->initial_error];
+    ENTER;
+    if (!allowed(in, function, IN(STATE_INITIALIZATION))) return fmi2Error;
+    if (layer_run_initialization(in, why, sizeof why)) {
+        in->outputs_current = 1;
+        memcpy(in->initial_error, why, sizeof why);
+        layer_log(in, fmi2Error, "%s: refused, the instance stays in Initialization Mode: %s",
+                  function, why);
+        return fmi2Error;
+    }
+    in->state = STATE_STEP_COMPLETE;
+    in->time = in->run.start_time;  /* None (no check of the first step) without setup */
+    validity(in, function);
+    return finish(in, fmi2OK);
+}
+
+FMI2_Export fmi2Status fmi2Terminate(fmi2Component c)
+{
+    ENTER;
+    if (!allowed(in, "fmi2Terminate", IN(STATE_STEP_COMPLETE))) return fmi2Error;
+    in->state = STATE_TERMINATED;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2Reset(fmi2Component c)
+{
+    char why[1200];
+    ENTER;
+    if (!initial_state(in, why, sizeof why)) {
+        layer_log(in, fmi2Error, "fmi2Reset: %s", why);
+        return fmi2Error;
+    }
+    return fmi2OK;
+}
+
+/* The front's argument checks of an array call; 0: refused (status in *status). */
+static int arrays_ok(Instance *in, const char *function, const void *vr, size_t nvr,
+                     const void *value, fmi2Status *status)
+{
+    *status = fmi2OK;
+    if (nvr == 0) return 0;
+    if (!vr || !value) *status = layer_refuse(in, fmi2Error, function, "vr[] or value[] is NULL");
+    else if (nvr > 1000000) *status = layer_refuse(in, fmi2Error, function, "nvr is implausibly large");
+    else return 1;
+    return 0;
+}
+
+#define GET_SET(name, kind, T)                                                                \
+    FMI2_Export fmi2Status fmi2##name(fmi2Component c, const fmi2ValueReference vr[],         \
+                                      size_t nvr, T value[])                                  \
+    {                                                                                         \
+        fmi2Status status;                                                                    \
+        ENTER;                                                                                \
+        if (!arrays_ok(in, "fmi2" #name, vr, nvr, value, &status)) return status;              \
+        return finish(in, layer_##kind(in, "fmi2" #name, GET_SET_KIND_##name, vr, nvr, value)); \
+    }
+#define GET_SET_KIND_GetReal SMA_REAL
+#define GET_SET_KIND_GetInteger SMA_INTEGER
+#define GET_SET_KIND_GetBoolean SMA_BOOLEAN
+#define GET_SET_KIND_GetString SMA_STRING
+#define GET_SET_KIND_SetReal SMA_REAL
+#define GET_SET_KIND_SetInteger SMA_INTEGER
+#define GET_SET_KIND_SetBoolean SMA_BOOLEAN
+GET_SET(GetReal, get, fmi2Real)
+GET_SET(GetInteger, get, fmi2Integer)
+GET_SET(GetBoolean, get, fmi2Boolean)
+GET_SET(GetString, get, fmi2String)
+GET_SET(SetReal, set, const fmi2Real)
+GET_SET(SetInteger, set, const fmi2Integer)
+GET_SET(SetBoolean, set, const fmi2Boolean)
+
+FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                     const fmi2String value[])
+{
+    fmi2Status status;
+    size_t i;
+    ENTER;
+    if (!arrays_ok(in, "fmi2SetString", vr, nvr, value, &status)) return status;
+    for (i = 0; i < nvr; ++i) {
+        if (!value[i] || !layer_valid_utf8(value[i])) {
+            layer_log(in, fmi2Error, "fmi2SetString: value[%lu] for value reference %u is %s; "
+                      "nothing was set", (unsigned long)i, vr[i], value[i] ? "not UTF-8" : "NULL");
+            return fmi2Error;
+        }
+    }
+    return finish(in, layer_set(in, "fmi2SetString", SMA_STRING, vr, nvr, value));
+}
+
+double sma_nominal_step(SmaRun *run, double step_size);
+
+/* guard._do_step: 1 done, 0 not (refused: fmi2Error logged, or discarded). */
+static fmi2Status do_step(Instance *in, double t, double h)
+{
+    const char *function = "fmi2DoStep";
+    char a[32], b[32], e[32];
+    double end, step;
+    SmaMessage message;
+    if (in->state != STATE_STEP_COMPLETE && !allowed(in, function, IN(STATE_STEP_COMPLETE)))
+        return fmi2Error;
+    layer_repr(t, a);
+    layer_repr(h, b);
+    if (!(isfinite(t) && h > 0.0 && h < HUGE_VAL)) {
+        layer_log(in, fmi2Error, "%s: currentCommunicationPoint = %s s and communicationStepSize "
+                  "= %s s must be finite, the step > 0", function, a, b);
+        return fmi2Error;
+    }
+    if (in->time_defined && t != in->time && !close_to(t, in->time, h)) {
+        layer_repr(in->time, e);
+        layer_log(in, fmi2Error, "%s: currentCommunicationPoint = %s s, but the last step ended at "
+                  "%s s (the communication points must follow one another)", function, a, e);
+        return fmi2Error;
+    }
+    end = t + h;
+    if (in->stop_defined && end > in->stop_time && !close_to(end, in->stop_time, h)) {
+        layer_repr(end, a);
+        layer_repr(in->stop_time, e);
+        layer_log(in, fmi2Error, "%s: the step to %s s passes stopTime = %s s", function, a, e);
+        return fmi2Error;
+    }
+    step = in->model->snaps_step ? sma_nominal_step(&in->run, h) : h;
+    message.text[0] = '\0';
+    if (in->model->step(in->stepper, in->values, &in->run, t, step, &message)) {
+        layer_log(in, fmi2Discard, "step at t = %s s discarded: %s", a, message.text);
+        return fmi2Discard;
+    }
+    if (!layer_outputs_finite(in, in->values)) {
+        in->state = STATE_ERROR;
+        layer_log(in, fmi2Error, "%s: internal error: the step at t = %s s gave a non-finite "
+                  "output; the instance is in the error state (restore a saved state or reset "
+                  "it)", function, a);
+        return fmi2Error;
+    }
+    in->time = end;
+    in->time_defined = 1;
+    validity(in, function);
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                                  fmi2Real communicationStepSize,
+                                  fmi2Boolean noSetFMUStatePriorToCurrentPoint)
+{
+    fmi2Status status;
+    int same_step;
+    ENTER;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    status = finish(in, do_step(in, currentCommunicationPoint, communicationStepSize));
+    if (status > fmi2Discard) return status;  /* refused: nothing was stepped */
+    in->stepped = 1;
+    if (status != fmi2Discard) {
+        in->terminated = in->have_discard = 0;
+        return status;
+    }
+    same_step = in->have_discard && in->discard_time == currentCommunicationPoint &&
+                in->discard_step == communicationStepSize;
+    in->terminated = same_step;
+    if (same_step) {
+        char a[32], b[32];
+        layer_repr(currentCommunicationPoint, a);
+        layer_repr(communicationStepSize, b);
+        layer_log(in, fmi2Error, "fmi2DoStep(t = %s s, h = %s s) was repeated unchanged after a "
+                  "discard and discarded again: reporting fmi2Terminated so the master stops", a, b);
+    }
+    in->have_discard = 1;
+    in->discard_time = currentCommunicationPoint;
+    in->discard_step = communicationStepSize;
+    return status;
+}
+
+FMI2_Export fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    ENTER;
+    return layer_refuse(in, fmi2Error, "fmi2CancelStep", "illegal call: no asynchronous step is in progress");
+}
+
+FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[],
+                                                    size_t nu, const fmi2ValueReference z[],
+                                                    size_t nz, const fmi2Real dz[], fmi2Real du[])
+{
+    ENTER;
+    (void)u; (void)nu; (void)z; (void)nz; (void)dz; (void)du;
+    return layer_refuse(in, fmi2Error, "fmi2GetDirectionalDerivative", "not supported by this "
+                        "FMU (providesDirectionalDerivative is false)");
+}
+
+FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                                   size_t nvr, const fmi2Integer order[],
+                                                   const fmi2Real value[])
+{
+    ENTER;
+    (void)vr; (void)nvr; (void)order; (void)value;
+    return layer_refuse(in, fmi2Error, "fmi2SetRealInputDerivatives", "not supported by this FMU "
+                        "(canInterpolateInputs is false)");
+}
+
+FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                                    size_t nvr, const fmi2Integer order[],
+                                                    fmi2Real value[])
+{
+    ENTER;
+    (void)vr; (void)nvr; (void)order; (void)value;
+    return layer_refuse(in, fmi2Error, "fmi2GetRealOutputDerivatives", "not supported by this FMU "
+                        "(maxOutputDerivativeOrder is 0)");
+}
+
+#define REQUIRE_STEPPED(function)                                                             \
+    if (!in->stepped)                                                                         \
+    return layer_refuse(in, fmi2Error, function, "illegal call sequence: allowed only after fmi2DoStep")
+
+FMI2_Export fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
+{
+    ENTER;
+    (void)s; (void)value;
+    REQUIRE_STEPPED("fmi2GetStatus");
+    return layer_refuse(in, fmi2Discard, "fmi2GetStatus", "defined only while fmi2DoStep is "
+                        "pending, and this FMU never returns fmi2Pending");
+}
+
+FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
+{
+    ENTER;
+    REQUIRE_STEPPED("fmi2GetRealStatus");
+    if (!value) return layer_refuse(in, fmi2Error, "fmi2GetRealStatus", "value is NULL");
+    if (s != fmi2LastSuccessfulTime)
+        return layer_refuse(in, fmi2Discard, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is defined");
+    *value = in->time_defined ? in->time : in->run.start_time;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
+{
+    ENTER;
+    (void)s; (void)value;
+    REQUIRE_STEPPED("fmi2GetIntegerStatus");
+    return layer_refuse(in, fmi2Discard, "fmi2GetIntegerStatus", "no integer status is defined");
+}
+
+FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
+{
+    ENTER;
+    REQUIRE_STEPPED("fmi2GetBooleanStatus");
+    if (!value) return layer_refuse(in, fmi2Error, "fmi2GetBooleanStatus", "value is NULL");
+    if (s != fmi2Terminated)
+        return layer_refuse(in, fmi2Discard, "fmi2GetBooleanStatus", "only fmi2Terminated is defined");
+    *value = in->terminated ? fmi2True : fmi2False;
+    return fmi2OK;
+}
+
+FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
+{
+    ENTER;
+    (void)s; (void)value;
+    REQUIRE_STEPPED("fmi2GetStringStatus");
+    return layer_refuse(in, fmi2Discard, "fmi2GetStringStatus", "no string status is defined");
+}

@@ -1,0 +1,107 @@
+/* The FMI 2.0 co-simulation layer shared by the five native models (private header).
+ *
+ * One Instance per fmi2Instantiate. Its calling-sequence states, refusals and messages are
+ * those of the pythonfmu FMUs' guard (slave_support/guards.py, lifecycle.py, interface.py),
+ * so both families refuse the same calls with the same status, and their messages name the
+ * same function and variable. Every message goes to the host's logger as a "%s" argument,
+ * never as a format. */
+#ifndef SMA_FMI2_LAYER_H
+#define SMA_FMI2_LAYER_H
+
+#include <stddef.h>
+
+#include "fmi2Functions.h"
+#include "sma_model.h"
+
+/* lifecycle.py's states, in STATES order; the texts are the states' names there */
+typedef enum {
+    STATE_INSTANTIATED,
+    STATE_INITIALIZATION,
+    STATE_STEP_COMPLETE,
+    STATE_TERMINATED,
+    STATE_ERROR,
+    STATE_COUNT
+} LayerState;
+extern const char *const STATE_NAMES[STATE_COUNT];
+
+/* A saved state handed to the host (fmi2GetFMUstate): the serialized bytes, so that a set,
+ * a serialization and a deserialization all take the same checked path. */
+typedef struct SavedState {
+    struct SavedState *next;
+    size_t size;
+    unsigned char *bytes;
+} SavedState;
+
+#define INSTANCE_MAGIC 0x534d4132u  /* "SMA2": what a live instance holds */
+
+typedef struct {
+    unsigned int magic;
+    const SmaModel *model;
+    char *name;
+    char *guid;
+    char *resources;                 /* the resources folder (a path), or NULL */
+    fmi2CallbackLogger logger;
+    fmi2ComponentEnvironment environment;
+    int log_all, log_problems;       /* host_log.c's rules, see fmi2_log.c */
+    char *categories;                /* enabled categories, each followed by '\n' */
+    LayerState state;
+    SmaRun run;
+    double stop_time;
+    int stop_defined;
+    int time_defined;
+    double time;                     /* the next communication point [s] */
+    int outputs_current;             /* Initialization Mode: outputs reflect what was set */
+    char initial_error[512];         /* why the outputs cannot be computed, or "" */
+    SmaValue *values;                /* one per variable of the model */
+    void *stepper;                   /* started stepper, or NULL */
+    fmi2Status worst;                /* worst status logged during the present call */
+    int stepped, terminated, have_discard;  /* fmi2GetXXXStatus bookkeeping (as the front) */
+    double discard_time, discard_step;
+    SavedState *states;              /* states handed out and not freed */
+} Instance;
+
+/* ---- log (fmi2_log.c) -------------------------------------------------------------------- */
+/* "<model> '<instance>': <text>" to the host's logger with `status` (which the call then
+ * returns at least); the text is formatted here from our literal `format`. */
+void layer_log(Instance *in, fmi2Status status, const char *format, ...)
+#if defined(__GNUC__) && defined(__MINGW32__)
+    __attribute__((format(gnu_printf, 3, 4)))
+#elif defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* A refused call: logs "<function>: <why>" with `status`, returns it. */
+fmi2Status layer_refuse(Instance *in, fmi2Status status, const char *function, const char *why);
+int layer_set_debug_logging(Instance *in, int on, size_t n, const fmi2String categories[]);
+int layer_valid_utf8(const char *text);
+/* Python's repr of a float ("1.0", "1e-05", "nan", "inf") into `text` (32 bytes). */
+void layer_repr(double value, char *text);
+
+/* ---- variables (fmi2_variables.c) -------------------------------------------------------- */
+int layer_values_init(Instance *in);          /* start values; 0: out of memory */
+void layer_values_free(const SmaModel *model, SmaValue *values);
+SmaValue *layer_values_copy(const SmaModel *model, const SmaValue *values); /* NULL: no memory */
+const SmaVariable *layer_variable(const SmaModel *model, unsigned int vr, size_t *index);
+fmi2Status layer_get(Instance *in, const char *function, SmaKind kind,
+                     const fmi2ValueReference vr[], size_t nvr, void *value);
+fmi2Status layer_set(Instance *in, const char *function, SmaKind kind,
+                     const fmi2ValueReference vr[], size_t nvr, const void *value);
+int layer_outputs_finite(const Instance *in, const SmaValue *values);
+/* Initialization Mode: the outputs from what was set (guard._refresh_initial_outputs). */
+int layer_refresh_outputs(Instance *in, const char *function);
+/* The model's start on the present values (guard._run_initialization): 0 or the reason in
+ * `why`. */
+int layer_run_initialization(Instance *in, char *why, size_t size);
+void layer_drop_stepper(Instance *in);
+
+/* ---- saved states (fmi2_states.c) -------------------------------------------------------- */
+void layer_free_states(Instance *in);
+
+/* ---- resources (fmi2_resources.c) -------------------------------------------------------- */
+/* The folder of a file: URI (or a plain absolute path) in `folder` (malloc'd), or 0 with the
+ * reason in `why`; *plain = 1 for a plain path. */
+int layer_resource_folder(const char *uri, char **folder, int *plain, char *why, size_t size);
+/* Packed start values (resources/start_values.json), if the FMU has them. */
+int layer_packed_start_values(Instance *in, char *why, size_t size);
+
+#endif

@@ -1,0 +1,13 @@
+/* Model-free helpers the adapters share (declared in sma_model.h). */
+#include <math.h>
+
+#include "sma_model.h"
+
+#define GRID_TOLERANCE 1e-6  /* runtime/scenario_signals.py: [steps] */
+
+double sma_nominal_step(SmaRun *run, double step_size)
+{
+    double first = run->first_step;
+    if (!(first > 0.0)) run->first_step = first = step_size;
+    return fabs(step_size - first) <= GRID_TOLERANCE * first ? first : step_size;
+}

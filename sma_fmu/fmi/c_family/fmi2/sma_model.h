@@ -1,0 +1,79 @@
+/* The contract between the FMI layer (fmi2/) and a model adapter (models/<Model>.c).
+ *
+ * Like the Reference-FMUs' model.h, nothing here is FMI: an adapter declares its variables
+ * (a generated table, <Model>_variables.h) and a few functions over its runtime stepper;
+ * the layer (FMI 2.0 today, an FMI 3.0 one could follow) owns the values, the calling
+ * sequence, the checks, the log and the saved states. The adapters are as thin as the
+ * pythonfmu slaves (fmi/slaves/) and keep their semantics: a failing start refuses
+ * fmi2ExitInitializationMode, a failing step discards it (slave_support/guards.py). */
+#ifndef SMA_MODEL_H
+#define SMA_MODEL_H
+
+#include <stddef.h>
+
+#include "sma_message.h"
+
+typedef enum { SMA_REAL, SMA_INTEGER, SMA_BOOLEAN, SMA_STRING } SmaKind;
+typedef enum { SMA_PARAMETER, SMA_INPUT, SMA_OUTPUT } SmaCausality;
+typedef enum { SMA_FIXED, SMA_TUNABLE, SMA_DISCRETE, SMA_CONTINUOUS } SmaVariability;
+
+/* One variable, as the pythonfmu FMU declares it (generated from its model description). */
+typedef struct {
+    unsigned int vr;            /* value reference */
+    const char *name;
+    SmaKind kind;
+    SmaCausality causality;
+    SmaVariability variability;
+    double start;               /* Real, Integer, Boolean (0/1) start value */
+    const char *start_text;     /* String start value (NULL for the others) */
+    int wire;                   /* index in PARAMETER_SPECS of a wire parameter, else -1 */
+} SmaVariable;
+
+/* A variable's present value: Real -> real, Integer and Boolean -> integer, String -> text
+ * (owned by the layer). */
+typedef union {
+    double real;
+    int integer;
+    char *text;
+} SmaValue;
+
+/* What the layer knows about the run that a model may use (slave_support/interface.py). */
+typedef struct {
+    const char *model_name;
+    const char *instance_name;
+    double start_time;          /* fmi2SetupExperiment's startTime [s] (0 until set) */
+    double first_step;          /* h0 [s], the first step's size; <= 0 until the first step */
+} SmaRun;
+
+/* A step within GRID_TOLERANCE steps of h0 is taken as h0 (SlaveInterface.nominal_step):
+ * returns h0 (setting it from `step_size` [s] at the first step) or `step_size`. */
+double sma_nominal_step(SmaRun *run, double step_size);
+
+/* A model: its variables and its stepper behind five functions. Each `int` function returns
+ * 0 or, with `message` filled (the runtime's ValueError text), nonzero; on error it changes
+ * neither the stepper nor the values. */
+typedef struct {
+    const char *name;                 /* modelName and modelIdentifier */
+    const char *guid;
+    const char *log_categories[8];    /* those of the model description, NULL-terminated */
+    const SmaVariable *variables;
+    size_t count;
+    int snaps_step;                   /* 1: the layer applies sma_nominal_step (StepperSlave) */
+    size_t stepper_size;              /* bytes of the stepper the layer allocates (zeroed) */
+    /* A new stepper in `stepper` from the parameters and inputs in `values`; writes the
+     * outputs after initialization into `values` (StepperSlave._start + _publish). */
+    int (*start)(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *message);
+    /* One step from t = `time` [s] by `step` [s] (already nominal if snaps_step). */
+    int (*step)(void *stepper, SmaValue *values, SmaRun *run, double time, double step,
+                SmaMessage *message);
+    void (*free)(void *stepper);      /* heap memory of a started stepper (may be NULL) */
+    const char *(*warning)(const void *stepper); /* validity warning of the last step, or "" */
+    size_t (*state_size)(const void *stepper);
+    void (*state_write)(const void *stepper, double *out);
+    int (*state_read)(void *stepper, const double *in, size_t count, SmaMessage *message);
+} SmaModel;
+
+/* Each adapter defines this one object (models/<Model>.c). */
+extern const SmaModel SMA_MODEL;
+
+#endif

@@ -1,0 +1,21 @@
+/* The wire parameters of an instance (sma_wire.h). */
+#include <stdio.h>
+
+#include "sma_wire.h"
+
+int sma_wire_parameters(const SmaModel *model, const SmaValue *values, const SmaRun *run,
+                        const double defaults[PARAM_COUNT], WireParameters *out,
+                        SmaMessage *message)
+{
+    double merged[PARAM_COUNT];
+    char source[256];
+    size_t i;
+    for (i = 0; i < PARAM_COUNT; ++i) merged[i] = defaults[i];
+    for (i = 0; i < model->count; ++i) {
+        const SmaVariable *v = &model->variables[i];
+        if (v->wire >= 0 && v->wire < PARAM_COUNT)
+            merged[v->wire] = v->kind == SMA_REAL ? values[i].real : (double)values[i].integer;
+    }
+    snprintf(source, sizeof source, "%s instance '%s'", run->model_name, run->instance_name);
+    return wire_parameters_from_values_source(out, merged, source, message);
+}
