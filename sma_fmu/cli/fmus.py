@@ -11,7 +11,7 @@ __all__ = ["register"]
 def _build(args):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        paths = fmu_build.build_fmus(args.out, args.model)
+        paths = fmu_build.build_fmus(args.out, args.model, native=args.native)
     for warning in caught:
         print(f"sma-fmu: warning: {warning.message}", file=sys.stderr)
     for name, path in paths.items():
@@ -37,6 +37,9 @@ def register(commands):
                        help="output folder")
     build.add_argument("--model", metavar="FILE",
                        help="parameter file the FMUs carry (default: the shipped reference_wire.toml)")
+    build.add_argument("--native", action="store_true",
+                       help="build the C family: source-code FMUs with linux64/win64 binaries, "
+                            "no Python needed (default: pythonfmu)")
     build.set_defaults(handler=_build)
 
     validate = commands.add_parser("validate", help="validate FMUs with fmpy (exit 1 on problems)")

@@ -169,12 +169,17 @@ def _build_into(model_name, folder, parameter_set, stamp):
                 sys.path.remove(str(Path(stage)))
 
 
-def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None):
+def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False):
     """Build FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``; return {name: path}.
 
     They are built in a temporary folder beside ``out_dir`` and moved there at the end, so
-    a failed build leaves ``out_dir`` as it was.
+    a failed build leaves ``out_dir`` as it was. ``native``: the C family instead
+    (:mod:`sma_fmu.fmi.c_family.native_build`: same interface, no Python inside).
     """
+    if native:
+        from sma_fmu.fmi.c_family.native_build import build_native_fmus
+
+        return build_native_fmus(out_dir, parameter_file, names)
     names = list(FMU_SCRIPTS) if names is None else list(names)
     unknown = [name for name in names if name not in FMU_SCRIPTS]
     if unknown:

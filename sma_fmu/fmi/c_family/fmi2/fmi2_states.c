@@ -3,6 +3,7 @@
  * A state is kept as its serialized bytes, so restoring a state and deserializing one take
  * the same checked path. The bytes (native byte order, declared by the header):
  *   "SMAFMU2S" | u32 format version | u32 byte-order mark | str model name | str GUID |
+ *   str the stepper's state format (e.g. PLANT_STATE_FORMAT) |
  *   u32 calling-sequence state | f64 start_time, stop_time, time, first_step |
  *   u8 stop_defined, time_defined, outputs_current | str initial_error |
  *   u32 variable count | each variable: f64 (Real), i32 (Integer, Boolean), str (String) |
@@ -56,6 +57,7 @@ static void write_state(const Instance *in, Writer *w)
     put_u32(w, BYTE_ORDER_MARK);
     put_text(w, model->name);
     put_text(w, model->guid);
+    put_text(w, model->state_format);
     put_u32(w, (uint32_t)in->state);
     put_f64(w, in->run.start_time);
     put_f64(w, in->stop_defined ? in->stop_time : 0.0);
@@ -211,7 +213,8 @@ static int parse(const Instance *in, Reader *r, Parsed *p)
     }
     if (!expect_text(r, "model", model->name, "") ||
         !expect_text(r, "the FMU build (GUID)", model->guid,
-                     ": another parameter file, version or model"))
+                     ": another parameter file, version or model") ||
+        !expect_text(r, "stepper state format", model->state_format, ""))
         return 0;
     if (!take_u32(r, &p->state, "the calling-sequence state")) return 0;
     if (p->state >= STATE_COUNT) {

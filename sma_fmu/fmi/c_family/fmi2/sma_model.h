@@ -55,6 +55,7 @@ double sma_nominal_step(SmaRun *run, double step_size);
 typedef struct {
     const char *name;                 /* modelName and modelIdentifier */
     const char *guid;
+    const char *state_format;         /* names the stepper's saved-state layout (its header) */
     const char *log_categories[8];    /* those of the model description, NULL-terminated */
     const SmaVariable *variables;
     size_t count;

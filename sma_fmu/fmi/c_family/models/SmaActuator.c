@@ -1,0 +1,73 @@
+/* SmaActuator: the SMA wire plant (thermal model + resistance hysteresis), native.
+ *
+ * A thin adapter over runtime/plant (PlantStepper), as fmi/slaves/sma_actuator.py is:
+ * doStep(t, h) holds P_in and load over the step (P_in <= 0 is applied as 0 W); the outputs
+ * are then the state at t + h. After initialization the outputs reflect T_start and the
+ * load. Invalid parameters refuse fmi2ExitInitializationMode; hysteresis_mode is an Integer
+ * (1 = continuous, 2 = switch); a step leaving the validity range logs fmi2Warning. */
+#include "plant.h"
+#include "sma_choices.h"
+#include "sma_wire.h"
+#include "SmaActuator_variables.h"
+
+static void publish(SmaValue *values, const PlantOutputs *outputs)
+{
+    values[VAR_R].real = outputs->R;
+    values[VAR_T].real = outputs->T;
+    values[VAR_x].real = outputs->x;
+    values[VAR_xi_P].real = outputs->xi_P;
+    values[VAR_xi_M].real = outputs->xi_M;
+    values[VAR_xi_F].real = outputs->xi_F;
+    values[VAR_P].real = outputs->P;
+    values[VAR_heating].integer = outputs->heating ? 1 : 0;
+}
+
+static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *message)
+{
+    PlantStepper *plant = (PlantStepper *)stepper;
+    WireParameters params;
+    const char *mode;
+    if (sma_wire_parameters(&SMA_MODEL, values, run, WIRE_DEFAULTS, &params, message) ||
+        choice_name("hysteresis_mode", values[VAR_hysteresis_mode].integer, &mode, message) ||
+        plant_stepper_init(plant, &params, &values[VAR_T_start].real, mode,
+                           values[VAR_load].real, message))
+        return 1;
+    publish(values, &plant->outputs);
+    return 0;
+}
+
+static int step(void *stepper, SmaValue *values, SmaRun *run, double time, double step_size,
+                SmaMessage *message)
+{
+    PlantStepper *plant = (PlantStepper *)stepper;
+    (void)run;
+    (void)time;
+    if (plant_stepper_step(plant, values[VAR_P_in].real, values[VAR_load].real, step_size,
+                           message))
+        return 1;
+    publish(values, &plant->outputs);
+    return 0;
+}
+
+static void release(void *stepper) { plant_stepper_free((PlantStepper *)stepper); }
+
+static const char *warning(const void *stepper) { return ((const PlantStepper *)stepper)->warning; }
+
+static size_t state_size(const void *stepper)
+{
+    return plant_stepper_state_size((const PlantStepper *)stepper);
+}
+
+static void state_write(const void *stepper, double *out)
+{
+    plant_stepper_state_write((const PlantStepper *)stepper, out);
+}
+
+static int state_read(void *stepper, const double *in, size_t count, SmaMessage *message)
+{
+    return plant_stepper_state_read((PlantStepper *)stepper, in, count, message);
+}
+
+const SmaModel SMA_MODEL = {
+    MODEL_NAME, MODEL_GUID, PLANT_STATE_FORMAT, LOG_CATEGORIES, VARIABLES, VAR_COUNT,
+    1, sizeof(PlantStepper), start, step, release, warning, state_size, state_write, state_read};
