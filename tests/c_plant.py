@@ -22,6 +22,7 @@ SHIM = r"""
 #include <stdlib.h>
 #include <string.h>
 #include "plant.h"
+#include "state_entries.h"
 
 static void copy_error(char *error, const SmaMessage *m) { memcpy(error, m->text, 512); }
 void *params_new(const double *values, const char *source, char *error) {
@@ -69,6 +70,13 @@ int direction_of_text(const char *text, int *sign, char *error) {
     if (direction_sign_of_text(text, NULL, sign, &m)) { copy_error(error, &m); return 1; }
     return 0;
 }
+int format_check(const char *found, char *error) {
+    SmaMessage m;
+    if (check_format(found, PLANT_STATE_FORMAT, "plant state", &m)) {
+        copy_error(error, &m); return 1;
+    }
+    return 0;
+}
 size_t plant_size(const void *s) { return plant_stepper_state_size(s); }
 void plant_write(const void *s, double *out) { plant_stepper_state_write(s, out); }
 int plant_read(void *s, const double *in, size_t count, char *error) {
@@ -87,7 +95,7 @@ SIGNATURES = {
     "plant_outputs": (None, [P, DP, C]), "plant_step": (I, [P, D, D, D, C]),
     "load_resistance": (I, [P, D, D, I, DP, C]), "entropy": (D, [D, D, D, D]),
     "direction_of_text": (I, [C, ctypes.POINTER(ctypes.c_int), C]),
-    "plant_size": (S, [P]), "plant_write": (None, [P, DP]), "plant_read": (I, [P, DP, S, C]),
+    "format_check": (I, [C, C]), "plant_size": (S, [P]), "plant_write": (None, [P, DP]), "plant_read": (I, [P, DP, S, C]),
 }
 
 

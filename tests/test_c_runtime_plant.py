@@ -260,9 +260,11 @@ def test_the_runtime_compiles_clean_for_win64(tmp_path):
 
 
 def test_the_major_branch_entropy_and_direction_names_equal_python(lib, params):
-    """constant_load_resistance, configurational_entropy and direction_sign of a name, which
-    the plant does not call, against Python on random arguments (and refusals alike)."""
+    """constant_load_resistance, configurational_entropy, direction_sign of a name and
+    check_format, which the plant does not call, against Python (refusals alike)."""
     from sma_fmu.runtime.checks import direction_sign
+    from sma_fmu.runtime.plant import STATE_FORMAT
+    from sma_fmu.runtime.state_entries import check_format
     from sma_fmu.runtime.constant_load import constant_load_fractions, constant_load_resistance
     from sma_fmu.runtime.phases import configurational_entropy
     cparams, rng = CParameters(lib, params.values()), random.Random(5)
@@ -294,3 +296,11 @@ def test_the_major_branch_entropy_and_direction_names_equal_python(lib, params):
             continue
         assert not lib.direction_of_text(text.encode(), ctypes.byref(sign), error)
         assert sign.value == expected
+    for found in (STATE_FORMAT, "sma-fmu plant state 1", None):
+        try:
+            check_format({"format": found}, STATE_FORMAT, "plant state")
+        except ValueError as refused:
+            assert lib.format_check(None if found is None else found.encode(), error)
+            assert error.value.decode() == str(refused)
+            continue
+        assert not lib.format_check(found.encode(), error)

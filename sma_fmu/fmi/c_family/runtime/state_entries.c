@@ -12,9 +12,10 @@ int check_format(const char *found, const char *expected, const char *what,
         return 0;
     }
     return sma_message_set(
-        message, "the %s has format '%.100s', not '%s': it was saved by an earlier sma-fmu build "
-        "(minor-loop memory of one reversal) and cannot be restored by this one",
-        what, found != NULL ? found : "None", expected);
+        message, "the %s has format %s%.100s%s, not '%s': it was saved by an earlier sma-fmu "
+        "build (minor-loop memory of one reversal) and cannot be restored by this one",
+        what, found != NULL ? "'" : "", found != NULL ? found : "None", found != NULL ? "'" : "",
+        expected);
 }
 
 int read_entries(size_t count, size_t required, const char *what, SmaMessage *message)
