@@ -1,7 +1,21 @@
-"""Shared fixtures: the reference wire's parameters, the FMUs built once per session, the C host."""
+"""Shared fixtures: the reference wire's parameters, the FMUs built once per session, the C host;
+the ``needs`` marker of tests/system_needs.py."""
 import pytest
 
 from sma_fmu import load_parameter_set
+from system_needs import need
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "needs(*names): system packages or root the test needs "
+                                       "(tests/system_needs.py): skipped without, failed under CI=true")
+
+
+def pytest_runtest_setup(item):
+    """The ``needs`` markers, before any fixture is set up (a missing compiler costs no build)."""
+    names = [name for marker in reversed(list(item.iter_markers("needs"))) for name in marker.args]
+    if names:
+        need(*dict.fromkeys(names))  # every missing one named, module's first
 
 
 @pytest.fixture(scope="session")
@@ -16,7 +30,9 @@ def params(parameter_set):
 
 @pytest.fixture(scope="session")
 def fmus(tmp_path_factory):
-    """Both FMUs, built once per test session from the reference parameter file."""
+    """The FMUs, built once per test session from the reference parameter file, with the
+    native front: the tests of them test the front too, so without a C compiler they skip."""
+    need("gcc")
     from sma_fmu.fmi.build import build_fmus
     return build_fmus(tmp_path_factory.mktemp("fmus"))
 
@@ -32,5 +48,6 @@ def unpacked(fmus, tmp_path_factory):
 @pytest.fixture(scope="session")
 def fmi_host_exe(tmp_path_factory):
     """sma_fmu/fmi/hosts/fmi_host.c compiled once per session (a plain C FMI host)."""
+    need("gcc")
     from sma_fmu.fmi.hosts import compile_host
     return compile_host("fmi_host", tmp_path_factory.mktemp("fmi_host"))

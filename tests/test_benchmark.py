@@ -4,8 +4,10 @@ import json
 import pytest
 
 from sma_fmu.cli import main
+from system_needs import needs
 
 
+@needs("gcc")  # the C hosts and the native floor FMU
 def test_benchmark_runs_and_reports_every_section(tmp_path, capsys):
     assert main(["bench", "--runs", "1", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out

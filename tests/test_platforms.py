@@ -6,6 +6,7 @@ with none of the front's guarantees and nothing saying so. Now:
 - with mingw-w64 the win64 binary is the front; without it, win64 is left out (warned);
 - without a C compiler, linux64 keeps pythonfmu's binary, and the FMU says what that loses;
 - ``sma-fmu build`` refuses a machine whose architecture pythonfmu's binaries do not match.
+What needs gcc or mingw-w64 says so (tests/system_needs.py).
 """
 import warnings
 import zipfile
@@ -18,6 +19,7 @@ from sma_fmu.fmi.build import build_fmu
 from sma_fmu.fmi.front import NativeFrontWarning, remove_front
 from sma_fmu.fmi.platforms import (DEGRADED, FRONT_MARKER, UnsupportedPlatformError,
                                    check_build_machine, platform_report)
+from system_needs import needs
 
 
 def _build(tmp_path, monkeypatch, **environment):
@@ -29,6 +31,7 @@ def _build(tmp_path, monkeypatch, **environment):
     return path, [str(w.message) for w in caught if issubclass(w.category, NativeFrontWarning)]
 
 
+@needs("gcc", "mingw-w64")
 def test_every_listed_platform_carries_the_front(fmus):
     for name, path in fmus.items():
         assert supported_platforms(str(path)) == ["linux64", "win64"], name
@@ -39,6 +42,7 @@ def test_every_listed_platform_carries_the_front(fmus):
             ("ok", "linux64"), ("ok", "win64")]
 
 
+@needs("gcc")  # linux64 "ok": its front
 def test_without_mingw_win64_is_left_out_and_the_build_says_so(tmp_path, monkeypatch):
     path, messages = _build(tmp_path, monkeypatch, SMA_FMU_WIN64_CC=str(tmp_path / "no-mingw-gcc"))
     assert supported_platforms(str(path)) == ["linux64"]
@@ -48,6 +52,7 @@ def test_without_mingw_win64_is_left_out_and_the_build_says_so(tmp_path, monkeyp
     assert [status for status, _, _ in platform_report(path)] == ["ok"]
 
 
+@needs("gcc", "mingw-w64")  # the C host of the check; win64 "ok"
 def test_without_a_c_compiler_linux64_says_what_is_degraded(tmp_path, monkeypatch, capsys):
     path, messages = _build(tmp_path, monkeypatch, CC=str(tmp_path / "no-cc"))
     assert any("linux64" in m and "no-cc" in m and "LD_PRELOAD" in m for m in messages), messages
@@ -67,6 +72,7 @@ def test_without_a_c_compiler_linux64_says_what_is_degraded(tmp_path, monkeypatc
     assert lines[1].startswith("ok ") and "platform win64" in lines[1]
 
 
+@needs("gcc", "mingw-w64")
 def test_check_fails_an_fmu_whose_binaries_and_description_disagree(fmus, tmp_path, capsys):
     plain = remove_front(fmus["SmaActuator"], tmp_path / "pythonfmu-only.fmu")  # as before issue 20
     assert [status for status, _, _ in platform_report(plain)] == ["FAIL", "FAIL"]

@@ -9,11 +9,11 @@ What can be checked here, and is:
   SMA_FMU_LIBPYTHON, and the host goes on (no crash); a Python found in the registry
   (PEP 514) is loaded; an old one is refused, naming its version.
 The "Pythons" are fakes: a few lines of C reporting a version. Running the FMU through a
-real Windows Python was not done here (docs/fmus.md, "Platforms"). Needs
-gcc-mingw-w64-x86-64 and wine64 (.ci/run installs both); none of it is skipped.
+real Windows Python was not done here (docs/fmus.md, "Platforms"). Needs gcc,
+gcc-mingw-w64-x86-64 and, under wine, wine64: skipped without them, failed under CI=true
+(.ci/run installs them; tests/system_needs.py).
 """
 import os
-import shutil
 import struct
 import subprocess
 from pathlib import Path
@@ -23,8 +23,10 @@ import pytest
 from fmi_host import ERROR, FmiHost, text, unpack
 from sma_fmu.fmi.hosts import compile_host, windows_compiler
 from sma_fmu.fmi.platforms import FRONT_MARKER
+from system_needs import need, needs, wine_command
 
-WINE = shutil.which("wine64") or "/usr/lib/wine/wine64"
+pytestmark = needs("gcc", "mingw-w64")  # the session's FMUs carry the win64 front
+WINE = wine_command()
 FMI2_CO_SIMULATION = {
     "fmi2GetTypesPlatform", "fmi2GetVersion", "fmi2SetDebugLogging", "fmi2Instantiate",
     "fmi2FreeInstance", "fmi2SetupExperiment", "fmi2EnterInitializationMode",
@@ -94,9 +96,9 @@ def plant_folder(fmus, tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def windows_dll(plant_folder):
+    need("mingw-w64")
     dll = plant_folder / "binaries/win64/SmaActuator.dll"
-    assert dll.is_file(), ("no win64 front: install gcc-mingw-w64-x86-64 (.ci/run does) "
-                           f"so that the build finds {windows_compiler()[0]}")
+    assert dll.is_file(), f"no win64 front, although {windows_compiler()[0]} is there"
     return dll.read_bytes()
 
 
@@ -118,7 +120,7 @@ def test_the_dll_needs_only_what_every_windows_has(windows_dll, plant_folder):
 @pytest.fixture(scope="module")
 def wine(tmp_path_factory):
     """(environment, host runner) for wine64 with a prefix of its own."""
-    assert Path(WINE).is_file(), "wine64 is needed (.ci/run installs Debian's wine64)"
+    need("wine64", "mingw-w64")
     root = tmp_path_factory.mktemp("wine")
     environment = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
     environment.update(WINEPREFIX=str(root / "prefix"), WINEDEBUG="-all", DISPLAY="")
@@ -150,6 +152,7 @@ def _finish(host):
     return code, host.process.stdout.read()
 
 
+@needs("wine64")
 def test_without_a_windows_python_instantiate_gives_null_and_says_what_to_do(wine, plant_folder):
     environment, runner = wine
     host = FmiHost(runner, _windows(plant_folder), env=environment)
@@ -169,6 +172,7 @@ def test_without_a_windows_python_instantiate_gives_null_and_says_what_to_do(win
 @pytest.mark.parametrize("uri, guid, message", [
     ("missing", "ok", "does not exist"), ("http", "ok", "is not a file: URI"),
     ("relative", "ok", "is not an absolute path"), ("ok", "wrong", "does not match the guid")])
+@needs("wine64")
 def test_resource_uris_and_guid_are_checked_the_windows_way(wine, plant_folder, uri, guid, message):
     environment, runner = wine
     host = FmiHost(runner, _windows(plant_folder), env=environment)
@@ -178,6 +182,7 @@ def test_resource_uris_and_guid_are_checked_the_windows_way(wine, plant_folder, 
     assert any(message in m for m in reply.logged(ERROR)), reply.logs
 
 
+@needs("wine64")
 def test_a_python_of_the_registry_is_found_and_an_old_one_refused(wine, plant_folder, tmp_path):
     environment, runner = wine
     newest = _fake_python(tmp_path / "Python312", "python312.dll", "3.12.0")

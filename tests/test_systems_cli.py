@@ -12,6 +12,7 @@ from sma_fmu.cli import main
 from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
 from sma_fmu.systems.closed_loop import LoopSystem, closed_loop
 from sma_fmu.systems.ssp import write_ssp
+from system_needs import needs
 
 
 @pytest.fixture(scope="module")
@@ -66,6 +67,7 @@ def test_export_errors_name_the_argument_and_write_nothing(fmu_dir, tmp_path, ca
     assert list(tmp_path.iterdir()) == []
 
 
+@needs("gcc", "mingw-w64")  # the C host (libcosim) and platform win64
 def test_check_passes_on_everything_built(fmus, exported, capsys):
     files = list(fmus.values()) + sorted((exported / "ssp").glob("*.ssp"))[:2]
     files += sorted(exported.glob("*.fmu"))
@@ -81,6 +83,7 @@ def test_check_passes_on_everything_built(fmus, exported, capsys):
     assert any(line.startswith("ok") and "SSD schema" in line for line in lines)
 
 
+@needs("gcc")  # the C host (libcosim) must run to fail on it
 def test_check_fails_on_a_system_that_cannot_run(fmu_dir, tmp_path, capsys):
     scenario = dataclasses.replace(load_scenario(resolve_scenarios(["heavy-pi"])[0]), stop_time_s=1.0)
     system = closed_loop(scenario, fmu_dir)
