@@ -25,6 +25,7 @@ from sma_fmu.fmi.hosts import CHostError, c_compiler, compile_host
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.systems.c_host import host_environment
+from system_needs import need, needs
 
 import libcosimpy  # noqa: E402,F401 - the test extra; the libcosim C host links its libcosimc
 
@@ -35,6 +36,7 @@ def _clean_env(**extra):
 
 @pytest.fixture(scope="module")
 def cosim_host(tmp_path_factory):
+    need("gcc")
     return compile_host("cosim_host", tmp_path_factory.mktemp("c_host"))
 
 
@@ -110,6 +112,7 @@ def test_host_environment_drops_ld_preload_and_the_keys_asked():
     assert "LD_PRELOAD" in environment  # the caller's mapping is left as it was
 
 
+@needs("gcc")
 def test_cc_is_split_like_a_shell(monkeypatch, tmp_path):
     """CC="ccache gcc" style: a compiler command with words, as make and the build take it."""
     monkeypatch.setenv("CC", f"{shutil.which('gcc')} -O0")
@@ -248,6 +251,7 @@ def test_without_a_compiler_the_build_keeps_pythonfmus_binary_and_says_so(
     assert "undefined symbol" in result.stdout + result.stderr
 
 
+@needs("gcc", "mingw-w64")  # the win64 binaries too
 def test_remove_front_gives_back_pythonfmus_binary(fmus, tmp_path, cosim_host):
     """The benchmark's "before": the FMU as pythonfmu wrote it, which needs libpython preloaded."""
     fmu = fmus["SmaActuator"]
@@ -269,6 +273,7 @@ def test_remove_front_gives_back_pythonfmus_binary(fmus, tmp_path, cosim_host):
     assert "undefined symbol" in result.stdout + result.stderr
 
 
+@needs("gcc", "python3")
 def test_fmpy_in_debians_static_python_uses_that_python(fmus, tmp_path):
     """The front must not load a second libpython into a process that has Python built in."""
     python = Path("/usr/bin/python3")

@@ -13,7 +13,8 @@ has another one, or none. The tests make that machine out of this one:
 - fake libpythons (a few lines of C reporting a version) for the newest-first order and
   for refused versions (issue 21: Python 3.6 and 2.7 used to fail with a SyntaxError or an
   undefined symbol).
-Needs root (unshare, chroot), gcc, and Debian's libpython3.11: none of it is skipped.
+Needs root (unshare, chroot), gcc, and Debian's libpython3.11: skipped without them, failed
+under CI=true (.ci/run installs them; tests/system_needs.py).
 """
 import os
 import re
@@ -25,7 +26,11 @@ import pytest
 
 from fmi_host import ERROR, OK, FmiHost, text, unpack
 from sma_fmu.fmi.front import compile_front, libpython_path
+from sma_fmu.fmi.hosts import c_compiler
 from sma_fmu.runtime.plant import PlantStepper
+from system_needs import needs
+
+pytestmark = needs("gcc")  # the C host, the front and the fake libpythons
 
 SYSTEM_LIBPYTHON = Path("/usr/lib/x86_64-linux-gnu/libpython3.11.so.1.0")
 STANDARD_FOLDERS = ("/usr/local/lib", "/usr/local/lib64", "/usr/lib/x86_64-linux-gnu",
@@ -73,7 +78,7 @@ def _fake_libpython(folder, name, version):
     folder.mkdir(parents=True, exist_ok=True)
     source = folder / "fake.c"
     source.write_text(FAKE_LIBPYTHON)
-    subprocess.run(["gcc", "-shared", "-fPIC", f'-DVERSION="{version}"', "-o", str(folder / name),
+    subprocess.run([*c_compiler(), "-shared", "-fPIC", f'-DVERSION="{version}"', "-o", str(folder / name),
                     str(source)], check=True, capture_output=True)
     return folder / name
 
@@ -83,6 +88,7 @@ def plant_folder(fmus, tmp_path_factory):
     return unpack(fmus["SmaActuator"], tmp_path_factory.mktemp("plant"))
 
 
+@needs("root", "libpython3.11")
 def test_the_build_libpython_hidden_the_fmu_runs_through_the_systems(fmi_host_exe, plant_folder,
                                                                       params, tmp_path):
     build_libpython = libpython_path()[0]
@@ -112,6 +118,7 @@ def _front_built_elsewhere(fmus, folder):
     return folder
 
 
+@needs("system-libpython")
 def test_a_python_not_installed_here_is_replaced_by_the_newest_installed(fmi_host_exe, fmus, params,
                                                                          tmp_path):
     folder = _front_built_elsewhere(fmus, tmp_path / "plant")
@@ -163,6 +170,7 @@ def _minimal_root(root, fmi_host_exe, folder):
     return root
 
 
+@needs("root")
 def test_no_python_at_all_gives_null_and_one_line_naming_what_was_tried(fmi_host_exe, plant_folder,
                                                                         tmp_path):
     root = _minimal_root(tmp_path / "root", fmi_host_exe, plant_folder)
