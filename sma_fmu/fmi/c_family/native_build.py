@@ -37,7 +37,8 @@ __all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_so
 C_FAMILY = Path(__file__).parent
 FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off", "-O2",
          "-shared"]
-_TARGETS = {"linux64": {"flags": ["-fPIC", "-fvisibility=hidden"], "libraries": ["-lm"],
+_TARGETS = {"linux64": {"flags": ["-fPIC", "-fvisibility=hidden", "-Wl,--no-undefined"],
+                        "libraries": ["-lm"],
                         "suffix": ".so"},
             "win64": {"flags": ["-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1", "-s"],
                       "libraries": [], "suffix": ".dll"}}
@@ -61,10 +62,26 @@ def _c_files():
     return files
 
 
+def _implementers(files):
+    """{header: [.c files implementing it]}: a .c file implements the header it includes
+    first (runtime/json_repr.c implements part of json_text.h); adapters implement none."""
+    from sma_fmu.fmi.build import FMU_SCRIPTS
+
+    found = {}
+    for name, path in files.items():
+        if name.endswith(".c") and name[:-2] not in FMU_SCRIPTS:
+            first = _INCLUDE.search(path.read_text(encoding="utf-8"))
+            if first:
+                found.setdefault(first.group(1), []).append(name)
+    return found
+
+
 def model_sources(model_name, generated=()):
     """The file names sources/ needs for ``model_name``: its adapter, the layer, and every
-    header (and its .c) they include, transitively; ``generated`` names files written later."""
+    header they include, transitively, with the .c files implementing it; ``generated``
+    names files written later."""
     files = _c_files()
+    implementers = _implementers(files)
     wanted = [f"{model_name}.c"] + sorted(n for n in files if n.startswith("fmi2") or n == "sma_model.c")
     found, queue = set(), list(wanted)
     while queue:
@@ -78,9 +95,7 @@ def model_sources(model_name, generated=()):
             raise ValueError(f"C family: {name} is included but does not exist")
         for header in _INCLUDE.findall(files[name].read_text(encoding="utf-8")):
             queue.append(header)
-            source = header[:-2] + ".c"
-            if header.endswith(".h") and source in files:
-                queue.append(source)
+            queue.extend(implementers.get(header, ()))
     return sorted(found)
 
 

@@ -1,11 +1,121 @@
 /* Packed start values: resources/start_values.json, which `sma-fmu export` writes into every
- * FMU it packs (slave_support/start_values.py). */
+ * FMU it packs (slave_support/start_values.py, systems/packed.py), read when the instance is
+ * created, as the pythonfmu slaves read it (SlaveInterface): each parameter it names starts
+ * with its value. Choice: the native FMU reads the same file as the pythonfmu one (with the
+ * runtime's JSON reader, json_text.c), so packing needs nothing per family and the model
+ * description's start attributes and the file cannot disagree for one family only.
+ * A file that is not such a document, or a value that is not of the parameter's type, makes
+ * fmi2Instantiate fail naming the file and the parameter, as in the pythonfmu FMUs. */
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "fmi2_layer.h"
+#include "json_text.h"
+
+#define START_VALUES_FILE "start_values.json"
+
+static const char *const KIND_NAMES[] = {"Real", "Integer", "Boolean", "String"};
+
+/* The file's text (malloc'd) or NULL: *missing = 1 when there is no such file. */
+static char *read_file(const char *path, int *missing, char *why, size_t size)
+{
+    FILE *stream = fopen(path, "rb");
+    char *text;
+    size_t used = 0, room = 4096;
+    *missing = 0;
+    if (!stream) {
+        *missing = 1;
+        return NULL;
+    }
+    text = (char *)malloc(room);
+    while (text) {
+        size_t n = fread(text + used, 1, room - used - 1, stream);
+        used += n;
+        if (n == 0) break;
+        if (room - used - 1 == 0) {
+            char *grown = room > JSON_TEXT_MAX_BYTES ? NULL : (char *)realloc(text, room * 2);
+            if (!grown) { free(text); text = NULL; break; }
+            text = grown;
+            room *= 2;
+        }
+    }
+    fclose(stream);
+    if (!text) {
+        snprintf(why, size, "%.300s: cannot be read (too large or out of memory)", path);
+        return NULL;
+    }
+    text[used] = '\0';
+    return text;
+}
+
+/* start_values.start_value: `value` as the start of `v`, into *out; else why. */
+static int start_value(const SmaVariable *v, const JsonValue *value, SmaValue *out, char *why,
+                       size_t size)
+{
+    char shown[200];
+    int ok = 0;
+    if (v->kind == SMA_REAL && value->kind == JSON_NUMBER && isfinite(value->number)) {
+        out->real = value->number;
+        ok = 1;
+    } else if (v->kind == SMA_INTEGER && value->kind == JSON_NUMBER && value->integer &&
+               value->number >= -2147483648.0 && value->number < 2147483648.0) {
+        out->integer = (int)value->number;
+        ok = 1;
+    } else if (v->kind == SMA_BOOLEAN && (value->kind == JSON_TRUE || value->kind == JSON_FALSE)) {
+        out->integer = value->kind == JSON_TRUE;
+        ok = 1;
+    } else if (v->kind == SMA_STRING && value->kind == JSON_STRING &&
+               strlen(value->text) == value->length) {
+        char *copy = (char *)malloc(value->length + 1);
+        if (!copy) { snprintf(why, size, "out of memory"); return 1; }
+        memcpy(copy, value->text, value->length + 1);
+        free(out->text);
+        out->text = copy;
+        ok = 1;
+    }
+    if (ok) return 0;
+    json_value_repr(value, shown, sizeof shown);
+    snprintf(why, size, "%s: %s = %s is not a valid %s start value", START_VALUES_FILE, v->name,
+             shown, KIND_NAMES[v->kind]);
+    return 1;
+}
 
 int layer_packed_start_values(Instance *in, char *why, size_t size)
 {
-    (void)in; (void)why; (void)size;
-    return 0;
+    char path[4200], error[400];
+    int missing, failed = 0;
+    size_t i, index;
+    char *text;
+    JsonValue document;
+    const JsonValue *values;
+    if (!in->resources) return 0;
+    snprintf(path, sizeof path, "%s/%s", in->resources, START_VALUES_FILE);
+    text = read_file(path, &missing, why, size);
+    if (!text) return missing ? 0 : 1;
+    if (json_text_parse(text, &document, error, sizeof error)) {
+        free(text);
+        snprintf(why, size, "%.300s: cannot be read (%s)", path, error);
+        return 1;
+    }
+    free(text);
+    values = document.kind == JSON_OBJECT ? json_object_get(&document, "values") : NULL;
+    if (!values || values->kind != JSON_OBJECT) {
+        json_value_free(&document);
+        snprintf(why, size, "%.300s: must be a JSON object with an object 'values'", path);
+        return 1;
+    }
+    for (i = 0; i < values->count && !failed; ++i) {
+        const JsonValue *key = &values->keys[i];
+        for (index = 0; index < in->model->count; ++index) {
+            const SmaVariable *v = &in->model->variables[index];
+            if (v->causality == SMA_PARAMETER && json_string_is(key, v->name)) {
+                failed = start_value(v, &values->items[i], &in->values[index], why, size);
+                break;
+            }
+        }
+    }
+    json_value_free(&document);
+    return failed;
 }

@@ -1,0 +1,56 @@
+/* SmaPwmDriver: the PWM wire driver (demanded power in, mean power of the wave out), native.
+ *
+ * A thin adapter over runtime/pwm (PwmDriver), as fmi/slaves/sma_pwm_driver.py is: a supply
+ * switched between peak_W and 0 W at frequency_Hz, periods starting at t = j / f; doStep(t, h)
+ * holds P_demand over the step and P_in then holds the exact mean of the wave over
+ * [t, t + h). The wave is taken on the step grid start + k h_0: a step that starts within a
+ * millionth of a step of a grid point and is h_0 long within as much is [t_k, t_k + h_0)
+ * exactly. After initialization P_in is 0 W. Invalid parameters refuse
+ * fmi2ExitInitializationMode; a non-finite P_demand discards the step. */
+#include "pwm.h"
+#include "scenario_signals.h"
+#include "SmaPwmDriver_variables.h"
+
+static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *message)
+{
+    (void)run;
+    if (pwm_driver_init((PwmDriver *)stepper, values[VAR_frequency_Hz].real,
+                        values[VAR_peak_W].real, message))
+        return 1;
+    values[VAR_P_in].real = 0.0;
+    return 0;
+}
+
+static int step(void *stepper, SmaValue *values, SmaRun *run, double time, double step_size,
+                SmaMessage *message)
+{
+    double nominal = sma_nominal_step(run, step_size), grid, power;
+    if (grid_point(time, run->start_time, run->first_step, &grid) && nominal == run->first_step) {
+        time = grid;
+        step_size = nominal;
+    }
+    if (pwm_driver_step((PwmDriver *)stepper, values[VAR_P_demand].real, time, step_size, &power,
+                        message))
+        return 1;
+    values[VAR_P_in].real = power;
+    return 0;
+}
+
+static size_t state_size(const void *stepper)
+{
+    return pwm_driver_state_size((const PwmDriver *)stepper);
+}
+
+static void state_write(const void *stepper, double *out)
+{
+    pwm_driver_state_write((const PwmDriver *)stepper, out);
+}
+
+static int state_read(void *stepper, const double *in, size_t count, SmaMessage *message)
+{
+    return pwm_driver_state_read((PwmDriver *)stepper, in, count, message);
+}
+
+const SmaModel SMA_MODEL = {
+    MODEL_NAME, MODEL_GUID, "sma-fmu PWM state", LOG_CATEGORIES, VARIABLES, VAR_COUNT,
+    0, sizeof(PwmDriver), start, step, NULL, NULL, state_size, state_write, state_read};

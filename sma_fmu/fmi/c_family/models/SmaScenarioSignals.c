@@ -1,0 +1,59 @@
+/* SmaScenarioSignals: a scenario's reference R_ref(t) and load f(t), native.
+ *
+ * A thin adapter over runtime/scenario_signals (SignalSource), as
+ * fmi/slaves/sma_scenario_signals.py is. Parameters: reference and load_profile, String
+ * parameters holding a scenario's [reference] and [load] tables as JSON objects (read with
+ * the runtime's JSON reader); their defaults are the build's default scenario, or in an
+ * FMU packed by `sma-fmu export` the exported scenario's (resources/start_values.json).
+ * A source: after initialization the outputs are the signals at the start time; after
+ * doStep(t, h) at t + h, on the step's grid. Invalid tables refuse
+ * fmi2ExitInitializationMode naming the parameter and the key. */
+#include "scenario_signals.h"
+#include "SmaScenarioSignals_variables.h"
+
+static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *message)
+{
+    SignalSource *source = (SignalSource *)stepper;
+    ReferenceSignal reference;
+    LoadProfile load;
+    if (signals_from_text(values[VAR_reference].text, values[VAR_load_profile].text, &reference,
+                          &load, message) ||
+        signal_source_init(source, &reference, &load, run->start_time, message))
+        return 1;
+    values[VAR_R_ref].real = source->outputs.R_ref;
+    values[VAR_load].real = source->outputs.load;
+    return 0;
+}
+
+static int step(void *stepper, SmaValue *values, SmaRun *run, double time, double step_size,
+                SmaMessage *message)
+{
+    SignalOutputs outputs;
+    (void)run;
+    if (signal_source_step((SignalSource *)stepper, time, step_size, &outputs, message))
+        return 1;
+    values[VAR_R_ref].real = outputs.R_ref;
+    values[VAR_load].real = outputs.load;
+    return 0;
+}
+
+static void release(void *stepper) { signal_source_free((SignalSource *)stepper); }
+
+static size_t state_size(const void *stepper)
+{
+    return signal_source_state_size((const SignalSource *)stepper);
+}
+
+static void state_write(const void *stepper, double *out)
+{
+    signal_source_state_write((const SignalSource *)stepper, out);
+}
+
+static int state_read(void *stepper, const double *in, size_t count, SmaMessage *message)
+{
+    return signal_source_state_read((SignalSource *)stepper, in, count, message);
+}
+
+const SmaModel SMA_MODEL = {
+    MODEL_NAME, MODEL_GUID, "sma-fmu signals state", LOG_CATEGORIES, VARIABLES, VAR_COUNT,
+    0, sizeof(SignalSource), start, step, release, NULL, state_size, state_write, state_read};
