@@ -22,6 +22,7 @@ __all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", 
            "platform_results"]
 
 FRONT_MARKER = b"sma-fmu native front"  # a string every front binary carries (fmi2_exports.c)
+NATIVE_MARKER = b"sma-fmu native C FMU"  # ... every C-family binary (c_family/fmi2/fmi2_functions.c)
 PLATFORMS = {"linux64": ".so", "win64": ".dll"}
 HOW_PYTHON_IS_FOUND = {
     "linux64": "the process's own Python, else $SMA_FMU_LIBPYTHON, else the build's libpython, "
@@ -56,6 +57,7 @@ class PlatformEntry:
     front: bool
     python: str = ""
     degraded: str = ""
+    native: bool = False  # a C-family binary (sma-fmu build --native): no Python at all
 
 
 def binary_architecture(data):
@@ -110,6 +112,8 @@ def annotate(model_description, entries):
                       f"front=\"{str(entry.front).lower()}\" python={quoteattr(entry.python)}")
         if entry.degraded:
             attributes += f" degraded={quoteattr(entry.degraded)}"
+        if entry.native:
+            attributes += ' native="true"'
         lines.append(f"\t\t\t\t<Platform {attributes}/>")
     lines += ["\t\t\t</Platforms>", "\t\t</Tool>"]
     block = "\n".join(lines) + "\n"
@@ -172,6 +176,10 @@ def _platform_line(archive, names, identifier, name, said):
     data = archive.read(binary)
     front = FRONT_MARKER in data
     what = f"{binary} ({binary_architecture(data) or 'unknown format'})"
+    if said is not None and said.get("native") == "true":
+        if NATIVE_MARKER not in data:
+            return "FAIL", name, f"modelDescription.xml says native, but {what} is no sma-fmu C-family binary"
+        return "ok", name, f"{what}: native C (sma-fmu build --native), no Python"
     if said is None:
         return "FAIL", name, f"{what}, {'the front' if front else 'without this front'}, is not " \
                              "declared in modelDescription.xml"
