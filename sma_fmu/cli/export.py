@@ -1,4 +1,5 @@
-"""Export commands: the closed loop for system-level tools (SSP package, container FMU)."""
+"""Export commands: the closed loop for system-level tools (SSP package, container FMU), and
+the FMI Cross-Check tree of the built FMUs."""
 from pathlib import Path
 
 from .arguments import add_fmus_argument, add_scenario_arguments, scenario_paths
@@ -26,8 +27,19 @@ def _container(args):
     return 0
 
 
+def _cross_check(args):
+    import sys
+
+    from sma_fmu.fmi.cross_check import export_cross_check
+
+    for folder in export_cross_check(args.fmus, args.out,
+                                     report=lambda line: print(line, file=sys.stderr)):
+        print(folder)
+    return 0
+
+
 def register(commands):
-    """Add ``export ssp`` and ``export container`` to the ``commands`` subparsers."""
+    """Add ``export ssp``, ``export container`` and ``export cross-check`` to ``commands``."""
     export = commands.add_parser("export", help="the closed loop for system tools: SSP, container FMU")
     kinds = export.add_subparsers(dest="kind", required=True, metavar="KIND")
 
@@ -50,3 +62,13 @@ def register(commands):
                            help="the container FMU to write")
     add_fmus_argument(container, "folder of the built FMUs (sma-fmu build)")
     container.set_defaults(handler=_container)
+
+    cross = kinds.add_parser(
+        "cross-check", help="the FMI Cross-Check tree of the built FMUs (fmus/2.0/cs/<platform>/"
+                            "sma-fmu/<version>/<Model>/)",
+        description="Per FMU with a reference result: the FMU, <Model>_ref.csv, <Model>_in.csv, "
+                    "<Model>_ref.opt, ReadMe.md and LICENSE.txt; each reference is checked first.")
+    add_fmus_argument(cross, "folder of the built FMUs (sma-fmu build)")
+    cross.add_argument("--out", type=Path, required=True, metavar="DIR",
+                       help="the folder that gets the fmus/ tree")
+    cross.set_defaults(handler=_cross_check)

@@ -31,6 +31,7 @@ from importlib import resources
 from pathlib import Path
 
 from sma_fmu import __version__
+from sma_fmu.fmi.fmu_extras import add_documentation_and_reference
 from sma_fmu.fmi.front import NativeFrontWarning, compile_fronts, install_fronts, stage_slave_module
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
@@ -191,6 +192,7 @@ def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=
         for name in names:
             path = _build_into(name, folder, parameter_set, stamp)
             install_fronts(path, name, fronts)
+            add_documentation_and_reference(path)  # documentation/, extra/ fmi-ls-ref (fmu_extras)
     for message in fronts.warnings():
         warnings.warn(NativeFrontWarning(message), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}

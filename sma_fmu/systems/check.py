@@ -6,6 +6,9 @@ Per FMU (a container is an FMU; the FMUs inside an SSP are checked one by one):
 - ``C host (libcosim)``: a short run in sma-fmu's C host (:mod:`.c_host`), all outputs finite;
 - ``state round trip``: save the state, step, restore, step again: the same outputs, bit
   for bit (serialized and read back when the FMU can); "n/a" when it does not declare it.
+- ``default experiment``: the FMU's default experiment run again in fmpy gives the
+  reference result it carries (:mod:`sma_fmu.fmi.fmu_reference`, the fmi-ls-ref layout);
+  "n/a" without one, or for an FMU an export packed with a scenario's values.
 Per SSP also ``SSD schema``: SystemStructure.ssd against the SSP 1.0 schemas (fmpy's
 copy); ``packed defaults``: the FMUs' packed start values agree with their model
 descriptions and the SSD's bindings; one ``host ...`` line per known host
@@ -29,8 +32,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.files.archives import inspect_archive
+from sma_fmu.fmi.fmu_reference import reference_check
 from sma_fmu.systems.c_host import run_c_host
 from sma_fmu.systems.host_needs import KNOWN_HOSTS, host_check, packed_defaults_check, read_ssp
+from sma_fmu.systems.packed import START_VALUES_ENTRY
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
@@ -142,6 +147,7 @@ def _fmu_checks(path, label, c_host=True):
         results.append(_run(label, "C host (libcosim)",
                             lambda: _short_run("fmu", path, _fmu_step(description()))))
     results.append(_run(label, "state round trip", lambda: _state_round_trip(path, description())))
+    results.append(_run(label, "default experiment", lambda: reference_check(path, START_VALUES_ENTRY)))
     return results
 
 
