@@ -55,6 +55,10 @@ static int big_set(Big *big, uint64_t value)
     return 0;
 }
 
+static const uint32_t POWERS_OF_5[13] = {
+    1u, 5u, 25u, 125u, 625u, 3125u, 15625u, 78125u, 390625u, 1953125u, 9765625u, 48828125u,
+    244140625u};
+
 static int big_mul_pow5(Big *big, int power)
 {
     for (; power >= 13; power -= 13) {
@@ -62,7 +66,7 @@ static int big_mul_pow5(Big *big, int power)
             return 1;
         }
     }
-    return big_mul_add(big, (uint32_t)pow(5.0, power), 0);
+    return big_mul_add(big, POWERS_OF_5[power], 0);
 }
 
 static int big_shift_left(Big *big, int bits)

@@ -29,39 +29,56 @@ static void put_text(Writer *writer, const char *text)
     put(writer, text, strlen(text));
 }
 
-/* repr(str): single quotes unless the text holds ' and no ", escapes as Python's. */
+/* Python's str.isprintable() for a code point >= 0xA0: false for the separators, format
+ * characters, surrogates and private use it knows without the Unicode database (an
+ * approximation: unassigned code points count as printable here). */
+static int printable(unsigned long code)
+{
+    static const unsigned long hidden[][2] = {
+        {0xA0, 0xA0}, {0xAD, 0xAD}, {0x600, 0x605}, {0x61C, 0x61C}, {0x6DD, 0x6DD},
+        {0x70F, 0x70F}, {0x8E2, 0x8E2}, {0x1680, 0x1680}, {0x180E, 0x180E}, {0x2000, 0x200F},
+        {0x2028, 0x202F}, {0x205F, 0x2064}, {0x2066, 0x206F}, {0x3000, 0x3000},
+        {0xD800, 0xF8FF}, {0xFEFF, 0xFEFF}, {0xFFF9, 0xFFFB}, {0xF0000, 0x10FFFF}};
+    size_t i;
+    for (i = 0; i < sizeof hidden / sizeof hidden[0]; i++) {
+        if (code >= hidden[i][0] && code <= hidden[i][1]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* repr(str): single quotes unless the text holds ' and no ", escapes as Python's. The text
+ * is UTF-8 (lone surrogates in their 3-byte form, as json_text.c keeps them). */
 static void put_string(Writer *writer, const char *text, size_t length)
 {
     char quote = memchr(text, '\'', length) != NULL && memchr(text, '"', length) == NULL ? '"'
                                                                                          : '\'';
-    size_t i;
+    size_t i = 0;
     put(writer, &quote, 1);
-    for (i = 0; i < length; i++) {
+    while (i < length) {
         unsigned char c = (unsigned char)text[i];
-        char escaped[8];
-        if (c == (unsigned char)quote || c == '\\') {
-            escaped[0] = '\\';
-            escaped[1] = (char)c;
-            put(writer, escaped, 2);
-        } else if (c == '\t' || c == '\n' || c == '\r') {
-            put_text(writer, c == '\t' ? "\\t" : c == '\n' ? "\\n" : "\\r");
-        } else if (c < 0x20 || c == 0x7F) {
-            snprintf(escaped, sizeof escaped, "\\x%02x", c);
-            put_text(writer, escaped);
-        } else if (c == 0xC2 && i + 1 < length && (unsigned char)text[i + 1] <= 0xA0) {
-            /* U+0080..U+00A0 are not printable: \x80 .. \xa0 */
-            snprintf(escaped, sizeof escaped, "\\x%02x", (unsigned char)text[++i]);
-            put_text(writer, escaped);
-        } else if (c == 0xED && i + 2 < length && (unsigned char)text[i + 1] >= 0xA0) {
-            /* a lone surrogate (kept by json_text.c as its 3-byte form): \udXXX */
-            unsigned code = 0xD000u | (((unsigned char)text[i + 1] & 0x3Fu) << 6)
-                            | ((unsigned char)text[i + 2] & 0x3Fu);
-            snprintf(escaped, sizeof escaped, "\\u%04x", code);
-            put_text(writer, escaped);
-            i += 2;
-        } else {
-            put(writer, text + i, 1);
+        size_t n = c < 0x80 ? 1 : c < 0xE0 ? 2 : c < 0xF0 ? 3 : 4, k;
+        unsigned long code = n == 1 ? c : (unsigned long)(c & (0x7F >> n));
+        char escaped[12];
+        for (k = 1; k < n && i + k < length; k++) {
+            code = (code << 6) | ((unsigned char)text[i + k] & 0x3Fu);
         }
+        if (code == (unsigned char)quote || code == '\\') {
+            escaped[0] = '\\';
+            escaped[1] = (char)code;
+            put(writer, escaped, 2);
+        } else if (code == '\t' || code == '\n' || code == '\r') {
+            put_text(writer, code == '\t' ? "\\t" : code == '\n' ? "\\n" : "\\r");
+        } else if (code < 0x20 || (code >= 0x7F && code < 0xA0)
+                   || (code >= 0xA0 && !printable(code))) {
+            snprintf(escaped, sizeof escaped, code < 0x100 ? "\\x%02lx" : code < 0x10000
+                     ? "\\u%04lx" : "\\U%08lx", code);
+            put_text(writer, escaped);
+        } else {
+            put(writer, text + i, n);
+        }
+        i += n;
     }
     put(writer, &quote, 1);
 }
