@@ -14,7 +14,8 @@ Each native FMU holds:
   linking no libpython;
 - ``resources/parameters.json``: the wire parameter file of the build, for the record
   (``sma-fmu check``): the binary has its values compiled in and reads only
-  ``resources/start_values.json``, which ``sma-fmu export`` packs.
+  ``resources/start_values.json``, which ``sma-fmu export`` packs;
+- ``extra/``: the pythonfmu twin's, if it has one (its reference result: the same numbers).
 """
 import re
 import shutil
@@ -29,7 +30,7 @@ from pathlib import Path
 from sma_fmu.fmi.c_family.native_description import native_description, variables_header
 from sma_fmu.fmi.front import NativeFrontWarning
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
-from sma_fmu.fmi.platforms import PlatformEntry, annotate
+from sma_fmu.fmi.platforms import NATIVE_MARKER, PlatformEntry, annotate
 
 __all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_sources",
            "build_native_fmus", "compile_binary"]
@@ -42,7 +43,6 @@ _TARGETS = {"linux64": {"flags": ["-fPIC", "-fvisibility=hidden", "-Wl,--no-unde
                         "suffix": ".so"},
             "win64": {"flags": ["-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1", "-s"],
                       "libraries": [], "suffix": ".dll"}}
-NATIVE_MARKER = b"sma-fmu native C FMU"  # in every native binary (fmi2/fmi2_functions.c)
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -164,7 +164,10 @@ def _build_one(model_name, python_fmu, folder, work):
             continue
         binary = f"binaries/{platform}/{model_name}{target['suffix']}"
         binaries[binary] = output.read_bytes()
-        entries.append(PlatformEntry(platform, binary, front=False, python="none (native C)"))
+        if NATIVE_MARKER not in binaries[binary]:
+            raise RuntimeError(f"{binary}: the native marker is missing (fmi2_functions.c)")
+        entries.append(PlatformEntry(platform, binary, front=False, python="none (native C)",
+                                     native=True))
     text = annotate(description.decode("utf-8"), entries)
     fmu = folder / f"{model_name}.fmu"
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
@@ -174,6 +177,9 @@ def _build_one(model_name, python_fmu, folder, work):
         for binary, data in binaries.items():
             archive.writestr(binary, data)
         archive.write(unpacked / "resources" / "parameters.json", "resources/parameters.json")
+        for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
+            if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
+                archive.write(extra, extra.relative_to(unpacked).as_posix())
     return problems
 
 
