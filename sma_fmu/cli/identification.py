@@ -10,8 +10,9 @@ from .arguments import bounded_integer, bounded_number, finite_number, number_li
 __all__ = ["register"]
 
 EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
-_ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length")
-_SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit")
+_ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag")
+_SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit",
+                        "lag_s", "drift_decay")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
 # choice: synth's limits, wide for any real test file and checked before anything is made
 MAX_ROWS = 1_000_000          # rows (or samples) one synth call may write
@@ -42,7 +43,8 @@ def _fit_isobaric(args, out):
     _check_fit_loads(args)
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
                               args.residual_strain or "per-cycle", args.reference_length,
-                              progress=lambda text: print(text, flush=True))
+                              progress=lambda text: print(text, flush=True), cycles=args.cycles,
+                              lag=args.lag or "fit")
     print(format_isobaric_report(report))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
           f"figures")
@@ -73,7 +75,9 @@ def _synth_isobaric(args, params, t_min, t_max):
         noise_K=3.0 if args.noise_K is None else args.noise_K,
         noise_strain=1e-4 if args.noise_strain is None else args.noise_strain,
         noise_ohm=0.05 if args.noise_ohm is None else args.noise_ohm,
-        residual=1.5e-3 if args.drift is None else args.drift, seed=args.seed)
+        residual=1.5e-3 if args.drift is None else args.drift, seed=args.seed,
+        decay=0.5 if args.drift_decay is None else args.drift_decay,
+        lag_s=args.lag_s or 0.0)
     texts = {}
     for index, load in enumerate(loads):
         run = dataclasses.replace(programme, seed=programme.seed + index)
@@ -88,6 +92,8 @@ def _synth_isobaric(args, params, t_min, t_max):
             f"{run.cycles} cycles, dwell {run.dwell:g} s, {run.points} samples",
             f"noise: temperature {run.noise_K:g} K, strain {run.noise_strain:g}, resistance "
             f"{run.noise_ohm:g} ohm; seed {run.seed}",
+            f"wire lag behind the thermocouple: {run.lag_s:g} s = {truth['lag_samples']:.6g} "
+            f"samples (first order)",
             "true residual-strain levels: " + ", ".join(f"{v:.6g}" for v in truth["offsets"])]
         texts[f"isobaric-{load:g}kg.csv"] = (isobaric_text(columns, header), load, run.points)
     if len(loads) == 1:
@@ -171,6 +177,14 @@ def register(commands):
     fit.add_argument("--residual-strain", choices=("per-cycle", "none"),
                      help="isobaric: a strain offset per residual-strain level (each cycle may "
                           "leave strain behind), or one per file (default: per-cycle)")
+    fit.add_argument("--cycles", metavar="A:B",
+                     help="isobaric: the cycles to fit, numbered from 1 as found in the file: "
+                          "'5:' drops the first four (unstabilised) cycles, '3:10', ':20', '4' "
+                          "(default: all)")
+    fit.add_argument("--lag", choices=("fit", "none"),
+                     help="isobaric: fit the wire's first-order lag behind the thermocouple (in "
+                          "seconds, or samples without a time column), or assume none "
+                          "(default: fit)")
     fit.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
                      help="isobaric: length the strain is measured from [m] (default: the base "
                           "file's x0)")
@@ -208,6 +222,14 @@ def register(commands):
     synth.add_argument("--drift", type=bounded_number(0.0, 0.1, closed=True),
                        help="isobaric: residual strain of the first cycle [1], halving each "
                             "cycle (default: 1.5e-3)")
+    synth.add_argument("--drift-decay", type=bounded_number(0.0, 1.0, closed=True),
+                       help="isobaric: ratio of one cycle's residual strain to the previous "
+                            "(default: 0.5; 0.97 drifts slowly over 100 cycles)")
+    synth.add_argument("--lag-s", type=bounded_number(0.0, 1e4, "s", closed=True),
+                       help="isobaric: time constant of the wire's lag behind the thermocouple "
+                            "[s] (default: 0). A lab-like file: --cycles 100 --points 26000 "
+                            "--dwell 0 --rate 20 --t-min 20 --t-max 115 --noise-K 10 --lag-s 20 "
+                            "--drift 1e-3 --drift-decay 0.97 --no-time")
     synth.add_argument("--strain-unit", choices=("percent", "fraction", "length"),
                        help="isobaric: strain_percent, strain or length_m column (default: percent)")
     synth.add_argument("--no-time", action="store_true", help="isobaric: leave out the time column")

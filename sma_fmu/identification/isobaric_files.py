@@ -21,14 +21,10 @@ fraction, a length [m] far from the reference length like millimetres (and back)
 The load comes from the caller or a preamble line ``load: 0.15 kg`` (g and N too) or
 ``stress: 83 MPa``.
 
-Branches: the temperature is smoothed (scipy's Savitzky-Golay filter over 2 % of the
-samples, polynomial order 2); turning points are the maxima and minima of the
-smoothed signal whose prominence is at least half its range (scipy's find_peaks); a
-branch runs from one turning point to the next and its direction is the sign of the
-smoothed temperature's change over it. Thermocouple noise (temperature not monotone
-within a branch) therefore neither splits a branch nor flips its direction. The
-``smoothed`` temperature kept for the tangent construction is filtered again over a quarter
-of the median branch length.
+Branches and cycles: :mod:`sma_fmu.identification.isobaric_cycles` (scales from the
+temperature's dominant period, so 2 and 1,000 cycles per file read alike); ``cycles``
+keeps a range of them. The ``smoothed`` temperature kept for the tangent construction is
+filtered again over a quarter of the median branch length.
 """
 import math
 import re
@@ -36,18 +32,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import signal
-
+from sma_fmu.identification.isobaric_cycles import (Branch, select_cycles, smooth,
+                                                   split_branches)
 from sma_fmu.identification.isobaric_synthetic import load_of_stress
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 
-__all__ = ["Branch", "IsobaricData", "read_isobaric", "split_branches", "smooth", "noise_level",
-           "MIN_TEMPERATURE_SPAN_K"]
+__all__ = ["Branch", "IsobaricData", "read_isobaric", "noise_level"]
 
-MIN_TEMPERATURE_SPAN_K = 10.0     # the smoothed temperature must move this much
 MIN_STRAIN_SPAN = 1e-3            # a complete branch must change the strain by this much [1]
-COMPLETE_SHARE = 0.7              # a branch covering 70 % of the range is complete
 _COMMENT = ("#", "%", "//", "!")
 _QUANTITIES = {
     "temperature": (("temp",), ("t",), {"": "C", "c": "C", "degc": "C", "celsius": "C",
@@ -61,18 +54,6 @@ _QUANTITIES = {
     "time": (("time",), (), {"": "s", "s": "s", "sec": "s", "ms": "ms", "min": "min", "h": "h"}),
 }
 _SCALE = {"ms": 1e-3, "s": 1.0, "min": 60.0, "h": 3600.0, "m": 1.0, "mm": 1e-3}
-
-
-@dataclass
-class Branch:
-    """Rows ``start`` .. ``stop - 1`` of one heating or cooling branch."""
-
-    start: int
-    stop: int
-    direction: int        # +1 heating, -1 cooling
-    cycle: int            # heating branches count cycles from 1; a leading cooling is cycle 0
-    level: int            # residual-strain level: heating uses it, cooling goes level -> level+1
-    complete: bool        # covers most of the temperature range
 
 
 @dataclass
@@ -90,6 +71,7 @@ class IsobaricData:
     time: np.ndarray            # or None
     smoothed: np.ndarray        # smoothed temperature [degC]
     branches: list
+    splitting: object = None    # isobaric_cycles.Splitting: how the branches were found
 
     @property
     def levels(self):
@@ -284,51 +266,13 @@ def noise_level(values):
     return float(1.4826 * np.median(np.abs(second - np.median(second))) / math.sqrt(6.0))
 
 
-def smooth(values, window):
-    """Savitzky-Golay smoothing (order 2) over ``window`` samples (made odd, at most the length)."""
-    values = np.asarray(values, dtype=float)
-    window = min(int(window) | 1, values.size if values.size % 2 else values.size - 1)
-    if window < 5:
-        return values.copy()
-    return signal.savgol_filter(values, window, 2, mode="interp")
-
-
-def split_branches(smoothed, path="<data>"):
-    """[Branch] of a smoothed temperature signal; raises MeasurementError without cycles."""
-    span = float(np.ptp(smoothed))
-    if span < MIN_TEMPERATURE_SPAN_K:
-        raise MeasurementError(f"{path}: the temperature does not vary: its smoothed signal spans "
-                               f"{span:.3g} K (at least {MIN_TEMPERATURE_SPAN_K:g} K needed for "
-                               f"thermal cycling)")
-    peaks, _ = signal.find_peaks(smoothed, prominence=0.5 * span)
-    troughs, _ = signal.find_peaks(-smoothed, prominence=0.5 * span)
-    turning = sorted(set(peaks.tolist()) | set(troughs.tolist()))
-    bounds = [0] + [t for t in turning if 0 < t < smoothed.size - 1] + [smoothed.size]
-    branches, cycle, level = [], 0, 0
-    for start, stop in zip(bounds, bounds[1:]):
-        change = float(smoothed[stop - 1] - smoothed[start])
-        direction = HEATING if change >= 0 else COOLING
-        if direction == HEATING:
-            cycle += 1
-        branches.append(Branch(start, stop, direction, cycle, level,
-                               abs(change) >= COMPLETE_SHARE * span))
-        if direction == COOLING:
-            level += 1
-    directions = {b.direction for b in branches if b.complete}
-    if directions != {HEATING, COOLING}:
-        only = "heating" if HEATING in directions else "cooling"
-        raise MeasurementError(f"{path}: a single branch: the temperature only goes one way "
-                               f"({only}, {smoothed[0]:.4g} -> {smoothed[-1]:.4g} degC smoothed); "
-                               f"isobaric cycling needs at least one heating and one cooling branch")
-    return branches
-
-
-def read_isobaric(path, load=None, reference_length=0.8, diameter=None):
+def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=None):
     """Read one isobaric file as :class:`IsobaricData`.
 
     ``load`` [kg] wins over a load stated in the preamble; ``reference_length`` [m] is the
     length strain is measured from (length and extension columns are converted with it);
-    ``diameter`` [m] converts a preamble ``stress: ... MPa``.
+    ``diameter`` [m] converts a preamble ``stress: ... MPa``; ``cycles`` = (first, last)
+    cycle numbers to keep (None: all; an end None: open), see ``isobaric_cycles.parse_cycles``.
     """
     path = Path(path)
     preamble, names, rows, decimal_comma = _table(path)
@@ -367,7 +311,13 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None):
                                    f"state it in the header (# load: 0.15 kg)")
     if not load >= 0:
         raise MeasurementError(f"{path}: load = {load!r} kg must be >= 0")
-    branches = split_branches(smooth(temperature, max(5, len(rows) // 50)), path)
+    branches, _, splitting = split_branches(temperature, path)
+    if cycles is not None:
+        keep, branches = select_cycles(branches, cycles, path)
+        splitting.selected = f"{cycles[0] or 1} to {cycles[1] or 'the last'}"
+        temperature, strain, rows = temperature[keep], strain[keep], rows[keep]
+        resistance = resistance[keep] if resistance is not None else None
+        time = time[keep] if time is not None else None
     # the tangent construction gets a smoother signal: a quarter of a branch (a ramp is
     # smooth; the turning points, where the window bends it, lie outside the transformation)
     smoothed = smooth(temperature, int(np.median([b.stop - b.start for b in branches])) // 4)
@@ -380,7 +330,7 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None):
                 f"{np.ptp(strain[b.start:b.stop]):.3g} (at least {MIN_STRAIN_SPAN:g} needed)")
     units = {q: (names[i], u) for q, (i, u) in columns.items()}
     return IsobaricData(path, float(load), float(reference_length), shape == "length", units,
-                        temperature, strain, resistance, time, smoothed, branches)
+                        temperature, strain, resistance, time, smoothed, branches, splitting)
 
 
 _NAMES = {HEATING: "heating", COOLING: "cooling"}

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from sma_fmu.identification.isobaric import RESIDUAL_OPTIONS, fit_isobaric
+from sma_fmu.identification.isobaric import LAG_OPTIONS, RESIDUAL_OPTIONS, fit_isobaric
+from sma_fmu.identification.isobaric_cycles import parse_cycles, splitting_note
 from sma_fmu.identification.isobaric_figures import isobaric_figures
 from sma_fmu.identification.isobaric_files import read_isobaric
 from sma_fmu.identification.isobaric_synthetic import load_of_stress, stress_of_load
@@ -77,9 +78,16 @@ def isobaric_report(files, fit, base_set, residual, rows):
     fixed = ["eps_T", "xi_F_inf", "f_F"] + [n for n in ("b_h", "b_c", "x_min", "R_P", "R_M", "R_F")
                                           if n not in fit.wire_names]
     per_file = []
-    for data, offsets, sigma in zip(files, fit.offsets, fit.sigma):
+    for data, offsets, sigma, lag, knots in zip(files, fit.offsets, fit.sigma, fit.lags,
+                                                fit.knots_per_branch):
         per_file.append({
             "file": str(data.path), "load_kg": data.load,
+            "cycles_found": splitting_note(data.splitting, data.branches, data.time is not None),
+            "lag": lag and dict(lag, note=(
+                "wire behind the thermocouple, first-order lag; no time column, so counted in "
+                "samples" if lag["unit"] == "samples" else
+                "wire behind the thermocouple, first-order lag")),
+            "profile_knots_per_branch": knots,
             "stress_MPa": stress_of_load(data.load, params.diameter),
             "points": int(data.strain.size),
             "columns": {q: list(v) for q, v in data.columns.items()},
@@ -109,6 +117,8 @@ def isobaric_report(files, fit, base_set, residual, rows):
         "transition": widths,
         "fixed_from_base": {name: getattr(params, name) for name in fixed},
         "residual_rms": fit.residual_rms,
+        "noise_estimates": fit.noise,
+        "verdict": fit.verdict,
         "variance_factor": fit.variance_factor,
         "degrees_of_freedom": fit.dof,
         "temperature_profile_unknowns": fit.profile_unknowns,
@@ -120,27 +130,38 @@ def isobaric_report(files, fit, base_set, residual, rows):
 
 
 def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
-                     reference_length=None, progress=lambda text: None):
-    """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report."""
+                     reference_length=None, progress=lambda text: None, cycles=None, lag="fit"):
+    """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report.
+
+    ``cycles``: the text of ``--cycles`` (``5:``, ``3:10``, ``:20``, ``4``) or None for all;
+    ``lag``: "fit" (the wire's lag behind the thermocouple) or "none".
+    """
     if not files:
         raise ValueError("no measurement file given")
     if residual not in RESIDUAL_OPTIONS:
         raise ValueError(f"--residual-strain must be one of {', '.join(RESIDUAL_OPTIONS)}, "
                          f"got {residual!r}")
+    if lag not in LAG_OPTIONS:
+        raise ValueError(f"--lag must be one of {', '.join(LAG_OPTIONS)}, got {lag!r}")
+    selection = parse_cycles(cycles) if cycles is not None else None
     check_folder(out_dir)
     base_set = load_parameter_set(model)
     base = base_set.params
     reference = base.x0 if reference_length is None else reference_length
     per_file = file_loads(files, loads, stresses, base.diameter)
-    data = [read_isobaric(Path(f), load, reference, base.diameter) for f, load in zip(files, per_file)]
+    data = [read_isobaric(Path(f), load, reference, base.diameter, selection)
+            for f, load in zip(files, per_file)]
+    for d in data:
+        progress(f"{d.path.name}: {splitting_note(d.splitting, d.branches, d.time is not None)}")
     progress(f"fitting {len(data)} file(s), {sum(d.strain.size for d in data)} points ...")
-    fit = fit_isobaric(data, base, residual)
+    fit = fit_isobaric(data, base, residual, lag, progress=progress)
     progress("transformation temperatures and figures ...")
     per_cycle = residual == "per-cycle"
-    rows = [row for d, offsets, profile in zip(data, fit.offsets, fit.profiles)
-            for row in cycle_rows(d, fit.params, offsets, profile, per_cycle)]
+    rows = [row for d, offsets, profile, bounds in zip(data, fit.offsets, fit.profiles,
+                                                       fit.wire_bounds)
+            for row in cycle_rows(d, fit.params, offsets, profile, per_cycle, bounds)]
     report = isobaric_report(data, fit, base_set, residual, rows)
-    figures = isobaric_figures(data, fit, per_cycle)
+    figures = isobaric_figures(data, fit, per_cycle, rows)
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     names = ", ".join(Path(f).name for f in files)
     with staged_folder(out_dir) as folder:
@@ -164,11 +185,21 @@ def format_isobaric_report(report):
     """A short text summary of an isobaric fit report."""
     rms = report["residual_rms"]
     solver = report["solver"]
-    lines = [f"isobaric fit: {report['points']} points in {len(report['files'])} file(s); RMS "
-             f"strain {rms['strain']:.3g}, temperature {rms['temperature_K']:.3g} K"
-             + (f", resistance {rms['resistance_ohm']:.3g} ohm" if rms["resistance_ohm"] else "")
-             + f"; {solver['seconds']:.2f} s ({solver['evaluations']} evaluations)",
-             f"{'parameter':<12}{'value':>14}{'std error':>12}"]
+    noise = report["noise_estimates"]
+    lines = [f"isobaric fit: {report['points']} points in {len(report['files'])} file(s); "
+             f"{solver['seconds']:.2f} s ({solver['evaluations']} evaluations)",
+             f"residual RMS (noise estimate): strain {rms['strain']:.3g} ({noise['strain']:.3g}), "
+             f"temperature {rms['temperature_K']:.3g} K ({noise['temperature_K']:.3g} K)"
+             + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
+                if rms["resistance_ohm"] else ""),
+             report["verdict"]]
+    for entry in report["files"]:
+        lines.append(f"{Path(entry['file']).name}: {entry['cycles_found']}")
+        if entry["lag"]:
+            lag = entry["lag"]
+            lines.append(f"{Path(entry['file']).name}: lag {lag['value']:.4g} +- "
+                         f"{lag['std_error']:.2g} {lag['unit']} ({lag['note']})")
+    lines.append(f"{'parameter':<12}{'value':>14}{'std error':>12}")
     for name, row in report["parameters"].items():
         lines.append(f"{name:<12}{row['value']:>14.6g}{row['std_error']:>12.3g}")
     for load, centre in report["hysteresis_centres_degC"].items():

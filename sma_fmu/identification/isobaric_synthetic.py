@@ -2,10 +2,14 @@
 
 The wire hangs at a constant load while a furnace runs a temperature programme: a dwell at
 ``t_low``, a ramp at ``rate`` up to ``t_high``, a dwell, a ramp down, a dwell, ``cycles``
-times. The wire's true temperature drives the model (major branches, spec section 4;
-the direction is that of the programme, kept through each dwell); the file reports:
+times. The thermocouple reads the programme; the wire follows it with a first-order lag of
+time constant ``lag_s`` [s] (:mod:`sma_fmu.identification.isobaric_lag`; 0: no lag). The
+wire's temperature drives the model (major branches, spec section 4; the direction is that
+of the wire's temperature, which turns after the thermocouple's, kept through each dwell),
+so with a lag a transformation that ends near the top goes on after the measured
+temperature has turned. The file reports:
 
-- temperature with Gaussian thermocouple noise ``noise_K`` [K] (so it is not monotone
+- the thermocouple temperature with Gaussian noise ``noise_K`` [K] (so it is not monotone
   within a branch),
 - strain relative to the reference length (x / L_ref - 1) with Gaussian noise
   ``noise_strain`` [1], in percent, as a fraction, or as a length [m],
@@ -15,16 +19,20 @@ the direction is that of the programme, kept through each dwell); the file repor
 - optionally time [s] and resistance [ohm] with noise ``noise_ohm``.
 
 A header of ``#`` lines states the load, the programme, the noise and the true drift.
+A lab-like file (issue 26): ``IsobaricProgramme(t_low=20, t_high=115, rate=20, cycles=100,
+dwell=0, points=26000, noise_K=10, lag_s=20, decay=0.97)`` written without a time column:
+100 cycles of 260 samples, the heating transformation finishing after the measured turn.
 """
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from sma_fmu.identification.isobaric_lag import lagged
 from sma_fmu.identification.isobaric_model import branch_share, branch_levels
 from sma_fmu.runtime.constants import COOLING, HEATING, STANDARD_GRAVITY
 
-__all__ = ["IsobaricProgramme", "temperature_programme", "isobaric_table", "isobaric_text",
+__all__ = ["IsobaricProgramme", "temperature_programme", "wire_temperature", "isobaric_table", "isobaric_text",
            "stress_of_load", "load_of_stress", "STRAIN_UNITS"]
 
 STRAIN_UNITS = ("percent", "fraction", "length")
@@ -57,6 +65,7 @@ class IsobaricProgramme:
     residual: float = 1.5e-3       # residual strain of the first cycle [1]
     decay: float = 0.5             # ratio of one cycle's residual strain to the previous
     seed: int = 0
+    lag_s: float = 0.0             # time constant of the wire behind the thermocouple [s]
 
     def __post_init__(self):
         if not self.t_high > self.t_low:
@@ -67,9 +76,28 @@ class IsobaricProgramme:
         for name in ("rate",):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
-        for name in ("dwell", "noise_K", "noise_strain", "noise_ohm", "residual", "decay"):
+        for name in ("dwell", "noise_K", "noise_strain", "noise_ohm", "residual", "decay", "lag_s"):
             if not getattr(self, name) >= 0:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be >= 0")
+
+
+def wire_temperature(programme):
+    """(time [s], measured temperature without noise [degC], wire temperature [degC], wire
+    direction +1/-1, cycle index from 0) of the programme with the wire's lag."""
+    time, measured, direction, cycle = temperature_programme(programme)
+    if not programme.lag_s > 0:
+        return time, measured, measured, direction, cycle
+    step = float(time[1] - time[0])
+    wire = lagged(measured, programme.lag_s, step)
+    # the wire heats while the thermocouple reads more than the wire (dw/dt = (u - w)/tau)
+    gap = measured - wire
+    direction = np.where(gap > 1e-9, HEATING, np.where(gap < -1e-9, COOLING, 0))
+    direction[0] = direction[0] or HEATING
+    for i in np.nonzero(direction == 0)[0]:
+        direction[i] = direction[i - 1]
+    starts = np.concatenate([[0], (np.diff(direction) > 0).astype(int)])
+    cycle = np.clip(np.cumsum(starts), 0, programme.cycles - 1)
+    return time, measured, wire, direction, cycle
 
 
 def temperature_programme(programme):
@@ -99,13 +127,14 @@ def isobaric_table(params, load, programme, strain_unit="percent", with_time=Tru
     """The columns of a synthetic file: {name: array}, plus the true offsets per level.
 
     ``load`` [kg]; ``reference_length`` [m] defaults to the wire's x0.
-    Returns (columns, truth) with truth = {"offsets": strain offset of each level [1]}.
+    Returns (columns, truth) with truth = {"offsets": strain offset of each level [1],
+    "true_temperature": the wire's [degC], "lag_samples": lag_s over the sample step}.
     """
     if strain_unit not in STRAIN_UNITS:
         raise ValueError(f"strain unit must be one of {', '.join(STRAIN_UNITS)}, got {strain_unit!r}")
     reference = params.x0 if reference_length is None else reference_length
     rng = np.random.default_rng(programme.seed)
-    time, true_t, direction, cycle = temperature_programme(programme)
+    time, measured_t, true_t, direction, cycle = wire_temperature(programme)
     strain = np.empty(time.size)
     resistance = np.empty(time.size)
     offsets = np.concatenate([[0.0], np.cumsum(programme.residual
@@ -122,14 +151,15 @@ def isobaric_table(params, load, programme, strain_unit="percent", with_time=Tru
     columns = {}
     if with_time:
         columns["time_s"] = time
-    columns["temperature_C"] = true_t + programme.noise_K * rng.standard_normal(time.size)
+    columns["temperature_C"] = measured_t + programme.noise_K * rng.standard_normal(time.size)
     measured = strain + programme.noise_strain * rng.standard_normal(time.size)
     columns[_COLUMN[strain_unit]] = {"percent": 100.0 * measured, "fraction": measured,
                                      "length": reference * (1.0 + measured)}[strain_unit]
     noise_r = programme.noise_ohm * rng.standard_normal(time.size)
     if with_resistance:
         columns["resistance_ohm"] = resistance + noise_r
-    return columns, {"offsets": offsets.tolist(), "true_temperature": true_t}
+    return columns, {"offsets": offsets.tolist(), "true_temperature": true_t,
+                     "lag_samples": programme.lag_s / float(time[1] - time[0])}
 
 
 _DIGITS = {"time_s": 3, "temperature_C": 3, "strain_percent": 6, "strain": 8, "length_m": 9,

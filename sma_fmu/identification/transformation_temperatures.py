@@ -4,7 +4,8 @@ On one heating or cooling branch:
 
 1. Rough levels: the median strain of the coldest and hottest 10 % of the samples; the
    temperatures T25, T50, T75 where the strain has gone 25, 50, 75 % of the way from one
-   level to the other (median temperature of the samples within 5 % of that share).
+   level to the other (median temperature of the samples within 5 % of that share; 10 or
+   15 % on a steep branch with fewer than two samples there).
 2. Baselines: straight lines (least squares) through the samples colder than
    T50 - 2.5 |T75 - T25| (martensite, "cold") and hotter than T50 + 2.5 |T75 - T25|
    (austenite, "hot"); they keep the slope of the data (thermal expansion, creep).
@@ -31,7 +32,7 @@ import numpy as np
 
 from sma_fmu.runtime.constants import HEATING
 
-__all__ = ["branch_tangents", "cycle_numbers", "QUANTITIES", "TAIL_WIDTHS", "BAND"]
+__all__ = ["branch_tangents", "branch_tangents_or_reason", "cycle_numbers", "QUANTITIES", "TAIL_WIDTHS", "BAND"]
 
 BAND = (0.4, 0.6)
 TAIL_WIDTHS = 2.5
@@ -41,10 +42,13 @@ QUANTITIES = (("A_s", "degC"), ("A_f", "degC"), ("M_s", "degC"), ("M_f", "degC")
 
 
 def _share_temperature(temperature, share, target):
-    near = np.abs(share - target) <= 0.05
-    if near.sum() < 2:
-        return None
-    return float(np.median(temperature[near]))
+    """Median temperature of the samples within 5 % of ``target`` (10 or 15 % when a steep,
+    sparsely sampled branch leaves fewer than two there)."""
+    for band in (0.05, 0.10, 0.15):
+        near = np.abs(share - target) <= band
+        if near.sum() >= 2:
+            return float(np.median(temperature[near]))
+    return None
 
 
 def _line(x, y):
@@ -68,34 +72,46 @@ def branch_tangents(temperature, strain, direction, band=BAND, tail=TAIL_WIDTHS)
     [degC], "cold", "hot" (intercept [1], slope [1/K]) of the baselines, "tangent"
     (intercept [degC], slope [K]) of T against strain, "lowest" [degC]}.
     """
+    return branch_tangents_or_reason(temperature, strain, direction, band, tail)[0]
+
+
+def branch_tangents_or_reason(temperature, strain, direction, band=BAND, tail=TAIL_WIDTHS):
+    """(:func:`branch_tangents` result, None), or (None, why the construction cannot be made)."""
+    heating = direction == HEATING
     order = np.argsort(temperature, kind="stable")
     t = np.asarray(temperature, dtype=float)[order]
     e = np.asarray(strain, dtype=float)[order]
     ends = max(3, t.size // 10)
     cold_level, hot_level = float(np.median(e[:ends])), float(np.median(e[-ends:]))
     if not cold_level > hot_level:
-        return None
+        return None, "the strain is not lower hot than cold: no transformation in the branch"
     share = (e - hot_level) / (cold_level - hot_level)
     marks = [_share_temperature(t, share, q) for q in (0.75, 0.5, 0.25)]
     if None in marks:
-        return None
+        return None, "too few samples at 25, 50 or 75 % of the strain change"
     t75, t50, t25 = marks
     width = max(abs(t25 - t75), 1e-6)
     cold_rows, hot_rows = t < t50 - tail * width, t > t50 + tail * width
-    if cold_rows.sum() < MIN_BASELINE_POINTS or hot_rows.sum() < MIN_BASELINE_POINTS:
-        return None
+    if hot_rows.sum() < MIN_BASELINE_POINTS:
+        return None, ("transformation not finished before the turn (no austenite baseline)"
+                      if heating else "transformation already under way at the branch's "
+                      "hottest point (no austenite baseline)")
+    if cold_rows.sum() < MIN_BASELINE_POINTS:
+        return None, ("transformation already under way at the branch's coldest point (no "
+                      "martensite baseline)" if heating else
+                      "transformation not finished before the turn (no martensite baseline)")
     cold, hot = _line(t[cold_rows], e[cold_rows]), _line(t[hot_rows], e[hot_rows])
     low_line = hot[0] + hot[1] * t
     progress = (e - low_line) / (cold[0] + cold[1] * t - low_line)
     rows = (progress >= band[0]) & (progress <= band[1])
     if rows.sum() < 2 or np.ptp(e[rows]) == 0.0:
-        return None
+        return None, "fewer than 2 samples between 40 and 60 % of the transformation"
     tangent = _line(e[rows], t[rows])
     middle = (0.5 * (cold[0] + hot[0]), 0.5 * (cold[1] + hot[1]))
     at_cold, at_hot = _meet(tangent, cold), _meet(tangent, hot)
-    start, finish = (at_cold, at_hot) if direction == HEATING else (at_hot, at_cold)
+    start, finish = (at_cold, at_hot) if heating else (at_hot, at_cold)
     return {"start": start, "finish": finish, "midpoint": _meet(tangent, middle), "cold": cold,
-            "hot": hot, "tangent": tangent, "lowest": float(t[0])}
+            "hot": hot, "tangent": tangent, "lowest": float(t[0])}, None
 
 
 def cycle_numbers(heating, cooling):

@@ -1,0 +1,127 @@
+"""The temperature the wire had: a smooth profile of the measured temperature, then the lag.
+
+Two steps, so that the wire temperature cannot absorb model misfit:
+
+1. Profile: the measured temperature is fitted alone by a piecewise-linear curve in time (in
+   the sample index without a time column) with knots at the branches' turning points and k
+   evenly spaced knots inside each branch; k is chosen from the temperature itself by the
+   Bayesian information criterion (n ln(RSS/n) + knots ln n), so a linear furnace ramp gets
+   few knots and a curved one more. Its residual is the temperature residual the report sets
+   beside the noise estimate; the knots' covariance sigma_T^2 (B^T B)^-1 goes into the
+   parameters' covariance (:mod:`sma_fmu.identification.isobaric`).
+2. Wire: the profile lagged by the fitted time constant
+   (:mod:`sma_fmu.identification.isobaric_lag`). The wire's branches turn where the wire
+   does, after the thermocouple: :func:`wire_rows` moves each turning point to the wire's
+   extremum.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import linalg
+
+from sma_fmu.identification.isobaric_lag import lagged
+
+__all__ = ["Profile", "temperature_profile", "wire_rows", "lagged_basis", "INTERIOR_KNOTS"]
+
+INTERIOR_KNOTS = (0, 1, 2, 3, 4, 6, 8, 12, 16, 24)   # candidates per branch
+
+
+@dataclass
+class Profile:
+    """Smoothed measured temperature [degC] at each sample and what it rests on."""
+
+    values: np.ndarray
+    basis: object              # sparse (samples x knots) linear interpolation
+    knots: np.ndarray          # sample index of each knot
+    knots_per_branch: int
+    residual_rms: float        # measured - profile [K]
+    sigma: float               # residual standard deviation [K] (dof-corrected)
+    factor: object             # splu of B^T B: the knots' covariance is sigma^2 (B^T B)^-1
+
+    @property
+    def knot_count(self):
+        return self.basis.shape[1]
+
+
+def _basis(axis, knots):
+    at = axis[knots]
+    k = np.clip(np.searchsorted(at, axis, side="right") - 1, 0, at.size - 2)
+    w = (axis - at[k]) / (at[k + 1] - at[k])
+    rows = np.arange(axis.size)
+    return sparse.csr_matrix((np.concatenate([1 - w, w]), (np.concatenate([rows, rows]),
+                                                           np.concatenate([k, k + 1]))),
+                             shape=(axis.size, at.size))
+
+
+def _knots(branches, size, interior):
+    knots = {0, size - 1}
+    for b in branches:
+        knots.update(np.linspace(b.start, b.stop - 1, interior + 2).round().astype(int).tolist())
+    return np.array(sorted(knots))
+
+
+def temperature_profile(temperature, branches, time=None):
+    """:class:`Profile` of the measured ``temperature`` [degC], knots chosen by BIC."""
+    n = temperature.size
+    axis = np.asarray(time, dtype=float) if time is not None else np.arange(n, dtype=float)
+    shortest = min(b.stop - b.start for b in branches)
+    best = None
+    for interior in INTERIOR_KNOTS:
+        if interior > 0 and (interior + 1) * 3 > shortest:
+            break
+        knots = _knots(branches, n, interior)
+        basis = _basis(axis, knots)
+        factor = linalg.splu((basis.T @ basis).tocsc())
+        values = basis @ factor.solve(basis.T @ temperature)
+        rss = float(np.sum((temperature - values) ** 2))
+        bic = n * np.log(max(rss, 1e-300) / n) + basis.shape[1] * np.log(n)
+        if best is None or bic < best[0]:
+            best = (bic, interior, basis, factor, values, rss, knots)
+    _, interior, basis, factor, values, rss, knots = best
+    dof = max(n - basis.shape[1], 1)
+    return Profile(values, basis, knots, interior, float(np.sqrt(rss / n)), float(np.sqrt(rss / dof)),
+                   factor)
+
+
+def wire_rows(wire, branches, levels_per_cycle=True):
+    """(direction, level, bounds) per sample of the lagged ``wire`` temperature; bounds are
+    the wire branches' first rows and the end.
+
+    Each turning point of the measured branches moves forward to the wire's extremum,
+    searched over the first half of the next branch.
+    """
+    n = wire.size
+    bounds = [0]
+    for previous, b in zip(branches, branches[1:]):
+        stop = b.start + max(1, (b.stop - b.start) // 2)
+        window = wire[b.start:stop] * previous.direction
+        bounds.append(b.start + int(np.argmax(window)))
+    bounds.append(n)
+    index = np.zeros(n, dtype=int)
+    for k, start in enumerate(bounds[1:-1], start=1):
+        index[start:] = k
+    direction = np.array([b.direction for b in branches])[index]
+    level = np.array([b.level if levels_per_cycle else 0 for b in branches])[index]
+    return direction, level, bounds
+
+
+
+def lagged_basis(basis, knots, tau, step):
+    """Sparse lagged(B) (samples x knots): each hat function's lagged response, cut where
+    the exponential tail has fallen below 1e-12 of its height."""
+    n, count = basis.shape
+    tail = int(np.ceil(28.0 * tau / step)) + 2 if tau > 0 else 1
+    rows, cols, values = [], [], []
+    csc = basis.tocsc()
+    for k in range(count):
+        first = knots[k - 1] if k > 0 else 0
+        stop = min(n, (knots[k + 1] if k + 1 < count else n - 1) + tail)
+        u = csc[first:stop, k].toarray().ravel()
+        w = lagged(u, tau, step)
+        keep = np.nonzero(np.abs(w) > 1e-12)[0]
+        rows.append(first + keep)
+        cols.append(np.full(keep.size, k))
+        values.append(w[keep])
+    return sparse.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                             shape=(n, count))
