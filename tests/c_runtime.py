@@ -11,6 +11,8 @@ import shutil
 import subprocess
 from pathlib import Path
 
+from system_needs import need
+
 RUNTIME_DIR = Path(__file__).resolve().parent.parent / "sma_fmu" / "fmi" / "c_family" / "runtime"
 FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off", "-O2")
 MINGW = "x86_64-w64-mingw32-gcc"
@@ -33,6 +35,7 @@ def _run(command):
 def compile_runtime(modules, folder, extra_source=None, name="runtime"):
     """The runtime ``modules`` (and ``extra_source``, C text such as a test-only shim that
     includes runtime headers) built with gcc into ``folder``/lib<name>.so; a ctypes.CDLL."""
+    need("gcc")  # skipped without it, failed under CI=true (tests/system_needs.py)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     sources = _sources(modules)
@@ -48,6 +51,7 @@ def compile_runtime(modules, folder, extra_source=None, name="runtime"):
 def compile_win64(modules, folder):
     """Compile the runtime ``modules`` to win64 objects with mingw-w64 under the same flags
     (-c, no link); returns the object paths, or None when mingw-w64 is not installed."""
+    need("mingw-w64")  # skipped without it, failed under CI=true (tests/system_needs.py)
     if shutil.which(MINGW) is None:
         return None
     folder = Path(folder)
