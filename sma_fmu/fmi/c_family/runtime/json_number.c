@@ -1,4 +1,4 @@
-/* Decimal text <-> double exactly as Python does it (see json_number.h).
+/* Decimal text -> double exactly as Python does it (see json_number.h).
  *
  * Reading: value = D * 10^E with D the significant digits. Small D and E take the exact
  * fast path (one correctly rounded multiplication or division by an exact power of ten);
@@ -11,13 +11,9 @@
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
 
 #define MAX_DIGITS 800
 #define BIG_LIMBS 200              /* 6400 bits: D 5^E 2^s stays below 5000 bits */
-#define TWO_TO_52 4503599627370496.0
 #define MANTISSA_TOP ((uint64_t)1 << 53)
 #define MIN_EXPONENT (-1074)       /* of the last bit of a subnormal */
 #define MAX_EXPONENT 971           /* of the last bit of DBL_MAX */
@@ -323,85 +319,4 @@ int json_number_value(const char *text, size_t length, double *out)
     }
     *out = negative ? -magnitude : magnitude;
     return 0;
-}
-
-void json_float_repr(double number, char *out, size_t size)
-{
-    char digits[40], mantissa[24], text[48];
-    int precision, exponent = 0, count = 0, negative = 0, i, at = 0, decimal_point;
-    double back = 0.0;
-    if (size == 0) {
-        return;
-    }
-    if (isnan(number) || isinf(number)) {
-        snprintf(out, size, "%s", isnan(number) ? "nan" : (number > 0 ? "inf" : "-inf"));
-        return;
-    }
-    if (number == 0.0) {
-        snprintf(out, size, "%s", signbit(number) ? "-0.0" : "0.0");
-        return;
-    }
-    /* the shortest correctly rounded digits that read back to the number (Python's 'r') */
-    for (precision = 1; precision <= 17; precision++) {
-        snprintf(digits, sizeof digits, "%.*e", precision - 1, number);
-        for (i = 0; digits[i] != '\0' && digits[i] != 'e'; i++) {
-            if (digits[i] == ',') {
-                digits[i] = '.';      /* a host's locale may print a decimal comma */
-            }
-        }
-        count = 0;
-        negative = digits[0] == '-';
-        for (i = 0; digits[i] != '\0' && digits[i] != 'e'; i++) {
-            if (digits[i] >= '0' && digits[i] <= '9' && count < (int)sizeof mantissa - 1) {
-                mantissa[count++] = digits[i];
-            }
-        }
-        mantissa[count] = '\0';
-        exponent = digits[i] == 'e' ? (int)strtol(digits + i + 1, NULL, 10) : 0;
-        snprintf(text, sizeof text, "%s%se%d", negative ? "-" : "", mantissa, exponent - count + 1);
-        if (json_number_value(text, strlen(text), &back) == 0 && back == number) {
-            break;
-        }
-    }
-    while (count > 1 && mantissa[count - 1] == '0') {
-        mantissa[--count] = '\0';
-    }
-    decimal_point = exponent + 1;     /* value = 0.mantissa * 10^decimal_point */
-    if (negative) {
-        text[at++] = '-';
-    }
-    if (decimal_point <= -4 || decimal_point > 16) {
-        text[at++] = mantissa[0];
-        if (count > 1) {
-            text[at++] = '.';
-            for (i = 1; i < count; i++) {
-                text[at++] = mantissa[i];
-            }
-        }
-        snprintf(text + at, sizeof text - (size_t)at, "e%c%02d", exponent < 0 ? '-' : '+',
-                 exponent < 0 ? -exponent : exponent);
-    } else if (decimal_point <= 0) {
-        text[at++] = '0';
-        text[at++] = '.';
-        for (i = 0; i < -decimal_point; i++) {
-            text[at++] = '0';
-        }
-        for (i = 0; i < count; i++) {
-            text[at++] = mantissa[i];
-        }
-        text[at] = '\0';
-    } else {
-        for (i = 0; i < count || i < decimal_point; i++) {
-            if (i == decimal_point) {
-                text[at++] = '.';
-            }
-            text[at++] = i < count ? mantissa[i] : '0';
-        }
-        if (count <= decimal_point) {
-            text[at++] = '.';
-            text[at++] = '0';
-        }
-        text[at] = '\0';
-    }
-    snprintf(out, size, "%s", text);
 }

@@ -1,7 +1,9 @@
 /* Python's repr() of loaded JSON values, for messages, and member look-up (json_text.h). */
 #include "json_text.h"
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "json_number.h"
@@ -168,4 +170,85 @@ const JsonValue *json_object_get(const JsonValue *object, const char *name)
         }
     }
     return NULL;
+}
+
+void json_float_repr(double number, char *out, size_t size)
+{
+    char digits[40], mantissa[24], text[48];
+    int precision, exponent = 0, count = 0, negative = 0, i, at = 0, decimal_point;
+    double back = 0.0;
+    if (size == 0) {
+        return;
+    }
+    if (isnan(number) || isinf(number)) {
+        snprintf(out, size, "%s", isnan(number) ? "nan" : (number > 0 ? "inf" : "-inf"));
+        return;
+    }
+    if (number == 0.0) {
+        snprintf(out, size, "%s", signbit(number) ? "-0.0" : "0.0");
+        return;
+    }
+    /* the shortest correctly rounded digits that read back to the number (Python's 'r') */
+    for (precision = 1; precision <= 17; precision++) {
+        snprintf(digits, sizeof digits, "%.*e", precision - 1, number);
+        for (i = 0; digits[i] != '\0' && digits[i] != 'e'; i++) {
+            if (digits[i] == ',') {
+                digits[i] = '.';      /* a host's locale may print a decimal comma */
+            }
+        }
+        count = 0;
+        negative = digits[0] == '-';
+        for (i = 0; digits[i] != '\0' && digits[i] != 'e'; i++) {
+            if (digits[i] >= '0' && digits[i] <= '9' && count < (int)sizeof mantissa - 1) {
+                mantissa[count++] = digits[i];
+            }
+        }
+        mantissa[count] = '\0';
+        exponent = digits[i] == 'e' ? (int)strtol(digits + i + 1, NULL, 10) : 0;
+        snprintf(text, sizeof text, "%s%se%d", negative ? "-" : "", mantissa, exponent - count + 1);
+        if (json_number_value(text, strlen(text), &back) == 0 && back == number) {
+            break;
+        }
+    }
+    while (count > 1 && mantissa[count - 1] == '0') {
+        mantissa[--count] = '\0';
+    }
+    decimal_point = exponent + 1;     /* value = 0.mantissa * 10^decimal_point */
+    if (negative) {
+        text[at++] = '-';
+    }
+    if (decimal_point <= -4 || decimal_point > 16) {
+        text[at++] = mantissa[0];
+        if (count > 1) {
+            text[at++] = '.';
+            for (i = 1; i < count; i++) {
+                text[at++] = mantissa[i];
+            }
+        }
+        snprintf(text + at, sizeof text - (size_t)at, "e%c%02d", exponent < 0 ? '-' : '+',
+                 exponent < 0 ? -exponent : exponent);
+    } else if (decimal_point <= 0) {
+        text[at++] = '0';
+        text[at++] = '.';
+        for (i = 0; i < -decimal_point; i++) {
+            text[at++] = '0';
+        }
+        for (i = 0; i < count; i++) {
+            text[at++] = mantissa[i];
+        }
+        text[at] = '\0';
+    } else {
+        for (i = 0; i < count || i < decimal_point; i++) {
+            if (i == decimal_point) {
+                text[at++] = '.';
+            }
+            text[at++] = i < count ? mantissa[i] : '0';
+        }
+        if (count <= decimal_point) {
+            text[at++] = '.';
+            text[at++] = '0';
+        }
+        text[at] = '\0';
+    }
+    snprintf(out, size, "%s", text);
 }

@@ -11,43 +11,16 @@
 #include <string.h>
 
 #include "json_number.h"
-
-typedef struct Scanner {
-    const char *text;
-    size_t length;
-    char *error;
-    size_t error_size;
-} Scanner;
+#include "json_string.h"
 
 static const JsonValue EMPTY_VALUE;
-
-/* Python's JSONDecodeError text: "<what>: line L column C (char N)", N in characters. */
-static int fail(Scanner *scanner, const char *what, size_t at)
-{
-    size_t i, line = 1, column = 1, chars = 0;
-    for (i = 0; i < at && i < scanner->length; i++) {
-        unsigned char byte = (unsigned char)scanner->text[i];
-        if ((byte & 0xC0) == 0x80) {
-            continue;             /* a UTF-8 continuation byte: not a new character */
-        }
-        chars++;
-        column++;
-        if (byte == '\n') {
-            line++;
-            column = 1;
-        }
-    }
-    snprintf(scanner->error, scanner->error_size, "%s: line %lu column %lu (char %lu)", what,
-             (unsigned long)line, (unsigned long)column, (unsigned long)chars);
-    return 1;
-}
 
 static int is_space(char c)
 {
     return c == ' ' || c == '\t' || c == '\n' || c == '\r';
 }
 
-static size_t skip_space(const Scanner *scanner, size_t at)
+static size_t skip_space(const JsonScanner *scanner, size_t at)
 {
     while (at < scanner->length && is_space(scanner->text[at])) {
         at++;
@@ -60,147 +33,7 @@ static int is_digit(char c)
     return c >= '0' && c <= '9';
 }
 
-/* Append bytes to a growing buffer; 1 when memory runs out. */
-static int append(char **buffer, size_t *length, size_t *capacity, const char *bytes,
-                  size_t count)
-{
-    if (*length + count + 1 > *capacity) {
-        size_t grown = (*capacity == 0 ? 16 : *capacity * 2) + count;
-        char *bigger = (char *)realloc(*buffer, grown);
-        if (bigger == NULL) {
-            return 1;
-        }
-        *buffer = bigger;
-        *capacity = grown;
-    }
-    memcpy(*buffer + *length, bytes, count);
-    *length += count;
-    (*buffer)[*length] = '\0';
-    return 0;
-}
-
-static int encode_utf8(unsigned long code, char *out)
-{
-    if (code < 0x80) {
-        out[0] = (char)code;
-        return 1;
-    }
-    if (code < 0x800) {
-        out[0] = (char)(0xC0 | (code >> 6));
-        out[1] = (char)(0x80 | (code & 0x3F));
-        return 2;
-    }
-    if (code < 0x10000) {     /* a lone surrogate is kept as its 3-byte form (WTF-8) */
-        out[0] = (char)(0xE0 | (code >> 12));
-        out[1] = (char)(0x80 | ((code >> 6) & 0x3F));
-        out[2] = (char)(0x80 | (code & 0x3F));
-        return 3;
-    }
-    out[0] = (char)(0xF0 | (code >> 18));
-    out[1] = (char)(0x80 | ((code >> 12) & 0x3F));
-    out[2] = (char)(0x80 | ((code >> 6) & 0x3F));
-    out[3] = (char)(0x80 | (code & 0x3F));
-    return 4;
-}
-
-/* Four hex digits at text[at..at+4) -> *code; 1 if one is not a hex digit. */
-static int hex4(const char *text, size_t at, unsigned long *code)
-{
-    size_t i;
-    *code = 0;
-    for (i = at; i < at + 4; i++) {
-        char c = text[i];
-        int digit = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10
-                    : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
-        if (digit < 0) {
-            return 1;
-        }
-        *code = *code * 16 + (unsigned long)digit;
-    }
-    return 0;
-}
-
-/* scanstring: the string whose opening quote is at begin - 1; *next after its closing one. */
-static int scan_string(Scanner *scanner, size_t begin, JsonValue *out, size_t *next)
-{
-    const char *text = scanner->text;
-    size_t len = scanner->length, at = begin, capacity = 0;
-    char *buffer = NULL, bytes[4];
-    *out = EMPTY_VALUE;
-    out->kind = JSON_STRING;
-    for (;;) {
-        size_t chunk = at;
-        unsigned long code;
-        while (at < len && text[at] != '"' && text[at] != '\\') {
-            if ((unsigned char)text[at] <= 0x1F) {
-                free(buffer);
-                return fail(scanner, "Invalid control character at", at);
-            }
-            at++;
-        }
-        if (append(&buffer, &out->length, &capacity, text + chunk, at - chunk)) {
-            free(buffer);
-            return fail(scanner, "out of memory", at);
-        }
-        if (at >= len) {
-            free(buffer);
-            return fail(scanner, "Unterminated string starting at", begin - 1);
-        }
-        if (text[at] == '"') {
-            break;
-        }
-        at++;                                    /* past the backslash */
-        if (at >= len) {
-            free(buffer);
-            return fail(scanner, "Unterminated string starting at", begin - 1);
-        }
-        if (text[at] != 'u') {
-            const char *plain = strchr("\"\\/bfnrt", text[at]);
-            static const char decoded[] = "\"\\/\b\f\n\r\t";
-            if (plain == NULL || text[at] == '\0') {
-                free(buffer);
-                return fail(scanner, "Invalid \\escape", at - 1);
-            }
-            bytes[0] = decoded[plain - "\"\\/bfnrt"];
-            at++;
-            if (append(&buffer, &out->length, &capacity, bytes, 1)) {
-                free(buffer);
-                return fail(scanner, "out of memory", at);
-            }
-            continue;
-        }
-        /* \uXXXX at `at` (the 'u'); as _json.c: needs a character after the four digits */
-        if (at + 1 + 4 >= len || hex4(text, at + 1, &code)) {
-            free(buffer);
-            return fail(scanner, "Invalid \\uXXXX escape", at);
-        }
-        at += 5;
-        if (code >= 0xD800 && code <= 0xDBFF && at + 6 < len && text[at] == '\\'
-            && text[at + 1] == 'u') {
-            unsigned long low;
-            if (hex4(text, at + 2, &low)) {
-                free(buffer);
-                return fail(scanner, "Invalid \\uXXXX escape", at + 1);
-            }
-            if (low >= 0xDC00 && low <= 0xDFFF) {
-                code = 0x10000 + ((code - 0xD800) << 10) + (low - 0xDC00);
-                at += 6;
-            }
-        }
-        if (append(&buffer, &out->length, &capacity, bytes, (size_t)encode_utf8(code, bytes))) {
-            free(buffer);
-            return fail(scanner, "out of memory", at);
-        }
-    }
-    if (buffer == NULL && append(&buffer, &out->length, &capacity, "", 0)) {
-        return fail(scanner, "out of memory", at);
-    }
-    out->text = buffer;
-    *next = at + 1;
-    return 0;
-}
-
-static int scan_value(Scanner *scanner, size_t at, int depth, JsonValue *out, size_t *next);
+static int scan_value(JsonScanner *scanner, size_t at, int depth, JsonValue *out, size_t *next);
 
 /* Add `value` (and `key` for an object) to `container`; a repeated key keeps its place and
  * takes the new value, as a dict does. 1: out of memory, 2: too many members. */
@@ -245,7 +78,7 @@ static int add_member(JsonValue *container, JsonValue *key, JsonValue *value, si
 }
 
 /* _parse_object / _parse_array: the container whose bracket is at at - 1. */
-static int scan_container(Scanner *scanner, size_t at, int depth, int object, JsonValue *out,
+static int scan_container(JsonScanner *scanner, size_t at, int depth, int object, JsonValue *out,
                           size_t *next)
 {
     size_t capacity = 0, len = scanner->length;
@@ -260,16 +93,16 @@ static int scan_container(Scanner *scanner, size_t at, int depth, int object, Js
             int added;
             if (object) {
                 if (at >= len || text[at] != '"') {
-                    return fail(scanner, "Expecting property name enclosed in double quotes",
+                    return json_fail(scanner, "Expecting property name enclosed in double quotes",
                                 at);
                 }
-                if (scan_string(scanner, at + 1, &key, &at)) {
+                if (json_scan_string(scanner, at + 1, &key, &at)) {
                     return 1;
                 }
                 at = skip_space(scanner, at);
                 if (at >= len || text[at] != ':') {
                     json_value_free(&key);
-                    return fail(scanner, "Expecting ':' delimiter", at);
+                    return json_fail(scanner, "Expecting ':' delimiter", at);
                 }
                 at = skip_space(scanner, at + 1);
             }
@@ -286,14 +119,14 @@ static int scan_container(Scanner *scanner, size_t at, int depth, int object, Js
                              "members", JSON_TEXT_MAX_MEMBERS);
                     return 1;
                 }
-                return fail(scanner, "out of memory", at);
+                return json_fail(scanner, "out of memory", at);
             }
             at = skip_space(scanner, at);
             if (at < len && text[at] == close) {
                 break;
             }
             if (at >= len || text[at] != ',') {
-                return fail(scanner, "Expecting ',' delimiter", at);
+                return json_fail(scanner, "Expecting ',' delimiter", at);
             }
             at = skip_space(scanner, at + 1);
         }
@@ -303,14 +136,14 @@ static int scan_container(Scanner *scanner, size_t at, int depth, int object, Js
 }
 
 /* Does the literal `word` start at `at`? */
-static int literal(const Scanner *scanner, size_t at, const char *word)
+static int literal(const JsonScanner *scanner, size_t at, const char *word)
 {
     size_t n = strlen(word);
     return at + n <= scanner->length && strncmp(scanner->text + at, word, n) == 0;
 }
 
 /* _match_number: a number starting at `at` (Expecting value when there is none). */
-static int scan_number(Scanner *scanner, size_t at, JsonValue *out, size_t *next)
+static int scan_number(JsonScanner *scanner, size_t at, JsonValue *out, size_t *next)
 {
     const char *text = scanner->text;
     size_t len = scanner->length, start = at, digits;
@@ -318,7 +151,7 @@ static int scan_number(Scanner *scanner, size_t at, JsonValue *out, size_t *next
     *out = EMPTY_VALUE;
     out->kind = JSON_NUMBER;
     if (text[at] == '-' && ++at >= len) {
-        return fail(scanner, "Expecting value", start);
+        return json_fail(scanner, "Expecting value", start);
     }
     if (text[at] >= '1' && text[at] <= '9') {
         while (++at < len && is_digit(text[at])) {
@@ -326,7 +159,7 @@ static int scan_number(Scanner *scanner, size_t at, JsonValue *out, size_t *next
     } else if (text[at] == '0') {
         at++;
     } else {
-        return fail(scanner, "Expecting value", start);
+        return json_fail(scanner, "Expecting value", start);
     }
     digits = at - start - (text[start] == '-');
     if (at + 1 < len && text[at] == '.' && is_digit(text[at + 1])) {
@@ -356,7 +189,7 @@ static int scan_number(Scanner *scanner, size_t at, JsonValue *out, size_t *next
         return 1;
     }
     if (json_number_value(text + start, at - start, &out->number)) {
-        return fail(scanner, "Expecting value", start);
+        return json_fail(scanner, "Expecting value", start);
     }
     out->integer = !is_float;
     if (out->integer && out->number == 0.0) {
@@ -364,7 +197,7 @@ static int scan_number(Scanner *scanner, size_t at, JsonValue *out, size_t *next
     }
     out->text = (char *)malloc(at - start + 1);
     if (out->text == NULL) {
-        return fail(scanner, "out of memory", start);
+        return json_fail(scanner, "out of memory", start);
     }
     memcpy(out->text, text + start, at - start);
     out->text[at - start] = '\0';
@@ -374,15 +207,15 @@ static int scan_number(Scanner *scanner, size_t at, JsonValue *out, size_t *next
 }
 
 /* scan_once: the value starting at `at`. */
-static int scan_value(Scanner *scanner, size_t at, int depth, JsonValue *out, size_t *next)
+static int scan_value(JsonScanner *scanner, size_t at, int depth, JsonValue *out, size_t *next)
 {
     *out = EMPTY_VALUE;
     if (at >= scanner->length) {
-        return fail(scanner, "Expecting value", at);
+        return json_fail(scanner, "Expecting value", at);
     }
     switch (scanner->text[at]) {
     case '"':
-        return scan_string(scanner, at + 1, out, next);
+        return json_scan_string(scanner, at + 1, out, next);
     case '{':
     case '[':
         if (depth >= JSON_TEXT_MAX_DEPTH) {
@@ -420,7 +253,7 @@ static int scan_value(Scanner *scanner, size_t at, int depth, JsonValue *out, si
             out->length = strlen(word);
             out->text = (char *)malloc(out->length + 1);
             if (out->text == NULL) {
-                return fail(scanner, "out of memory", at);
+                return json_fail(scanner, "out of memory", at);
             }
             memcpy(out->text, word, out->length + 1);
             *next = at + out->length;
@@ -434,36 +267,9 @@ static int scan_value(Scanner *scanner, size_t at, int depth, JsonValue *out, si
     return scan_number(scanner, at, out, next);
 }
 
-/* Length of the valid UTF-8 prefix of text[0..length). */
-static size_t valid_utf8(const unsigned char *text, size_t length)
-{
-    size_t at = 0;
-    while (at < length) {
-        unsigned char c = text[at];
-        size_t n = c < 0x80 ? 1 : (c & 0xE0) == 0xC0 ? 2 : (c & 0xF0) == 0xE0 ? 3
-                   : (c & 0xF8) == 0xF0 ? 4 : 0, i;
-        unsigned long code;
-        if (n == 0 || at + n > length || (n == 2 && c < 0xC2) || (n == 4 && c > 0xF4)) {
-            return at;
-        }
-        code = n == 1 ? c : (unsigned long)(c & (0x7F >> n));
-        for (i = 1; i < n; i++) {
-            if ((text[at + i] & 0xC0) != 0x80) {
-                return at;
-            }
-            code = (code << 6) | (text[at + i] & 0x3F);
-        }
-        if ((n == 3 && code < 0x800) || (n == 4 && (code < 0x10000 || code > 0x10FFFF))) {
-            return at;
-        }
-        at += n;
-    }
-    return at;
-}
-
 int json_text_parse(const char *text, JsonValue *out, char *error, size_t error_size)
 {
-    Scanner scanner;
+    JsonScanner scanner;
     size_t at, valid;
     *out = EMPTY_VALUE;
     scanner.text = text;
@@ -476,13 +282,13 @@ int json_text_parse(const char *text, JsonValue *out, char *error, size_t error_
         snprintf(error, error_size, "the text is longer than %d bytes", JSON_TEXT_MAX_BYTES);
         return 1;
     }
-    valid = valid_utf8((const unsigned char *)text, scanner.length);
+    valid = json_valid_utf8((const unsigned char *)text, scanner.length);
     if (valid != scanner.length) {
         snprintf(error, error_size, "invalid UTF-8 at byte %lu", (unsigned long)valid);
         return 1;
     }
     if (scanner.length >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0) {
-        return fail(&scanner, "Unexpected UTF-8 BOM (decode using utf-8-sig)", 0);
+        return json_fail(&scanner, "Unexpected UTF-8 BOM (decode using utf-8-sig)", 0);
     }
     if (scan_value(&scanner, skip_space(&scanner, 0), 0, out, &at)) {
         json_value_free(out);
@@ -491,7 +297,7 @@ int json_text_parse(const char *text, JsonValue *out, char *error, size_t error_
     at = skip_space(&scanner, at);
     if (at != scanner.length) {
         json_value_free(out);
-        return fail(&scanner, "Extra data", at);
+        return json_fail(&scanner, "Extra data", at);
     }
     return 0;
 }

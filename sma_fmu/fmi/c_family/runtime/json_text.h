@@ -53,5 +53,7 @@ const JsonValue *json_object_get(const JsonValue *object, const char *name);
  * always NUL-terminated); for messages. */
 void json_value_repr(const JsonValue *value, char *out, size_t size);
 void json_text_repr(const char *text, size_t length, char *out, size_t size);
+/* Python's repr(float(number)): the shortest digits that read back to it. */
+void json_float_repr(double number, char *out, size_t size);
 
 #endif

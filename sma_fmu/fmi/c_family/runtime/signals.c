@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "json_number.h"
 
 #define PI 3.14159265358979323846
 #define TEXT_SIZE 512
