@@ -210,6 +210,30 @@ def test_signal_source_equals_python(lib, seed):
             c.free()
 
 
+def test_signal_source_refusals(lib):
+    """Bad steps, bad saved times and math.sin's domain error: refused alike, nothing changed
+    (but the first step's size, which Python takes before it checks the end)."""
+    texts = ('{"kind":"sine","offset_ohm":40,"amplitude_ohm":2,"frequency_hz":1e300}',
+             '{"times_s":[0],"values_kg":[0.05]}')
+    python = SignalSource(*signals_from_text(*texts), 0.0)
+    c = CSignalSource(lib, *texts, 0.0)
+    for t, size in ((math.nan, 1e-3), (0.0, 0.0), (0.0, -1.0), (1e10, 1e-3), (0.0, math.inf),
+                    (1.7e308, 1.7e308)):
+        same_refusal(refused(lambda: python.step(t, size)), refused(lambda: c.step(t, size)))
+        assert c.state() == [python.time]
+    # the first step's size (1e-3, from the domain error's step) now puts 2e-3 on the grid
+    assert c.step(1e-3 + 1e-12, 1e-3) == tuple(python.step(1e-3 + 1e-12, 1e-3))
+    assert c.state() == [python.time] == [0.002]
+    for bad in (-1.0, math.nan, math.inf, 1e10):   # 1e10 s: math.sin's domain error
+        same_refusal(refused(lambda: python.restore({"time": bad})),
+                     refused(lambda: c.restore([bad])))
+        assert c.state() == [python.time]
+    assert "signals state" in refused(lambda: c.restore([]))
+    same_refusal(refused(lambda: SignalSource(*signals_from_text(*texts), math.inf)),
+                 refused(lambda: CSignalSource(lib, *texts, math.inf)))
+    c.free()
+
+
 def test_grid_point_equals_python(lib):
     rng = random.Random(3)
     import ctypes
