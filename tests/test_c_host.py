@@ -3,14 +3,17 @@
 - libcosim (Open Simulation Platform, from the libcosimpy wheel) driven from a C program,
   sma-fmu's C host (sma_fmu/fmi/hosts/cosim_host.c): it loads the FMU through the FMI Library;
 - a plain dlopen C host (sma_fmu/fmi/hosts/fmi_host.c), as fmusim does;
-- fmpy under Debian's statically linked /usr/bin/python3 (the front must use that
-  process's Python, not load a second libpython).
+- fmpy under a Python linked into its executable: Debian's /usr/bin/python3 when it is the
+  running minor version, else one linked from the running Python's libpython3.X.a (the front
+  must use that process's Python, not load a second libpython).
 The results equal the library steppers'. Without the native front (no C compiler at build
 time) the FMU's binary is pythonfmu's own, which does not load in a C host.
 """
 import re
 import shutil
 import subprocess
+import sys
+import sysconfig
 import warnings
 import zipfile
 from pathlib import Path
@@ -273,11 +276,41 @@ def test_remove_front_gives_back_pythonfmus_binary(fmus, tmp_path, cosim_host):
     assert "undefined symbol" in result.stdout + result.stderr
 
 
+STATIC_MAIN = "#include <Python.h>\nint main(int argc, char** argv) { return Py_BytesMain(argc, argv); }\n"
+
+
+def _python_with_python_built_in(folder):
+    """(executable, extra environment) of a Python of the running minor version that has Python
+    linked into the executable, as Debian's /usr/bin/python3 does: Debian's own when its minor
+    is the running one, else one linked here from the running Python's libpython3.X.a (what
+    the venv's numpy and fmpy are built for; Debian's python3 could not load them)."""
+    minor = "%d.%d" % sys.version_info[:2]
+    debian = Path("/usr/bin/python3")
+    assert debian.is_file(), "Debian's python3 is part of the test machine"
+    debian_minor = subprocess.run([str(debian), "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+                                  capture_output=True, text=True, check=True).stdout.strip()
+    if debian_minor == minor:
+        return debian, {}
+    archive = Path(sysconfig.get_config_var("LIBPL") or "") / (sysconfig.get_config_var("LIBRARY") or "")
+    assert archive.name.endswith(".a") and archive.is_file(), (
+        f"Debian's python3 is {debian_minor}, this Python {minor} ships no static libpython "
+        f"({archive}) to link one of its version")
+    source = folder / "static_python.c"
+    source.write_text(STATIC_MAIN)
+    executable = folder / f"python{minor}-static"
+    flags = [flag for name in ("LINKFORSHARED", "LIBS", "SYSLIBS", "MODLIBS", "LOCALMODLIBS")
+             for flag in (sysconfig.get_config_var(name) or "").split()]
+    subprocess.run([*c_compiler(), str(source), f"-I{sysconfig.get_config_var('INCLUDEPY')}", "-o",
+                    str(executable), str(archive), *flags], check=True, capture_output=True, text=True)
+    return executable, {"PYTHONHOME": sys.base_prefix}
+
+
 @needs("gcc", "python3")
 def test_fmpy_in_debians_static_python_uses_that_python(fmus, tmp_path):
     """The front must not load a second libpython into a process that has Python built in."""
-    python = Path("/usr/bin/python3")
-    assert python.is_file(), "Debian's python3 is part of the test machine"
+    python, environment = _python_with_python_built_in(tmp_path)
+    libraries = subprocess.run(["ldd", str(python)], capture_output=True, text=True, check=True).stdout
+    assert "libpython" not in libraries, libraries  # Python is in the executable itself
     import fmpy
     script = tmp_path / "run.py"
     script.write_text(
@@ -285,11 +318,14 @@ def test_fmpy_in_debians_static_python_uses_that_python(fmus, tmp_path):
         "r = simulate_fmu(sys.argv[1], stop_time=1.0, step_size=1e-3, output_interval=1e-3,"
         " start_values={'P_in': 2.0, 'load': 0.05}, output=['T'])\n"
         "maps = open('/proc/self/maps').read()\n"
-        "print(sorted({l.split()[-1] for l in maps.splitlines() if 'libpython' in l}), r['T'][-1])\n")
+        "print('%d.%d' % sys.version_info[:2], sorted({l.split()[-1] for l in maps.splitlines() if 'libpython' in l}),"
+        " r['T'][-1])\n")
     site = str(Path(fmpy.__file__).parent.parent)
     result = subprocess.run([str(python), str(script), str(fmus["SmaActuator"])], capture_output=True,
-                            text=True, env=_clean_env(PYTHONPATH=site), timeout=120)
+                            text=True, env=_clean_env(PYTHONPATH=site, **environment), timeout=120)
     assert result.returncode == 0, result.stderr[-2000:]
-    libraries, temperature = result.stdout.strip().rsplit(" ", 1)
+    version, rest = result.stdout.strip().split(" ", 1)
+    libraries, temperature = rest.rsplit(" ", 1)
+    assert version == "%d.%d" % sys.version_info[:2]
     assert libraries == "[]"  # no libpython mapped: the executable's own Python ran the FMU
     assert 20.0 < float(temperature) < 60.0

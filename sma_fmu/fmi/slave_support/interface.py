@@ -203,5 +203,8 @@ class SlaveInterface:
             values, source=f"{self.slave.modelName} instance '{self.slave.instance_name}'")
 
     def decorate(self, root):
-        """Add units, output dependencies and InitialUnknowns to pythonfmu's description."""
-        return decorate_model_description(root, self.units)
+        """Add units, output dependencies, InitialUnknowns and exact Real starts to
+        pythonfmu's description."""
+        starts = {v.name: v.start for v in self.slave.vars.values()
+                  if isinstance(v, Real) and v.start is not None}
+        return decorate_model_description(root, self.units, starts)

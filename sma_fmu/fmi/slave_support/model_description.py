@@ -2,11 +2,16 @@
 
 - ``<UnitDefinitions>`` and a ``unit`` attribute on every Real variable that has one;
 - ``ModelStructure/Outputs`` dependencies (empty: outputs change only in doStep);
-- ``ModelStructure/InitialUnknowns`` listing the outputs computed at initialization.
+- ``ModelStructure/InitialUnknowns`` listing the outputs computed at initialization;
+- Real ``start`` values that read back exactly: pythonfmu writes ``f"{start:.16g}"``, and a
+  double can need 17 significant digits (issue 32: a fitted a_h of 59.713553341652535 came
+  back from the FMU as 59.71355334165253, one unit in the last place away).
 """
 from xml.etree.ElementTree import Element, SubElement
 
-__all__ = ["UNIT_DEFINITIONS", "set_units", "decorate_model_description"]
+from .start_values import start_value_text
+
+__all__ = ["UNIT_DEFINITIONS", "set_units", "set_exact_starts", "decorate_model_description"]
 
 # FMI 2.0 BaseUnit exponents (kg, m, s, A, K) and offset for every unit the FMUs use
 UNIT_DEFINITIONS = {
@@ -60,12 +65,26 @@ def set_units(root, units):
     return root
 
 
-def decorate_model_description(root, units):
+def set_exact_starts(root, starts):
+    """Rewrite the ``start`` of each Real variable of ``root`` named in ``starts`` (variable
+    name -> float) whose text does not read back as that value, as ``repr``; returns ``root``.
+    (Texts that do, like pythonfmu's ``0`` for 0.0, stay as they are.)"""
+    for variable in root.find("ModelVariables"):
+        real, name = variable.find("Real"), variable.get("name")
+        if real is not None and real.get("start") is not None and name in starts \
+                and float(real.get("start")) != float(starts[name]):
+            real.set("start", start_value_text("Real", starts[name]))
+    return root
+
+
+def decorate_model_description(root, units, starts=None):
     """Complete pythonfmu's ``root`` element in place and return it.
 
-    ``units`` maps variable names to unit names (keys of :data:`UNIT_DEFINITIONS`).
+    ``units`` maps variable names to unit names (keys of :data:`UNIT_DEFINITIONS`);
+    ``starts`` maps Real variable names to the start values pythonfmu wrote rounded.
     """
     set_units(root, units)
+    set_exact_starts(root, starts or {})
     output_indices = [index for index, variable in enumerate(root.find("ModelVariables"), start=1)
                       if variable.get("causality") == "output"
                       and variable.get("initial") in ("calculated", "approx")]
