@@ -47,6 +47,7 @@ from sma_fmu.identification.isobaric_profile import temperature_profile
 from sma_fmu.identification.measurements import MeasurementError
 
 __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "IsobaricFit", "fit_isobaric", "prepare",
+           "residual_blocks",
            "EXPLAINED_RATIO"]
 
 RESIDUAL_OPTIONS = ("per-cycle", "none")
@@ -148,6 +149,21 @@ def _reported_covariance(jac, factor, count):
     return factor * inverse / np.outer(scale[:count], scale[:count])
 
 
+def residual_blocks(x, layout, prepared):
+    """Weighted residuals of every file: [temperature, strain(, resistance)] per file."""
+    params = layout.params(x)
+    out = []
+    for f in prepared:
+        profile, _, wire, direction, level, _ = file_state(x, layout, f)
+        strain, resistance = file_model(params, f.data, wire, layout.levels(x, f.index),
+                                        direction, level, f.per_cycle)
+        out.append((profile - f.data.temperature) / f.sigma["temperature"])
+        out.append((strain - f.data.strain) / f.sigma["strain"])
+        if resistance is not None:
+            out.append((resistance - f.data.resistance) / f.sigma["resistance"])
+    return out
+
+
 def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=300,
                  progress=None):
     """Fit the isobaric files (list of IsobaricData) jointly; returns :class:`IsobaricFit`.
@@ -168,17 +184,7 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     clock = {"last": began, "evaluations": 0}
 
     def pieces(x):
-        params = layout.params(x)
-        out = []
-        for f in prepared:
-            profile, _, wire, direction, level, _ = file_state(x, layout, f)
-            strain, resistance = file_model(params, f.data, wire, layout.levels(x, f.index),
-                                            direction, level, f.per_cycle)
-            out.append((profile - f.data.temperature) / f.sigma["temperature"])
-            out.append((strain - f.data.strain) / f.sigma["strain"])
-            if resistance is not None:
-                out.append((resistance - f.data.resistance) / f.sigma["resistance"])
-        return out
+        return residual_blocks(x, layout, prepared)
 
     def residuals(x):
         out = np.concatenate(pieces(x))

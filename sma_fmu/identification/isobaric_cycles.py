@@ -9,7 +9,9 @@ How the cycles are found (the reader states it in the report, :func:`splitting_n
    keeps the turning points of a cycle of P samples and averages thermocouple noise.
 3. Turning points are the maxima and minima of the smoothed signal with a prominence of at
    least half its range, at least P/2 apart (scipy's ``find_peaks``); a branch runs from one
-   turning point to the next, its direction the sign of the smoothed change over it.
+   turning point to the next, its direction the sign of the smoothed change over it. A
+   branch is complete when it swings through 70 % of the median branch's swing (of the
+   whole range with two branches or fewer).
 
 ``select_cycles`` keeps a range of cycles (``--cycles 5:``): labs drop the first, unstabilised
 cycles. Cycle numbers stay those of the file; residual-strain levels restart at 0.
@@ -28,7 +30,7 @@ __all__ = ["Branch", "Splitting", "dominant_period", "smooth", "split_branches",
            "select_cycles", "splitting_note", "MIN_TEMPERATURE_SPAN_K", "COMPLETE_SHARE"]
 
 MIN_TEMPERATURE_SPAN_K = 10.0     # the smoothed temperature must move this much
-COMPLETE_SHARE = 0.7              # a branch covering 70 % of the range is complete
+COMPLETE_SHARE = 0.7              # a branch swinging 70 % of a typical branch is complete
 SMOOTHING_PER_PERIOD = 6          # Savitzky-Golay window = period / this
 
 
@@ -91,13 +93,15 @@ def split_branches(temperature, path="<data>"):
     turning = sorted(set(peaks.tolist()) | set(troughs.tolist()))
     bounds = [0] + [t for t in turning if 0 < t < smoothed.size - 1] + [smoothed.size]
     branches, cycle, level = [], 0, 0
-    for start, stop in zip(bounds, bounds[1:]):
-        change = float(smoothed[stop - 1] - smoothed[start])
+    changes = [float(smoothed[stop - 1] - smoothed[start]) for start, stop in zip(bounds, bounds[1:])]
+    # complete: most of a typical branch's swing (noise spikes widen the full range)
+    typical = min(span, float(np.median(np.abs(changes)))) if len(changes) > 2 else span
+    for (start, stop), change in zip(zip(bounds, bounds[1:]), changes):
         direction = HEATING if change >= 0 else COOLING
         if direction == HEATING:
             cycle += 1
         branches.append(Branch(start, stop, direction, cycle, level,
-                               abs(change) >= COMPLETE_SHARE * span))
+                               abs(change) >= COMPLETE_SHARE * typical))
         if direction == COOLING:
             level += 1
     directions = {b.direction for b in branches if b.complete}

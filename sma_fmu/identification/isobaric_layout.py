@@ -134,10 +134,13 @@ def starts(files, layout, base):
         else:
             start[a] = float(np.mean(tau - getattr(base, b) * f_))
     # the 25-75 % width of the logistic is 2 ln 3 k_B T^2 / dH
-    energy = np.median([2.0 * math.log(3.0) * BOLTZMANN * t * t / w for t, w, _ in widths])
-    per_nu = base.eps_T - STANDARD_GRAVITY * float(np.median([f_ for _, _, f_ in widths])) \
-        * base.x_T / base.N
-    start["nu"] = float(energy / per_nu)
+    if widths:
+        energy = np.median([2.0 * math.log(3.0) * BOLTZMANN * t * t / w for t, w, _ in widths])
+        per_nu = base.eps_T - STANDARD_GRAVITY * float(np.median([f_ for _, _, f_ in widths])) \
+            * base.x_T / base.N
+        start["nu"] = float(energy / per_nu)
+    if not (widths and math.isfinite(start["nu"]) and start["nu"] > 0):
+        start["nu"] = base.nu   # no branch resolves its 25-75 % width: the base file's
     span = float(np.median([s for _, s, _, _ in spans]))
     if not span > 0:
         raise MeasurementError(f"{layout.paths}: the strain is lower when cold than when hot; "

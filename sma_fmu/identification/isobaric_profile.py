@@ -4,9 +4,10 @@ Two steps, so that the wire temperature cannot absorb model misfit:
 
 1. Profile: the measured temperature is fitted alone by a piecewise-linear curve in time (in
    the sample index without a time column) with knots at the branches' turning points and k
-   evenly spaced knots inside each branch; k is chosen from the temperature itself by the
-   Bayesian information criterion (n ln(RSS/n) + knots ln n), so a linear furnace ramp gets
-   few knots and a curved one more. Its residual is the temperature residual the report sets
+   evenly spaced knots inside each branch; k is chosen from the temperature itself by Akaike's
+   information criterion (n ln(RSS/n) + 2 knots), so a linear furnace ramp gets few knots and
+   a curved one, or one with dwells, more. (The Bayesian criterion's heavier penalty left
+   the dwells' corners unresolved, and the systematic error biased the transition width.) Its residual is the temperature residual the report sets
    beside the noise estimate; the knots' covariance sigma_T^2 (B^T B)^-1 goes into the
    parameters' covariance (:mod:`sma_fmu.identification.isobaric`).
 2. Wire: the profile lagged by the fitted time constant
@@ -62,7 +63,7 @@ def _knots(branches, size, interior):
 
 
 def temperature_profile(temperature, branches, time=None):
-    """:class:`Profile` of the measured ``temperature`` [degC], knots chosen by BIC."""
+    """:class:`Profile` of the measured ``temperature`` [degC], knots chosen by AIC."""
     n = temperature.size
     axis = np.asarray(time, dtype=float) if time is not None else np.arange(n, dtype=float)
     shortest = min(b.stop - b.start for b in branches)
@@ -75,9 +76,9 @@ def temperature_profile(temperature, branches, time=None):
         factor = linalg.splu((basis.T @ basis).tocsc())
         values = basis @ factor.solve(basis.T @ temperature)
         rss = float(np.sum((temperature - values) ** 2))
-        bic = n * np.log(max(rss, 1e-300) / n) + basis.shape[1] * np.log(n)
-        if best is None or bic < best[0]:
-            best = (bic, interior, basis, factor, values, rss, knots)
+        aic = n * np.log(max(rss, 1e-300) / n) + 2.0 * basis.shape[1]
+        if best is None or aic < best[0]:
+            best = (aic, interior, basis, factor, values, rss, knots)
     _, interior, basis, factor, values, rss, knots = best
     dof = max(n - basis.shape[1], 1)
     return Profile(values, basis, knots, interior, float(np.sqrt(rss / n)), float(np.sqrt(rss / dof)),
