@@ -127,9 +127,10 @@ def test_pwm_driver_beyond_int64(lib):
     rng = random.Random(7)
     for frequency in (1e9, 50.0, 1e-6):
         python, c = PwmDriver(frequency, 10.0), CPwmDriver(lib, frequency, 10.0)
-        for k in range(3000):
+        for k in range(4000):
             t = rng.choice((10 ** rng.uniform(6, 308), -(10 ** rng.uniform(6, 308)),
-                            2.0 ** 63 / frequency, 2.0 ** 53 / frequency))
+                            2.0 ** 63 / frequency, 2.0 ** 53 / frequency,
+                            -(2.0 ** 53 + rng.choice((0, 2, 4, 64))) / frequency))
             size = rng.choice((1e-3, abs(t) * rng.uniform(1e-17, 1e-14), abs(t) * 2.0 ** -52,
                                abs(t) * rng.uniform(0.1, 3)))
             demand = rng.uniform(-2, 12)

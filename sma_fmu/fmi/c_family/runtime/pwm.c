@@ -29,10 +29,11 @@ static double index_value(PwmIndex index)
     return index.minus_one ? index.base - 1.0 : index.base;
 }
 
-/* Python's int - 1 kept exact: folded into base where base - 1 is a double. */
+/* Python's int - 1 kept exact: folded into base where base - 1 is a double (base in
+ * (-2^53, 2^53]; -2^53 - 1 is not one). */
 static PwmIndex index_less_one(PwmIndex index)
 {
-    if (index.minus_one == 0 && fabs(index.base) <= TWO_TO_53) {
+    if (index.minus_one == 0 && index.base > -TWO_TO_53 && index.base <= TWO_TO_53) {
         index.base -= 1.0;
     } else {
         index.minus_one = 1;
