@@ -111,11 +111,12 @@ def test_pwm_driver_equals_python(lib, frequency):
         peak = rng.uniform(0.5, 20.0)
         python, c = PwmDriver(frequency, peak), CPwmDriver(lib, frequency, peak)
         h = 10 ** rng.uniform(-7, 0.5) if walk % 3 else rng.choice((1e-3, 1 / frequency))
-        start = rng.choice((0.0, rng.uniform(-10, 10), 10 ** rng.uniform(3, 8)))
+        start = rng.choice((0.0, -1e-300, rng.uniform(-10, 10), 10 ** rng.uniform(3, 8)))
         for k, (t, size) in enumerate(host_times(rng, start, h, 1500)):
             demand = rng.choice((rng.uniform(-0.3, 1.3), rng.uniform(0, 1))) * peak
             assert c.step(demand, t, size) == python.step(demand, t, size), (walk, k)
             assert c.held() == python.held
+            assert math.copysign(1.0, c.state()[0]) > 0 or c.state()[0] != 0   # no index -0
             if k % 499 == 0:
                 fresh = CPwmDriver(lib, frequency, peak)
                 fresh.restore(c.state())

@@ -151,10 +151,10 @@ static int period_index(const PwmDriver *driver, double time_s, PwmIndex *index,
     nearest = nearbyint(position);
     index->minus_one = 0;
     if (fabs(position - nearest) <= PERIOD_TOLERANCE * py_max(1.0, fabs(position))) {
-        index->base = nearest;
+        index->base = nearest + 0.0;       /* + 0.0: Python's int has no -0 */
         *starts = 1;
     } else {
-        index->base = floor(position);
+        index->base = floor(position) + 0.0;
         *starts = 0;
     }
     return 0;
