@@ -74,12 +74,13 @@ def test_check_passes_on_everything_built(fmus, exported, capsys):
     assert main(["check", *map(str, files)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert not [line for line in lines if line.startswith("FAIL")]
-    for path in fmus.values():  # four checks and two platforms per FMU, each passed
+    for path in fmus.values():  # five checks and two platforms per FMU, each passed
         assert [line.split(": ")[1] for line in lines if line.startswith(f"ok    {path}:")] == [
             "fmpy validation", "FMI checker", "C host (libcosim)", "state round trip",
-            "platform linux64", "platform win64"]
+            "default experiment", "platform linux64", "platform win64"]
     container = exported / "heavy-pi.fmu"
     assert f"n/a   {container}: state round trip: the FMU does not declare canGetAndSetFMUstate" in lines
+    assert any(line.startswith(f"n/a   {container}: default experiment: no ") for line in lines)
     assert any(line.startswith("ok") and "SSD schema" in line for line in lines)
 
 

@@ -76,7 +76,7 @@ def _readme(model, description, experiment, has_inputs, stride):
             "(`sma-fmu build` computes it; `sma-fmu check` and this export run it again and "
             "compare, to 1e-9 relative). The FMU carries the same files in "
             f"`{LS_REF_FOLDER}/` (FMI-LS-REF).\n\n"
-            f"- `{model}_ref.csv`: every output, every {stride}th step "
+            f"- `{model}_ref.csv`: every output, once every {stride} steps "
             f"(OutputIntervalLength {stride * experiment.step!r} s), Booleans as 0/1;\n"
             + inputs +
             f"- `{model}_ref.opt`: StartTime, StopTime, StepSize (the communication step), "

@@ -11,7 +11,7 @@ The experiment is the FMU's DefaultExperiment (start, stop, communication step).
 stimuli (:data:`STIMULI`) are piecewise linear (a host interpolates linearly between the
 rows, as the FMI Cross-Check rules ask); an input they do not name stays at its start
 value. fmpy's ``simulate_fmu`` runs it, one communication step of ``stepSize`` at a time;
-the result keeps every output, Booleans as 0/1, at every :func:`output_stride`-th step
+the result keeps every output, Booleans as 0/1, once every :func:`output_stride` steps
 (at most :data:`MAX_ROWS` rows: each CSV stays under the rules' 1 MB).
 :func:`reference_check` runs it again and compares (``sma-fmu check``).
 """
@@ -103,16 +103,19 @@ def stimuli(description, experiment):
 
 
 def output_stride(experiment):
-    """Steps between result rows: 1, 2, 5, 10, 20, 50, ... the first with <= MAX_ROWS rows."""
-    for decade in (1, 10, 100, 1000, 10 ** 4, 10 ** 5, 10 ** 6):
-        for factor in (1, 2, 5):
-            if experiment.steps // (decade * factor) + 1 <= MAX_ROWS:
-                return decade * factor
-    raise ValueError(f"{experiment.steps} steps: too many for a reference result")
+    """Steps between result rows: the smallest prime giving at most MAX_ROWS rows (1 if
+    every step fits). A prime does not alias with a periodic output (the PWM driver's 20
+    steps per period, sampled every 20th step, would show one phase only)."""
+    stride = 1
+    while experiment.steps // stride + 1 > MAX_ROWS:
+        stride += 1
+        while any(stride % divisor == 0 for divisor in range(2, int(stride ** 0.5) + 1)):
+            stride += 1
+    return stride
 
 
 def simulate_experiment(fmu_path, description, experiment, inputs):
-    """Run the default experiment in fmpy's ``simulate_fmu``; every output, every stride-th
+    """Run the default experiment in fmpy's ``simulate_fmu``; every output, once every stride
     step (rows from ``start``; Booleans as 0/1)."""
     from fmpy import simulate_fmu
 
@@ -204,8 +207,8 @@ def reference_check(fmu_path, packed_entry=None):
             worst, where = float(excess[row]), (name, row)
     if where is not None:
         name, row = where
-        return "FAIL", (f"{name} at t = {reference['time'][row]!r} s is {result[name][row]!r}, the "
-                        f"reference {reference[name][row]!r} (tolerance {RTOL:g} relative, {ATOL:g} "
+        return "FAIL", (f"{name} at t = {float(reference['time'][row])!r} s is "
+                        f"{float(result[name][row])!r}, the reference {float(reference[name][row])!r} (tolerance {RTOL:g} relative, {ATOL:g} "
                         "absolute)")
     return "ok", (f"{experiment.steps} steps of {experiment.step:g} s reproduce {reference.size} rows of "
                   f"{len(reference.dtype.names) - 1} output(s) (tolerance {RTOL:g} relative)")
