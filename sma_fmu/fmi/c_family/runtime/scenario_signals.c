@@ -73,7 +73,7 @@ int grid_point(double time_s, double start_s, double step_s, double *grid)
     if (!(fabs(steps) < TWO_TO_52)) {   /* beyond the integers a double holds (or inf, nan) */
         return 0;
     }
-    point = start_s + nearbyint(steps) * step_s;
+    point = start_s + (nearbyint(steps) + 0.0) * step_s;   /* + 0.0: Python's int has no -0 */
     if (fabs(time_s - point) <= GRID_TOLERANCE * step_s) {
         *grid = point;
         return 1;
