@@ -30,7 +30,7 @@ def test_every_variable_has_description_and_every_real_a_defined_unit(fmus, name
         if variable.type == "Real":
             assert variable.unit in units, variable.name
     experiment = description.defaultExperiment
-    assert (experiment.startTime, experiment.stopTime, experiment.stepSize) == ("0.0", "30.0", "0.001")
+    assert (experiment.startTime, experiment.stopTime, experiment.stepSize) == ("0.0", "10.0", "0.001")
     outputs = {v for v in description.modelVariables if v.causality == "output"}
     assert {u.variable for u in description.initialUnknowns} == outputs
     assert all(u.dependencies == [] for u in description.outputs)
@@ -41,7 +41,7 @@ def test_every_fmu_names_its_author_and_default_experiment(fmus, name):
     description = read_model_description(str(fmus[name]))
     assert description.author == "sma-fmu"
     experiment = description.defaultExperiment
-    assert (experiment.startTime, experiment.stopTime, experiment.stepSize) == ("0.0", "30.0", "0.001")
+    assert (experiment.startTime, experiment.stopTime, experiment.stepSize) == ("0.0", "10.0", "0.001")
 
 
 def test_plant_interface(fmus, parameter_set):

@@ -25,7 +25,7 @@ from sma_fmu.fmi.fmu_reference import (LS_REF_FOLDER, MANIFEST, Experiment, csv_
 
 __all__ = ["DEFAULT_EXPERIMENT", "add_documentation_and_reference"]
 
-DEFAULT_EXPERIMENT = Experiment(0.0, 30.0, 1e-3)   # start, stop, step [s] for an FMU without one
+DEFAULT_EXPERIMENT = Experiment(0.0, 10.0, 1e-3)   # start, stop, step [s] for an FMU without one
 _MODEL_DESCRIPTION = "modelDescription.xml"
 _FILE_MODE = 0o644 << 16   # a regular file, rw-r--r--
 

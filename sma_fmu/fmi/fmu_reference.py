@@ -34,18 +34,18 @@ MAX_ROWS = 1501       # result rows at most (the stride grows to keep under it)
 RTOL, ATOL = 1e-9, 1e-12   # reference_check's tolerance: |result - ref| <= ATOL + RTOL |ref|
 
 # model name -> {input: ((t [s], value in the input's unit), ...)}, linear in between and
-# held after the last row. Over the 30 s default experiment: the plant heats through its
+# held after the last row. Over the 10 s default experiment: the plant heats through its
 # transformation and cools back (a triangle of power at 0.15 kg), the compensator and the PI
-# see the resistance such a wire would pass through, the PWM driver a ramp of demand.
+# see the resistance such a wire passes through, the PWM driver a ramp of demand.
 STIMULI = {
-    "SmaActuator": {"P_in": ((0.0, 0.0), (10.0, 4.0), (20.0, 0.0), (30.0, 0.0)),
-                    "load": ((0.0, 0.15), (30.0, 0.15))},
-    "SmaFeedforward": {"R_ref": ((0.0, 48.0), (10.0, 36.0), (20.0, 48.0), (30.0, 48.0)),
-                       "load": ((0.0, 0.15), (30.0, 0.15))},
-    "SmaPiController": {"R": ((0.0, 48.0), (10.0, 36.0), (20.0, 48.0), (30.0, 48.0)),
-                        "R_ref": ((0.0, 42.0), (30.0, 42.0)),
-                        "P_ff": ((0.0, 2.9), (30.0, 2.9))},
-    "SmaPwmDriver": {"P_demand": ((0.0, 0.0), (20.0, 12.0), (30.0, 12.0))},
+    "SmaActuator": {"P_in": ((0.0, 0.0), (4.0, 4.0), (8.0, 0.0), (10.0, 0.0)),
+                    "load": ((0.0, 0.15), (10.0, 0.15))},
+    "SmaFeedforward": {"R_ref": ((0.0, 48.0), (4.0, 36.0), (8.0, 48.0), (10.0, 48.0)),
+                       "load": ((0.0, 0.15), (10.0, 0.15))},
+    "SmaPiController": {"R": ((0.0, 48.0), (4.0, 36.0), (8.0, 48.0), (10.0, 48.0)),
+                        "R_ref": ((0.0, 42.0), (10.0, 42.0)),
+                        "P_ff": ((0.0, 2.9), (10.0, 2.9))},
+    "SmaPwmDriver": {"P_demand": ((0.0, 0.0), (8.0, 12.0), (10.0, 12.0))},
 }
 
 

@@ -27,7 +27,7 @@ class StepperSlave(Fmi2Slave):
 
     # modelDescription.xml attributes every sma-fmu FMU shares (pythonfmu reads the class's)
     author = "sma-fmu"
-    default_experiment = DefaultExperiment(start_time=0.0, stop_time=30.0, step_size=1e-3)
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=10.0, step_size=1e-3)
     # a step within GRID_TOLERANCE of the first step's size is taken as that size
     # (SlaveInterface.nominal_step); slaves that put their time on the grid themselves say no
     snaps_step = True
