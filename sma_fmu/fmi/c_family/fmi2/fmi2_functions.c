@@ -76,7 +76,7 @@ FMI2_Export fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingO
 {
     ENTER;
     if (!layer_set_debug_logging(in, loggingOn, nCategories, categories))
-        return layer_refuse(in, fmi2Error, "fmi2SetDebugLogging", "categories[] is NULL or holds "
+        return layer_reject(in, fmi2Error, "fmi2SetDebugLogging", "categories[] is NULL or holds "
                             "a NULL or non-UTF-8 category");
     return fmi2OK;
 }
@@ -144,30 +144,30 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
     in->run.model_name = in->model->name;
     in->run.instance_name = in->name;
     if (!good_name) {
-        layer_refuse(in, fmi2Error, "fmi2Instantiate", "instanceName must be a non-empty UTF-8 string");
+        layer_reject(in, fmi2Error, "fmi2Instantiate", "instanceName must be a non-empty UTF-8 string");
         goto fail;
     }
     if (fmuType != fmi2CoSimulation) {
-        layer_refuse(in, fmi2Error, "fmi2Instantiate", "this FMU supports co-simulation only");
+        layer_reject(in, fmi2Error, "fmi2Instantiate", "this FMU supports co-simulation only");
         goto fail;
     }
     if (!fmuGUID || !layer_valid_utf8(fmuGUID)) {
-        layer_refuse(in, fmi2Error, "fmi2Instantiate", "fmuGUID is NULL or not UTF-8");
+        layer_reject(in, fmi2Error, "fmi2Instantiate", "fmuGUID is NULL or not UTF-8");
         goto fail;
     }
     if (strcmp(fmuGUID, in->model->guid) != 0) {
-        layer_log(in, fmi2Error, "fmi2Instantiate: fmuGUID '%s' does not match the guid '%s' of "
+        layer_plain(in, fmi2Error, "fmi2Instantiate: fmuGUID '%s' does not match the guid '%s' of "
                   "this FMU", fmuGUID, in->model->guid);
         goto fail;
     }
     in->guid = copy_text(fmuGUID);
     if (!in->guid) goto fail;
     if (!layer_resource_folder(fmuResourceLocation, &in->resources, &plain, why, sizeof why)) {
-        layer_log(in, fmi2Error, "fmi2Instantiate: %s", why);
+        layer_plain(in, fmi2Error, "fmi2Instantiate: %s", why);
         goto fail;
     }
     if (plain)
-        layer_log(in, fmi2Warning, "fmi2Instantiate: fmuResourceLocation '%s' is a path, not a "
+        layer_plain(in, fmi2Warning, "fmi2Instantiate: fmuResourceLocation '%s' is a path, not a "
                   "file: URI (FMI 2.0 section 2.1.6); accepted", fmuResourceLocation);
     if (!initial_state(in, why, sizeof why)) {
         layer_log(in, fmi2Error, "fmi2Instantiate: %s", why);
@@ -269,8 +269,8 @@ static int arrays_ok(Instance *in, const char *function, const void *vr, size_t 
 {
     *status = fmi2OK;
     if (nvr == 0) return 0;
-    if (!vr || !value) *status = layer_refuse(in, fmi2Error, function, "vr[] or value[] is NULL");
-    else if (nvr > 1000000) *status = layer_refuse(in, fmi2Error, function, "nvr is implausibly large");
+    if (!vr || !value) *status = layer_reject(in, fmi2Error, function, "vr[] or value[] is NULL");
+    else if (nvr > 1000000) *status = layer_reject(in, fmi2Error, function, "nvr is implausibly large");
     else return 1;
     return 0;
 }
@@ -308,7 +308,7 @@ FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference v
     if (!arrays_ok(in, "fmi2SetString", vr, nvr, value, &status)) return status;
     for (i = 0; i < nvr; ++i) {
         if (!value[i] || !layer_valid_utf8(value[i])) {
-            layer_log(in, fmi2Error, "fmi2SetString: value[%lu] for value reference %u is %s; "
+            layer_plain(in, fmi2Error, "fmi2SetString: value[%lu] for value reference %u is %s; "
                       "nothing was set", (unsigned long)i, vr[i], value[i] ? "not UTF-8" : "NULL");
             return fmi2Error;
         }
@@ -384,13 +384,10 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
     same_step = in->have_discard && in->discard_time == currentCommunicationPoint &&
                 in->discard_step == communicationStepSize;
     in->terminated = same_step;
-    if (same_step) {
-        char a[32], b[32];
-        layer_repr(currentCommunicationPoint, a);
-        layer_repr(communicationStepSize, b);
-        layer_log(in, fmi2Error, "fmi2DoStep(t = %s s, h = %s s) was repeated unchanged after a "
-                  "discard and discarded again: reporting fmi2Terminated so the master stops", a, b);
-    }
+    if (same_step)
+        layer_plain(in, fmi2Error, "fmi2DoStep(t = %.17g s, h = %.17g s) was repeated unchanged "
+                    "after a discard and discarded again: reporting fmi2Terminated so the master "
+                    "stops", currentCommunicationPoint, communicationStepSize);
     in->have_discard = 1;
     in->discard_time = currentCommunicationPoint;
     in->discard_step = communicationStepSize;
@@ -400,7 +397,7 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
 FMI2_Export fmi2Status fmi2CancelStep(fmi2Component c)
 {
     ENTER;
-    return layer_refuse(in, fmi2Error, "fmi2CancelStep", "illegal call: no asynchronous step is in progress");
+    return layer_reject(in, fmi2Error, "fmi2CancelStep", "illegal call: no asynchronous step is in progress");
 }
 
 FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[],
@@ -409,7 +406,7 @@ FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2V
 {
     ENTER;
     (void)u; (void)nu; (void)z; (void)nz; (void)dz; (void)du;
-    return layer_refuse(in, fmi2Error, "fmi2GetDirectionalDerivative", "not supported by this "
+    return layer_reject(in, fmi2Error, "fmi2GetDirectionalDerivative", "not supported by this "
                         "FMU (providesDirectionalDerivative is false)");
 }
 
@@ -419,7 +416,7 @@ FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2Va
 {
     ENTER;
     (void)vr; (void)nvr; (void)order; (void)value;
-    return layer_refuse(in, fmi2Error, "fmi2SetRealInputDerivatives", "not supported by this FMU "
+    return layer_reject(in, fmi2Error, "fmi2SetRealInputDerivatives", "not supported by this FMU "
                         "(canInterpolateInputs is false)");
 }
 
@@ -429,20 +426,20 @@ FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2V
 {
     ENTER;
     (void)vr; (void)nvr; (void)order; (void)value;
-    return layer_refuse(in, fmi2Error, "fmi2GetRealOutputDerivatives", "not supported by this FMU "
+    return layer_reject(in, fmi2Error, "fmi2GetRealOutputDerivatives", "not supported by this FMU "
                         "(maxOutputDerivativeOrder is 0)");
 }
 
 #define REQUIRE_STEPPED(function)                                                             \
     if (!in->stepped)                                                                         \
-    return layer_refuse(in, fmi2Error, function, "illegal call sequence: allowed only after fmi2DoStep")
+    return layer_reject(in, fmi2Error, function, "illegal call sequence: allowed only after fmi2DoStep")
 
 FMI2_Export fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
 {
     ENTER;
     (void)s; (void)value;
     REQUIRE_STEPPED("fmi2GetStatus");
-    return layer_refuse(in, fmi2Discard, "fmi2GetStatus", "defined only while fmi2DoStep is "
+    return layer_reject(in, fmi2Discard, "fmi2GetStatus", "defined only while fmi2DoStep is "
                         "pending, and this FMU never returns fmi2Pending");
 }
 
@@ -450,9 +447,9 @@ FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s
 {
     ENTER;
     REQUIRE_STEPPED("fmi2GetRealStatus");
-    if (!value) return layer_refuse(in, fmi2Error, "fmi2GetRealStatus", "value is NULL");
+    if (!value) return layer_reject(in, fmi2Error, "fmi2GetRealStatus", "value is NULL");
     if (s != fmi2LastSuccessfulTime)
-        return layer_refuse(in, fmi2Discard, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is defined");
+        return layer_reject(in, fmi2Discard, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is defined");
     *value = in->time_defined ? in->time : in->run.start_time;
     return fmi2OK;
 }
@@ -462,16 +459,16 @@ FMI2_Export fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKin
     ENTER;
     (void)s; (void)value;
     REQUIRE_STEPPED("fmi2GetIntegerStatus");
-    return layer_refuse(in, fmi2Discard, "fmi2GetIntegerStatus", "no integer status is defined");
+    return layer_reject(in, fmi2Discard, "fmi2GetIntegerStatus", "no integer status is defined");
 }
 
 FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
 {
     ENTER;
     REQUIRE_STEPPED("fmi2GetBooleanStatus");
-    if (!value) return layer_refuse(in, fmi2Error, "fmi2GetBooleanStatus", "value is NULL");
+    if (!value) return layer_reject(in, fmi2Error, "fmi2GetBooleanStatus", "value is NULL");
     if (s != fmi2Terminated)
-        return layer_refuse(in, fmi2Discard, "fmi2GetBooleanStatus", "only fmi2Terminated is defined");
+        return layer_reject(in, fmi2Discard, "fmi2GetBooleanStatus", "only fmi2Terminated is defined");
     *value = in->terminated ? fmi2True : fmi2False;
     return fmi2OK;
 }
@@ -481,5 +478,5 @@ FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind
     ENTER;
     (void)s; (void)value;
     REQUIRE_STEPPED("fmi2GetStringStatus");
-    return layer_refuse(in, fmi2Discard, "fmi2GetStringStatus", "no string status is defined");
+    return layer_reject(in, fmi2Discard, "fmi2GetStringStatus", "no string status is defined");
 }

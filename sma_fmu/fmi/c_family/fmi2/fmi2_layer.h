@@ -72,6 +72,17 @@ void layer_log(Instance *in, fmi2Status status, const char *format, ...)
     ;
 /* A refused call: logs "<function>: <why>" with `status`, returns it. */
 fmi2Status layer_refuse(Instance *in, fmi2Status status, const char *function, const char *why);
+/* The same without the "<model> '<instance>': " prefix: the refusals the pythonfmu FMUs'
+ * front makes before a call reaches the slave (argument checks, unsupported functions,
+ * saved-state pointers), worded as there. */
+void layer_plain(Instance *in, fmi2Status status, const char *format, ...)
+#if defined(__GNUC__) && defined(__MINGW32__)
+    __attribute__((format(gnu_printf, 3, 4)))
+#elif defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+fmi2Status layer_reject(Instance *in, fmi2Status status, const char *function, const char *why);
 int layer_set_debug_logging(Instance *in, int on, size_t n, const fmi2String categories[]);
 int layer_valid_utf8(const char *text);
 /* Python's repr of a float ("1.0", "1e-05", "nan", "inf") into `text` (32 bytes). */

@@ -47,19 +47,42 @@ static int wanted(const Instance *in, fmi2Status status)
     return in->log_all || category_enabled(in, "logAll") || category_enabled(in, category);
 }
 
-void layer_log(Instance *in, fmi2Status status, const char *format, ...)
+/* Formats and passes on one message; `prefixed`: "<model> '<instance>': " first. */
+static void emit(Instance *in, fmi2Status status, int prefixed, const char *format,
+                 va_list arguments)
 {
     char text[2048];
-    int used;
-    va_list arguments;
+    int used = 0;
     if (status > in->worst) in->worst = status;
     if (!in->logger || !wanted(in, status)) return;
-    used = snprintf(text, sizeof text, "%s '%s': ", in->model->name, in->name);
-    if (used < 0 || (size_t)used >= sizeof text) used = 0;
-    va_start(arguments, format);
+    if (prefixed) {
+        used = snprintf(text, sizeof text, "%s '%s': ", in->model->name, in->name);
+        if (used < 0 || (size_t)used >= sizeof text) used = 0;
+    }
     vsnprintf(text + used, sizeof text - (size_t)used, format, arguments);
-    va_end(arguments);
     in->logger(in->environment, in->name, status, status_category(status), "%s", text);
+}
+
+void layer_log(Instance *in, fmi2Status status, const char *format, ...)
+{
+    va_list arguments;
+    va_start(arguments, format);
+    emit(in, status, 1, format, arguments);
+    va_end(arguments);
+}
+
+void layer_plain(Instance *in, fmi2Status status, const char *format, ...)
+{
+    va_list arguments;
+    va_start(arguments, format);
+    emit(in, status, 0, format, arguments);
+    va_end(arguments);
+}
+
+fmi2Status layer_reject(Instance *in, fmi2Status status, const char *function, const char *why)
+{
+    layer_plain(in, status, "%s: %s", function, why);
+    return status;
 }
 
 fmi2Status layer_refuse(Instance *in, fmi2Status status, const char *function, const char *why)

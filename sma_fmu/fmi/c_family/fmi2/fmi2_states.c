@@ -434,9 +434,9 @@ FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
     size_t size = 0;
     Instance *in = live(c);
     if (!in) return fmi2Error;
-    if (!state) return layer_refuse(in, fmi2Error, "fmi2GetFMUstate", "FMUstate is NULL");
+    if (!state) return layer_reject(in, fmi2Error, "fmi2GetFMUstate", "FMUstate is NULL");
     if (*state && !find(in, *state))
-        return layer_refuse(in, fmi2Error, "fmi2GetFMUstate", "*FMUstate is neither NULL nor a "
+        return layer_reject(in, fmi2Error, "fmi2GetFMUstate", "*FMUstate is neither NULL nor a "
                             "state of this instance");
     bytes = serialize(in, &size);
     if (!bytes) return layer_refuse(in, fmi2Error, "fmi2GetFMUstate", "out of memory");
@@ -450,7 +450,7 @@ FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
     if (!in) return fmi2Error;
     saved = state ? find(in, state) : NULL;
     if (!saved)
-        return layer_refuse(in, fmi2Error, "fmi2SetFMUstate", "FMUstate is not a state of this "
+        return layer_reject(in, fmi2Error, "fmi2SetFMUstate", "FMUstate is not a state of this "
                             "instance (NULL, freed, or another instance's)");
     return restore(in, saved->bytes, saved->size);
 }
@@ -463,7 +463,7 @@ FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
     if (!state || !*state) return fmi2OK;  /* FMI 2.0: freeing NULL does nothing */
     saved = find(in, *state);
     if (!saved)
-        return layer_refuse(in, fmi2Error, "fmi2FreeFMUstate", "*FMUstate is not a state of this "
+        return layer_reject(in, fmi2Error, "fmi2FreeFMUstate", "*FMUstate is not a state of this "
                             "instance (freed, or another instance's)");
     drop(in, saved);
     *state = NULL;
@@ -477,7 +477,7 @@ FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate 
     if (!in) return fmi2Error;
     saved = state ? find(in, state) : NULL;
     if (!saved || !size)
-        return layer_refuse(in, fmi2Error, "fmi2SerializedFMUstateSize", "FMUstate is not a state "
+        return layer_reject(in, fmi2Error, "fmi2SerializedFMUstateSize", "FMUstate is not a state "
                             "of this instance, or size is NULL");
     *size = saved->size;
     return fmi2OK;
@@ -491,7 +491,7 @@ FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state
     if (!in) return fmi2Error;
     saved = state ? find(in, state) : NULL;
     if (!saved || !serializedState)
-        return layer_refuse(in, fmi2Error, "fmi2SerializeFMUstate", "FMUstate is not a state of "
+        return layer_reject(in, fmi2Error, "fmi2SerializeFMUstate", "FMUstate is not a state of "
                             "this instance, or serializedState is NULL");
     if (size < saved->size) {
         layer_log(in, fmi2Error, "fmi2SerializeFMUstate: size %lu is less than the %lu bytes of "
@@ -513,10 +513,10 @@ FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte s
     Instance *in = live(c);
     if (!in) return fmi2Error;
     if (!state || (!serializedState && size))
-        return layer_refuse(in, fmi2Error, "fmi2DeSerializeFMUstate", "serializedState or "
+        return layer_reject(in, fmi2Error, "fmi2DeSerializeFMUstate", "serializedState or "
                             "FMUstate is NULL");
     if (*state && !find(in, *state))
-        return layer_refuse(in, fmi2Error, "fmi2DeSerializeFMUstate", "*FMUstate is neither NULL "
+        return layer_reject(in, fmi2Error, "fmi2DeSerializeFMUstate", "*FMUstate is neither NULL "
                             "nor a state of this instance");
     r.bytes = (const unsigned char *)serializedState; r.size = size; r.at = 0;
     r.why = why; r.why_size = sizeof why;
