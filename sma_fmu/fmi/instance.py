@@ -8,10 +8,12 @@ C functions with preallocated arrays; everything else uses fmpy's wrappers.
 import shutil
 import sys
 from pathlib import Path
-from ctypes import POINTER, PyDLL, c_double, c_int, c_size_t, c_uint, c_void_p
+from ctypes import POINTER, PyDLL, byref, c_double, c_int, c_size_t, c_uint, c_void_p
+from itertools import count
 
 from fmpy import extract
 from fmpy.fmi1 import FMICallException
+from fmpy.logging import addLoggerProxy
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2CallbackFunctions,
                        fmi2CallbackLoggerTYPE)
 
@@ -21,6 +23,21 @@ from sma_fmu.fmi.build import read_description
 __all__ = ["FmuError", "FmuInstance"]
 
 _STATUS = ["ok", "warning", "discard", "error", "fatal", "pending"]
+# FMI passes a message as a printf format with arguments (the native family: "%s" and the
+# text); ctypes cannot take C varargs, so fmpy's C proxy formats it. The proxy keeps one
+# Python logger for the process: this permanent one hands each message to its instance,
+# found by the componentEnvironment the instance gave.
+_LOGGERS = {}
+_KEYS = count(1)
+
+
+def _dispatch(environment, instance_name, status, category, message):
+    log = _LOGGERS.get(environment)
+    if log is not None:
+        log(environment, instance_name, status, category, message)
+
+
+_DISPATCH = fmi2CallbackLoggerTYPE(_dispatch)
 
 
 class FmuError(RuntimeError):
@@ -96,14 +113,13 @@ class FmuInstance:
                               modelIdentifier=description.coSimulation.modelIdentifier,
                               instanceName=instance_name)
         self._callbacks = fmi2CallbackFunctions()
-        self._logger = fmi2CallbackLoggerTYPE(self._log)
-        self._callbacks.logger = self._logger
+        self._key = next(_KEYS)
+        _LOGGERS[self._key] = self._log
+        self._callbacks.componentEnvironment = self._key
+        self._callbacks.logger = _DISPATCH
         self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
         self._callbacks.freeMemory = defaultCallbacks.freeMemory
-        # No fmpy.logging.addLoggerProxy: it keeps ONE logger in a C global, so messages of
-        # every instance would reach the last instance's logger, and a freed logger would be
-        # called later (heap corruption). The FMUs pass the finished message as the format,
-        # '%' doubled, without varargs, so a plain per-instance callback receives it whole.
+        addLoggerProxy(byref(self._callbacks))  # formats; see _dispatch
         self._ports = {}
         self._reported = 0  # messages before this index are in an earlier FmuError already
         # the library fmpy loaded, called without releasing the GIL: pythonfmu's C++ takes it
@@ -144,9 +160,9 @@ class FmuInstance:
             raise
 
     def _log(self, environment, instance_name, status, category, message):
-        # FMI passes a printf format; ours carry no arguments and write a '%' as "%%"
+        # the message as fmpy's proxy formatted it (_dispatch)
         self.messages.append((_STATUS[status] if 0 <= status < len(_STATUS) else str(status),
-                              message.decode("utf-8", "replace").replace("%%", "%")))
+                              message.decode("utf-8", "replace")))
 
     def _call(self, name, function, *args, **kwargs):
         """Call one of fmpy's wrappers; a failure becomes :class:`FmuError`."""
@@ -251,6 +267,7 @@ class FmuInstance:
             except FMICallException:
                 pass
             self._fmu.freeInstance()
+        _LOGGERS.pop(self._key, None)  # after the instance's last message
         shutil.rmtree(self._unzipped, ignore_errors=True)
         resources = str(Path(self._unzipped) / "resources")
         sys.path[:] = [entry for entry in sys.path if entry.rstrip("/") != resources]
