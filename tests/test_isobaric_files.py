@@ -134,10 +134,12 @@ def test_lab_file_to_parameter_file_to_fmus_and_a_run(tmp_path, capsys):
         <= 4 * centre["heating"]["std_error"]
     assert report["covariance"]["parameters"] == list(report["parameters"])
     table = (out / "transformation_temperatures.csv").read_text().splitlines()
-    assert table[0] == "file,load_kg,cycle,quantity,unit,data,model" and len(table) == 1 + 3 * 7
+    assert table[0] == ("file,load_kg,cycle,quantity,unit,data,data_wire,model,data_note,"
+                        "data_wire_note,model_note") and len(table) == 1 + 3 * 7
     assert (out / "transformation_temperatures.md").read_text().count("| A_s |") == 3
+    assert report["verdict"].startswith("the model explains the data")
     for name in ("fit_isobaric_cycles.png", "fit_isobaric_residuals.png",
-                 "fit_isobaric_resistance.png"):
+                 "fit_isobaric_stabilisation.png", "fit_isobaric_resistance.png"):
         assert (out / name).read_bytes()[:4] == b"\x89PNG"
     assert main(["build", "--model", str(out / "identified.toml"), "--out", str(tmp_path / "fmus")]) == 0
     scenario = tmp_path / "s.toml"

@@ -3,13 +3,14 @@
 Columns: the physical parameters, the strain offsets of every file, the lag of every file
 (when fitted), then every file's temperature-profile knots. Starting values are estimated
 from the data: centres and widths from the branches' half-way crossings on the
-temperature-only profile, levels from the strain, the lag at a hundredth of a cycle.
+temperature-only profile (lagged by the starting lag), levels from the strain.
 """
 import math
 
 import numpy as np
 
 from sma_fmu.identification.isobaric_jacobian import file_model
+from sma_fmu.identification.isobaric_lag import lagged
 from sma_fmu.identification.isobaric_profile import wire_rows
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constant_load import residual_f_fraction
@@ -93,17 +94,23 @@ def _crossings(f, temperature):
     return out
 
 
-def starts(files, layout, base):
-    """Starting vector and bounds, estimated from the data."""
+def starts(files, layout, base, lag_fraction=0.01):
+    """Starting vector and bounds, estimated from the data; with a lag column the lag starts
+    at ``lag_fraction`` of a cycle and the crossings are read on the profile lagged by it."""
     vector = np.zeros(layout.size)
     lower = np.full(layout.size, -np.inf)
     upper = np.full(layout.size, np.inf)
     centres = {HEATING: [], COOLING: []}
     widths, spans, r_levels = [], [], []
     for f in files:
-        profile = f.profile.values
         vector[layout.knots[f.index]] = f.profile.factor.solve(f.profile.basis.T @ f.data.temperature)
         lower[layout.knots[f.index]] = -KELVIN_OFFSET + 1.0
+        profile = f.profile.values
+        if layout.lags[f.index] is not None:
+            period = f.data.splitting.period_samples * f.step if f.data.splitting else 100 * f.step
+            vector[layout.lags[f.index]] = lag_fraction * period
+            lower[layout.lags[f.index]], upper[layout.lags[f.index]] = 0.0, period / 4.0
+            profile = lagged(profile, lag_fraction * period, f.step)
         marks = _crossings(f, profile)
         for d in (HEATING, COOLING):
             for centre, width, span, cold, hot in marks[d]:
@@ -116,10 +123,6 @@ def starts(files, layout, base):
             low, high = np.quantile(profile, [0.1, 0.9])
             r_levels.append((f.data, float(np.median(f.data.resistance[profile >= high])),
                              float(np.median(f.data.resistance[profile <= low]))))
-        if layout.lags[f.index] is not None:
-            period = f.data.splitting.period_samples * f.step if f.data.splitting else 100 * f.step
-            vector[layout.lags[f.index]] = period / 100.0
-            lower[layout.lags[f.index]], upper[layout.lags[f.index]] = 0.0, period / 4.0
     for d in (HEATING, COOLING):
         if not centres[d]:
             raise MeasurementError(f"{layout.paths}: no complete "

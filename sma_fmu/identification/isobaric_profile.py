@@ -3,8 +3,8 @@
 Two steps, so that the wire temperature cannot absorb model misfit:
 
 1. Profile: the measured temperature is fitted alone by a piecewise-linear curve in time (in
-   the sample index without a time column) with knots at the branches' turning points and k
-   evenly spaced knots inside each branch; k is chosen from the temperature itself by Akaike's
+   the sample index without a time column) with knots at the branches' turning points, at
+   the corners where a ramp leaves or reaches a dwell, and k evenly spaced knots on each ramp; k is chosen from the temperature itself by Akaike's
    information criterion (n ln(RSS/n) + 2 knots), so a linear furnace ramp gets few knots and
    a curved one, or one with dwells, more. (The Bayesian criterion's heavier penalty left
    the dwells' corners unresolved, and the systematic error biased the transition width.) Its residual is the temperature residual the report sets
@@ -18,7 +18,7 @@ Two steps, so that the wire temperature cannot absorb model misfit:
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
+from scipy import signal, sparse
 from scipy.sparse import linalg
 
 from sma_fmu.identification.isobaric_lag import lagged
@@ -55,23 +55,51 @@ def _basis(axis, knots):
                              shape=(axis.size, at.size))
 
 
-def _knots(branches, size, interior):
-    knots = {0, size - 1}
+def _corners(temperature, branches, window):
+    """(first, last) sample of each branch's ramp: the largest curvature of the temperature
+    (Savitzky-Golay second derivative over ``window`` samples, whose response to a kink is
+    symmetric about it) in the first and in the second half of the branch. On a ramp between
+    dwells these are the dwell corners; on a triangle they fall near the turning points."""
+    window = max(5, int(window) | 1)
+    if temperature.size <= window:
+        return [(b.start, b.stop - 1) for b in branches]
+    curvature = np.abs(signal.savgol_filter(temperature, window, 2, deriv=2, mode="interp"))
+    curvature[:window // 2] = curvature[-(window // 2):] = 0.0   # the filter's edge fits
+    out = []
     for b in branches:
-        knots.update(np.linspace(b.start, b.stop - 1, interior + 2).round().astype(int).tolist())
+        half = (b.stop - b.start) // 2
+        if half < 2:
+            out.append((b.start, b.stop - 1))
+            continue
+        out.append((b.start + int(np.argmax(curvature[b.start:b.start + half])),
+                    b.start + half + int(np.argmax(curvature[b.start + half:b.stop]))))
+    return out
+
+
+def _knots(branches, ramps, size, interior):
+    knots = {0, size - 1}
+    for b, (first, last) in zip(branches, ramps):
+        knots.update((b.start, b.stop - 1))
+        knots.update(np.linspace(first, last, interior + 2).round().astype(int).tolist())
     return np.array(sorted(knots))
 
 
-def temperature_profile(temperature, branches, time=None):
-    """:class:`Profile` of the measured ``temperature`` [degC], knots chosen by AIC."""
+def temperature_profile(temperature, branches, time=None, window=5):
+    """:class:`Profile` of the measured ``temperature`` [degC], knots chosen by AIC.
+
+    Knots: each branch's turning points, the corners where its ramp leaves and reaches a
+    dwell (found on the temperature smoothed over ``window`` samples), and ``k`` evenly
+    spaced knots on the ramp.
+    """
     n = temperature.size
     axis = np.asarray(time, dtype=float) if time is not None else np.arange(n, dtype=float)
+    ramps = _corners(temperature, branches, window)
     shortest = min(b.stop - b.start for b in branches)
     best = None
     for interior in INTERIOR_KNOTS:
         if interior > 0 and (interior + 1) * 3 > shortest:
             break
-        knots = _knots(branches, n, interior)
+        knots = _knots(branches, ramps, n, interior)
         basis = _basis(axis, knots)
         factor = linalg.splu((basis.T @ basis).tocsc())
         values = basis @ factor.solve(basis.T @ temperature)

@@ -1,0 +1,76 @@
+"""Levenberg-Marquardt with sparse direct steps, for the isobaric fit's large sparse problems.
+
+scipy's ``least_squares`` offers exact trust-region steps only for dense Jacobians, and its
+iterative (lsmr) steps need thousands of inner iterations on this ill-conditioned problem
+(the lag trades against the centres and the profile's knots). Here every step solves the
+damped normal equations (J^T J + lambda diag(J^T J)) dx = -J^T r with scipy's sparse LU
+(``splu``), so a 26,000-sample, 100-cycle fit with ~1,000 unknowns takes seconds. Bounds
+are kept by projecting each trial point onto the box (Marquardt's scaling makes the step
+invariant to the unknowns' units). Stops when a step lowers the cost by less than ``ftol``
+relative, moves every unknown by less than ``xtol`` relative, or after ``max_evaluations``.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse import linalg
+
+__all__ = ["Solution", "levenberg_marquardt"]
+
+
+@dataclass
+class Solution:
+    """What :func:`levenberg_marquardt` found (fields named as scipy's OptimizeResult)."""
+
+    x: np.ndarray
+    fun: np.ndarray
+    cost: float          # 0.5 * sum(fun^2)
+    nfev: int
+    status: int          # > 0 converged, 0 evaluation limit
+    message: str
+
+
+def _step(jac, gradient, damping):
+    normal = (jac.T @ jac).tocsc()
+    diagonal = np.maximum(normal.diagonal(), 1e-12 * max(normal.diagonal().max(), 1e-300))
+    damped = (normal + sparse.diags(damping * diagonal)).tocsc()
+    try:
+        return -linalg.splu(damped).solve(gradient)
+    except RuntimeError:           # exactly singular: damp harder
+        return None
+
+
+def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e-10,
+                        xtol=1e-10, damping=1e-3):
+    """Minimise 0.5 |fun(x)|^2 for ``lower <= x <= upper``; ``jac`` returns a sparse matrix."""
+    x = np.clip(np.asarray(x0, dtype=float), lower, upper)
+    r = fun(x)
+    cost, evaluations = 0.5 * float(r @ r), 1
+    j = jac(x)
+    while evaluations < max_evaluations:
+        gradient = j.T @ r
+        step = _step(j, gradient, damping)
+        if step is None or not np.all(np.isfinite(step)):
+            damping *= 10.0
+            if damping > 1e12:
+                return Solution(x, r, cost, evaluations, 2, "the damped step is not finite")
+            continue
+        trial = np.clip(x + step, lower, upper)
+        r_trial = fun(trial)
+        evaluations += 1
+        cost_trial = 0.5 * float(r_trial @ r_trial)
+        if np.isfinite(cost_trial) and cost_trial <= cost:
+            decrease = cost - cost_trial
+            moved = np.max(np.abs(trial - x) / np.maximum(np.abs(x), 1e-8))
+            x, r, cost = trial, r_trial, cost_trial
+            damping = max(damping / 3.0, 1e-12)
+            if decrease <= ftol * cost:
+                return Solution(x, r, cost, evaluations, 2, "the cost changes by less than ftol")
+            if moved <= xtol:
+                return Solution(x, r, cost, evaluations, 3, "the unknowns change by less than xtol")
+            j = jac(x)
+        else:
+            damping *= 4.0
+            if damping > 1e12:
+                return Solution(x, r, cost, evaluations, 1, "no step lowers the cost")
+    return Solution(x, r, cost, evaluations, 0, "the evaluation limit was reached")
