@@ -64,3 +64,15 @@ def test_fmu_steps_on_after_a_zero_reference_with_one_warning(fmus, params):
             fmu.step(k * STEP, STEP)
             out = library.step(44.0 - 0.01 * k, 0.05, STEP)
         assert fmu.get_real(("P_ff", "T_ref")) == [out.P_ff, out.T_ref]
+
+
+@pytest.mark.parametrize("table", [{"kind": "constant", "value_ohm": 0.0},
+                                   {"kind": "ramp", "start_time_s": 0.0, "end_time_s": 1.0,
+                                    "start_ohm": 44.0, "end_ohm": -1.0}])
+def test_the_batch_engine_never_sees_r_ref_at_or_below_zero(table):
+    """Its references are scenario signals, which stay > 0 ohm: the unconnected start is a
+    host's first step only, so BatchFeedforward needs no such case."""
+    from sma_fmu.runtime.signals import reference_from_table
+
+    with pytest.raises(ValueError, match=r"the reference must stay > 0 ohm"):
+        reference_from_table(table)
