@@ -38,6 +38,11 @@ void forget_resources(const char* folder)
     if (calls.forget_resources) calls.forget_resources(folder);
 }
 
+int call_python(void* callable)
+{
+    return calls.call_python ? calls.call_python(callable) : -1;
+}
+
 #ifndef _WIN32
 /*
  * pythonfmu 0.7.0 releases its PyState twice at process exit: the destructor of its static

@@ -20,14 +20,28 @@
  * and takes the outputs back in its own crossing. Initialization Mode (outputs follow the
  * inputs there), terminated and error states are never served here.
  *
+ * fmi2DoStep without pythonfmu (fast_step): while the buffer is current and shows
+ * stepComplete, the front makes the guard's model-free checks itself (finite t, 0 < h < inf,
+ * t follows the last step up to rounding, the step's end not past stopTime: the guard's
+ * _do_step, on the time and stopTime the slave writes) and, if they pass, calls the slave's
+ * step (FastPath.step, its address in the header) through Python's C API: the inputs,
+ * the model's step, the outputs. Messages the step queued reach the host through one more
+ * crossing (fmi2GetString of FAST_LOG_VR), after which pythonfmu passes them on as it does
+ * after any call. A step the checks do not pass goes through pythonfmu's DoStep, so the
+ * guard refuses it with its own message. SMA_FMU_NO_DIRECT_STEP=1 switches this off.
+ *
  * Buffer: FAST_HEADER doubles, then n values (slot order of the table), then n "pending"
  * flags. Header: [0] 1 if the slave is in stepComplete, [1] 1 once the slave has written
  * the buffer (the front clears it before a crossing), [2] 1 if an input is pending, [3] the
- * front's sync request, [4] 1: the next step writes every value, not only the outputs.
+ * front's sync request, [4] 1: the next step writes every value, not only the outputs,
+ * [5] the guard's time (where the next step must start; NaN: none), [6] its stopTime (NaN:
+ * none), [7] 1 if [5] and [6] may be checked in C, [8] t and [9] h of a direct step, [10]
+ * the messages it queued, [11] the front's log request, [12] the direct step's address.
  */
 #define _GNU_SOURCE
 #include <stdio.h>
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 
 #include "front.h"
@@ -37,6 +51,14 @@
 #define H_PENDING 2
 #define H_SYNC 3
 #define H_FULL 4
+#define H_TIME 5
+#define H_STOP 6
+#define H_CHECKABLE 7
+#define H_T 8
+#define H_H 9
+#define H_LOGGED 10
+#define H_LOG 11
+#define H_ENTRY 12
 #define MAX_TABLE_VR 65536u
 
 static int kind_index(char kind) { return kind == 'R' ? 0 : kind == 'I' ? 1 : kind == 'B' ? 2 : -1; }
@@ -120,6 +142,11 @@ void fast_attach(Instance* in)
             in->logged_status == fmi2OK && in->fast.buffer[H_FRESH] == 1.0) {
             in->fast.attached = 1;
             in->fast.maybe_step_complete = in->fast.buffer[H_STEP_COMPLETE] == 1.0;
+            double entry = in->fast.buffer[H_ENTRY];
+            int direct = !(environment("SMA_FMU_NO_DIRECT_STEP", off, sizeof off) &&
+                           strcmp(off, "0") != 0);
+            if (direct && entry > 0.0 && entry < 9007199254740992.0) /* an address, exact */
+                in->fast.step = (void*)(size_t)entry;
         }
     }
     if (!in->fast.attached) fast_free(&in->fast);
@@ -229,4 +256,60 @@ void fast_after_step(Instance* in)
     /* the slave wrote the outputs (every value if it was asked to) and its state */
     in->fast.stale = in->fast.buffer[H_FRESH] != 1.0;
     in->fast.maybe_step_complete = 1;
+}
+
+static double magnitude(double x) { return x < 0.0 ? -x : x; }
+
+/* The guard's _close: equal up to rounding (relative 1e-9 of the larger magnitude). */
+static int close_to(double a, double b, double step)
+{
+    double scale = magnitude(a);
+    if (magnitude(b) > scale) scale = magnitude(b);
+    if (step > scale) scale = step; /* Python's max(abs(a), abs(b), step) */
+    return magnitude(a - b) <= 1e-9 * scale;
+}
+
+/* 1 if the guard's _do_step would pass fmi2DoStep(t, h) on to its advance(): the buffer is
+ * current and shows stepComplete, t is finite, 0 < h < inf, t follows the last step and the
+ * step does not pass stopTime (the same comparisons, in the same order). */
+static int direct_step_allowed(const FastPath* fast, double t, double h)
+{
+    const double* b = fast->buffer;
+    if (!fast->attached || !fast->step || fast->stale || b[H_STEP_COMPLETE] != 1.0 ||
+        b[H_CHECKABLE] != 1.0)
+        return 0;
+    if (!(t > -HUGE_VAL && t < HUGE_VAL && h > 0.0 && h < HUGE_VAL)) return 0;
+    double expected = b[H_TIME];
+    if (expected == expected && t != expected && !close_to(t, expected, h)) return 0;
+    double end = t + h, stop = b[H_STOP];
+    if (stop == stop && end > stop && !close_to(end, stop, h)) return 0;
+    return 1;
+}
+
+int fast_step(Instance* in, double t, double h)
+{
+    FastPath* fast = &in->fast;
+    if (!direct_step_allowed(fast, t, h)) return -1;
+    double* b = fast->buffer;
+    b[H_FRESH] = 0.0;
+    b[H_FULL] = 0.0; /* not stale: the outputs are enough */
+    b[H_T] = t;
+    b[H_H] = h;
+    b[H_LOGGED] = 0.0;
+    int done = call_python(fast->step);
+    if (b[H_LOGGED] != 0.0) { /* pythonfmu passes the queued messages on after this call */
+        const fmi2ValueReference vr = FAST_LOG_VR;
+        fmi2String text = NULL;
+        b[H_LOG] = 1.0;
+        if (backend.GetString(in->backend, &vr, 1, &text) == fmi2Fatal) in->dead = 1;
+        b[H_LOG] = 0.0;
+    }
+    fast_after_step(in);
+    if (in->dead) return finish(in, fmi2Fatal);
+    if (done < 0) /* a Python exception the guard lets through (never an Exception) */
+        return refuse(in, fmi2Error, "fmi2DoStep", "internal error: the slave's step raised "
+                      "an exception that is not an Exception (printed on stderr)");
+    in->own_last_time = 1;
+    in->last_time = done ? t + h : t; /* as pythonfmu's fmi2DoStep */
+    return finish(in, done ? fmi2OK : fmi2Discard);
 }

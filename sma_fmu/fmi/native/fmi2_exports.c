@@ -23,7 +23,8 @@
  *  - fmi2Instantiate takes pythonfmu's entry for the resources folder off sys.path again.
  *  - in stepComplete, fmi2Set/GetReal, Integer and Boolean are served from values the front
  *    holds (fast_path.c): Python runs in fmi2DoStep, which hands the inputs over and takes
- *    the outputs back. Every other call, and every call the front would refuse, goes to the
+ *    the outputs back. fmi2DoStep itself makes the guard's model-free checks in C and calls
+ *    the slave's step directly (not through pythonfmu) when they pass. Every other call, and every call the front would refuse, goes to the
  *    slave (after the pending inputs), so the guard's rules and messages stay as they are.
  */
 #define _GNU_SOURCE
@@ -281,11 +282,17 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint
                              fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint)
 {
     ENTER(DoStep);
-    fast_before_step(in); /* the slave takes the pending inputs and writes the outputs */
-    fmi2Status status = finish(in, backend.DoStep(in->backend, currentCommunicationPoint,
-                                                  communicationStepSize,
-                                                  noSetFMUStatePriorToCurrentPoint));
-    fast_after_step(in);
+    int direct = fast_step(in, currentCommunicationPoint, communicationStepSize);
+    fmi2Status status;
+    if (direct >= 0) {
+        status = (fmi2Status)direct;
+    } else {
+        fast_before_step(in); /* the slave takes the pending inputs and writes the outputs */
+        status = finish(in, backend.DoStep(in->backend, currentCommunicationPoint,
+                                           communicationStepSize, noSetFMUStatePriorToCurrentPoint));
+        fast_after_step(in);
+        in->own_last_time = 0; /* pythonfmu's fmi2LastSuccessfulTime is current again */
+    }
     if (status > fmi2Discard) return status; /* refused (illegal call): nothing was stepped */
     in->stepped = 1;
     if (status != fmi2Discard) {
@@ -331,6 +338,10 @@ EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi
     if (!value) return refuse(in, fmi2Error, "fmi2GetRealStatus", "value is NULL");
     if (s != fmi2LastSuccessfulTime)
         return refuse(in, fmi2Discard, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is defined");
+    if (in->own_last_time) { /* the last step was direct: pythonfmu's value is older */
+        *value = in->last_time;
+        return fmi2OK;
+    }
     FORWARD(in, 0, backend.GetRealStatus(in->backend, s, value));
     return status;
 }

@@ -66,6 +66,9 @@ typedef struct {
     fmi2Component (*instantiate)(fmi2String name, fmi2Type type, fmi2String guid, fmi2String uri,
                                  const fmi2CallbackFunctions* cb, fmi2Boolean visible);
     void (*forget_resources)(const char* folder);
+    /* calls a Python callable with no arguments (GIL taken and released): 1 if the result
+     * is true, 0 if false, -1 if it raised (the exception is printed and cleared) */
+    int (*call_python)(void* callable);
 } RuntimeCalls;
 
 /*
@@ -76,7 +79,7 @@ typedef struct {
  * loading its own, so it holds nothing the host's unloading of it would leave behind.
  */
 #define SHARE_MAGIC "SMAFRONT"
-#define SHARE_ABI 1
+#define SHARE_ABI 2 /* 2: RuntimeCalls.call_python */
 typedef struct {
     char magic[8];
     unsigned abi;
@@ -100,6 +103,7 @@ void keep_thread_state(void); /* the owner's: one parked Python thread state per
 fmi2Component instantiate_backend(fmi2String name, fmi2Type type, fmi2String guid, fmi2String uri,
                                   const fmi2CallbackFunctions* cb, fmi2Boolean visible);
 void forget_resources(const char* folder); /* takes pythonfmu's sys.path entry away again */
+int call_python(void* callable);           /* RuntimeCalls.call_python; -1 without one */
 /* The GNU build ID of an ELF file (0 elsewhere or without one: then nothing is shared). */
 int backend_build_id(const char* path, unsigned char* id, size_t* size);
 /* An owner's record for a backend with this build ID, or NULL. */
@@ -131,10 +135,11 @@ typedef struct FrontState {
 } FrontState;
 
 /* Values the front holds for the slave, so that fmi2Set/Get need no Python (fast_path.c). */
-#define FAST_HEADER 6
+#define FAST_HEADER 13 /* as _HEADER in slave_support/fast_path.py */
 #define FAST_DESCRIBE_VR 0xFFFFFA51u /* fmi2GetString: the slave's variable table */
 #define FAST_ATTACH_VR 0xFFFFFA52u   /* fmi2SetString: the buffer's address */
 #define FAST_SYNC_VR 0xFFFFFA53u     /* fmi2GetString: take pending inputs, write every value */
+#define FAST_LOG_VR 0xFFFFFA54u      /* fmi2GetString: pythonfmu passes queued messages on */
 typedef struct {
     int attached;            /* the slave writes its values into buffer */
     int stale;               /* a call went to the slave since it last wrote them all */
@@ -144,6 +149,7 @@ typedef struct {
     unsigned char* settable; /* per slot: settable in stepComplete */
     int* slot_of[3];         /* Real, Integer, Boolean: value reference -> slot or -1 */
     unsigned table_size[3];
+    void* step;              /* the slave's direct doStep (a Python callable), or NULL */
 } FastPath;
 
 typedef struct {
@@ -162,6 +168,9 @@ typedef struct {
     /* fmi2Terminated and fmi2GetXXXStatus bookkeeping */
     int stepped, terminated, have_discard;
     double discard_time, discard_step;
+    /* fmi2LastSuccessfulTime: the front's own after a direct step (pythonfmu's did not run) */
+    int own_last_time;
+    double last_time;
     int dead; /* the backend returned fmi2Fatal: pythonfmu has freed its objects */
     int freed; /* fmi2FreeInstance was called: only the name is left */
     FrontState* states; /* the states this instance handed out and that are not freed */
@@ -179,6 +188,10 @@ int fast_get(Instance* in, char kind, const fmi2ValueReference vr[], size_t nvr,
 int fast_set(Instance* in, char kind, const fmi2ValueReference vr[], size_t nvr, const void* value);
 void fast_before_step(Instance* in);
 void fast_after_step(Instance* in);
+/* fmi2DoStep without pythonfmu: the guard's model-free checks in C, then the slave's step
+ * called directly; -1 if not taken (then pythonfmu's DoStep runs, and the guard refuses
+ * what C would not take, with its message), else the call's status. */
+int fast_step(Instance* in, double t, double h);
 
 /* ---- forwarding (fmi2_exports.c) and saved states (fmi2_states.c) ----------------------- */
 fmi2Status refuse(Instance* in, fmi2Status status, const char* function, const char* why);

@@ -43,6 +43,10 @@ static struct {
     int (*Object_DelItem)(void*, void*);
     void (*Err_Clear)(void);
     void (*DecRef)(void*);
+    /* the direct doStep (fast_path.c) */
+    void* (*Object_CallObject)(void*, void*);
+    int (*Object_IsTrue)(void*);
+    void (*Err_Print)(void);
 } py;
 
 #define PY_EQ 2
@@ -161,6 +165,20 @@ static void owner_forget_resources(const char* folder)
     py.GILState_Release(gil);
 }
 
+/* The slave's direct step (fast_path.c): one call with no arguments under the GIL. An
+ * exception cannot come from the guard (it catches Exception); anything else (a
+ * KeyboardInterrupt) is printed as Python would and cleared, and the call says -1. */
+static int owner_call_python(void* callable)
+{
+    int gil = py.GILState_Ensure();
+    void* result = py.Object_CallObject(callable, NULL);
+    int truth = result ? py.Object_IsTrue(result) : -1;
+    if (result) py.DecRef(result);
+    if (truth < 0) py.Err_Print();
+    py.GILState_Release(gil);
+    return truth;
+}
+
 int start_python_runtime(RuntimeCalls* calls)
 {
 #define LOOKUP(field, name) *(void**)(&py.field) = python_symbol(name)
@@ -184,6 +202,9 @@ int start_python_runtime(RuntimeCalls* calls)
     LOOKUP(Object_DelItem, "PyObject_DelItem");
     LOOKUP(Err_Clear, "PyErr_Clear");
     LOOKUP(DecRef, "Py_DecRef");
+    LOOKUP(Object_CallObject, "PyObject_CallObject");
+    LOOKUP(Object_IsTrue, "PyObject_IsTrue");
+    LOOKUP(Err_Print, "PyErr_Print");
 #undef LOOKUP
     char off[16];
     use_thread_state_keeper = !(environment("SMA_FMU_NO_TSTATE", off, sizeof off) &&
@@ -192,6 +213,8 @@ int start_python_runtime(RuntimeCalls* calls)
     calls->keep_thread_state = owner_keep_thread_state;
     calls->instantiate = owner_instantiate;
     calls->forget_resources = owner_forget_resources;
+    calls->call_python = py.Object_CallObject && py.Object_IsTrue && py.Err_Print &&
+                         py.DecRef && py.GILState_Release ? owner_call_python : NULL;
     return py.IsInitialized && py.GILState_Ensure && py.GILState_GetThisThreadState &&
            py.Eval_SaveThread && py.Eval_RestoreThread;
 }

@@ -15,10 +15,21 @@ only as the only reference of a call:
 - fmi2SetString(``ATTACH``, ``"<address> <n>"``): the buffer. The slave writes every value.
 - fmi2GetString(``SYNC``): take the pending inputs, write every value. Answered only when the
   front has set the buffer's request flag, so a host calling with it is refused as before.
+- fmi2GetString(``LOG``): nothing (answered only when the front asked); pythonfmu passes the
+  messages queued by a direct step (below) to the logger at the end of this call.
+
+fmi2DoStep: the front makes the guard's model-free checks in C (stepComplete, finite t and
+h > 0, t follows the last step, stopTime; from the time, stopTime and state the slave writes
+into the header) and, when they pass, calls :meth:`FastPath.step` itself through Python's C
+API (its address is in the header): no pythonfmu DoStep, no log-queue crossing unless a
+message was queued. Otherwise the call takes pythonfmu's DoStep and the guard refuses it
+with its message, as before.
 
 Slot order: the variables a step changes (outputs, locals) first, then inputs and parameters.
 Buffer: header (``_HEADER`` doubles: stepComplete, written, pending, sync request, write all
-at the next step), the n values, the n pending flags. Without the front (or with
+at the next step; the guard's time and stopTime (NaN: None) and whether C may check them; the
+direct step's t and h, the messages it queued, the log request, :meth:`FastPath.step`'s
+address), the n values, the n pending flags. Without the front (or with
 ``SMA_FMU_NO_FAST_PATH=1``) nothing is attached and every call takes the guard's path.
 """
 import ctypes
@@ -26,11 +37,13 @@ import struct
 
 from .lifecycle import INSTANTIATED, STEP_COMPLETE
 
-__all__ = ["FastPath", "DESCRIBE", "ATTACH", "SYNC", "PENDING"]
+__all__ = ["FastPath", "DESCRIBE", "ATTACH", "SYNC", "LOG", "PENDING"]
 
-DESCRIBE, ATTACH, SYNC = 0xFFFFFA51, 0xFFFFFA52, 0xFFFFFA53
-_HEADER = 6
-_STEP_COMPLETE, _WRITTEN, PENDING, _SYNC, _FULL = range(5)  # PENDING: inputs set in C since the last step
+DESCRIBE, ATTACH, SYNC, LOG = 0xFFFFFA51, 0xFFFFFA52, 0xFFFFFA53, 0xFFFFFA54
+_HEADER = 13  # as FAST_HEADER in fmi/native/front.h
+(_STEP_COMPLETE, _WRITTEN, PENDING, _SYNC, _FULL,  # PENDING: inputs set in C since the last step
+ _TIME, _STOP, _CHECKABLE, _T, _H, _LOGGED, _LOG, _ENTRY) = range(_HEADER)
+_NAN = float("nan")
 _KINDS = (("Real", "R", float), ("Integer", "I", int), ("Boolean", "B", bool))
 
 
@@ -55,7 +68,7 @@ class FastPath:
         if len(references) != 1:
             return None
         reference = references[0] & 0xFFFFFFFF
-        return reference if reference in (DESCRIBE, ATTACH, SYNC) else None
+        return reference if reference in (DESCRIBE, ATTACH, SYNC, LOG) else None
 
     # ---- the table -------------------------------------------------------------------------
     def _table(self):
@@ -103,7 +116,10 @@ class FastPath:
         self._raw = memoryview(array).cast("B")
         self._other = [(i, name, self._to_double[i])
                        for i, name in enumerate(self._names[n_outputs:n_changing], n_outputs)]
+        self._log_queue = self.guard.slave._get_log_queue()  # pythonfmu's list (it empties it)
+        self._entry = self.step  # kept alive with the slave: the front holds its address
         self.write_all()
+        self.view[_ENTRY] = float(id(self._entry))
 
     # ---- values ------------------------------------------------------------------------------
     def take_inputs(self):
@@ -123,9 +139,22 @@ class FastPath:
             for index, (name, to_double) in enumerate(zip(self._names, self._to_double)):
                 view[_HEADER + index] = to_double(getattr(slave, name))
             view[_STEP_COMPLETE] = 1.0 if self.guard.state is STEP_COMPLETE else 0.0
+            self._write_times()
         except Exception:  # noqa: BLE001 - then every call goes to the guard
             view[_STEP_COMPLETE] = 0.0
         view[_WRITTEN] = 1.0
+
+    def _write_times(self):
+        """The guard's time and stopTime for the front's doStep checks (NaN: None); C checks
+        them only when both are floats or None (a restored state may hold an int)."""
+        view, guard = self.view, self.guard
+        time, stop = guard.time, guard.stop_time
+        checkable = (time is None or time.__class__ is float) and \
+            (stop is None or stop.__class__ is float)
+        view[_CHECKABLE] = 1.0 if checkable else 0.0
+        if checkable:
+            view[_TIME] = _NAN if time is None else time
+            view[_STOP] = _NAN if stop is None else stop
 
     def write_step(self, outputs=None):
         """After fmi2DoStep: the outputs (``outputs``: the Real outputs' values the guard read
@@ -141,16 +170,46 @@ class FastPath:
             self._outputs.pack_into(self._raw, 8 * _HEADER, *outputs)
             for index, name, to_double in self._other:
                 view[_HEADER + index] = to_double(getattr(slave, name))
-            view[_STEP_COMPLETE] = 1.0 if self.guard.state is STEP_COMPLETE else 0.0
+            guard = self.guard
+            view[_STEP_COMPLETE] = 1.0 if guard.state is STEP_COMPLETE else 0.0
+            time = guard.time
+            if time.__class__ is float:  # the usual case: only the time moved
+                view[_TIME] = time
+            else:
+                self._write_times()
         except Exception:  # noqa: BLE001
             view[_STEP_COMPLETE] = 0.0
         view[_WRITTEN] = 1.0
 
-    def sync(self):
-        """fmi2GetString(SYNC) from the front: take the pending inputs, write every value.
+    def step(self):
+        """fmi2DoStep called by the front after its checks passed (the guard's do_step
+        without them): t and h from the header; True if done. The number of messages queued
+        goes into the header (the front then has pythonfmu pass them on, see ``LOG``)."""
+        view, guard = self.view, self.guard
+        guard.last_outputs = None
+        try:
+            if view[PENDING]:
+                self.take_inputs()
+            return guard.advance(view[_T], view[_H])
+        except Exception as error:  # noqa: BLE001 - nothing may reach the front
+            return guard.internal("fmi2DoStep", error, False)
+        finally:
+            self.write_step(guard.last_outputs)
+            view[_LOGGED] = len(self._log_queue)
+
+    def sync(self, reference):
+        """fmi2GetString(SYNC) from the front: take the pending inputs, write every value;
+        fmi2GetString(LOG): nothing (pythonfmu passes the queued messages on after it).
         False if the front did not ask (a host's call: refused as an unknown reference)."""
         view = self.view
-        if view is None or not view[_SYNC]:
+        if view is None:
+            return False
+        if reference == LOG:
+            if not view[_LOG]:
+                return False
+            view[_LOG] = 0.0
+            return True
+        if reference != SYNC or not view[_SYNC]:
             return False
         view[_SYNC] = 0.0
         if view[PENDING]:

@@ -201,6 +201,8 @@ class CallGuard:
                 self.fast.write_step(self.last_outputs)
 
     def _do_step(self, current_time, step_size):
+        """The model-free checks, then :meth:`advance`. The front makes the same checks in C
+        (``fast_path.c``: ``direct_step_allowed``) and calls :meth:`advance` directly."""
         function = "fmi2DoStep"
         if self.state is not STEP_COMPLETE and not self.allowed(function):
             return False
@@ -218,6 +220,12 @@ class CallGuard:
         stop = self.stop_time
         if stop is not None and end > stop and not _close(end, stop, step_size):
             return self.refuse(function, f"the step to {end!r} s passes stopTime = {stop!r} s")
+        return self.advance(current_time, step_size)
+
+    def advance(self, current_time, step_size):
+        """A step that passed :meth:`_do_step`'s checks: the model's step, the outputs'
+        finiteness, the next communication point and the validity warning."""
+        function = "fmi2DoStep"
         try:
             done = bool(self._model["do_step"](current_time, step_size))
         except Exception as error:  # noqa: BLE001 - a step the model rejects is discarded
@@ -232,7 +240,7 @@ class CallGuard:
             return self.refuse(function, f"internal error: the step at t = {current_time!r} s gave a "
                                          "non-finite output; the instance is in the error state "
                                          "(restore a saved state or reset it)")
-        self.time = end
+        self.time = current_time + step_size
         self.validity(function)
         return True
 
@@ -320,7 +328,7 @@ class CallGuard:
         special = self.fast.reference(references)
         if special == DESCRIBE and self.fast.view is None:
             return [self.fast.describe()]
-        if special is not None and self.fast.sync():
+        if special is not None and self.fast.sync(special):
             return [""]
         return self._get("fmi2GetString", "String", references, str, "")
 
