@@ -19,7 +19,7 @@ from pathlib import Path
 
 from sma_fmu import __version__
 from sma_fmu.files.output_folder import staged_folder
-from sma_fmu.fmi.fmu_reference import (LS_REF_FOLDER, MANIFEST, _read_manifest, output_stride,
+from sma_fmu.fmi.fmu_reference import (LS_REF_FOLDER, MANIFEST, read_manifest, output_stride,
                                        reference_check)
 
 __all__ = ["TOOL", "MINIMUM_FMUS", "REL_TOL", "cross_check_platform", "model_folder",
@@ -100,7 +100,7 @@ def _entries(fmu_path, platform):
             return None, f"no {MANIFEST} (not built by sma-fmu build)"
         if not any(name.startswith(f"binaries/{platform}/") for name in names):
             return None, f"no binaries/{platform}/"
-        experiment, stimuli_file, reference_file = _read_manifest(archive)
+        experiment, stimuli_file, reference_file = read_manifest(archive)
         reference = archive.read(reference_file)
         stimuli = archive.read(stimuli_file) if stimuli_file else None
     status, detail = reference_check(fmu_path)

@@ -23,7 +23,7 @@ import numpy as np
 
 __all__ = ["LS_REF_FOLDER", "MANIFEST", "LS_REF_VERSION", "STIMULI", "MAX_ROWS", "RTOL", "ATOL",
            "Experiment", "experiment_of", "stimuli", "output_stride", "simulate_experiment",
-           "csv_bytes", "read_csv_bytes", "manifest_bytes", "reference_check"]
+           "csv_bytes", "read_csv_bytes", "manifest_bytes", "read_manifest", "reference_check"]
 
 LS_REF_FOLDER = "extra/org.fmi-standard.fmi-ls-ref"
 MANIFEST = f"{LS_REF_FOLDER}/fmi-ls-manifest.xml"
@@ -166,7 +166,7 @@ def manifest_bytes(model_name, experiment, has_stimuli):
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def _read_manifest(archive):
+def read_manifest(archive):
     """(Experiment, stimuli file or None, references file) of the manifest in ``archive``."""
     root = ET.fromstring(archive.read(MANIFEST))
     node = root.find("Experiment")
@@ -191,7 +191,7 @@ def reference_check(fmu_path, packed_entry=None):
         if packed_entry and packed_entry in names:
             return "n/a", ("packed with a scenario's values as defaults: its reference is of the "
                            "built FMU's defaults")
-        experiment, stimuli_file, reference_file = _read_manifest(archive)
+        experiment, stimuli_file, reference_file = read_manifest(archive)
         reference = read_csv_bytes(archive.read(reference_file))
         inputs = read_csv_bytes(archive.read(stimuli_file)) if stimuli_file else None
     description = read_model_description(str(fmu_path))
