@@ -38,6 +38,14 @@ def fmus(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def native_fmus(tmp_path_factory):
+    """The native (C) FMUs, built once per session (sma-fmu build --native): {name: path}."""
+    need("gcc")
+    from sma_fmu.fmi.c_family.native_build import build_native_fmus
+    return build_native_fmus(tmp_path_factory.mktemp("native_fmus"))
+
+
+@pytest.fixture(scope="session")
 def unpacked(fmus, tmp_path_factory):
     """Both FMUs unpacked once per session: {name: folder}."""
     from fmi_host import unpack

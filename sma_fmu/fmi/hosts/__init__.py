@@ -23,7 +23,7 @@ from pathlib import Path
 
 __all__ = ["CHostError", "HOST_PROGRAMS", "c_compiler", "windows_compiler", "compile_host"]
 
-HOST_PROGRAMS = ("fmi_host", "cosim_host")
+HOST_PROGRAMS = ("fmi_host", "cosim_host", "loop_host")
 _FLAGS = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"]
 
 
@@ -58,10 +58,10 @@ def _libcosimc_folder():
 
 def _link_flags(name, windows=False):
     if windows:
-        if name != "fmi_host":
-            raise CHostError(f"only fmi_host is built for Windows, not {name}")
+        if name == "cosim_host":
+            raise CHostError(f"only fmi_host and loop_host are built for Windows, not {name}")
         return ["-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1"]
-    if name == "fmi_host":
+    if name in ("fmi_host", "loop_host"):  # loop_host.c: a sequential loop of FMUs
         return ["-ldl"]
     library = _libcosimc_folder()
     return [f"-L{library}", "-lcosimc", f"-Wl,-rpath,{library}"]

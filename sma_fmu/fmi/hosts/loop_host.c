@@ -1,0 +1,344 @@
+/*
+ * loop_host.c - a plain C host that runs a system of FMI 2.0 co-simulation FMUs as a
+ * sequential (Gauss-Seidel) loop, the way an embedded or HIL master does: no libpython, no
+ * FMI library, one process. It loads DIR/binaries/linux64/<id>.so (built for Windows with
+ * mingw-w64: DIR/binaries/win64/<id>.dll, run under wine), so the same source runs the
+ * linux64 and the win64 binaries of the same FMUs and their outputs can be compared.
+ *
+ * usage: loop_host < SYSTEM   where SYSTEM has one item a line (strings hex-encoded):
+ *   fmu NAME DIR                   a component (unpacked FMU folder); the order of these
+ *                                  lines is the data-flow order of initialization
+ *   real|integer|boolean NAME VR VALUE   a start value, set in Initialization Mode
+ *   string NAME VR HEX             a String start value
+ *   connect SRC VR DST VR          the Real output SRC.VR feeds the Real input DST.VR
+ *   order NAME ...                 the step order (Gauss-Seidel: each component takes the
+ *                                  outputs of those before it in this step)
+ *   record real|boolean NAME VR    a recorded output (one column)
+ *   run STEP_S STEPS [timing]      initialize, then STEPS steps of STEP_S at t_k = k STEP_S
+ * Initialization: in the order of the fmu lines, each component gets its start values and
+ * the current outputs of its sources, then leaves Initialization Mode.
+ * Output: "row V..." (%.17g; Booleans 0/1) after initialization and after every step; with
+ * "timing", only the last row and first "timing P50_US P99_US P999_US MAX_US TOTAL_S" of the
+ * wall time of each step (all components set, stepped and read). Every FMU log message is a
+ * line "log STATUS NAME CATEGORY TEXT" (TEXT hex, formatted as printf like fmusim does).
+ * Exit status 0, 1 when an FMI call fails (stderr names it), 2 on a bad system.
+ */
+#define _GNU_SOURCE
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#ifdef _WIN32
+#define WIN32_LEAN_AND_MEAN
+#include <windows.h>
+#define PLATFORM "win64"
+#define SUFFIX ".dll"
+#else
+#include <dlfcn.h>
+#define PLATFORM "linux64"
+#define SUFFIX ".so"
+#endif
+
+#define PATH_SIZE 4096
+#define MAX_COMPONENTS 8
+#define MAX_ITEMS 256
+
+typedef void* Component;
+typedef struct {
+    void (*logger)(void*, const char*, int, const char*, const char*, ...);
+    void* (*allocate)(size_t, size_t);
+    void (*release)(void*);
+    void* step_finished;
+    void* environment;
+} Callbacks;
+
+typedef struct {
+    char name[64], dir[PATH_SIZE], guid[256], model[256];
+    Component c;
+    Component (*Instantiate)(const char*, int, const char*, const char*, const Callbacks*, int, int);
+    void (*FreeInstance)(Component);
+    int (*SetupExperiment)(Component, int, double, double, int, double);
+    int (*EnterInitializationMode)(Component), (*ExitInitializationMode)(Component);
+    int (*Terminate)(Component);
+    int (*SetReal)(Component, const unsigned*, size_t, const double*);
+    int (*GetReal)(Component, const unsigned*, size_t, double*);
+    int (*SetInteger)(Component, const unsigned*, size_t, const int*);
+    int (*SetBoolean)(Component, const unsigned*, size_t, const int*);
+    int (*GetBoolean)(Component, const unsigned*, size_t, int*);
+    int (*SetString)(Component, const unsigned*, size_t, const char* const*);
+    int (*DoStep)(Component, double, double, int);
+} Fmu;
+
+typedef struct { int kind, component; unsigned vr; double real; int integer; char* text; } Start;
+typedef struct { int source, target; unsigned output, input; } Link;
+typedef struct { int boolean, component; unsigned vr; } Column;
+
+static Fmu fmu[MAX_COMPONENTS];
+static int components, order[MAX_COMPONENTS], ordered;
+static Start start[MAX_ITEMS];
+static Link edge[MAX_ITEMS];
+static Column column[MAX_ITEMS];
+static int starts, links, columns;
+
+static void logger(void* env, const char* name, int status, const char* category, const char* message, ...)
+{
+    (void)env;
+    char text[8192];
+    va_list args;
+    va_start(args, message);
+    vsnprintf(text, sizeof text, message, args); /* the message is a printf format (FMI 2.0) */
+    va_end(args);
+    printf("log %d %s %s ", status, name && *name ? name : "-", category && *category ? category : "-");
+    for (const char* p = text; *p; ++p) printf("%02x", (unsigned char)*p);
+    if (!*text) putchar('_');
+    putchar('\n');
+}
+
+static char* unhex(const char* hex)
+{
+    size_t n = strcmp(hex, "_") ? strlen(hex) / 2 : 0;
+    char* out = calloc(n + 1, 1);
+    for (size_t i = 0; out && i < n; ++i) sscanf(hex + 2 * i, "%2hhx", (unsigned char*)&out[i]);
+    return out;
+}
+
+static int bad(const char* what, const char* detail)
+{
+    fprintf(stderr, "loop_host: %s: %s\n", what, detail);
+    exit(2);
+}
+
+static int find(const char* name)
+{
+    for (int i = 0; i < components; ++i)
+        if (!strcmp(fmu[i].name, name)) return i;
+    return bad("no component", name);
+}
+
+static void read_model_description(Fmu* f)
+{
+    char path[PATH_SIZE + 32];
+    snprintf(path, sizeof path, "%s/modelDescription.xml", f->dir);
+    FILE* file = fopen(path, "r");
+    if (!file) bad("cannot open", path);
+    static char xml[1 << 18];
+    xml[fread(xml, 1, sizeof xml - 1, file)] = '\0';
+    fclose(file);
+    char* g = strstr(xml, " guid=\"");
+    char* m = strstr(xml, "modelIdentifier=\"");
+    if (!g || !m) bad("no guid or modelIdentifier in", path);
+    sscanf(g + 7, "%255[^\"]", f->guid);
+    sscanf(m + 17, "%255[^\"]", f->model);
+}
+
+#ifdef _WIN32
+static void* symbol(HMODULE library, const char* name)
+{
+    FARPROC address = GetProcAddress(library, name);
+    void* pointer;
+    memcpy(&pointer, &address, sizeof pointer);
+    return pointer;
+}
+#else
+#define symbol dlsym
+#endif
+
+static void load(Fmu* f)
+{
+    char path[2 * PATH_SIZE];
+    snprintf(path, sizeof path, "%s/binaries/" PLATFORM "/%s" SUFFIX, f->dir, f->model);
+#ifdef _WIN32
+    for (char* p = path; *p; ++p)
+        if (*p == '/') *p = '\\';
+    HMODULE library = LoadLibraryExA(path, NULL, LOAD_WITH_ALTERED_SEARCH_PATH);
+    if (!library) { fprintf(stderr, "loop_host: LoadLibrary %s: error %lu\n", path, GetLastError()); exit(1); }
+#else
+    void* library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!library) { fprintf(stderr, "loop_host: dlopen: %s\n", dlerror()); exit(1); }
+#endif
+#define SYM(n) if (!(*(void**)&f->n = symbol(library, "fmi2" #n))) bad("no fmi2" #n " in", path);
+    SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
+    SYM(ExitInitializationMode) SYM(Terminate) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
+    SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(DoStep)
+#undef SYM
+}
+
+/* file:// URI of DIR/resources ("file:///C:/dir/resources" on Windows). */
+static void resource_uri(const char* dir, char* uri, size_t size)
+{
+    char absolute[PATH_SIZE];
+#ifdef _WIN32
+    if (!_fullpath(absolute, dir, sizeof absolute)) bad("no absolute path for", dir);
+    for (char* p = absolute; *p; ++p)
+        if (*p == '\\') *p = '/';
+    snprintf(uri, size, "file:///%s/resources", absolute);
+#else
+    if (!realpath(dir, absolute)) bad("no absolute path for", dir);
+    snprintf(uri, size, "file://%s/resources", absolute);
+#endif
+}
+
+static double now(void)
+{
+#ifdef _WIN32
+    LARGE_INTEGER count, frequency;
+    QueryPerformanceCounter(&count);
+    QueryPerformanceFrequency(&frequency);
+    return (double)count.QuadPart / (double)frequency.QuadPart;
+#else
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+#endif
+}
+
+static void check(int status, const Fmu* f, const char* call)
+{
+    if (status > 1) {
+        fprintf(stderr, "loop_host: %s.%s returned %d\n", f->name, call, status);
+        exit(1);
+    }
+}
+
+/* Each input of component i gets its source's output now. */
+static void feed(int i)
+{
+    for (int k = 0; k < links; ++k) {
+        if (edge[k].target != i) continue;
+        const Fmu* s = &fmu[edge[k].source];
+        double value;
+        check(s->GetReal(s->c, &edge[k].output, 1, &value), s, "fmi2GetReal");
+        check(fmu[i].SetReal(fmu[i].c, &edge[k].input, 1, &value), &fmu[i], "fmi2SetReal");
+    }
+}
+
+static void print_row(void)
+{
+    fputs("row", stdout);
+    for (int k = 0; k < columns; ++k) {
+        const Fmu* f = &fmu[column[k].component];
+        if (column[k].boolean) {
+            int value;
+            check(f->GetBoolean(f->c, &column[k].vr, 1, &value), f, "fmi2GetBoolean");
+            printf(" %d", value ? 1 : 0);
+        } else {
+            double value;
+            check(f->GetReal(f->c, &column[k].vr, 1, &value), f, "fmi2GetReal");
+            printf(" %.17g", value);
+        }
+    }
+    putchar('\n');
+}
+
+static void initialize(double stop, const Callbacks* callbacks)
+{
+    for (int i = 0; i < components; ++i) {
+        Fmu* f = &fmu[i];
+        char uri[PATH_SIZE + 64];
+        resource_uri(f->dir, uri, sizeof uri);
+        f->c = f->Instantiate(f->name, 1, f->guid, uri, callbacks, 0, 0);
+        if (!f->c) { fprintf(stderr, "loop_host: %s: fmi2Instantiate returned NULL\n", f->name); exit(1); }
+        check(f->SetupExperiment(f->c, 0, 0.0, 0.0, 1, stop), f, "fmi2SetupExperiment");
+        check(f->EnterInitializationMode(f->c), f, "fmi2EnterInitializationMode");
+    }
+    for (int i = 0; i < components; ++i) {
+        Fmu* f = &fmu[i];
+        for (int k = 0; k < starts; ++k) {
+            const Start* s = &start[k];
+            if (s->component != i) continue;
+            const char* text = s->text;
+            int status = s->kind == 0 ? f->SetReal(f->c, &s->vr, 1, &s->real)
+                       : s->kind == 1 ? f->SetInteger(f->c, &s->vr, 1, &s->integer)
+                       : s->kind == 2 ? f->SetBoolean(f->c, &s->vr, 1, &s->integer)
+                       : f->SetString(f->c, &s->vr, 1, &text);
+            check(status, f, "fmi2Set (start value)");
+        }
+        feed(i);
+        check(f->ExitInitializationMode(f->c), f, "fmi2ExitInitializationMode");
+    }
+}
+
+static int by_value(const void* a, const void* b)
+{
+    double x = *(const double*)a, y = *(const double*)b;
+    return (x > y) - (x < y);
+}
+
+static void run(double h, long steps, int timing)
+{
+    double* cost = timing ? malloc(sizeof(double) * (size_t)steps) : NULL;
+    if (timing && !cost) bad("out of memory for", "the timings");
+    if (!timing) print_row();
+    const double begin = now();
+    for (long k = 0; k < steps; ++k) {
+        const double t = (double)k * h, before = timing ? now() : 0.0;
+        for (int j = 0; j < ordered; ++j) {
+            Fmu* f = &fmu[order[j]];
+            feed(order[j]);
+            check(f->DoStep(f->c, t, h, 1), f, "fmi2DoStep");
+        }
+        if (timing) cost[k] = now() - before;
+        else print_row();
+    }
+    const double total = now() - begin;
+    if (timing) {
+        qsort(cost, (size_t)steps, sizeof(double), by_value);
+        printf("timing %.4f %.4f %.4f %.4f %.6f\n", 1e6 * cost[steps / 2],
+               1e6 * cost[(long)((double)steps * 0.99)], 1e6 * cost[(long)((double)steps * 0.999)],
+               1e6 * cost[steps - 1], total);
+        print_row();
+        free(cost);
+    }
+}
+
+int main(void)
+{
+    static char line[1 << 20];
+    Callbacks callbacks = {logger, calloc, free, NULL, NULL};
+    while (fgets(line, sizeof line, stdin)) {
+        char* word[MAX_COMPONENTS + 8];
+        int n = 0;
+        for (char* p = strtok(line, " \r\n"); p && n < MAX_COMPONENTS + 8; p = strtok(NULL, " \r\n")) word[n++] = p;
+        if (n == 0) continue;
+        if (!strcmp(word[0], "fmu") && n == 3 && components < MAX_COMPONENTS) {
+            Fmu* f = &fmu[components++];
+            snprintf(f->name, sizeof f->name, "%s", word[1]);
+            snprintf(f->dir, sizeof f->dir, "%s", word[2]);
+            read_model_description(f);
+            load(f);
+        } else if ((!strcmp(word[0], "real") || !strcmp(word[0], "integer") || !strcmp(word[0], "boolean")
+                    || !strcmp(word[0], "string")) && n == 4 && starts < MAX_ITEMS) {
+            Start* s = &start[starts++];
+            s->kind = word[0][0] == 'r' ? 0 : word[0][0] == 'i' ? 1 : word[0][0] == 'b' ? 2 : 3;
+            s->component = find(word[1]);
+            s->vr = (unsigned)strtoul(word[2], NULL, 10);
+            s->real = strtod(word[3], NULL);
+            s->integer = (int)strtol(word[3], NULL, 10);
+            s->text = s->kind == 3 ? unhex(word[3]) : NULL;
+        } else if (!strcmp(word[0], "connect") && n == 5 && links < MAX_ITEMS) {
+            edge[links++] = (Link){find(word[1]), find(word[3]), (unsigned)strtoul(word[2], NULL, 10),
+                                   (unsigned)strtoul(word[4], NULL, 10)};
+        } else if (!strcmp(word[0], "order") && n - 1 <= MAX_COMPONENTS) {
+            for (ordered = 0; ordered < n - 1; ++ordered) order[ordered] = find(word[ordered + 1]);
+        } else if (!strcmp(word[0], "record") && n == 4 && columns < MAX_ITEMS) {
+            column[columns++] = (Column){!strcmp(word[1], "boolean"), find(word[2]),
+                                         (unsigned)strtoul(word[3], NULL, 10)};
+        } else if (!strcmp(word[0], "run") && (n == 3 || (n == 4 && !strcmp(word[3], "timing")))) {
+            const double h = strtod(word[1], NULL);
+            const long steps = atol(word[2]);
+            if (!(h > 0.0) || steps < 1 || ordered != components) bad("bad run line or step order", word[1]);
+            initialize((double)steps * h, &callbacks);
+            run(h, steps, n == 4);
+            for (int i = 0; i < components; ++i) {
+                check(fmu[i].Terminate(fmu[i].c), &fmu[i], "fmi2Terminate");
+                fmu[i].FreeInstance(fmu[i].c);
+            }
+            fflush(stdout);
+            return 0;
+        } else {
+            bad("bad line", word[0]);
+        }
+    }
+    return bad("no run line", "stdin");
+}
