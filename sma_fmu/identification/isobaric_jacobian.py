@@ -151,7 +151,7 @@ def file_jacobian(x, layout, f):
     knots = layout.knots[f.index]
     strain, resistance, offsets = _parameter_columns(x, layout, f, wire, direction, level)
     d_strain, d_resistance = through_temperature(params, f, wire, levels, direction, level)
-    lag_b = lagged_basis(f.profile.basis, f.profile.knots, tau, f.step).tocoo()
+    lag_b = lagged_basis(f.profile, tau, f.step).tocoo()
     temperature = f.profile.basis.tocoo()
     blocks = [sparse.csr_matrix((temperature.data / f.sigma["temperature"],
                                  (temperature.row, knots.start + temperature.col)),

@@ -30,14 +30,16 @@ def lag_coefficients(tau, step=1.0):
 
 
 def lagged(u, tau, step=1.0):
-    """Wire temperature w (array, like ``u`` [degC]) lagging ``u`` by ``tau`` (unit of ``step``)."""
+    """Wire temperature w (array like ``u`` [degC], lagged along its last axis) lagging ``u``
+    by ``tau`` (unit of ``step``)."""
     u = np.asarray(u, dtype=float)
     a, b0, b1 = lag_coefficients(tau, step)
-    if a == 0.0 and b1 == 0.0 or u.size < 2:
+    if a == 0.0 and b1 == 0.0 or u.shape[-1] < 2:
         return u.copy()
     out = np.empty_like(u)
-    out[0] = u[0]
-    out[1:], _ = signal.lfilter([b0, b1], [1.0, -a], u[1:], zi=[(b1 + a) * u[0]])
+    out[..., 0] = u[..., 0]
+    out[..., 1:], _ = signal.lfilter([b0, b1], [1.0, -a], u[..., 1:],
+                                     zi=(b1 + a) * u[..., :1])
     return out
 
 

@@ -39,6 +39,8 @@ class Profile:
     residual_rms: float        # measured - profile [K]
     sigma: float               # residual standard deviation [K] (dof-corrected)
     factor: object             # splu of B^T B: the knots' covariance is sigma^2 (B^T B)^-1
+    left: np.ndarray           # per sample: the knot on its left (column of the basis)
+    weight: np.ndarray         # per sample: the right knot's weight
 
     @property
     def knot_count(self):
@@ -46,13 +48,14 @@ class Profile:
 
 
 def _basis(axis, knots):
+    """(sparse basis, left knot of each sample, weight of the right knot)."""
     at = axis[knots]
     k = np.clip(np.searchsorted(at, axis, side="right") - 1, 0, at.size - 2)
     w = (axis - at[k]) / (at[k + 1] - at[k])
     rows = np.arange(axis.size)
     return sparse.csr_matrix((np.concatenate([1 - w, w]), (np.concatenate([rows, rows]),
                                                            np.concatenate([k, k + 1]))),
-                             shape=(axis.size, at.size))
+                             shape=(axis.size, at.size)), k, w
 
 
 def _corners(temperature, branches, window):
@@ -100,17 +103,17 @@ def temperature_profile(temperature, branches, time=None, window=5):
         if interior > 0 and (interior + 1) * 3 > shortest:
             break
         knots = _knots(branches, ramps, n, interior)
-        basis = _basis(axis, knots)
+        basis, left, weight = _basis(axis, knots)
         factor = linalg.splu((basis.T @ basis).tocsc())
         values = basis @ factor.solve(basis.T @ temperature)
         rss = float(np.sum((temperature - values) ** 2))
         aic = n * np.log(max(rss, 1e-300) / n) + 2.0 * basis.shape[1]
         if best is None or aic < best[0]:
-            best = (aic, interior, basis, factor, values, rss, knots)
-    _, interior, basis, factor, values, rss, knots = best
+            best = (aic, interior, basis, factor, values, rss, knots, left, weight)
+    _, interior, basis, factor, values, rss, knots, left, weight = best
     dof = max(n - basis.shape[1], 1)
-    return Profile(values, basis, knots, interior, float(np.sqrt(rss / n)), float(np.sqrt(rss / dof)),
-                   factor)
+    return Profile(values, basis, knots, interior, float(np.sqrt(rss / n)),
+                   float(np.sqrt(rss / dof)), factor, left, weight)
 
 
 def wire_rows(wire, branches, levels_per_cycle=True):
@@ -136,21 +139,22 @@ def wire_rows(wire, branches, levels_per_cycle=True):
 
 
 
-def lagged_basis(basis, knots, tau, step):
-    """Sparse lagged(B) (samples x knots): each hat function's lagged response, cut where
-    the exponential tail has fallen below 1e-12 of its height."""
-    n, count = basis.shape
+def lagged_basis(profile, tau, step):
+    """Sparse lagged(B) (samples x knots) of a :class:`Profile`: each hat function's lagged
+    response, cut where the exponential tail has fallen below 1e-12 of its height (all hat
+    functions at once, one row each of a padded block)."""
+    n, count = profile.basis.shape
+    knots = profile.knots
     tail = int(np.ceil(28.0 * tau / step)) + 2 if tau > 0 else 1
-    rows, cols, values = [], [], []
-    csc = basis.tocsc()
-    for k in range(count):
-        first = knots[k - 1] if k > 0 else 0
-        stop = min(n, (knots[k + 1] if k + 1 < count else n - 1) + tail)
-        u = csc[first:stop, k].toarray().ravel()
-        w = lagged(u, tau, step)
-        keep = np.nonzero(np.abs(w) > 1e-12)[0]
-        rows.append(first + keep)
-        cols.append(np.full(keep.size, k))
-        values.append(w[keep])
-    return sparse.csr_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+    first = np.concatenate([[0], knots[:-1]])
+    stop = np.minimum(n, np.concatenate([knots[1:], [n - 1]]) + tail)
+    rows = first[:, None] + np.arange(int((stop - first).max()))[None, :]
+    inside = rows < stop[:, None]
+    rows = np.minimum(rows, n - 1)
+    column = np.arange(count)[:, None]
+    left, weight = profile.left[rows], profile.weight[rows]
+    hat = np.where(left == column, 1.0 - weight, np.where(left + 1 == column, weight, 0.0))
+    response = lagged(np.where(inside, hat, 0.0), tau, step)
+    keep = inside & (np.abs(response) > 1e-12)
+    return sparse.csr_matrix((response[keep], (rows[keep], np.broadcast_to(column, rows.shape)[keep])),
                              shape=(n, count))
