@@ -297,6 +297,24 @@ def test_refusals_agree(families):
         twins.close()
 
 
+def test_values_in_messages_printed_as_python_does(families):
+    """A refused set quotes the value as Python's repr does, to the character."""
+    rng = random.Random(11)
+    values = [0.0, -0.0, 1.0, 100.0, 1e16, 1e-5, 1.5e-4, 123456789012345678.0, 0.1, math.pi,
+              5e-324, 1.7976931348623157e308, math.nan, math.inf, -math.inf]
+    values += [rng.uniform(-1, 1) * 10 ** rng.randint(-30, 30) for _ in range(300)]
+    twins = Twins(families, "SmaPiController", "repr")
+    try:
+        assert twins.both("start") == [0, 0]
+        for value in values:
+            assert twins.both("set", "P", value) == [3, 3]
+            py, nat = twins.py.log[-1][1], twins.nat.log[-1][1]
+            assert py.replace(twins.py.name, "#") == nat.replace(twins.nat.name, "#")
+            assert nat.endswith(f"(value {value!r})")
+    finally:
+        twins.close()
+
+
 def test_bad_signal_table_refused_alike(families):
     twins = Twins(families, "SmaScenarioSignals", "badsig")
     try:

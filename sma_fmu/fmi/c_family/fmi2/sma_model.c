@@ -2,8 +2,7 @@
 #include <math.h>
 
 #include "sma_model.h"
-
-#define GRID_TOLERANCE 1e-6  /* runtime/scenario_signals.py: [steps] */
+#include "scenario_signals.h"  /* GRID_TOLERANCE */
 
 double sma_nominal_step(SmaRun *run, double step_size)
 {
