@@ -327,14 +327,15 @@ static fmi2Status do_step(Instance *in, double t, double h)
     SmaMessage message;
     if (in->state != STATE_STEP_COMPLETE && !allowed(in, function, IN(STATE_STEP_COMPLETE)))
         return fmi2Error;
-    layer_repr(t, a);
-    layer_repr(h, b);
-    if (!(isfinite(t) && h > 0.0 && h < HUGE_VAL)) {
+    if (!(isfinite(t) && h > 0.0 && h < HUGE_VAL)) {  /* reprs only for a message: they cost us */
+        layer_repr(t, a);
+        layer_repr(h, b);
         layer_log(in, fmi2Error, "%s: currentCommunicationPoint = %s s and communicationStepSize "
                   "= %s s must be finite, the step > 0", function, a, b);
         return fmi2Error;
     }
     if (in->time_defined && t != in->time && !close_to(t, in->time, h)) {
+        layer_repr(t, a);
         layer_repr(in->time, e);
         layer_log(in, fmi2Error, "%s: currentCommunicationPoint = %s s, but the last step ended at "
                   "%s s (the communication points must follow one another)", function, a, e);
@@ -350,11 +351,13 @@ static fmi2Status do_step(Instance *in, double t, double h)
     step = in->model->snaps_step ? sma_nominal_step(&in->run, h) : h;
     message.text[0] = '\0';
     if (in->model->step(in->stepper, in->values, &in->run, t, step, &message)) {
+        layer_repr(t, a);
         layer_log(in, fmi2Discard, "step at t = %s s discarded: %s", a, message.text);
         return fmi2Discard;
     }
     if (!layer_outputs_finite(in, in->values)) {
         in->state = STATE_ERROR;
+        layer_repr(t, a);
         layer_log(in, fmi2Error, "%s: internal error: the step at t = %s s gave a non-finite "
                   "output; the instance is in the error state (restore a saved state or reset "
                   "it)", function, a);
