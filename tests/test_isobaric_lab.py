@@ -104,6 +104,20 @@ def test_a_lagging_wire_is_fitted_by_the_lag_not_by_moving_the_temperature(tmp_p
     assert width - (params.a_h - params.a_c) > SIGMAS * error
 
 
+def test_a_two_step_transformation_is_not_called_explained(tmp_path, params):
+    """A second, R-phase-like step of 0.3 % strain at 40 degC of the wire, which one logistic
+    per branch cannot follow: the verdict line says the model does not explain the data."""
+    settings = dict(LAB, cycles=10, points=2600, seed=6)
+    columns, truth = isobaric_table(params, 0.15, IsobaricProgramme(**settings), with_time=False)
+    columns["strain_percent"] += 0.3 / (1.0 + np.exp((truth["true_temperature"] - 40.0) / 2.0))
+    path = tmp_path / "two-step.csv"
+    path.write_text(isobaric_text(columns, ["load: 0.15 kg"]), encoding="utf-8")
+    fit = fit_isobaric([read_isobaric(path)], params)
+    assert fit.residual_rms["strain"] > 1.5 * fit.noise["strain"]
+    assert fit.verdict.startswith("the model does not explain the data: ")
+    assert "strain residual" in fit.verdict
+
+
 def test_every_cell_of_the_table_is_a_number_or_a_reason(tmp_path, params):
     """Heating finishes after the measured turn: against the measured temperature the tangent
     construction cannot always be made, against the fitted wire temperature it can."""

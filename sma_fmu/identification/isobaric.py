@@ -130,13 +130,15 @@ def prepare(data, index, residual="per-cycle"):
 def _verdict(rms, noise):
     """One line: whether the residuals are what the noise estimates predict."""
     ratios = {key: rms[key] / noise[key] for key in rms if rms[key] is not None and noise[key]}
-    worst = [f"{key.split('_')[0]} residual {rms[key]:.3g} is {ratio:.1f}x its noise estimate "
-             f"{noise[key]:.3g}" for key, ratio in ratios.items() if ratio > EXPLAINED_RATIO]
+    unit = {"temperature_K": " K", "strain": "", "resistance_ohm": " ohm"}
+    worst = [f"{key.split('_')[0]} residual {rms[key]:.3g}{unit[key]} is {ratio:.1f}x its noise "
+             f"estimate {noise[key]:.3g}{unit[key]}" for key, ratio in ratios.items()
+             if ratio > EXPLAINED_RATIO]
     if worst:
         return "the model does not explain the data: " + "; ".join(worst) + \
             (" (the wire temperature had to move beyond the thermocouple noise)"
              if ratios.get("temperature_K", 0) > EXPLAINED_RATIO else "")
-    return (f"the model explains the data within the noise: residuals "
+    return ("the model explains the data within the noise: residuals "
             + ", ".join(f"{key.split('_')[0]} {ratio:.2f}x" for key, ratio in ratios.items())
             + " their noise estimates")
 
@@ -272,7 +274,7 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         sigma=[f.sigma for f in prepared], residual_rms=rms, noise=noise,
         verdict=_verdict(rms, noise), variance_factor=factor, dof=dof, profile_unknowns=n - k,
         knots_per_branch=[f.profile.knots_per_branch for f in prepared],
-        evaluations=int(solution.nfev), converged=bool(solution.status > 0),
+        evaluations=int(clock["evaluations"]), converged=bool(solution.status > 0),
         message=str(solution.message), seconds=seconds)
 
 

@@ -129,8 +129,9 @@ def _stabilisation(files, rows):
                      label=f"{quantity} data")
             top.plot(cycle, [r["model"] for r in these], "-", lw=1.2, color=colour,
                      label=f"{quantity} model")
-        top.set(title=f"{data.path.name}: tangent-line temperatures per cycle (faint: at the "
-                      f"measured temperature; gaps: see the table)",
+        top.set_title(f"{data.path.name}: tangent-line temperatures per cycle (dots: at the wire "
+                      f"temperature, faint: at the measured one)", fontsize=10)
+        top.set(
                 xlabel="cycle", ylabel="temperature [degC]")
         top.legend(fontsize=7, ncol=4)
         these = [r for r in mine if r["quantity"] == "residual_strain"]

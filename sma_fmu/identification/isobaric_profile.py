@@ -1,15 +1,17 @@
 """The temperature the wire had: a smooth profile of the measured temperature, then the lag.
 
-Two steps, so that the wire temperature cannot absorb model misfit:
+Two pieces, so that the wire temperature can absorb model misfit only as far as the
+thermocouple's noise allows:
 
 1. Profile: the measured temperature is fitted alone by a piecewise-linear curve in time (in
    the sample index without a time column) with knots at the branches' turning points, at
-   the corners where a ramp leaves or reaches a dwell, and k evenly spaced knots on each ramp; k is chosen from the temperature itself by Akaike's
-   information criterion (n ln(RSS/n) + 2 knots), so a linear furnace ramp gets few knots and
-   a curved one, or one with dwells, more. (The Bayesian criterion's heavier penalty left
-   the dwells' corners unresolved, and the systematic error biased the transition width.) Its residual is the temperature residual the report sets
-   beside the noise estimate; the knots' covariance sigma_T^2 (B^T B)^-1 goes into the
-   parameters' covariance (:mod:`sma_fmu.identification.isobaric`).
+   the corners where a ramp leaves or reaches a dwell, and k evenly spaced knots on each
+   ramp; k is chosen from the temperature itself by Akaike's information criterion
+   (n ln(RSS/n) + 2 knots), so a linear furnace ramp gets few knots and a curved one more.
+   (The Bayesian criterion's heavier penalty left dwell corners unresolved, and that
+   systematic error biased the transition width.) Its knots are then fitted jointly with the
+   parameters, held to the measured temperature by its noise
+   (:mod:`sma_fmu.identification.isobaric`).
 2. Wire: the profile lagged by the fitted time constant
    (:mod:`sma_fmu.identification.isobaric_lag`). The wire's branches turn where the wire
    does, after the thermocouple: :func:`wire_rows` moves each turning point to the wire's
@@ -38,7 +40,7 @@ class Profile:
     knots_per_branch: int
     residual_rms: float        # measured - profile [K]
     sigma: float               # residual standard deviation [K] (dof-corrected)
-    factor: object             # splu of B^T B: the knots' covariance is sigma^2 (B^T B)^-1
+    factor: object             # splu of B^T B (least-squares knots of the temperature alone)
     left: np.ndarray           # per sample: the knot on its left (column of the basis)
     weight: np.ndarray         # per sample: the right knot's weight
 
