@@ -1,14 +1,15 @@
 """Co-simulation command: run scenarios and write their results."""
 from pathlib import Path
 
-from .arguments import add_fmus_argument, add_scenario_arguments, scenario_paths
+from .arguments import add_fmus_argument, add_scenario_arguments, positive_number, scenario_paths
 
 __all__ = ["register"]
 
 
 def _run(args):
     from sma_fmu.systems.runner import timed_run
-    timed_run(scenario_paths(args), args.out, args.path, args.fmus)
+    timed_run(scenario_paths(args), args.out, args.path, args.fmus,
+              output_interval_s=args.output_interval, fmt=args.format)
     return 0
 
 
@@ -22,4 +23,10 @@ def register(commands):
                      help="fmu: the FMUs under fmpy; library: the steppers directly; ssp: the "
                           "SSP package in libcosim (Jacobi); container: the one-FMU loop in libcosim")
     add_fmus_argument(run)
+    run.add_argument("--output-interval", type=positive_number, metavar="S",
+                     help="record every k-th step in the time series and figures: S seconds, a "
+                          "whole number of steps (default: the scenario's output_interval_s, else "
+                          "every step); the metrics always use every step")
+    run.add_argument("--format", choices=("csv", "parquet"), default="csv",  # recording.FORMATS
+                     help="time-series file: timeseries.csv (default) or timeseries.parquet")
     run.set_defaults(handler=_run)

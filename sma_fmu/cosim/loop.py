@@ -60,7 +60,8 @@ ROWS_PER_CHUNK = 4096   # rows gathered as tuples before they go into the result
 
 @dataclass
 class LoopResult:
-    """Time series of one run: ``data`` is a structured array with the fields of :data:`COLUMNS`."""
+    """Time series of one run: ``data`` is a structured array with the fields of :data:`COLUMNS`
+    (None when the run streamed its rows to a sink)."""
 
     scenario: object
     data: np.ndarray
@@ -132,7 +133,7 @@ def library_driver(scenario):
     return LibraryDriver(scenario) if scenario.drive.pwm else None
 
 
-def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=None):
+def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=None, sink=None):
     """Close the loop over ``scenario``; returns the structured time-series array.
 
     ``plant`` has ``outputs()`` and ``step(t, power, load, h)`` returning the
@@ -145,6 +146,10 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
     Row k holds the samples at t_k, the compensator's and the PI's outputs of step k and the
     power the plant applied over [t_k, t_k+1); the stroke is the contraction x_0 - x_k [m]
     (positive: the wire shortened).
+
+    ``sink``: None keeps the whole series and returns it; else a callable that gets the
+    rows in blocks of :data:`ROWS_PER_CHUNK` (the last one shorter), as structured arrays
+    it may keep, and the run keeps nothing (returns None): memory does not grow with it.
     """
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {', '.join(COUPLINGS)}, got {coupling!r}")
@@ -153,7 +158,10 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
         driver = library_driver(scenario)
     h, n = scenario.step_s, scenario.steps
     reference_at, load_at = scenario.reference.value, scenario.load.value
-    data = np.empty(n + 1, dtype=TIMESERIES_DTYPE)   # the result: its memory is all the run keeps
+    if sink is None:  # the result: its memory is all the run keeps
+        data = np.empty(n + 1, dtype=TIMESERIES_DTYPE)
+    else:
+        data = np.empty(ROWS_PER_CHUNK, dtype=TIMESERIES_DTYPE)
     gains = scenario.controller
     pi = PIController(gains.Kp, gains.Ki)
     nan = math.nan
@@ -191,22 +199,32 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
             time_s, plant_power, load, h)
         rows.append(sample + (applied, load, saturated))
         if len(rows) == ROWS_PER_CHUNK:  # into the result: a tuple row costs ~5x its 113 bytes
-            data[first_row:first_row + ROWS_PER_CHUNK] = rows
-            first_row, rows = first_row + ROWS_PER_CHUNK, []
+            if sink is None:
+                data[first_row:first_row + ROWS_PER_CHUNK] = rows
+                first_row += ROWS_PER_CHUNK
+            else:
+                data[:] = rows
+                sink(data)
+                data = np.empty(ROWS_PER_CHUNK, dtype=TIMESERIES_DTYPE)
+            rows = []
     time_s = n * h
     rows.append((time_s, reference_at(time_s), resistance, temperature, nan, length,
                  start_length - length, xi_p, xi_m, xi_f, nan, nan, nan, load_at(time_s), False))
-    data[first_row:] = rows
-    return data
+    if sink is None:
+        data[first_row:] = rows
+        return data
+    sink(np.array(rows, dtype=TIMESERIES_DTYPE))
+    return None
 
 
-def run_library(scenario, coupling="gauss-seidel"):
+def run_library(scenario, coupling="gauss-seidel", sink=None):
     """Run ``scenario`` on the library steppers (no FMUs); returns a :class:`LoopResult`.
 
     ``coupling``: one of :data:`COUPLINGS`; "jacobi" gives what an SSP host computes.
+    ``sink``: see :func:`run_loop` (then the result's ``data`` is None).
     """
     start = time.perf_counter()
     plant = LibraryPlant(scenario)
     compensator = LibraryCompensator(scenario) if scenario.controller.feedforward else None
-    data = run_loop(scenario, plant, compensator, coupling)
+    data = run_loop(scenario, plant, compensator, coupling, sink=sink)
     return LoopResult(scenario, data, "library", time.perf_counter() - start)

@@ -181,8 +181,11 @@ def needed_fmus(scenario):
             + (["SmaPwmDriver"] if scenario.drive.pwm else []))
 
 
-def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR):
-    """Run ``scenario`` through the FMUs in ``fmu_dir``; returns a :class:`LoopResult`."""
+def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None):
+    """Run ``scenario`` through the FMUs in ``fmu_dir``; returns a :class:`LoopResult`.
+
+    ``sink``: see :func:`~sma_fmu.cosim.loop.run_loop` (then the result's ``data`` is None).
+    """
     paths = default_fmu_paths(fmu_dir)
     for name in needed_fmus(scenario):
         if not paths[name].is_file():
@@ -197,7 +200,7 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR):
         if scenario.drive.pwm:
             parts["driver"] = FmuDriver(scenario, paths["SmaPwmDriver"])
         data = run_loop(scenario, parts["plant"], parts.get("compensator"),
-                        driver=parts.get("driver"))
+                        driver=parts.get("driver"), sink=sink)
     except FmuError as error:
         raise FmuError(f"scenario {scenario.name}: {error}", error.status) from None
     finally:

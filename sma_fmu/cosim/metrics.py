@@ -4,18 +4,25 @@ Over all samples k = 0 ... n with t_k >= the scenario's ``[analysis] metrics_sta
 (2 s for the paper's 30-s runs: the start-up transient is left out), and per load
 segment (the same window applied inside each segment).
 
+Every step counts, block by block (:class:`StreamingMetrics`): a run of any length
+needs no whole series, and what a run records to its file (``output_interval_s``) does
+not change its metrics.
+
 Reachability: where R_ref(t_k) lies outside the band (R_hot(f_k), R_cold(f_k)) the wire can
 reach at the load of that sample (:func:`sma_fmu.runtime.reachable_band.reachable_band`),
 no controller can track it. The metrics give the fraction of the window where that is
 so, the metrics over the reachable rest, the intervals (whole run) and a warning.
 """
+import math
+
 import numpy as np
 
+from sma_fmu.cosim.loop import ROWS_PER_CHUNK
 from sma_fmu.runtime.reachable_band import reachable_band
 
 __all__ = ["EMPTY_METRICS", "error_metrics", "band_edges", "unreachable_samples",
            "unreachable_intervals", "reachability_warning", "metric_windows", "assemble_metrics",
-           "scenario_metrics"]
+           "scenario_metrics", "ErrorSums", "StreamingMetrics"]
 
 _LISTED_INTERVALS = 4  # a warning names at most this many intervals, then counts the rest
 EMPTY_METRICS = {"rmse_ohm": None, "max_abs_ohm": None, "iae_ohm_s": None, "samples": 0}
@@ -136,20 +143,101 @@ def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped
     }
 
 
+class ErrorSums:
+    """Running sums of an error signal [ohm]: sum of squares, of magnitudes, the largest
+    magnitude, the count; :meth:`metrics` gives the :func:`~.metrics.error_metrics` record."""
+
+    def __init__(self):
+        self.squares = self.magnitudes = 0.0
+        self.largest = -math.inf
+        self.count = 0
+
+    def add(self, errors):
+        """Count the errors [ohm] of one block (an array)."""
+        if errors.size == 0:
+            return
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverged run gives inf, as such
+            magnitudes = np.abs(errors)
+            self.squares += float(np.sum(np.square(errors)))
+            self.magnitudes += float(np.sum(magnitudes))
+            self.largest = float(np.maximum(self.largest, np.max(magnitudes)))  # NaN propagates
+        self.count += int(errors.size)
+
+    def metrics(self, step_size):
+        """{"rmse_ohm", "max_abs_ohm", "iae_ohm_s", "samples"}; ``step_size`` [s]."""
+        if self.count == 0:
+            return dict(EMPTY_METRICS)
+        return {"rmse_ohm": math.sqrt(self.squares / self.count), "max_abs_ohm": self.largest,
+                "iae_ohm_s": step_size * self.magnitudes, "samples": self.count}
+
+
+class StreamingMetrics:
+    """The metrics of one run of ``scenario``, fed block by block (:meth:`update`)."""
+
+    def __init__(self, scenario):
+        self.scenario = scenario
+        self.overall, self.reachable = ErrorSums(), ErrorSums()
+        self.segments = [ErrorSums() for _ in scenario.load.segments(scenario.stop_time_s)]
+        self.window = self.saturated = self.clamped = self.unreachable = 0
+        self.intervals = []
+        self._last_time = None   # the time of the last row seen [s]
+
+    def update(self, block):
+        """Count one block of consecutive rows (a structured array)."""
+        if block.size == 0:
+            return
+        t = block["t"]
+        error = block["R"] - block["R_ref"]
+        window, segments = metric_windows(t, self.scenario)
+        below, above = unreachable_samples(block["R_ref"], block["load"], self.scenario.params)
+        unreachable = below | above
+        self.overall.add(error[window])
+        for sums, inside in zip(self.segments, segments):
+            sums.add(error[inside])
+        self.reachable.add(error[window & ~unreachable])
+        self.window += int(np.count_nonzero(window))
+        self.saturated += int(np.count_nonzero(block["saturated"][window]))
+        # the final row's P is NaN, never 0: counting it changes nothing (see result)
+        self.clamped += int(np.count_nonzero(block["P"][window] == 0.0))
+        self.unreachable += int(np.count_nonzero(unreachable[window]))
+        self._join(unreachable_intervals(t, below, above), float(t[0]))
+        self._last_time = float(t[-1])
+
+    def _join(self, intervals, first_time):
+        """Add a block's unreachable intervals, joining one that goes on from the last block."""
+        for interval in intervals:
+            start, _, side = interval
+            if start == first_time and self._last_time is not None:
+                joined = next((known for known in self.intervals
+                               if known[2] == side and known[1] == self._last_time), None)
+                if joined is not None:
+                    joined[1] = interval[1]
+                    continue
+            self.intervals.append(interval)
+
+    def result(self):
+        """The metrics record (:func:`~.metrics.assemble_metrics`)."""
+        step = self.scenario.step_s
+        window = self.window
+        return assemble_metrics(
+            self.scenario,
+            overall=self.overall.metrics(step),
+            segments=[sums.metrics(step) for sums in self.segments],
+            saturated_fraction=self.saturated / window if window else math.nan,
+            clamped_fraction=self.clamped / (window - 1) if window > 1 else None,
+            unreachable_fraction=self.unreachable / window if window else math.nan,
+            reachable=self.reachable.metrics(step),
+            intervals=sorted(self.intervals))
+
+
 def scenario_metrics(data, scenario):
-    """Metrics of one run: over the metrics window and per load segment, ready for JSON."""
-    t = data["t"]
-    error = data["R"] - data["R_ref"]
-    window, segments = metric_windows(t, scenario)
-    below, above = unreachable_samples(data["R_ref"], data["load"], scenario.params)
-    unreachable = below | above
-    return assemble_metrics(
-        scenario,
-        overall=error_metrics(error[window], scenario.step_s),
-        segments=[error_metrics(error[inside], scenario.step_s) for inside in segments],
-        saturated_fraction=float(np.mean(data["saturated"][window])),
-        clamped_fraction=(float(np.mean(data["P"][window][:-1] == 0.0))
-                          if window.sum() > 1 else None),
-        unreachable_fraction=float(np.mean(unreachable[window])),
-        reachable=error_metrics(error[window & ~unreachable], scenario.step_s),
-        intervals=unreachable_intervals(t, below, above))
+    """Metrics of one run: over the metrics window and per load segment, ready for JSON.
+
+    ``data`` goes through :class:`StreamingMetrics` in the blocks a loop streams
+    (:data:`~sma_fmu.cosim.loop.ROWS_PER_CHUNK` rows), so a run's metrics are the same
+    whether its series was kept whole or streamed.
+    """
+    metrics = StreamingMetrics(scenario)
+    for first in range(0, max(len(data), 1), ROWS_PER_CHUNK):
+        metrics.update(data[first:first + ROWS_PER_CHUNK])
+    return metrics.result()

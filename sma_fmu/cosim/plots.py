@@ -123,7 +123,9 @@ def plot_comparison(runs, scenario, title, path):
     rms = figure.add_subplot(grid[2, :], sharex=overview)
     overview.plot(t, first["R_ref"], color="black", ls="--", lw=0.8, label="R_ref")
     zoomed.plot(t[zoom], first["R_ref"][zoom], color="black", ls="--", lw=1.1, label="R_ref")
-    samples = max(1, int(round(_reference_period(scenario) / scenario.step_s)))
+    # the series may hold every k-th step (an output interval, a long run's figure rows)
+    spacing = float(np.median(np.diff(t))) if len(t) > 1 else scenario.step_s
+    samples = max(1, int(round(_reference_period(scenario) / spacing)))
     for label, data in runs.items():
         colour, error = colours[label], data["R"] - data["R_ref"]
         overview.plot(t, data["R"], color=colour, lw=0.6, label=label)
@@ -136,7 +138,7 @@ def plot_comparison(runs, scenario, title, path):
     zoomed_error.set(ylabel="error R - R_ref [ohm]", xlabel="time t [s]", title="error, enlarged")
     zoomed_error.axhline(0.0, color="0.5", lw=0.6)
     rms.set(ylabel="RMS error [ohm]", xlabel="time t [s]",
-            title=f"RMS of R - R_ref over {samples * scenario.step_s:g} s (one reference period)")
+            title=f"RMS of R - R_ref over {samples * spacing:g} s (one reference period)")
     for index, axis in enumerate((overview, rms)):
         _mark(axis, first, window.metrics_start_s, label=index == 0)
     overview.axvspan(window.zoom_start_s, window.zoom_end_s, color="tab:blue", alpha=0.08, lw=0,

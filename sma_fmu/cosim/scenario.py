@@ -7,6 +7,7 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     stop_time_s = 30.0
     step_s = 0.001
     # model = "../models/reference_wire.toml"   (parameter file, relative to this file)
+    # output_interval_s = 0.01  (optional: record every 10th step; metrics use every step)
 
     [reference]                 # R_ref(t) in ohm; kinds: constant step ramp sine cosine table
     kind = "cosine"
@@ -44,6 +45,7 @@ from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
+from sma_fmu.cosim.recording import interval_steps
 from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.files.package_data import shipped_file, shipped_files
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
@@ -67,7 +69,7 @@ PAPER_SET = tuple(f"{profile}-{controller}" for profile in ("load-step", "heavy"
                   for controller in CONTROLLERS)
 MAX_STEPS = 4_000_000  # 66 min at 1 ms; the time series (113 B per step) is held in memory
 _SECTIONS = {
-    "scenario": {"description", "stop_time_s", "step_s", "model", "group"},
+    "scenario": {"description", "stop_time_s", "step_s", "model", "group", "output_interval_s"},
     "reference": None,  # checked by signals.reference_from_table
     "load": None,       # checked by signals.load_from_table
     "controller": {"kind", "Kp_W_per_ohm", "Ki_W_per_ohm_s", "alpha_s", "beta_s", "model_load_kg",
@@ -163,6 +165,7 @@ class Scenario:
     group_name: str = None
     compensator_parameter_set: object = None   # the compensator's model; None: the wire's
     drive: DriveSettings = DriveSettings()     # the file's [drive]; default: power as demanded
+    output_interval_s: float = None            # record every k-th step [s]; None: every step
 
     @property
     def params(self):
@@ -348,6 +351,13 @@ def scenario_from_document(document, path, parameter_set=None):
     stop = _number(path, "scenario", head, "stop_time_s", positive=True)
     step = _number(path, "scenario", head, "step_s", positive=True)
     _steps(path, stop, step)
+    interval = None
+    if "output_interval_s" in head:
+        interval = _number(path, "scenario", head, "output_interval_s", positive=True)
+        try:
+            interval_steps(interval, step, "output_interval_s")
+        except ValueError as error:
+            _fail(path, f"[scenario] {error}")
     model = _string(path, "scenario", head, "model")
     if parameter_set is None:
         try:
@@ -377,7 +387,7 @@ def scenario_from_document(document, path, parameter_set=None):
         controller=controller,
         hysteresis_mode=mode, T_start=t_start, parameter_set=parameter_set,
         analysis_window=_analysis(path, document["analysis"], stop) if "analysis" in document else None,
-        group_name=_string(path, "scenario", head, "group"),
+        group_name=_string(path, "scenario", head, "group"), output_interval_s=interval,
         drive=_drive(path, document["drive"]) if "drive" in document else DriveSettings())
 
 

@@ -1,7 +1,7 @@
 """Run scenarios and write their results: CSV, metrics JSON, figures, comparison table.
 
-For each scenario ``NAME`` in ``out_dir``: ``NAME/timeseries.csv``, ``NAME/metrics.json``
-and ``NAME/figure.png``. Scenarios with the same file name from different folders get
+For each scenario ``NAME`` in ``out_dir``: ``NAME/timeseries.csv`` (or ``.parquet``),
+``NAME/metrics.json`` and ``NAME/figure.png``, written while the run goes. Scenarios with the same file name from different folders get
 ``FOLDER-NAME`` instead, so none overwrites another. For each group of scenarios (see
 :attr:`~sma_fmu.cosim.scenario.Scenario.group`): ``comparison-GROUP.png``. Over the whole
 run: ``comparison.md``, which ranks the runs by RMSE in each group, and ``summary.json``.
@@ -10,11 +10,10 @@ Everything is written into a temporary folder and moved into ``out_dir`` at the 
 import time
 from collections import Counter
 
-import numpy as np
-
-from sma_fmu.cosim.loop import COLUMN_NAMES, COLUMNS, run_library
+from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.master import run_fmus
-from sma_fmu.cosim.metrics import scenario_metrics
+from sma_fmu.cosim.recording import (RunRecorder, TimeseriesWriter, interval_steps, progress_bar,
+                                     timeseries_name)
 from sma_fmu.cosim.plots import plot_comparison, plot_run
 from sma_fmu.cosim.report import comparison_markdown, groups, summary_table
 from sma_fmu.cosim.scenario import load_scenario
@@ -26,15 +25,20 @@ from sma_fmu.systems.runs import run_container, run_ssp
 __all__ = ["PATHS", "run_scenarios", "timed_run", "write_timeseries", "result_names",
            "comparison_labels"]
 
-PATHS = {"fmu": run_fmus, "library": lambda scenario, fmu_dir: run_library(scenario),
-         "ssp": run_ssp, "container": run_container}
+# path -> run(scenario, fmu_dir, sink): the loops stream their rows into the sink; the
+# system hosts (libcosim) give a whole series, which the runner then feeds it
+PATHS = {"fmu": lambda scenario, fmu_dir, sink: run_fmus(scenario, fmu_dir, sink),
+         "library": lambda scenario, fmu_dir, sink: run_library(scenario, sink=sink),
+         "ssp": lambda scenario, fmu_dir, sink: run_ssp(scenario, fmu_dir),
+         "container": lambda scenario, fmu_dir, sink: run_container(scenario, fmu_dir)}
 
 
-def write_timeseries(data, path):
-    """CSV with a header of names and units (``t_s,R_ref_ohm,...``), time first."""
-    header = ",".join(COLUMN_NAMES)
-    table = np.column_stack([data[name].astype(float) for name, _ in COLUMNS])
-    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.10g")
+def write_timeseries(data, path, fmt="csv"):
+    """A whole series as a file (``fmt``: CSV, a header of names and units ``t_s,R_ref_ohm,...``
+    with time first; or Parquet)."""
+    writer = TimeseriesWriter(path, fmt)
+    writer.write(data)
+    writer.close()
 
 
 def result_names(scenarios):
@@ -57,15 +61,25 @@ def comparison_labels(scenarios, names):
             for s, name in zip(scenarios, names)]
 
 
-def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print):
+def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print,
+                  output_interval_s=None, fmt="csv"):
     """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
-    a failed run leaves ``out_dir`` as it was.
+    a failed run leaves ``out_dir`` as it was. ``output_interval_s`` [s]: record every
+    k-th step in the time series and figures (None: the scenario's ``[scenario]
+    output_interval_s``, else every step); the metrics count every step. ``fmt``: the time
+    series' format, "csv" or "parquet". Each run streams into its files
+    (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
     """
     if path not in PATHS:
         raise ValueError(f"path must be one of {', '.join(PATHS)}, got {path!r}")
+    timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
+    every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
+             if output_interval_s is not None
+             else interval_steps(s.output_interval_s, s.step_s, f"{s.path}: [scenario] output_interval_s")
+             for s in scenarios]
     names = result_names(scenarios)
     labels = comparison_labels(scenarios, names)
     rows, series = [], {}
@@ -73,20 +87,19 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         for index, (scenario, name, label) in enumerate(zip(scenarios, names, labels), start=1):
             if len(scenarios) > 1:
                 progress(f"[{index}/{len(scenarios)}] {name} ({path}) ...")
-            result = PATHS[path](scenario, fmu_dir)
             folder = stage / name
             folder.mkdir()
-            write_timeseries(result.data, folder / "timeseries.csv")
-            metrics = scenario_metrics(result.data, scenario)
-            metrics.update(path=path, wall_time_s=result.wall_time_s)
+            metrics, figure_rows, wall_time_s = _record_run(scenario, path, fmu_dir, folder,
+                                                             every[index - 1], fmt)
+            metrics.update(path=path, wall_time_s=wall_time_s)
             for warning in metrics["warnings"]:
                 progress(f"warning: {scenario.name}: {warning}")
             (folder / "metrics.json").write_text(json_text(metrics), encoding="utf-8")
-            plot_run(result.data, scenario, folder / "figure.png")
+            plot_run(figure_rows, scenario, folder / "figure.png")
             rows.append({"scenario": name, "label": label, "group": scenario.group,
-                         "metrics": metrics, "wall_time_s": result.wall_time_s,
-                         "real_time_factor": scenario.stop_time_s / result.wall_time_s})
-            series[name] = (scenario, result.data)
+                         "metrics": metrics, "wall_time_s": wall_time_s,
+                         "real_time_factor": scenario.stop_time_s / wall_time_s})
+            series[name] = (scenario, figure_rows)
         for group, members in groups(rows).items():
             if len(members) > 1:
                 runs = {row["label"]: series[row["scenario"]][1] for row in members}
@@ -97,10 +110,27 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     return rows
 
 
-def timed_run(paths, out_dir, path, fmu_dir, progress=print):
+def _record_run(scenario, path, fmu_dir, folder, every, fmt):
+    """Run one scenario into ``folder`` through a :class:`RunRecorder`; returns (metrics,
+    figure rows, wall time [s] of the run itself)."""
+    bar = progress_bar(scenario.steps + 1, scenario.name)
+    recorder = RunRecorder(scenario, folder, every, fmt, None if bar is None else bar.update)
+    try:
+        result = PATHS[path](scenario, fmu_dir, recorder)
+        wall_time_s = result.wall_time_s - recorder.seconds  # the run, not its recording
+        if result.data is not None:  # a host that kept the whole series
+            recorder.feed(result.data)
+    finally:
+        metrics, figure_rows = recorder.close()
+        if bar is not None:
+            bar.close()
+    return metrics, figure_rows, wall_time_s
+
+
+def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv"):
     """:func:`run_scenarios`, then print the summary table; returns the rows."""
     start = time.perf_counter()
-    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress)
+    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt)
     progress(summary_table(rows))
     progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)")
     return rows

@@ -1,0 +1,205 @@
+"""Record a run while it goes: the metrics from every step, the file and the figure from every k-th.
+
+A :class:`RunRecorder` is the sink of :func:`sma_fmu.cosim.loop.run_loop`. It gets the rows
+in blocks and passes each on at once:
+
+- every row to :class:`~sma_fmu.cosim.metrics.StreamingMetrics` (metrics never depend on
+  the output interval);
+- every k-th row (k = ``output_interval_s`` / ``step_s``; row 0 and the final row always)
+  to the time-series file, written block by block (:class:`TimeseriesWriter`: CSV or
+  Parquet);
+- the same rows to :class:`FigureSeries`, which keeps at most :data:`FIGURE_ROWS` of them,
+  evenly spaced (it halves what it keeps when it fills), for the figures.
+
+So the memory of a run does not grow with its length. :func:`read_timeseries` reads either
+format back as a pandas DataFrame with the CSV's column names.
+"""
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from sma_fmu.cosim.loop import COLUMN_NAMES, COLUMNS, TIMESERIES_DTYPE
+from sma_fmu.cosim.metrics import StreamingMetrics
+
+__all__ = ["FORMATS", "FIGURE_ROWS", "CSV_FORMAT", "interval_steps", "TimeseriesWriter",
+           "FigureSeries", "RunRecorder", "read_timeseries", "timeseries_name", "progress_bar"]
+
+FORMATS = ("csv", "parquet")
+FIGURE_ROWS = 20_000    # a figure keeps 20,000-40,000 rows (a 30-s run at 1 ms all 30,001)
+CSV_FORMAT = "%.10g"    # the CSV's numbers: 10 significant digits (Parquet keeps every bit)
+_FILE_NAMES = {"csv": "timeseries.csv", "parquet": "timeseries.parquet"}
+
+
+def timeseries_name(fmt):
+    """The time-series file name of format ``fmt`` (one of :data:`FORMATS`)."""
+    if fmt not in _FILE_NAMES:
+        raise ValueError(f"format must be one of {', '.join(FORMATS)}, got {fmt!r}")
+    return _FILE_NAMES[fmt]
+
+
+def interval_steps(output_interval_s, step_s, what="output interval"):
+    """k: record every k-th step, for ``output_interval_s`` [s] (None: every step) and
+    ``step_s`` [s]; the interval must be a whole number (>= 1) of steps, to 1e-9."""
+    if output_interval_s is None:
+        return 1
+    if not (isinstance(output_interval_s, (int, float)) and math.isfinite(output_interval_s)
+            and output_interval_s > 0.0):
+        raise ValueError(f"{what} must be a number of seconds > 0, got {output_interval_s!r}")
+    steps = output_interval_s / step_s
+    k = round(steps)
+    if k < 1 or abs(steps - k) > 1e-9 * max(1.0, steps):
+        raise ValueError(f"{what} = {output_interval_s!r} s is not a whole number of steps of "
+                         f"{step_s!r} s")
+    return int(k)
+
+
+class TimeseriesWriter:
+    """Writes rows (structured arrays) to ``path`` block by block: CSV (a header of names
+    with units, ``t_s,R_ref_ohm,...``) or Parquet (the same columns, every bit kept)."""
+
+    def __init__(self, path, fmt="csv"):
+        timeseries_name(fmt)
+        self.path, self.fmt, self.rows = Path(path), fmt, 0
+        self._stream = self._parquet = None
+        if fmt == "csv":
+            self._stream = open(self.path, "w", encoding="utf-8", newline="\n")
+            self._stream.write(",".join(COLUMN_NAMES) + "\n")
+
+    def write(self, rows):
+        """Append ``rows`` (a structured array with the fields of :data:`COLUMNS`)."""
+        if rows.size == 0:
+            return
+        if self.fmt == "csv":
+            table = np.column_stack([rows[name].astype(float) for name, _ in COLUMNS])
+            np.savetxt(self._stream, table, delimiter=",", fmt=CSV_FORMAT)
+        else:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            table = pa.table({label: rows[name] for (name, _), label in zip(COLUMNS, COLUMN_NAMES)})
+            if self._parquet is None:
+                self._parquet = pq.ParquetWriter(str(self.path), table.schema)
+            self._parquet.write_table(table)
+        self.rows += rows.size
+
+    def close(self):
+        """Finish the file (an empty run still gets its header or schema)."""
+        if self._stream is not None:
+            self._stream.close()
+        elif self._parquet is None:
+            self.write_empty()
+        if self._parquet is not None:
+            self._parquet.close()
+            self._parquet = None
+
+    def write_empty(self):
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        empty = np.empty(0, dtype=TIMESERIES_DTYPE)
+        pq.write_table(pa.table({label: empty[name] for (name, _), label
+                                 in zip(COLUMNS, COLUMN_NAMES)}), str(self.path))
+
+
+class FigureSeries:
+    """The rows a figure draws: every ``stride``-th recorded row, at most ``2 * limit`` kept
+    between halvings; the last recorded row is always kept (the run's end)."""
+
+    def __init__(self, limit=FIGURE_ROWS):
+        self.limit, self.stride, self.count = limit, 1, 0
+        self._blocks, self._kept, self._last = [], 0, None
+
+    def add(self, rows):
+        """Offer recorded rows (consecutive, in order)."""
+        if rows.size == 0:
+            return
+        ordinals = self.count + np.arange(rows.size)
+        chosen = rows[ordinals % self.stride == 0]
+        self.count += rows.size
+        self._last = rows[-1:].copy()
+        self._blocks.append(chosen.copy())
+        self._kept += chosen.size
+        if self._kept > 2 * self.limit:  # halve: keep every other kept row
+            kept = np.concatenate(self._blocks)
+            ordinals = np.arange(kept.size) * self.stride
+            self.stride *= 2
+            kept = kept[ordinals % self.stride == 0]
+            self._blocks, self._kept = [kept], kept.size
+
+    def rows(self):
+        """The kept rows (a structured array), ending with the last row offered."""
+        if self._last is None:
+            return np.empty(0, dtype=TIMESERIES_DTYPE)
+        kept = np.concatenate(self._blocks)
+        if kept[-1]["t"] != self._last[0]["t"]:
+            kept = np.concatenate([kept, self._last])
+        return kept
+
+
+class RunRecorder:
+    """The sink of one run: metrics from every row, the file and the figure every k-th row.
+
+    ``folder``: where the time series goes (:func:`timeseries_name` of ``fmt``);
+    ``every``: k (:func:`interval_steps`); ``progress``: a callable given the number of
+    rows of each block, or None.
+    """
+
+    def __init__(self, scenario, folder, every=1, fmt="csv", progress=None):
+        self.every, self.seen = every, 0
+        self.seconds = 0.0                 # [s] spent recording (not running the model)
+        self.metrics = StreamingMetrics(scenario)
+        self.figure = FigureSeries()
+        self.writer = TimeseriesWriter(Path(folder) / timeseries_name(fmt), fmt)
+        self.last_row = scenario.steps     # index of the final row (always recorded)
+        self.progress = progress
+
+    def __call__(self, block):
+        started = time.perf_counter()
+        self.metrics.update(block)
+        index = self.seen + np.arange(block.size)
+        recorded = block if self.every == 1 else block[(index % self.every == 0) | (index == self.last_row)]
+        self.writer.write(recorded)
+        self.figure.add(recorded)
+        self.seen += block.size
+        if self.progress is not None:
+            self.progress(block.size)
+        self.seconds += time.perf_counter() - started
+
+    def feed(self, data):
+        """Record a whole series kept by a host (SSP, container) in loop-sized blocks."""
+        from sma_fmu.cosim.loop import ROWS_PER_CHUNK
+
+        for first in range(0, len(data), ROWS_PER_CHUNK):
+            self(data[first:first + ROWS_PER_CHUNK])
+
+    def close(self):
+        """Finish the file; returns (metrics record, figure rows)."""
+        self.writer.close()
+        return self.metrics.result(), self.figure.rows()
+
+
+def read_timeseries(path):
+    """A run's time series (``timeseries.csv`` or ``timeseries.parquet``) as a pandas
+    DataFrame with the columns ``t_s, R_ref_ohm, ...``."""
+    import pandas as pd
+
+    path = Path(path)
+    if path.suffix == ".parquet":
+        return pd.read_parquet(path)
+    if path.suffix == ".csv":
+        return pd.read_csv(path)
+    raise ValueError(f"{path}: a time series is a .csv or .parquet file")
+
+
+def progress_bar(total_rows, label, stream=None):
+    """A tqdm bar over ``total_rows`` rows that shows only on a terminal and after 2 s, or None."""
+    stream = sys.stderr if stream is None else stream
+    if not getattr(stream, "isatty", lambda: False)():
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total_rows, desc=label, unit="step", unit_scale=True, delay=2.0,
+                file=stream, leave=False)
