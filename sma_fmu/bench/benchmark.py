@@ -229,6 +229,9 @@ def run_benchmarks(out_dir, runs=5, progress=print):
         progress(f"native C FMU floor, C host and fmpy master ({runs} alternating runs) ...")
         from sma_fmu.wire.parameter_file import load_parameters
         floor = floor_costs(fmu_paths, load_parameters(), runs, folder)
+        progress(f"native (C) FMUs: plant step and HIL closed loop ({runs} alternating runs) ...")
+        from sma_fmu.bench.native import native_section
+        native = native_section(fmu_paths, load_parameters(), runs, folder)
         progress(f"closed loops, load-step 30 s ({runs} alternating runs per controller and path) ...")
         loops = closed_loop_times(stage / "fmus", runs)
         progress("library throughput over the shipped scenarios ...")
@@ -240,6 +243,7 @@ def run_benchmarks(out_dir, runs=5, progress=print):
             "ratios": ratio_table(loops, floor),
             "closed_loop_load_step_30s": loops, "library_throughput": throughput,
             "identification_4_loads_s": identification_time(runs), "targets": TARGETS,
+            "native": native,
             # --runs 1 or 2 is a smoke run: 1 s batch runs, where the setup weighs more
             "batch_engine": batch_throughput(stop_time_s=5.0 if runs >= 3 else 1.0,
                                              progress=progress),
@@ -271,6 +275,9 @@ def format_table(results):
               f"{_verdict(ff, TARGETS['feedforward_step_us'])} us", ""]
     lines += _c_host_lines(results)
     lines += [""] + _ratio_lines(results)
+    if "native" in results:
+        from sma_fmu.bench.native import native_lines
+        lines += [""] + native_lines(results["native"])
     lines += ["",
               "load-step, 30 s at 1 ms          wall [s]   x real time   (min ... max of runs)"]
     for name, row in results["closed_loop_load_step_30s"].items():
