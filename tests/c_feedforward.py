@@ -128,7 +128,7 @@ class CStepper:
         if not self.pointer:
             raise ValueError(error.value.decode())
         self._out, self._saturated = (ctypes.c_double * 2)(), ctypes.c_int()
-        self._warning = ctypes.create_string_buffer(256)
+        self._warning = ctypes.create_string_buffer(512)  # feedforward.h: warning[512]
         self._error = ctypes.create_string_buffer(512)
         self.warning = None
 
@@ -228,7 +228,8 @@ def reference_walk(rng, params, steps):
             samples += [(start + (level - start) * k / n, load, h) for k in range(1, n + 1)]
         elif kind < 0.85:                       # a load change (sometimes past the limit)
             load = rng.choice([0.0, 0.02, 0.05, 0.1, 0.25, rng.uniform(0.0, 0.3),
-                               params.load_max * rng.uniform(1.0, 1.6)])
+                               params.load_max * rng.uniform(1.0, 1.6),
+                               rng.choice([10.0, 100.0])])  # T_ref bounded to T_max there
         elif kind < 0.9:                        # a continuously varying load
             for _ in range(rng.randint(5, 40)):
                 load = max(0.0, load + rng.gauss(0.0, 0.01))

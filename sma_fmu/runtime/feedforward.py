@@ -30,6 +30,13 @@ unconnected start, not an error. That step outputs P_ff = 0 W, T_ref = T_room an
 ``saturated`` = True, sets one warning (the first such step only) and changes no state:
 the first R_ref > 0 is the compensator's first sample (filter started in steady state).
 After a reference has arrived, R_ref <= 0 is refused (``ValueError``) as before.
+
+**choice** (the demand beyond validity): the compensator never demands a temperature above
+``validity.T_max``. Where the inverse gives more (a load far above the validity limit
+makes the transformation, and so the inverse, climb to thousands of degC), T_ref is
+bounded to T_max, P_ff is the steady-state power of T_max, ``saturated`` is True, and the
+first step of each such excursion sets a warning. The inverse's own memory (the minor-loop
+stack) keeps the unbounded temperature, as the plant's branch would.
 """
 import math
 from collections import namedtuple
@@ -108,6 +115,7 @@ class FeedforwardStepper:
         self.warning = None               # validity warning of the last step (the load)
         self._load_before = -math.inf     # load of the last step [kg]
         self._unconnected_warned = False  # the no-reference-yet warning was given
+        self._bounded_before = False      # the last step's T_ref was bounded to T_max
 
     def _invert(self, reference, load, direction):
         """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
@@ -157,7 +165,8 @@ class FeedforwardStepper:
         reference = require_positive("R_ref", reference)
         load = require_nonnegative("load", load)
         sensed = self._invert(reference, load, self._direction_for(reference))[0]
-        return FeedforwardOutputs(self._power(sensed), sensed.temperature, sensed.saturated)
+        temperature, saturated = self._demand(sensed)
+        return FeedforwardOutputs(self._power(temperature), temperature, saturated)
 
     def step(self, reference, load, step_size):
         """Compensate one sample: R_ref [ohm] and load [kg] at t_k, step h [s] -> outputs.
@@ -181,18 +190,32 @@ class FeedforwardStepper:
         sensed, points, fraction = self._invert(reference, load, direction)
         warning = (validity_warning(self.params, -math.inf, -math.inf, load, self._load_before)
                    if load > self.params.load_max else None)
-        output = self.filter.step(self._power(sensed), step_size)
+        temperature, saturated = self._demand(sensed)
+        bounded = temperature != sensed.temperature
+        if bounded and not self._bounded_before:
+            bound = (f"T_ref = {sensed.temperature:.6g} degC demanded above validity.T_max = "
+                     f"{self.params.T_max:g} degC (R_ref = {reference:.6g} ohm, load = {load:.6g} "
+                     f"kg): bounded to T_max, saturated")
+            warning = bound if warning is None else f"{warning}; {bound}"
+        output = self.filter.step(self._power(temperature), step_size)
         self.direction = direction
         self.previous_reference = reference
         self.reversals = points
-        self.warning, self._load_before = warning, load
+        self.warning, self._load_before, self._bounded_before = warning, load, bounded
         self.previous_temperature = sensed.temperature
         self.previous_fraction = fraction
-        return _new_tuple(FeedforwardOutputs, (output, sensed.temperature, sensed.saturated))
+        return _new_tuple(FeedforwardOutputs, (output, temperature, saturated))
 
-    def _power(self, sensed):
-        """v = (T_ref - T_room)/K_th [W]: the steady-state power of the sensed temperature."""
-        return (sensed.temperature - self.params.T_room) / self.params.K_th
+    def _demand(self, sensed):
+        """(T_ref [degC], saturated): the sensed temperature, bounded to validity.T_max
+        (module docstring)."""
+        if sensed.temperature > self.params.T_max:
+            return self.params.T_max, True
+        return sensed.temperature, sensed.saturated
+
+    def _power(self, temperature):
+        """v = (T_ref - T_room)/K_th [W]: the steady-state power of ``temperature`` [degC]."""
+        return (temperature - self.params.T_room) / self.params.K_th
 
     def state(self):
         """JSON-ready hidden state (direction, last reference, reversal stack, filter)."""

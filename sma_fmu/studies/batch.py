@@ -43,7 +43,9 @@ CHUNK_ELEMENTS = 65536      # steps x runs per chunk of precomputed signals and 
 # what the engine implements; a field added later is refused until it is added here
 _KNOWN_SCENARIO_FIELDS = {"name", "path", "description", "stop_time_s", "step_s", "reference",
                           "load", "controller", "hysteresis_mode", "T_start", "parameter_set",
-                          "analysis_window", "group_name", "compensator_parameter_set", "drive"}
+                          "analysis_window", "group_name", "compensator_parameter_set", "drive",
+                          # what `sma-fmu run` records; metrics use every step here as there
+                          "output_interval_s"}
 _KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load", "inverse"}
 _KNOWN_DRIVE_FIELDS = {"kind", "frequency_Hz", "peak_W"}
 _DRIVE_KINDS = ("power", "pwm")   # not runtime.pwm.DRIVE_KINDS: a kind added there is refused

@@ -96,6 +96,7 @@ class BatchFeedforward:
         p = [s.compensator_params for s in chosen]
         self.span = column([q.R_MF - q.R_P for q in p])
         self.T_room = column([q.T_room for q in p])
+        self.T_max = column([q.T_max for q in p])
         self.gain = column([q.K_th for q in p])
         self.adaptive = np.array([s.controller.adapt_to_load for s in chosen], dtype=bool)
         M = table["M"][:, runs]
@@ -169,6 +170,9 @@ class BatchFeedforward:
             if bad.any():
                 failures += [(row, part.start + column, float(exponent[row, column]),
                               float(energy[row, column])) for row, column in zip(*np.nonzero(bad))]
+            over = T_ref > self.T_max[part]  # the demand bounded to validity.T_max, as
+            if over.any():                    # FeedforwardStepper._demand does
+                T_ref, low = np.where(over, self.T_max[part], T_ref), low | over
             values.append((T_ref - self.T_room[part]) / self.gain[part])
             saturated.append(low)
             sensed.append(T_ref)

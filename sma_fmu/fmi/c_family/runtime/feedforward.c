@@ -60,6 +60,7 @@ int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *par
     self->warning[0] = '\0';
     self->load_before = -HUGE_VAL;
     self->unconnected_warned = 0;
+    self->bounded_before = 0;
     return 0;
 }
 
@@ -126,10 +127,24 @@ static void unconnected(const FeedforwardStepper *self, FeedforwardOutputs *outp
     outputs->saturated = 1;
 }
 
-/* v = (T_ref - T_room)/K_th [W]: the steady-state power of the sensed temperature. */
-static double power_of(const FeedforwardStepper *self, const SensedTemperature *sensed)
+/* (T_ref [degC], saturated): the sensed temperature, bounded to validity.T_max (the
+ * compensator never demands more; runtime/feedforward.py's choice). */
+static void demand_of(const FeedforwardStepper *self, const SensedTemperature *sensed,
+                      double *temperature, int *saturated)
 {
-    return (sensed->temperature - self->params.T_room) / self->params.K_th;
+    if (sensed->temperature > self->params.T_max) {
+        *temperature = self->params.T_max;
+        *saturated = 1;
+    } else {
+        *temperature = sensed->temperature;
+        *saturated = sensed->saturated;
+    }
+}
+
+/* v = (T_ref - T_room)/K_th [W]: the steady-state power of ``temperature`` [degC]. */
+static double power_of(const FeedforwardStepper *self, double temperature)
+{
+    return (temperature - self->params.T_room) / self->params.K_th;
 }
 
 int feedforward_stepper_initial_outputs(FeedforwardStepper *self, double reference,
@@ -156,9 +171,8 @@ int feedforward_stepper_initial_outputs(FeedforwardStepper *self, double referen
                   &fraction, message)) {
         return 1;
     }
-    outputs->P_ff = power_of(self, &sensed);
-    outputs->T_ref = sensed.temperature;
-    outputs->saturated = sensed.saturated;
+    demand_of(self, &sensed, &outputs->T_ref, &outputs->saturated);
+    outputs->P_ff = power_of(self, outputs->T_ref);
     return 0;
 }
 
@@ -169,9 +183,9 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     SensedTemperature sensed;
     ReversalPoint *stack;
     size_t kept;
-    double fraction, output;
+    double fraction, output, temperature;
     char warning[sizeof self->warning];
-    int direction;
+    int direction, saturated, bounded;
     if (no_reference_yet(self, reference)) {
         if (fast_nonnegative("load", load, message)
             || fast_positive("step_size", step_size, message)) {
@@ -201,7 +215,16 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
         validity_warning(&self->params, -HUGE_VAL, -HUGE_VAL, load, self->load_before, warning,
                          sizeof warning);
     }
-    if (phase_lag_filter_step(&self->filter, power_of(self, &sensed), step_size, &output,
+    demand_of(self, &sensed, &temperature, &saturated);
+    bounded = temperature != sensed.temperature;
+    if (bounded && !self->bounded_before) {
+        size_t used = strlen(warning);
+        snprintf(warning + used, sizeof warning - used, "%sT_ref = %.6g degC demanded above "
+                 "validity.T_max = %g degC (R_ref = %.6g ohm, load = %.6g kg): bounded to T_max, "
+                 "saturated", used ? "; " : "", sensed.temperature, self->params.T_max, reference,
+                 load);
+    }
+    if (phase_lag_filter_step(&self->filter, power_of(self, temperature), step_size, &output,
                               message)) {
         return 1;
     }
@@ -213,11 +236,12 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     self->reversal_count = kept;
     memcpy(self->warning, warning, sizeof warning);
     self->load_before = load;
+    self->bounded_before = bounded;
     self->previous_temperature = sensed.temperature;
     self->previous_fraction = fraction;
     outputs->P_ff = output;
-    outputs->T_ref = sensed.temperature;
-    outputs->saturated = sensed.saturated;
+    outputs->T_ref = temperature;
+    outputs->saturated = saturated;
     return 0;
 }
 

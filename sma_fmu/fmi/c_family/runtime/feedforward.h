@@ -77,9 +77,10 @@ typedef struct FeedforwardStepper {
     double previous_temperature;  /* T_ref,k-1 [degC]; NaN = None */
     double previous_fraction;     /* xi_MF,k-1 [1] the compensator assumed; NaN = None */
     BranchCache branches;
-    char warning[256];            /* validity warning of the last step; "" = None */
+    char warning[512];            /* validity warning of the last step; "" = None */
     double load_before;           /* load of the last step [kg] (-inf before the first) */
     int unconnected_warned;       /* the no-reference-yet warning was given (not saved) */
+    int bounded_before;           /* the last step's T_ref was bounded to T_max (not saved) */
 } FeedforwardStepper;
 
 /* Python's FeedforwardStepper(params, alpha, beta, model_load, adapt_to_load, inverse). For
