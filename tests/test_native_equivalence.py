@@ -360,3 +360,22 @@ def test_print_largest_differences():
     for (model, name), difference in sorted(LARGEST.items()):
         print(f"{model:20s} {name:10s} {difference:.3g}")
     assert all(d <= TOLERANCE for d in LARGEST.values())
+
+
+def test_ssp_and_container_of_either_family_are_interchangeable(families, tmp_path):
+    """The SSP's SystemStructure.ssd does not depend on the family (so one made with either
+    runs with the other's FMUs), and libcosim runs both SSPs to the same time series."""
+    ssd, series = {}, {}
+    for family, paths in families.items():
+        folder = str(next(iter(paths.values())).parent)
+        ssp = tmp_path / f"{family}.ssp"
+        subprocess.run([sys.executable, "-m", "sma_fmu", "export", "ssp", "heavy-pi+ff-fixed",
+                        "--fmus", folder, "--out", str(ssp)], check=True, capture_output=True)
+        with __import__("zipfile").ZipFile(ssp) as archive:
+            ssd[family] = archive.read("SystemStructure.ssd")
+        out = tmp_path / f"run-{family}"
+        subprocess.run([sys.executable, "-m", "sma_fmu", "run", "load-step-pi+ff-adaptive", "--path",
+                        "ssp", "--fmus", folder, "--out", str(out)], check=True, capture_output=True)
+        series[family] = (out / "load-step-pi+ff-adaptive" / "timeseries.csv").read_bytes()
+    assert ssd["py"] == ssd["nat"]
+    assert series["py"] == series["nat"]
