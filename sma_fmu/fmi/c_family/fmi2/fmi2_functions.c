@@ -25,7 +25,7 @@ static const char NATIVE_MARKER[] = "sma-fmu native C FMU";
 const char *const STATE_NAMES[STATE_COUNT] = {
     "instantiated", "Initialization Mode", "stepComplete", "terminated", "error"};
 
-static Instance *live(fmi2Component c)
+Instance *layer_instance(fmi2Component c)
 {
     Instance *in = (Instance *)c;
     if (!in || in->magic != INSTANCE_MAGIC) return NULL;
@@ -33,18 +33,12 @@ static Instance *live(fmi2Component c)
     return in;
 }
 
-#define ENTER                                                                                 \
-    Instance *in = live(c);                                                                   \
-    if (!in) return fmi2Error
-
-/* The call's status: `status`, or worse if the call logged worse. */
-static fmi2Status finish(const Instance *in, fmi2Status status)
+fmi2Status layer_finish(const Instance *in, fmi2Status status)
 {
     return in->worst > status ? in->worst : status;
 }
 
-/* guard.allowed: 1 if the present state is one of the `mask` bits, else refused. */
-static int allowed(Instance *in, const char *function, unsigned int mask)
+int layer_allowed(Instance *in, const char *function, unsigned int mask)
 {
     char why[80];
     if (mask & (1u << in->state)) return 1;
@@ -52,17 +46,7 @@ static int allowed(Instance *in, const char *function, unsigned int mask)
     layer_refuse(in, fmi2Error, function, why);
     return 0;
 }
-#define IN(state) (1u << (state))
-
-/* guards._close: communication points equal up to rounding. */
-static int close_to(double a, double b, double step)
-{
-    double scale = fabs(a) > fabs(b) ? fabs(a) : fabs(b);
-    if (step > scale) scale = step;
-    return fabs(a - b) <= 1e-9 * scale;
-}
-
-static void validity(Instance *in, const char *function)
+void layer_validity(Instance *in, const char *function)
 {
     const char *warning = in->model->warning && in->stepper ? in->model->warning(in->stepper) : "";
     if (warning && *warning) layer_log(in, fmi2Warning, "%s: %s", function, warning);
@@ -183,7 +167,7 @@ fail:
 
 FMI2_Export void fmi2FreeInstance(fmi2Component c)
 {
-    Instance *in = live(c);
+    Instance *in = layer_instance(c);
     if (in) free_instance(in);
 }
 
@@ -196,7 +180,7 @@ FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranc
     ENTER;
     (void)toleranceDefined;
     (void)tolerance;
-    if (!allowed(in, function, IN(STATE_INSTANTIATED))) return fmi2Error;
+    if (!layer_allowed(in, function, IN(STATE_INSTANTIATED))) return fmi2Error;
     layer_repr(startTime, a);
     layer_repr(stopTime, b);
     if (!isfinite(startTime)) {
@@ -218,7 +202,7 @@ FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranc
 FMI2_Export fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
     ENTER;
-    if (!allowed(in, "fmi2EnterInitializationMode", IN(STATE_INSTANTIATED))) return fmi2Error;
+    if (!layer_allowed(in, "fmi2EnterInitializationMode", IN(STATE_INSTANTIATED))) return fmi2Error;
     in->state = STATE_INITIALIZATION;
     in->outputs_current = 0;
     in->stepped = in->terminated = in->have_discard = 0;
@@ -230,7 +214,7 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     const char *function = "fmi2ExitInitializationMode";
     char why[sizeof ((Instance *)0)->initial_error];
     ENTER;
-    if (!allowed(in, function, IN(STATE_INITIALIZATION))) return fmi2Error;
+    if (!layer_allowed(in, function, IN(STATE_INITIALIZATION))) return fmi2Error;
     if (layer_run_initialization(in, why, sizeof why)) {
         in->outputs_current = 1;
         memcpy(in->initial_error, why, sizeof why);
@@ -240,14 +224,14 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     }
     in->state = STATE_STEP_COMPLETE;
     in->time = in->run.start_time;  /* None (no check of the first step) without setup */
-    validity(in, function);
-    return finish(in, fmi2OK);
+    layer_validity(in, function);
+    return layer_finish(in, fmi2OK);
 }
 
 FMI2_Export fmi2Status fmi2Terminate(fmi2Component c)
 {
     ENTER;
-    if (!allowed(in, "fmi2Terminate", IN(STATE_STEP_COMPLETE))) return fmi2Error;
+    if (!layer_allowed(in, "fmi2Terminate", IN(STATE_STEP_COMPLETE))) return fmi2Error;
     in->state = STATE_TERMINATED;
     return fmi2OK;
 }
@@ -282,7 +266,7 @@ static int arrays_ok(Instance *in, const char *function, const void *vr, size_t 
         fmi2Status status;                                                                    \
         ENTER;                                                                                \
         if (!arrays_ok(in, "fmi2" #name, vr, nvr, value, &status)) return status;              \
-        return finish(in, layer_##kind(in, "fmi2" #name, GET_SET_KIND_##name, vr, nvr, value)); \
+        return layer_finish(in, layer_##kind(in, "fmi2" #name, GET_SET_KIND_##name, vr, nvr, value)); \
     }
 #define GET_SET_KIND_GetReal SMA_REAL
 #define GET_SET_KIND_GetInteger SMA_INTEGER
@@ -313,173 +297,5 @@ FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference v
             return fmi2Error;
         }
     }
-    return finish(in, layer_set(in, "fmi2SetString", SMA_STRING, vr, nvr, value));
-}
-
-double sma_nominal_step(SmaRun *run, double step_size);
-
-/* guard._do_step: 1 done, 0 not (refused: fmi2Error logged, or discarded). */
-static fmi2Status do_step(Instance *in, double t, double h)
-{
-    const char *function = "fmi2DoStep";
-    char a[32], b[32], e[32];
-    double end, step;
-    SmaMessage message;
-    if (in->state != STATE_STEP_COMPLETE && !allowed(in, function, IN(STATE_STEP_COMPLETE)))
-        return fmi2Error;
-    if (!(isfinite(t) && h > 0.0 && h < HUGE_VAL)) {  /* reprs only for a message: they cost us */
-        layer_repr(t, a);
-        layer_repr(h, b);
-        layer_log(in, fmi2Error, "%s: currentCommunicationPoint = %s s and communicationStepSize "
-                  "= %s s must be finite, the step > 0", function, a, b);
-        return fmi2Error;
-    }
-    if (in->time_defined && t != in->time && !close_to(t, in->time, h)) {
-        layer_repr(t, a);
-        layer_repr(in->time, e);
-        layer_log(in, fmi2Error, "%s: currentCommunicationPoint = %s s, but the last step ended at "
-                  "%s s (the communication points must follow one another)", function, a, e);
-        return fmi2Error;
-    }
-    end = t + h;
-    if (in->stop_defined && end > in->stop_time && !close_to(end, in->stop_time, h)) {
-        layer_repr(end, a);
-        layer_repr(in->stop_time, e);
-        layer_log(in, fmi2Error, "%s: the step to %s s passes stopTime = %s s", function, a, e);
-        return fmi2Error;
-    }
-    step = in->model->snaps_step ? sma_nominal_step(&in->run, h) : h;
-    message.text[0] = '\0';
-    if (in->model->step(in->stepper, in->values, &in->run, t, step, &message)) {
-        layer_repr(t, a);
-        layer_log(in, fmi2Discard, "step at t = %s s discarded: %s", a, message.text);
-        return fmi2Discard;
-    }
-    if (!layer_outputs_finite(in, in->values)) {
-        in->state = STATE_ERROR;
-        layer_repr(t, a);
-        layer_log(in, fmi2Error, "%s: internal error: the step at t = %s s gave a non-finite "
-                  "output; the instance is in the error state (restore a saved state or reset "
-                  "it)", function, a);
-        return fmi2Error;
-    }
-    in->time = end;
-    in->time_defined = 1;
-    validity(in, function);
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
-                                  fmi2Real communicationStepSize,
-                                  fmi2Boolean noSetFMUStatePriorToCurrentPoint)
-{
-    fmi2Status status;
-    int same_step;
-    ENTER;
-    (void)noSetFMUStatePriorToCurrentPoint;
-    status = finish(in, do_step(in, currentCommunicationPoint, communicationStepSize));
-    if (status > fmi2Discard) return status;  /* refused: nothing was stepped */
-    in->stepped = 1;
-    if (status != fmi2Discard) {
-        in->terminated = in->have_discard = 0;
-        return status;
-    }
-    same_step = in->have_discard && in->discard_time == currentCommunicationPoint &&
-                in->discard_step == communicationStepSize;
-    in->terminated = same_step;
-    if (same_step)
-        layer_plain(in, fmi2Error, "fmi2DoStep(t = %.17g s, h = %.17g s) was repeated unchanged "
-                    "after a discard and discarded again: reporting fmi2Terminated so the master "
-                    "stops", currentCommunicationPoint, communicationStepSize);
-    in->have_discard = 1;
-    in->discard_time = currentCommunicationPoint;
-    in->discard_step = communicationStepSize;
-    return status;
-}
-
-FMI2_Export fmi2Status fmi2CancelStep(fmi2Component c)
-{
-    ENTER;
-    return layer_reject(in, fmi2Error, "fmi2CancelStep", "illegal call: no asynchronous step is in progress");
-}
-
-FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[],
-                                                    size_t nu, const fmi2ValueReference z[],
-                                                    size_t nz, const fmi2Real dz[], fmi2Real du[])
-{
-    ENTER;
-    (void)u; (void)nu; (void)z; (void)nz; (void)dz; (void)du;
-    return layer_reject(in, fmi2Error, "fmi2GetDirectionalDerivative", "not supported by this "
-                        "FMU (providesDirectionalDerivative is false)");
-}
-
-FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
-                                                   size_t nvr, const fmi2Integer order[],
-                                                   const fmi2Real value[])
-{
-    ENTER;
-    (void)vr; (void)nvr; (void)order; (void)value;
-    return layer_reject(in, fmi2Error, "fmi2SetRealInputDerivatives", "not supported by this FMU "
-                        "(canInterpolateInputs is false)");
-}
-
-FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
-                                                    size_t nvr, const fmi2Integer order[],
-                                                    fmi2Real value[])
-{
-    ENTER;
-    (void)vr; (void)nvr; (void)order; (void)value;
-    return layer_reject(in, fmi2Error, "fmi2GetRealOutputDerivatives", "not supported by this FMU "
-                        "(maxOutputDerivativeOrder is 0)");
-}
-
-#define REQUIRE_STEPPED(function)                                                             \
-    if (!in->stepped)                                                                         \
-    return layer_reject(in, fmi2Error, function, "illegal call sequence: allowed only after fmi2DoStep")
-
-FMI2_Export fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
-{
-    ENTER;
-    (void)s; (void)value;
-    REQUIRE_STEPPED("fmi2GetStatus");
-    return layer_reject(in, fmi2Discard, "fmi2GetStatus", "defined only while fmi2DoStep is "
-                        "pending, and this FMU never returns fmi2Pending");
-}
-
-FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
-{
-    ENTER;
-    REQUIRE_STEPPED("fmi2GetRealStatus");
-    if (!value) return layer_reject(in, fmi2Error, "fmi2GetRealStatus", "value is NULL");
-    if (s != fmi2LastSuccessfulTime)
-        return layer_reject(in, fmi2Discard, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is defined");
-    *value = in->time_defined ? in->time : in->run.start_time;
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
-{
-    ENTER;
-    (void)s; (void)value;
-    REQUIRE_STEPPED("fmi2GetIntegerStatus");
-    return layer_reject(in, fmi2Discard, "fmi2GetIntegerStatus", "no integer status is defined");
-}
-
-FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
-{
-    ENTER;
-    REQUIRE_STEPPED("fmi2GetBooleanStatus");
-    if (!value) return layer_reject(in, fmi2Error, "fmi2GetBooleanStatus", "value is NULL");
-    if (s != fmi2Terminated)
-        return layer_reject(in, fmi2Discard, "fmi2GetBooleanStatus", "only fmi2Terminated is defined");
-    *value = in->terminated ? fmi2True : fmi2False;
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
-{
-    ENTER;
-    (void)s; (void)value;
-    REQUIRE_STEPPED("fmi2GetStringStatus");
-    return layer_reject(in, fmi2Discard, "fmi2GetStringStatus", "no string status is defined");
+    return layer_finish(in, layer_set(in, "fmi2SetString", SMA_STRING, vr, nvr, value));
 }

@@ -9,6 +9,7 @@
 #define SMA_FMI2_LAYER_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "fmi2Functions.h"
 #include "sma_model.h"
@@ -60,6 +61,20 @@ typedef struct {
     SavedState *states;              /* states handed out and not freed */
 } Instance;
 
+/* ---- calls (fmi2_functions.c) -------------------------------------------------------------- */
+/* `c` if it is a live instance (its magic number), its worst status reset; else NULL. */
+Instance *layer_instance(fmi2Component c);
+#define ENTER                                                                                 \
+    Instance *in = layer_instance(c);                                                         \
+    if (!in) return fmi2Error
+#define IN(state) (1u << (state))
+/* The call's status: `status`, or worse if the call logged worse. */
+fmi2Status layer_finish(const Instance *in, fmi2Status status);
+/* guard.allowed: 1 if the present state is one of the IN(...) bits of `mask`, else refused. */
+int layer_allowed(Instance *in, const char *function, unsigned int mask);
+/* guard.validity: the stepper's validity warning of its last start or step, as fmi2Warning. */
+void layer_validity(Instance *in, const char *function);
+
 /* ---- log (fmi2_log.c) -------------------------------------------------------------------- */
 /* "<model> '<instance>': <text>" to the host's logger with `status` (which the call then
  * returns at least); the text is formatted here from our literal `format`. */
@@ -105,8 +120,24 @@ int layer_refresh_outputs(Instance *in, const char *function);
 int layer_run_initialization(Instance *in, char *why, size_t size);
 void layer_drop_stepper(Instance *in);
 
-/* ---- saved states (fmi2_states.c) -------------------------------------------------------- */
+/* ---- saved states (fmi2_states.c, fmi2_state_bytes.c) ------------------------------------ */
 void layer_free_states(Instance *in);
+/* A state read from bytes, checked but not applied. */
+typedef struct {
+    uint32_t state;
+    double start_time, stop_time, time, first_step;
+    int stop_defined, time_defined, outputs_current, has_stepper;
+    char *initial_error;
+    SmaValue *values;
+    double *doubles;
+    uint32_t count;
+} Parsed;
+/* The serialized state of `in` (malloc'd) and its size; NULL: out of memory. */
+unsigned char *layer_serialize(const Instance *in, size_t *size);
+/* 1 with *p filled (free it with layer_parsed_free), or 0 with the reason in `why`. */
+int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, Parsed *p,
+                      char *why, size_t why_size);
+void layer_parsed_free(const SmaModel *model, Parsed *p);
 
 /* ---- resources (fmi2_resources.c) -------------------------------------------------------- */
 /* The folder of a file: URI (or a plain absolute path) in `folder` (malloc'd), or 0 with the
