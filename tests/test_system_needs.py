@@ -9,6 +9,7 @@ parameters) need nothing and pass either way.
 """
 import os
 import re
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -40,7 +41,11 @@ def _fresh_machine(tmp_path, ci):
     """The child pytest's (summary line, output) on the simulated fresh machine."""
     bin_folder = tmp_path / "bin"
     bin_folder.mkdir(parents=True)
-    (bin_folder / "python").symlink_to(sys.executable)
+    # runs this Python by its own path (a link would lose a venv's packages: a venv is found
+    # from the path the interpreter was started by)
+    launcher = bin_folder / "python"
+    launcher.write_text(f'#!/bin/sh\nexec {shlex.quote(sys.executable)} "$@"\n')
+    launcher.chmod(0o755)
     environment = {k: v for k, v in os.environ.items()
                    if k not in ("CI", "CC", "SMA_FMU_WIN64_CC", WITHOUT_VARIABLE, "PYTEST_ADDOPTS")}
     environment.update(PATH=str(bin_folder), COLUMNS="1000",  # summary lines kept whole
