@@ -37,7 +37,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse import linalg
 from threadpoolctl import threadpool_limits
 
 from sma_fmu.identification.isobaric_files import noise_level
@@ -45,7 +44,7 @@ from sma_fmu.identification.isobaric_jacobian import file_jacobian, file_model, 
 from sma_fmu.identification.isobaric_lag import uniform_step
 from sma_fmu.identification.isobaric_layout import Layout, starts
 from sma_fmu.identification.isobaric_profile import temperature_profile
-from sma_fmu.identification.isobaric_solver import levenberg_marquardt
+from sma_fmu.identification.isobaric_solver import OrderedLU, levenberg_marquardt
 from sma_fmu.identification.measurements import MeasurementError
 
 __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "IsobaricFit", "fit_isobaric", "prepare",
@@ -117,12 +116,12 @@ def prepare(data, index, residual="per-cycle"):
     """:class:`PreparedFile` of one IsobaricData: profile knots, step, noise estimates."""
     def floor(values, estimate, least=1.0):
         return max(estimate, _FLOOR * max(float(np.ptp(values)), least))
+    window = data.splitting.window_samples if data.splitting is not None else 5
     sigma = {"temperature": floor(data.temperature, noise_level(data.temperature)),
              "strain": floor(data.strain, noise_level(data.strain), 1e-3)}
     if data.resistance is not None:
         sigma["resistance"] = floor(data.resistance, noise_level(data.resistance))
     step, spread = uniform_step(data.time)
-    window = data.splitting.window_samples if data.splitting is not None else 5
     profile = temperature_profile(data.temperature, data.branches, data.time, window)
     return PreparedFile(index, data, profile, step, spread, sigma, residual == "per-cycle")
 
@@ -159,16 +158,16 @@ def _lag_scan(start, solve, progress):
     return best.x
 
 
-def _reported_covariance(jac, factor, count):
+def _reported_covariance(jac, factor, count, order):
     """s^2 (J^T J)^-1 restricted to the first ``count`` unknowns (sparse LU of the scaled
     normal matrix; a tiny ridge keeps unvisited levels from making it singular)."""
     normal = (jac.T @ jac).tocsc()
     scale = np.sqrt(np.clip(normal.diagonal(), 1e-300, None))
     scaled = sparse.diags(1 / scale) @ normal @ sparse.diags(1 / scale)
-    scaled = (scaled + 1e-12 * sparse.identity(scaled.shape[0])).tocsc()
+    scaled = scaled + 1e-12 * sparse.identity(scaled.shape[0])
     unit = np.zeros((scaled.shape[0], count))
     unit[np.arange(count), np.arange(count)] = 1.0
-    inverse = linalg.splu(scaled).solve(unit)[:count]
+    inverse = OrderedLU(scaled, order).solve(unit)[:count]
     return factor * inverse / np.outer(scale[:count], scale[:count])
 
 
@@ -202,6 +201,7 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     layout = Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
                     any(d.resistance is not None for d in files), lag == "fit")
     vector, lower, upper = starts(prepared, layout, base)
+    order = layout.time_order(prepared)
     first = vector[:len(layout.reported)].copy()
     began = time.perf_counter()
     clock = {"last": began, "evaluations": 0}
@@ -223,7 +223,8 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         return sparse.vstack([b for f in prepared for b in file_jacobian(x, layout, f)]).tocsr()
 
     def solve(x0, evaluations):
-        return levenberg_marquardt(residuals, jacobian, x0, lower, upper, evaluations, ftol=1e-8)
+        return levenberg_marquardt(residuals, jacobian, x0, lower, upper, evaluations, ftol=1e-8,
+                                   order=order)
 
     # the sparse solves gain nothing from BLAS threads, which only contend for the cores
     with threadpool_limits(limits=1, user_api="blas"):
@@ -239,7 +240,7 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     dof = max(m - n, 1)
     factor = float(np.sum(solution.fun ** 2)) / dof
     k = len(layout.reported)
-    cov = _reported_covariance(jac, factor, k)
+    cov = _reported_covariance(jac, factor, k, order)
     if not np.all(np.isfinite(cov)):
         raise MeasurementError(f"{layout.paths}: the fit's covariance is not finite; the data do "
                                f"not determine the unknowns")

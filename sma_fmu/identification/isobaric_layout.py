@@ -69,6 +69,21 @@ class Layout:
             raise MeasurementError(f"{self.paths}: the fit reached an invalid parameter "
                                    f"({detail})") from None
 
+    def time_order(self, files):
+        """Column order for the sparse solves: every file's offsets and knots by the sample
+        where they act, file after file, then the physical unknowns and the lags."""
+        key = np.full(self.size, np.inf)
+        for f in files:
+            base = f.index * (f.data.temperature.size + 1.0)
+            key[self.knots[f.index]] = base + f.profile.knots
+            first, count, fixed = self.offsets[f.index]
+            starts = {}
+            for b in f.data.branches:
+                starts.setdefault(b.level if f.per_cycle else 0, b.start)
+            for level in range(fixed, count + fixed):
+                key[first + level - fixed] = base + starts.get(level, f.data.temperature.size)
+        return np.argsort(key, kind="stable")
+
     def levels(self, vector, index):
         first, count, fixed = self.offsets[index]
         return np.concatenate([[0.0] * fixed, vector[first:first + count]])

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import linalg
 
-__all__ = ["Solution", "levenberg_marquardt"]
+__all__ = ["Solution", "OrderedLU", "levenberg_marquardt"]
 
 
 @dataclass
@@ -30,26 +30,49 @@ class Solution:
     message: str
 
 
-def _step(jac, gradient, damping):
+class OrderedLU:
+    """Sparse LU of a symmetric matrix with its rows and columns taken in ``order`` (None:
+    SuperLU's own COLAMD ordering). Ordered by time with the few dense unknowns last, the
+    isobaric normal matrix is banded with a dense border, and its factors stay sparse."""
+
+    def __init__(self, matrix, order=None):
+        self.order = order
+        if order is None:
+            self.lu = linalg.splu(matrix.tocsc())
+        else:
+            # symmetric positive definite: diagonal pivots keep the band
+            self.lu = linalg.splu(matrix.tocsr()[order][:, order].tocsc(), permc_spec="NATURAL",
+                                  diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+
+    def solve(self, rhs):
+        if self.order is None:
+            return self.lu.solve(rhs)
+        out = np.empty_like(rhs, dtype=float)
+        out[self.order] = self.lu.solve(np.asarray(rhs, dtype=float)[self.order])
+        return out
+
+
+def _step(jac, gradient, damping, order):
     normal = (jac.T @ jac).tocsc()
     diagonal = np.maximum(normal.diagonal(), 1e-12 * max(normal.diagonal().max(), 1e-300))
-    damped = (normal + sparse.diags(damping * diagonal)).tocsc()
+    damped = normal + sparse.diags(damping * diagonal)
     try:
-        return -linalg.splu(damped).solve(gradient)
+        return -OrderedLU(damped, order).solve(gradient)
     except RuntimeError:           # exactly singular: damp harder
         return None
 
 
 def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e-10,
-                        xtol=1e-10, damping=1e-3):
-    """Minimise 0.5 |fun(x)|^2 for ``lower <= x <= upper``; ``jac`` returns a sparse matrix."""
+                        xtol=1e-10, damping=1e-3, order=None):
+    """Minimise 0.5 |fun(x)|^2 for ``lower <= x <= upper``; ``jac`` returns a sparse matrix;
+    ``order``: the unknowns' elimination order for the sparse LU (see :class:`OrderedLU`)."""
     x = np.clip(np.asarray(x0, dtype=float), lower, upper)
     r = fun(x)
     cost, evaluations = 0.5 * float(r @ r), 1
     j = jac(x)
     while evaluations < max_evaluations:
         gradient = j.T @ r
-        step = _step(j, gradient, damping)
+        step = _step(j, gradient, damping, order)
         if step is None or not np.all(np.isfinite(step)):
             damping *= 10.0
             if damping > 1e12:
