@@ -82,7 +82,11 @@ class Instance:
         return found
 
     def step(self, time, step):
-        return self.call("doStep", time, step)[0]
+        """doStep's status (fmpy's doStep drops it: a warning would read as fmi2OK)."""
+        try:
+            return self.fmu.fmi2DoStep(self.fmu.component, time, step, 1)
+        except FMICallException as error:
+            return error.status
 
     def close(self):
         try:

@@ -210,6 +210,32 @@ def test_compensator_walks_agree(families, params, inverse, adapt):
         twins.close()
 
 
+def test_validity_warnings_agree(families):
+    """Excursions above T_max and the load limit: the same fmi2Warning steps and texts."""
+    twins = Twins(families, "SmaActuator", "warn")
+    try:
+        assert twins.both("start", {"T_max": 50.0, "load": 0.1}) == [0, 0]
+        inputs = []
+        for k in range(6000):
+            power = 4.0 if (k // 1000) % 2 == 0 else 0.0        # heat past T_max, cool, again
+            load = 3.0 if 2500 <= k < 2600 else 0.1             # past the load limit once
+            inputs.append({"P_in": power, "load": load})
+        statuses = []
+        time = 0.0
+        for values in inputs:
+            for name, value in values.items():
+                twins.both("set", name, value)
+            statuses.append(twins.both("step", time, 1e-3)[0])
+            time += 1e-3
+            twins.compare()
+        warnings_py = [(s, t.replace(twins.py.name, "#")) for s, t in twins.py.log if s == 1]
+        warnings_nat = [(s, t.replace(twins.nat.name, "#")) for s, t in twins.nat.log if s == 1]
+        assert [_numbers(t) for _, t in warnings_py] == [_numbers(t) for _, t in warnings_nat]
+        assert 2 <= statuses.count(1) == len(warnings_nat) < 20  # once per excursion
+    finally:
+        twins.close()
+
+
 def test_pi_walk_agrees(families):
     rng = random.Random(3)
     twins = Twins(families, "SmaPiController", "pi")

@@ -273,3 +273,15 @@ def test_win64_binaries_run_under_wine_as_linux64(native, tmp_path, fmi_host_exe
                             for row_a, row_b in zip(a, b) for x, y in zip(row_a, row_b))
     print("win64 under wine against linux64, largest relative difference:", largest)
     assert all(value <= 1e-12 for value in largest.values())
+
+
+def test_sma_fmu_check_passes_a_native_fmu(native):
+    """sma-fmu check: fmpy, the FMI checker, libcosim, the state round trip, the reference
+    result and each platform, declared native and without Python."""
+    result = subprocess.run([sys.executable, "-m", "sma_fmu", "check", str(native["SmaPiController"])],
+                            capture_output=True, text=True)
+    lines = result.stdout.splitlines()
+    assert result.returncode == 0 and not [line for line in lines if line.startswith("FAIL")], result.stdout
+    platforms = [line for line in lines if "platform" in line]
+    assert platforms and all(line.startswith("ok") and "native C" in line and "no Python" in line
+                             for line in platforms)
