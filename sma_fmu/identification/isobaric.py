@@ -143,19 +143,18 @@ def _verdict(rms, noise):
 
 
 def _lag_scan(start, solve, progress):
-    """The best of short fits started from lags of 1/300 to 1/6 of a cycle, each with the
+    """The two best of short fits started from lags of 1/300 to 1/6 of a cycle, each with the
     centres read on the profile lagged by it (the lag trades against the centres, and the
-    cost surface can have more than one valley)."""
-    best = None
+    cost surface can have more than one valley; the full fit runs from both)."""
+    trials = []
     for fraction in LAG_STARTS:
-        vector = start(fraction)
-        trial = solve(vector, SCAN_EVALUATIONS)
+        trial = solve(start(fraction), SCAN_EVALUATIONS)
         if progress is not None:
             progress(f"  lag start {fraction:.3g} of a cycle: cost {trial.cost:.6g} after "
                      f"{trial.nfev} evaluations")
-        if best is None or trial.cost < best.cost:
-            best = trial
-    return best.x
+        trials.append(trial)
+    trials.sort(key=lambda trial: trial.cost)
+    return [trial.x for trial in trials[:2]]
 
 
 def _reported_covariance(jac, factor, count, order):
@@ -228,10 +227,9 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
 
     # the sparse solves gain nothing from BLAS threads, which only contend for the cores
     with threadpool_limits(limits=1, user_api="blas"):
-        if lag == "fit":
-            vector = _lag_scan(lambda fraction: starts(prepared, layout, base, fraction)[0],
-                               solve, progress)
-        solution = solve(vector, max_evaluations)
+        firsts = [vector] if lag != "fit" else _lag_scan(
+            lambda fraction: starts(prepared, layout, base, fraction)[0], solve, progress)
+        solution = min((solve(x, max_evaluations) for x in firsts), key=lambda s: s.cost)
     if not np.all(np.isfinite(solution.x)):
         layout.params(np.where(np.isfinite(solution.x), solution.x, np.nan))
     seconds = time.perf_counter() - began

@@ -6,8 +6,9 @@ iterative (lsmr) steps need thousands of inner iterations on this ill-conditione
 damped normal equations (J^T J + lambda diag(J^T J)) dx = -J^T r with scipy's sparse LU
 (``splu``), so a 26,000-sample, 100-cycle fit with ~1,000 unknowns takes seconds. Bounds
 are kept by projecting each trial point onto the box (Marquardt's scaling makes the step
-invariant to the unknowns' units). Stops when a step lowers the cost by less than ``ftol``
-relative, moves every unknown by less than ``xtol`` relative, or after ``max_evaluations``.
+invariant to the unknowns' units). Stops when three steps in a row lower the cost by less
+than ``ftol`` relative, a step moves every unknown by less than ``xtol`` relative, or after
+``max_evaluations``.
 """
 from dataclasses import dataclass
 
@@ -68,7 +69,7 @@ def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e
     ``order``: the unknowns' elimination order for the sparse LU (see :class:`OrderedLU`)."""
     x = np.clip(np.asarray(x0, dtype=float), lower, upper)
     r = fun(x)
-    cost, evaluations = 0.5 * float(r @ r), 1
+    cost, evaluations, small = 0.5 * float(r @ r), 1, 0
     j = jac(x)
     while evaluations < max_evaluations:
         gradient = j.T @ r
@@ -87,7 +88,8 @@ def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e
             moved = np.max(np.abs(trial - x) / np.maximum(np.abs(x), 1e-8))
             x, r, cost = trial, r_trial, cost_trial
             damping = max(damping / 3.0, 1e-12)
-            if decrease <= ftol * cost:
+            small = small + 1 if decrease <= ftol * cost else 0
+            if small >= 3:    # three steps in a row: one small step may be a curved valley's
                 return Solution(x, r, cost, evaluations, 2, "the cost changes by less than ftol")
             if moved <= xtol:
                 return Solution(x, r, cost, evaluations, 3, "the unknowns change by less than xtol")
