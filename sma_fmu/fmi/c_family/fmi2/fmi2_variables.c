@@ -17,6 +17,10 @@ static const char *const CAUSALITY_NAMES[] = {"parameter", "input", "output"};
 const SmaVariable *layer_variable(const SmaModel *model, unsigned int vr, size_t *index)
 {
     size_t i;
+    if (vr < model->count && model->variables[vr].vr == vr) {  /* pythonfmu numbers 0, 1, ... */
+        if (index) *index = vr;
+        return &model->variables[vr];
+    }
     for (i = 0; i < model->count; ++i) {
         if (model->variables[i].vr == vr) {
             if (index) *index = i;
