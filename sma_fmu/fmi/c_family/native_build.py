@@ -202,7 +202,8 @@ def build_native_fmus(out_dir, parameter_file=None, names=None):
             for name in names:
                 problems += _build_one(name, python_fmus[name], folder, work)
     for message in sorted(set(p.split(": ", 1)[1] for p in problems)):
-        warnings.warn(NativeBuildWarning(f"native FMUs {message}. Install mingw-w64 (Debian: "
-                                          "apt-get install gcc-mingw-w64-x86-64) or set "
-                                          "SMA_FMU_WIN64_CC for win64"), stacklevel=2)
+        hint = (" Install mingw-w64 (Debian: apt-get install gcc-mingw-w64-x86-64) or set "
+                "SMA_FMU_WIN64_CC" if message.startswith("built without win64") else
+                " Their sources/ compile there: fmpy.build.build_platform_binary")
+        warnings.warn(NativeBuildWarning(f"native FMUs {message}.{hint}"), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}
