@@ -92,7 +92,7 @@ class IsobaricFit:
     wire_std_errors: np.ndarray
     wire_covariance: np.ndarray
     offsets: list             # per file: strain offset of each level [1]
-    lags: list                # per file: {"value", "std_error", "unit"} or None
+    lags: list                # per file: {"value", "std_error", "unit", "step", "step_spread"}
     profiles: list            # per file: fitted wire temperature [degC] at each sample
     measured_profiles: list   # per file: fitted thermocouple temperature (before the lag)
     directions: list          # per file: the wire's branch direction (+1/-1) at each sample
@@ -261,7 +261,9 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
              for key, v in noise.items()}
     wire_names, wire_values, wire_cov = _wire_covariance(layout, solution.x, cov)
     lags = [None if c is None else {"value": float(solution.x[c]), "std_error": float(errors[c]),
-                                    "unit": f.lag_unit} for f, c in zip(prepared, layout.lags)]
+                                    "unit": f.lag_unit, "step": f.step,
+                                    "step_spread": f.step_spread}
+            for f, c in zip(prepared, layout.lags)]
     return IsobaricFit(
         params=params, names=list(layout.reported), values=solution.x[:k].copy(),
         std_errors=errors, covariance=cov, starts=first,

@@ -65,6 +65,17 @@ def _centres(fit, loads):
     return out
 
 
+def _lag_note(lag):
+    """What the lag is and in which unit (and, with a time column, how even its steps are)."""
+    if lag["unit"] == "samples":
+        return "wire behind the thermocouple, first-order lag; no time column, so counted in samples"
+    note = f"wire behind the thermocouple, first-order lag; median time step {lag['step']:.4g} s"
+    if lag["step_spread"] > 0.01:
+        note += (f", steps differ from it by up to {100 * lag['step_spread']:.3g} % (the lag is "
+                 f"computed on the median step)")
+    return note
+
+
 def isobaric_report(files, fit, base_set, residual, rows):
     """The JSON-ready report of an isobaric fit."""
     params = fit.params
@@ -83,10 +94,7 @@ def isobaric_report(files, fit, base_set, residual, rows):
         per_file.append({
             "file": str(data.path), "load_kg": data.load,
             "cycles_found": splitting_note(data.splitting, data.branches, data.time is not None),
-            "lag": lag and dict(lag, note=(
-                "wire behind the thermocouple, first-order lag; no time column, so counted in "
-                "samples" if lag["unit"] == "samples" else
-                "wire behind the thermocouple, first-order lag")),
+            "lag": lag and dict(lag, note=_lag_note(lag)),
             "profile_knots_per_branch": knots,
             "stress_MPa": stress_of_load(data.load, params.diameter),
             "points": int(data.strain.size),
