@@ -285,3 +285,28 @@ def test_sma_fmu_check_passes_a_native_fmu(native):
     platforms = [line for line in lines if "platform" in line]
     assert platforms and all(line.startswith("ok") and "native C" in line and "no Python" in line
                              for line in platforms)
+
+
+def test_resource_locations_taken_and_refused_as_the_front_does(native, tmp_path):
+    """file:///abs, file:/abs, file://localhost/abs, percent escapes and a plain absolute path
+    are taken; another host, a relative path, another scheme, a missing folder are refused
+    (NULL, never a crash)."""
+    library, guid, uri = _library(native["SmaPiController"], tmp_path)
+    library.fmi2Instantiate.restype = ctypes.c_void_p
+    library.fmi2Instantiate.argtypes = [ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p,
+                                        ctypes.c_char_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+    library.fmi2FreeInstance.argtypes = [ctypes.c_void_p]
+    folder = str(tmp_path / "SmaPiController" / "resources")
+    spaced = tmp_path / "with space" / "resources"
+    spaced.mkdir(parents=True)
+    taken = [uri, f"file:{folder}", f"file://localhost{folder}", folder,
+             "file://" + str(spaced).replace(" ", "%20")]
+    refused = ["http://example.com/resources", "file://elsewhere" + folder, "file:resources",
+               f"file://{folder}/missing", "file://" + folder + "%zz", ""]
+    for text in taken:
+        component = library.fmi2Instantiate(b"u", 1, guid, text if isinstance(text, bytes) else text.encode(),
+                                            None, 0, 0)
+        assert component, text
+        library.fmi2FreeInstance(component)
+    for text in refused:
+        assert library.fmi2Instantiate(b"u", 1, guid, text.encode(), None, 0, 0) is None, text
