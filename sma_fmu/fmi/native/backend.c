@@ -38,9 +38,12 @@ void forget_resources(const char* folder)
     if (calls.forget_resources) calls.forget_resources(folder);
 }
 
-int call_python(void* callable)
+int can_call_python(void) { return calls.call_python != NULL; }
+
+int call_python(void* callable, void* queue, long* queued)
 {
-    return calls.call_python ? calls.call_python(callable) : -1;
+    *queued = 1;
+    return calls.call_python ? calls.call_python(callable, queue, queued) : -1;
 }
 
 #ifndef _WIN32

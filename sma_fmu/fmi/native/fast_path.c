@@ -34,9 +34,10 @@
  * flags. Header: [0] 1 if the slave is in stepComplete, [1] 1 once the slave has written
  * the buffer (the front clears it before a crossing), [2] 1 if an input is pending, [3] the
  * front's sync request, [4] 1: the next step writes every value, not only the outputs,
- * [5] the guard's time (where the next step must start; NaN: none), [6] its stopTime (NaN:
- * none), [7] 1 if [5] and [6] may be checked in C, [8] t and [9] h of a direct step, [10]
- * the messages it queued, [11] the front's log request, [12] the direct step's address.
+ * [5] the guard's stopTime (NaN: none), [6] 1 if [5] and [12] may be checked in C, [7] t
+ * and [8] h of a direct step, [9] the front's log request, [10] the direct step's address,
+ * [11] pythonfmu's log queue's address, [12] the guard's time (where the next step must
+ * start; NaN: none), next to the values: the slave writes both in one pack.
  */
 #define _GNU_SOURCE
 #include <stdio.h>
@@ -51,14 +52,14 @@
 #define H_PENDING 2
 #define H_SYNC 3
 #define H_FULL 4
-#define H_TIME 5
-#define H_STOP 6
-#define H_CHECKABLE 7
-#define H_T 8
-#define H_H 9
-#define H_LOGGED 10
-#define H_LOG 11
-#define H_ENTRY 12
+#define H_STOP 5
+#define H_CHECKABLE 6
+#define H_T 7
+#define H_H 8
+#define H_LOG 9
+#define H_ENTRY 10
+#define H_QUEUE 11
+#define H_TIME 12
 #define MAX_TABLE_VR 65536u
 
 static int kind_index(char kind) { return kind == 'R' ? 0 : kind == 'I' ? 1 : kind == 'B' ? 2 : -1; }
@@ -142,11 +143,15 @@ void fast_attach(Instance* in)
             in->logged_status == fmi2OK && in->fast.buffer[H_FRESH] == 1.0) {
             in->fast.attached = 1;
             in->fast.maybe_step_complete = in->fast.buffer[H_STEP_COMPLETE] == 1.0;
-            double entry = in->fast.buffer[H_ENTRY];
-            int direct = !(environment("SMA_FMU_NO_DIRECT_STEP", off, sizeof off) &&
+            double entry = in->fast.buffer[H_ENTRY], queue = in->fast.buffer[H_QUEUE];
+            int direct = can_call_python() &&
+                         !(environment("SMA_FMU_NO_DIRECT_STEP", off, sizeof off) &&
                            strcmp(off, "0") != 0);
-            if (direct && entry > 0.0 && entry < 9007199254740992.0) /* an address, exact */
+            if (direct && entry > 0.0 && entry < 9007199254740992.0 && queue > 0.0 &&
+                queue < 9007199254740992.0) { /* addresses, exact in a double */
                 in->fast.step = (void*)(size_t)entry;
+                in->fast.queue = (void*)(size_t)queue;
+            }
         }
     }
     if (!in->fast.attached) fast_free(&in->fast);
@@ -295,9 +300,9 @@ int fast_step(Instance* in, double t, double h)
     b[H_FULL] = 0.0; /* not stale: the outputs are enough */
     b[H_T] = t;
     b[H_H] = h;
-    b[H_LOGGED] = 0.0;
-    int done = call_python(fast->step);
-    if (b[H_LOGGED] != 0.0) { /* pythonfmu passes the queued messages on after this call */
+    long queued = 0;
+    int done = call_python(fast->step, fast->queue, &queued);
+    if (queued != 0) { /* pythonfmu passes the queued messages on after this call */
         const fmi2ValueReference vr = FAST_LOG_VR;
         fmi2String text = NULL;
         b[H_LOG] = 1.0;

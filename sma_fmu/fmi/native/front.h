@@ -67,8 +67,9 @@ typedef struct {
                                  const fmi2CallbackFunctions* cb, fmi2Boolean visible);
     void (*forget_resources)(const char* folder);
     /* calls a Python callable with no arguments (GIL taken and released): 1 if the result
-     * is true, 0 if false, -1 if it raised (the exception is printed and cleared) */
-    int (*call_python)(void* callable);
+     * is true, 0 if false, -1 if it raised (the exception is printed and cleared); then
+     * *queued = the length of the Python list `queue` (1 if it is none) */
+    int (*call_python)(void* callable, void* queue, long* queued);
 } RuntimeCalls;
 
 /*
@@ -103,7 +104,8 @@ void keep_thread_state(void); /* the owner's: one parked Python thread state per
 fmi2Component instantiate_backend(fmi2String name, fmi2Type type, fmi2String guid, fmi2String uri,
                                   const fmi2CallbackFunctions* cb, fmi2Boolean visible);
 void forget_resources(const char* folder); /* takes pythonfmu's sys.path entry away again */
-int call_python(void* callable);           /* RuntimeCalls.call_python; -1 without one */
+int call_python(void* callable, void* queue, long* queued); /* RuntimeCalls.call_python; -1 without */
+int can_call_python(void);                                  /* 1 if there is one */
 /* The GNU build ID of an ELF file (0 elsewhere or without one: then nothing is shared). */
 int backend_build_id(const char* path, unsigned char* id, size_t* size);
 /* An owner's record for a backend with this build ID, or NULL. */
@@ -150,6 +152,7 @@ typedef struct {
     int* slot_of[3];         /* Real, Integer, Boolean: value reference -> slot or -1 */
     unsigned table_size[3];
     void* step;              /* the slave's direct doStep (a Python callable), or NULL */
+    void* queue;             /* pythonfmu's log queue of the slave (a Python list) */
 } FastPath;
 
 typedef struct {

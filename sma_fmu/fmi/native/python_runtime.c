@@ -168,13 +168,16 @@ static void owner_forget_resources(const char* folder)
 /* The slave's direct step (fast_path.c): one call with no arguments under the GIL. An
  * exception cannot come from the guard (it catches Exception); anything else (a
  * KeyboardInterrupt) is printed as Python would and cleared, and the call says -1. */
-static int owner_call_python(void* callable)
+static int owner_call_python(void* callable, void* queue, long* queued)
 {
     int gil = py.GILState_Ensure();
     void* result = py.Object_CallObject(callable, NULL);
     int truth = result ? py.Object_IsTrue(result) : -1;
     if (result) py.DecRef(result);
     if (truth < 0) py.Err_Print();
+    ptrdiff_t size = queue ? py.List_Size(queue) : 1;
+    if (size < 0) py.Err_Clear();
+    *queued = size < 0 ? 1 : (long)size;
     py.GILState_Release(gil);
     return truth;
 }
@@ -214,7 +217,8 @@ int start_python_runtime(RuntimeCalls* calls)
     calls->instantiate = owner_instantiate;
     calls->forget_resources = owner_forget_resources;
     calls->call_python = py.Object_CallObject && py.Object_IsTrue && py.Err_Print &&
-                         py.DecRef && py.GILState_Release ? owner_call_python : NULL;
+                         py.List_Size && py.Err_Clear && py.DecRef && py.GILState_Release
+                         ? owner_call_python : NULL;
     return py.IsInitialized && py.GILState_Ensure && py.GILState_GetThisThreadState &&
            py.Eval_SaveThread && py.Eval_RestoreThread;
 }

@@ -19,11 +19,10 @@ the class's methods, so a slave written in the usual style gets it by creating i
 :class:`~.interface.SlaveInterface`).
 """
 import math
-from operator import attrgetter
 
 from pythonfmu.enums import Fmi2Status
 
-from .fast_path import ATTACH, DESCRIBE, PENDING, FastPath
+from .fast_path import ATTACH, DESCRIBE, PENDING, FastPath, attribute_reader
 from .lifecycle import ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED
 from .saved_state import SavedStates
 
@@ -58,7 +57,6 @@ class CallGuard:
         self.time = None            # the next communication point [s]
         self.outputs_current = False  # Initialization Mode: outputs reflect what was set
         self.initial_error = None   # why the outputs cannot be computed from what was set
-        self.last_outputs = None    # the Real outputs outputs_finite read last
         self.describing = False     # inside to_xml (the build reads start values)
         self.states = SavedStates(self)
         self.fast = FastPath(self)  # the front's values (attached by the front, if there is one)
@@ -103,14 +101,11 @@ class CallGuard:
     def outputs_finite(self):
         """True if every Real output is finite (the invariant a step or restore must keep)."""
         if self._real_outputs is None:
-            names = self.interface.real_output_names()
-            self._real_outputs = attrgetter(*names) if names else (lambda slave: ())
+            self._real_outputs = attribute_reader(self.interface.real_output_names())
         values = self._real_outputs(self.slave)
-        if not isinstance(values, tuple):
-            values = (values,)
-        self.last_outputs = values  # what fmi2DoStep gives the front
         try:
-            return all(map(math.isfinite, values))
+            total = sum(values)  # finite: all are (one sum, not a call per value) ...
+            return total - total == 0.0 or all(map(math.isfinite, values))  # ... or overflowed
         except TypeError:  # not even a number
             return False
 
@@ -189,7 +184,6 @@ class CallGuard:
 
     def do_step(self, current_time, step_size):
         fast = self.fast.view
-        self.last_outputs = None
         try:
             if fast is not None and fast[PENDING]:  # inputs the front accepted since the last step
                 self.fast.take_inputs()
@@ -198,7 +192,7 @@ class CallGuard:
             return self.internal("fmi2DoStep", error, False)
         finally:
             if fast is not None:
-                self.fast.write_step(self.last_outputs)
+                self.fast.write_step()
 
     def _do_step(self, current_time, step_size):
         """The model-free checks, then :meth:`advance`. The front makes the same checks in C
@@ -241,7 +235,9 @@ class CallGuard:
                                          "non-finite output; the instance is in the error state "
                                          "(restore a saved state or reset it)")
         self.time = current_time + step_size
-        self.validity(function)
+        warning = getattr(getattr(self.slave, "stepper", None), "warning", None)  # validity()
+        if warning:
+            self.log(Fmi2Status.warning, function, warning)
         return True
 
     def to_xml(self, model_options=None):
