@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from scipy import sparse
 
-from sma_fmu.identification.isobaric import fit_isobaric
-from sma_fmu.identification.isobaric_files import read_isobaric
-from sma_fmu.identification.isobaric_model import (model_resistance, model_strain,
+from sma_fmu.identification.isobaric.fit import fit_isobaric
+from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.model import (model_resistance, model_strain,
                                                    tangent_closed_form)
-from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
+from sma_fmu.identification.isobaric.synthetic import (IsobaricProgramme, isobaric_table,
                                                        isobaric_text)
 from sma_fmu.identification.transformation_temperatures import branch_tangents
 from sma_fmu.runtime.constant_load import constant_load_fractions
@@ -122,9 +122,9 @@ def test_noise_free_recovery_is_exact(tmp_path, params):
 def test_analytic_jacobian_matches_finite_differences(tmp_path, params):
     """Every kind of column: physical, offsets, the lag and the profile's knots (the wire
     temperature lags the profile by 4 samples, so the knots act through the lagged basis)."""
-    from sma_fmu.identification.isobaric import prepare, residual_blocks
-    from sma_fmu.identification.isobaric_jacobian import file_jacobian
-    from sma_fmu.identification.isobaric_layout import Layout, starts
+    from sma_fmu.identification.isobaric.fit import prepare, residual_blocks
+    from sma_fmu.identification.isobaric.jacobian import file_jacobian
+    from sma_fmu.identification.isobaric.layout import Layout, starts
     path, _ = _file(tmp_path, _truth(params), 0.15, resistance=True, points=400)
     f = prepare(read_isobaric(path), 0)
     layout = Layout([f], params, False, False, True, True)

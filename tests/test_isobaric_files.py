@@ -7,8 +7,8 @@ import pytest
 
 from cli_failure import fails as _fails
 from sma_fmu.cli import main
-from sma_fmu.identification.isobaric_files import read_isobaric
-from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
+from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.synthetic import (IsobaricProgramme, isobaric_table,
                                                        isobaric_text)
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.wire.parameter_file import load_parameter_set

@@ -19,15 +19,15 @@ import pytest
 
 from cli_failure import fails
 from sma_fmu.cli import main
-from sma_fmu.identification.isobaric import fit_isobaric, prepare
-from sma_fmu.identification.isobaric_cycles import parse_cycles
-from sma_fmu.identification.isobaric_files import read_isobaric
-from sma_fmu.identification.isobaric_lag import lag_adjoint, lagged
-from sma_fmu.identification.isobaric_layout import Layout
-from sma_fmu.identification.isobaric_profile import temperature_profile
-from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
+from sma_fmu.identification.isobaric.fit import fit_isobaric, prepare
+from sma_fmu.identification.isobaric.cycles import parse_cycles
+from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.lag import lag_adjoint, lagged
+from sma_fmu.identification.isobaric.layout import Layout
+from sma_fmu.identification.isobaric.profile import temperature_profile
+from sma_fmu.identification.isobaric.synthetic import (IsobaricProgramme, isobaric_table,
                                                        isobaric_text)
-from sma_fmu.identification.isobaric_tables import SOURCES, cycle_rows, rows_markdown
+from sma_fmu.identification.isobaric.tables import SOURCES, cycle_rows, rows_markdown
 from sma_fmu.identification.measurements import MeasurementError
 
 SIGMAS = 4.0

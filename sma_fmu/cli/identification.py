@@ -39,7 +39,7 @@ def _check_fit_loads(args):
 
 
 def _fit_isobaric(args, out):
-    from sma_fmu.identification.isobaric_runner import format_isobaric_report, run_isobaric_fit
+    from sma_fmu.identification.isobaric.runner import format_isobaric_report, run_isobaric_fit
     _check_fit_loads(args)
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
                               args.residual_strain or "per-cycle", args.reference_length,
@@ -65,7 +65,7 @@ def _fit(args):
 
 
 def _synth_isobaric(args, params, t_min, t_max):
-    from sma_fmu.identification.isobaric_synthetic import (IsobaricProgramme, isobaric_table,
+    from sma_fmu.identification.isobaric.synthetic import (IsobaricProgramme, isobaric_table,
                                                            isobaric_text, stress_of_load)
     from sma_fmu.files.output_folder import staged_folder, write_file
     loads = args.loads or [0.15]

@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from sma_fmu.identification.isobaric import LAG_OPTIONS, RESIDUAL_OPTIONS, fit_isobaric
-from sma_fmu.identification.isobaric_cycles import parse_cycles, splitting_note
-from sma_fmu.identification.isobaric_figures import isobaric_figures
-from sma_fmu.identification.isobaric_files import read_isobaric
-from sma_fmu.identification.isobaric_synthetic import load_of_stress, stress_of_load
-from sma_fmu.identification.isobaric_tables import cycle_rows, rows_csv, rows_markdown
+from sma_fmu.identification.isobaric.fit import LAG_OPTIONS, RESIDUAL_OPTIONS, fit_isobaric
+from sma_fmu.identification.isobaric.cycles import parse_cycles, splitting_note
+from sma_fmu.identification.isobaric.figures import isobaric_figures
+from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
+from sma_fmu.identification.isobaric.tables import cycle_rows, rows_csv, rows_markdown
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import check_folder, staged_folder
 from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file

@@ -18,8 +18,8 @@ import numpy as np
 from matplotlib import cm, colormaps, colors
 from matplotlib.figure import Figure
 
-from sma_fmu.identification.isobaric_jacobian import file_model
-from sma_fmu.identification.isobaric_tables import model_branch_strain
+from sma_fmu.identification.isobaric.jacobian import file_model
+from sma_fmu.identification.isobaric.tables import model_branch_strain
 from sma_fmu.runtime.constants import HEATING
 
 __all__ = ["isobaric_figures", "GRID_CYCLES"]

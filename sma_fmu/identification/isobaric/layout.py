@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 
-from sma_fmu.identification.isobaric_jacobian import file_model
-from sma_fmu.identification.isobaric_lag import lagged
-from sma_fmu.identification.isobaric_profile import wire_rows
+from sma_fmu.identification.isobaric.jacobian import file_model
+from sma_fmu.identification.isobaric.lag import lagged
+from sma_fmu.identification.isobaric.profile import wire_rows
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constant_load import residual_f_fraction
 from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY

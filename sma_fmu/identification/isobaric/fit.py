@@ -7,7 +7,7 @@ file. The model of every sample i of a file at load f, on the branch of its dire
     eps_i = eps_hot(f) + span(f) q(T_i; tau_d(f), dH(f)) + offset_i             [1]
     R_i   = R_hot(f)   + R_span(f) q(T_i; tau_d(f), dH(f))                       [ohm]
 
-(:mod:`sma_fmu.identification.isobaric_model`). Fitted:
+(:mod:`sma_fmu.identification.isobaric.model`). Fitted:
 - the hysteresis centres: a_h, a_c at one load (b_h, b_c from the base file), or
   a_h, b_h, a_c, b_c when the files hold two loads or more;
 - nu, the domain size that sets the transition width (eps_T from the base file: only
@@ -21,15 +21,15 @@ file. The model of every sample i of a file at load f, on the branch of its dire
   when the file has no time column] (``lag="fit"``; ``lag="none"`` holds it at zero).
 
 The wire temperature T_i is lagged(profile): the profile is piecewise linear with few knots
-per branch, chosen from the measured temperature alone (:mod:`isobaric_profile`), and its
+per branch, chosen from the measured temperature alone (:mod:`profile`), and its
 knots are fitted jointly with the parameters against the residuals (profile - measured
 temperature)/sigma_T, (model strain - measured strain)/sigma_eps (and resistance), each sigma
 the data's own scatter (median absolute second difference). So the profile can move only
 as far as the thermocouple noise allows: a wire that lags is explained by the lag, and a
 temperature residual much larger than the noise says the model does not explain the data
 (``verdict``). The covariance s^2 (J^T J)^-1 of all unknowns accounts for the temperature
-noise. Levenberg-Marquardt with sparse direct steps (:mod:`isobaric_solver`) runs on a sparse
-closed-form Jacobian (:mod:`isobaric_jacobian`), so a 26,000-sample, 100-cycle file fits in
+noise. Levenberg-Marquardt with sparse direct steps (:mod:`solver`) runs on a sparse
+closed-form Jacobian (:mod:`jacobian`), so a 26,000-sample, 100-cycle file fits in
 seconds; a short scan of starting lags picks the valley first.
 """
 import time
@@ -39,12 +39,12 @@ import numpy as np
 from scipy import sparse
 from threadpoolctl import threadpool_limits
 
-from sma_fmu.identification.isobaric_files import noise_level
-from sma_fmu.identification.isobaric_jacobian import file_jacobian, file_model, file_state
-from sma_fmu.identification.isobaric_lag import uniform_step
-from sma_fmu.identification.isobaric_layout import Layout, starts
-from sma_fmu.identification.isobaric_profile import temperature_profile
-from sma_fmu.identification.isobaric_solver import OrderedLU, levenberg_marquardt
+from sma_fmu.identification.isobaric.files import noise_level
+from sma_fmu.identification.isobaric.jacobian import file_jacobian, file_model, file_state
+from sma_fmu.identification.isobaric.lag import uniform_step
+from sma_fmu.identification.isobaric.layout import Layout, starts
+from sma_fmu.identification.isobaric.profile import temperature_profile
+from sma_fmu.identification.isobaric.solver import OrderedLU, levenberg_marquardt
 from sma_fmu.identification.measurements import MeasurementError
 
 __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "IsobaricFit", "fit_isobaric", "prepare",

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from sma_fmu.identification.isobaric_model import branch_levels, branch_share
+from sma_fmu.identification.isobaric.model import branch_levels, branch_share
 from sma_fmu.identification.transformation_temperatures import (QUANTITIES,
                                                                 branch_tangents_or_reason,
                                                                 cycle_numbers)

@@ -13,7 +13,7 @@ thermocouple's noise allows:
    parameters, held to the measured temperature by its noise
    (:mod:`sma_fmu.identification.isobaric`).
 2. Wire: the profile lagged by the fitted time constant
-   (:mod:`sma_fmu.identification.isobaric_lag`). The wire's branches turn where the wire
+   (:mod:`sma_fmu.identification.isobaric.lag`). The wire's branches turn where the wire
    does, after the thermocouple: :func:`wire_rows` moves each turning point to the wire's
    extremum.
 """
@@ -23,7 +23,7 @@ import numpy as np
 from scipy import signal, sparse
 from scipy.sparse import linalg
 
-from sma_fmu.identification.isobaric_lag import lagged
+from sma_fmu.identification.isobaric.lag import lagged
 
 __all__ = ["Profile", "temperature_profile", "wire_rows", "lagged_basis", "INTERIOR_KNOTS"]
 

@@ -3,7 +3,7 @@
 The wire hangs at a constant load while a furnace runs a temperature programme: a dwell at
 ``t_low``, a ramp at ``rate`` up to ``t_high``, a dwell, a ramp down, a dwell, ``cycles``
 times. The thermocouple reads the programme; the wire follows it with a first-order lag of
-time constant ``lag_s`` [s] (:mod:`sma_fmu.identification.isobaric_lag`; 0: no lag). The
+time constant ``lag_s`` [s] (:mod:`sma_fmu.identification.isobaric.lag`; 0: no lag). The
 wire's temperature drives the model (major branches, spec section 4; the direction is that
 of the wire's temperature, which turns after the thermocouple's, kept through each dwell),
 so with a lag a transformation that ends near the top goes on after the measured
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sma_fmu.identification.isobaric_lag import lagged
-from sma_fmu.identification.isobaric_model import branch_share, branch_levels
+from sma_fmu.identification.isobaric.lag import lagged
+from sma_fmu.identification.isobaric.model import branch_share, branch_levels
 from sma_fmu.runtime.constants import COOLING, HEATING, STANDARD_GRAVITY
 
 __all__ = ["IsobaricProgramme", "temperature_programme", "wire_temperature", "isobaric_table", "isobaric_text",

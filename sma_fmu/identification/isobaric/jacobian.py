@@ -5,7 +5,7 @@ x_T = x_min - l_MF, the strain residual eps_hot + (span + d_offset) q + offset -
 differentiates through q (dq/dLambda = -q(1-q)) into the centres (a, b), E (nu, l_MF,
 x_min) and the wire temperature T; T = lagged(B c) (the profile's knots c, the lag's time
 constant), so dT/dc = lagged(B) (sparse: each hat function's decaying response) and dT/dtau
-comes from :func:`sma_fmu.identification.isobaric_lag.lag_derivative`. The levels
+comes from :func:`sma_fmu.identification.isobaric.lag.lag_derivative`. The levels
 (l_MF, x_min, R_P, R_MF) and the offsets enter directly. Rows: temperature (profile -
 measured)/sigma_T, strain, resistance. tests/test_isobaric.py checks it against central
 differences.
@@ -13,9 +13,9 @@ differences.
 import numpy as np
 from scipy import sparse
 
-from sma_fmu.identification.isobaric_lag import lag_derivative, lagged
-from sma_fmu.identification.isobaric_model import branch_levels, branch_share
-from sma_fmu.identification.isobaric_profile import lagged_basis, wire_rows
+from sma_fmu.identification.isobaric.lag import lag_derivative, lagged
+from sma_fmu.identification.isobaric.model import branch_levels, branch_share
+from sma_fmu.identification.isobaric.profile import lagged_basis, wire_rows
 from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 
 __all__ = ["file_state", "file_model", "file_jacobian", "through_temperature"]

@@ -21,7 +21,7 @@ fraction, a length [m] far from the reference length like millimetres (and back)
 The load comes from the caller or a preamble line ``load: 0.15 kg`` (g and N too) or
 ``stress: 83 MPa``.
 
-Branches and cycles: :mod:`sma_fmu.identification.isobaric_cycles` (scales from the
+Branches and cycles: :mod:`sma_fmu.identification.isobaric.cycles` (scales from the
 temperature's dominant period, so 2 and 1,000 cycles per file read alike); ``cycles``
 keeps a range of them. The ``smoothed`` temperature kept for the tangent construction is
 filtered again over a quarter of the median branch length.
@@ -32,9 +32,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from sma_fmu.identification.isobaric_cycles import (Branch, select_cycles, smooth,
+from sma_fmu.identification.isobaric.cycles import (Branch, select_cycles, smooth,
                                                    split_branches)
-from sma_fmu.identification.isobaric_synthetic import load_of_stress
+from sma_fmu.identification.isobaric.synthetic import load_of_stress
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 
@@ -71,7 +71,7 @@ class IsobaricData:
     time: np.ndarray            # or None
     smoothed: np.ndarray        # smoothed temperature [degC]
     branches: list
-    splitting: object = None    # isobaric_cycles.Splitting: how the branches were found
+    splitting: object = None    # cycles.Splitting: how the branches were found
 
     @property
     def levels(self):
@@ -272,7 +272,7 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     ``load`` [kg] wins over a load stated in the preamble; ``reference_length`` [m] is the
     length strain is measured from (length and extension columns are converted with it);
     ``diameter`` [m] converts a preamble ``stress: ... MPa``; ``cycles`` = (first, last)
-    cycle numbers to keep (None: all; an end None: open), see ``isobaric_cycles.parse_cycles``.
+    cycle numbers to keep (None: all; an end None: open), see ``cycles.parse_cycles``.
     """
     path = Path(path)
     preamble, names, rows, decimal_comma = _table(path)

@@ -1,0 +1,22 @@
+"""The isobaric fit: the constant-load model identified from a lab's thermal-cycling files.
+
+The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` writes
+``identified.toml``, which ``sma-fmu build --model`` turns into FMUs (docs/identification.md).
+
+- :mod:`~.files`: read lab files (columns, units, preamble) into branches and cycles
+  (:func:`read_isobaric`), splitting them with :mod:`~.cycles`;
+- :mod:`~.fit`: the joint fit of parameters, temperature profile and lag (:func:`fit_isobaric`),
+  on :mod:`~.model` (the model along the cycles), :mod:`~.profile` and :mod:`~.lag` (the wire's
+  temperature), :mod:`~.layout` (the unknowns), :mod:`~.jacobian` and :mod:`~.solver`
+  (sparse Levenberg-Marquardt);
+- :mod:`~.runner`: ``sma-fmu fit isobaric`` (the parameter file, report, per-cycle
+  :mod:`~.tables` and :mod:`~.figures`); not imported here, so reading and fitting need no
+  matplotlib;
+- :mod:`~.synthetic`: seeded synthetic files for ``sma-fmu synth isobaric`` and the tests.
+"""
+from sma_fmu.identification.isobaric.files import IsobaricData, read_isobaric
+from sma_fmu.identification.isobaric.fit import LAG_OPTIONS, RESIDUAL_OPTIONS, IsobaricFit, fit_isobaric
+from sma_fmu.identification.isobaric.synthetic import IsobaricProgramme, isobaric_table, isobaric_text
+
+__all__ = ["IsobaricData", "read_isobaric", "LAG_OPTIONS", "RESIDUAL_OPTIONS", "IsobaricFit",
+           "fit_isobaric", "IsobaricProgramme", "isobaric_table", "isobaric_text"]
