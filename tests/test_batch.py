@@ -22,9 +22,9 @@ import pytest
 import sma_fmu.runtime.feedforward as runtime_feedforward
 import sma_fmu.runtime.plant as runtime_plant
 import sma_fmu.runtime.sensing as runtime_sensing
-import sma_fmu.studies.batch as batch
-import sma_fmu.studies.batch_minor_loops as batch_minor_loops
-import sma_fmu.studies.batch_plant as batch_plant
+import sma_fmu.studies.batch.engine as batch_engine
+import sma_fmu.studies.batch.minor_loops as batch_minor_loops
+import sma_fmu.studies.batch.plant as batch_plant
 from sma_fmu.cosim.loop import LibraryCompensator, LibraryPlant, run_library, run_loop
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
@@ -32,7 +32,7 @@ from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, major_value, value_of
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.signals import ReferenceSignal
-from sma_fmu.studies.batch_inputs import BatchInputs
+from sma_fmu.studies.batch.inputs import BatchInputs
 from sma_fmu.studies import BatchUnsupported, StudyError, run_batch, run_many, template
 from sma_fmu.studies.random_set import ALL_CONTROLLERS, gain_grid_scenarios, random_scenarios
 
@@ -98,7 +98,7 @@ def test_random_sets_equal_the_library_path(seed, chunk, load_step_s, monkeypatc
     """Load steps at random times (one run each), or at 1.5 s in every run (then the
     plants' minor branches are re-evaluated for many runs at once)."""
     if chunk:   # tiny chunks: load steps and reversals inside chunks, many chunk boundaries
-        monkeypatch.setattr(batch, "CHUNK_ELEMENTS", chunk)
+        monkeypatch.setattr(batch_engine, "CHUNK_ELEMENTS", chunk)
     scenarios = mixed_set(24, seed, load_step_s=load_step_s)
     results = run_batch(scenarios, "timeseries")
     kinds = {(s.controller.kind, s.controller.inverse, s.hysteresis_mode) for s in scenarios}
@@ -215,7 +215,7 @@ def test_nested_minor_loops_equal_the_library_path(engine, monkeypatch):
     if engine != "default":
         monkeypatch.setattr(batch_plant, "FEW_RUNS", 0)
         monkeypatch.setattr(batch_minor_loops, "WINDOW", 2)
-        monkeypatch.setattr(batch, "CHUNK_ELEMENTS", 60)
+        monkeypatch.setattr(batch_engine, "CHUNK_ELEMENTS", 60)
     scenarios = nested_scenarios()
     results = run_batch(scenarios, "timeseries")
     counter = PushCounter(monkeypatch, plant=runtime_plant, compensator=runtime_feedforward)
@@ -247,7 +247,7 @@ def test_the_batch_stacks_are_the_scalar_stacks_and_never_exceed_the_depth(monke
                  or s.controller.inverse == "minor-loop"]
     made = {}
 
-    class CheckedPlant(batch.BatchPlant):
+    class CheckedPlant(batch_engine.BatchPlant):
         def __init__(self, inputs, ordered):
             super().__init__(inputs, ordered)
             made["plant"], made["order"], made["deepest"] = self, ordered, 0
@@ -257,7 +257,7 @@ def test_the_batch_stacks_are_the_scalar_stacks_and_never_exceed_the_depth(monke
             assert (self.reversal_count <= self.depth).all()
             made["deepest"] = max(made["deepest"], int(self.reversal_count.max()))
 
-    class CheckedFeedforward(batch.BatchFeedforward):
+    class CheckedFeedforward(batch_engine.BatchFeedforward):
         def __init__(self, inputs, ordered):
             super().__init__(inputs, ordered)
             made["feedforward"], made["stacked"] = self, 0
@@ -269,8 +269,8 @@ def test_the_batch_stacks_are_the_scalar_stacks_and_never_exceed_the_depth(monke
                                                                       memory.depths))
             made["stacked"] = max([made["stacked"]] + [len(points) for points in memory.points])
             return out
-    monkeypatch.setattr(batch, "BatchPlant", CheckedPlant)
-    monkeypatch.setattr(batch, "BatchFeedforward", CheckedFeedforward)
+    monkeypatch.setattr(batch_engine, "BatchPlant", CheckedPlant)
+    monkeypatch.setattr(batch_engine, "BatchFeedforward", CheckedFeedforward)
     run_batch(scenarios, "metrics")
     plant, feedforward, order = made["plant"], made["feedforward"], made["order"]
     assert made["deepest"] >= 4 and made["stacked"] >= 4
@@ -312,7 +312,7 @@ def test_plant_events_equal_the_scalar_plant_step_by_step(few_runs, monkeypatch)
             hysteresis_mode="switch" if index % 6 == 5 else "continuous",
             parameter_set=dataclasses.replace(scenario.parameter_set, params=params)))
     inputs = BatchInputs(scenarios)
-    plant = batch.BatchPlant(inputs, scenarios)
+    plant = batch_engine.BatchPlant(inputs, scenarios)
     steppers = [PlantStepper(s.params, s.T_start, s.hysteresis_mode, s.load.value(0.0))
                 for s in scenarios]
     hold = np.array([(65.0 - s.params.T_room) / s.params.K_th for s in scenarios])
@@ -354,7 +354,7 @@ def test_compensators_shared_by_a_gain_grid_equal_the_library_path():
 
 
 def test_streamed_metrics_equal_scenario_metrics(monkeypatch):
-    monkeypatch.setattr(batch, "CHUNK_ELEMENTS", 200)
+    monkeypatch.setattr(batch_engine, "CHUNK_ELEMENTS", 200)
     scenarios = mixed_set(12, 3)
     streamed = run_batch(scenarios, "metrics")
     for scenario, result in zip(scenarios, streamed):
@@ -395,12 +395,12 @@ def test_options_the_engine_lacks_are_refused_never_computed_differently():
     """A controller option added later (here a made-up one) is refused until implemented."""
     base = template("load-step-pi+ff-adaptive")
     minor = base.scenario({"scenario.stop_time_s": 3.0, "controller.inverse": "minor-loop"})
-    assert batch.unsupported_reason(minor) is None
+    assert batch_engine.unsupported_reason(minor) is None
     extended = dataclasses.make_dataclass("Extended", [("sensor_noise_ohm", float, 0.0)],
                                           bases=(type(minor.controller),), frozen=True)
     noisy = dataclasses.replace(minor, controller=extended(
         **dataclasses.asdict(minor.controller), sensor_noise_ohm=0.01))
-    assert "sensor_noise_ohm = 0.01" in batch.unsupported_reason(noisy)
+    assert "sensor_noise_ohm = 0.01" in batch_engine.unsupported_reason(noisy)
     with pytest.raises(BatchUnsupported, match="sensor_noise_ohm"):
         run_batch([minor, noisy])
     with pytest.raises(StudyError, match="path='library'"):
@@ -418,11 +418,11 @@ def test_run_batches_groups_by_step_and_duration_and_keeps_the_order():
     base = template("load-step-pi")
     items = [base.scenario({"scenario.stop_time_s": t, "controller.Ki_W_per_ohm_s": k})
              for t, k in ((3.0, 1.0), (4.0, 2.0), (3.0, 3.0))]
-    outcomes = batch.run_batches(items)
+    outcomes = batch_engine.run_batches(items)
     assert all(outcome.scenario is item for outcome, item in zip(outcomes, items))
     # t >= 10 % of the run, 1 ms steps: 0.3-3 s and 0.4-4 s
     assert [o.metrics["overall"]["samples"] for o in outcomes] == [2701, 3601, 2701]
     together = run_batch([items[0], items[2]])           # the two 3-s runs: one batch
     assert [outcomes[0].metrics, outcomes[2].metrics] == [r.metrics for r in together]
     assert all(o.path == "batch" and o.wall_time_s > 0 for o in outcomes)
-    assert batch.run_batches([]) == []
+    assert batch_engine.run_batches([]) == []

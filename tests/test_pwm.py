@@ -17,7 +17,7 @@ from sma_fmu.runtime.pwm import PwmDriver
 from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.studies import BatchUnsupported, run_batch
 from sma_fmu.studies.batch import unsupported_reason
-from sma_fmu.studies.batch_pwm import BatchPwm
+from sma_fmu.studies.batch.pwm import BatchPwm
 
 BATCH_TOLERANCE = 1e-10      # ohm, degC, m, W, kg, 1: the bound on every column
 PWM_SCENARIOS = ("setpoints-pwm-pi+ff-adaptive", "setpoints-pwm-continuous-pi+ff-adaptive")

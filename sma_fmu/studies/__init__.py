@@ -3,7 +3,8 @@
 - :mod:`~sma_fmu.studies.runs`: run a scenario with overrides on the library, FMU or batch
   path; time series as a pandas DataFrame, metrics as a record (:func:`run`, :func:`run_many`);
 - :mod:`~sma_fmu.studies.overrides`: scenarios with fields overridden (``"section.key"``);
-- :mod:`~sma_fmu.studies.batch`: N closed loops in lock-step with numpy (:func:`run_batch`);
+- :mod:`~sma_fmu.studies.batch`: the subpackage of the batch engine, N closed loops in lock-step
+  with numpy (:func:`run_batch`; its throughput: :mod:`~sma_fmu.studies.batch_benchmark`);
 - :mod:`~sma_fmu.studies.spec`, :mod:`~sma_fmu.studies.design`, :mod:`~sma_fmu.studies.sweep`,
   :mod:`~sma_fmu.studies.results`: study specs, their designs, ``sma-fmu sweep``, its results;
 - :mod:`~sma_fmu.studies.tuning`: ``sma-fmu tune``.

@@ -4,7 +4,7 @@ The compensator is open loop: its output at step k depends only on R_ref(t_k), f
 its own memory (d_ref, the minor-loop reversal stack, the filter), never on the plant. So the
 inverse of :mod:`~sma_fmu.runtime.sensing` (major branch of the reference direction, at the
 measured or the fixed model load, with the saturation clamp; for ``inverse = "minor-loop"``
-the branch of the compensator's own stack of reversal points, :mod:`.batch_minor_loops`) is
+the branch of the compensator's own stack of reversal points, :mod:`.minor_loops`) is
 computed for a whole chunk of steps in a few numpy calls, once per distinct compensator
 (runs that differ only in gains or filter share it), and only the phase-lag filter
 (Tustin, started in steady state) runs step by step, per run. The operations are those of
@@ -17,7 +17,7 @@ several times slower), in place (``out=``) where it can.
 import numpy as np
 
 from sma_fmu.runtime.phase_lag import tustin_coefficients
-from sma_fmu.studies.batch_minor_loops import (MinorLoopMemory, clamp_fractions,
+from sma_fmu.studies.batch.minor_loops import (MinorLoopMemory, clamp_fractions,
                                                temperature_of_fractions)
 
 __all__ = ["BatchFeedforward", "FeedforwardChunk"]

@@ -77,7 +77,7 @@ class _Totals:
 class MetricsAccumulator:
     """Metrics of every run of a batch from chunks of e_k = R_k - R_ref(t_k), P_k and flags.
 
-    ``inputs`` is the batch's :class:`~sma_fmu.studies.batch_inputs.BatchInputs`;
+    ``inputs`` is the batch's :class:`~sma_fmu.studies.batch.inputs.BatchInputs`;
     ``scenarios`` give the load segments and the metrics window.
     """
 

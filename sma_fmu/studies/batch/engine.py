@@ -6,7 +6,7 @@ quantity is an array of N. Per step k, as :func:`sma_fmu.cosim.loop.run_loop` do
 e_k = R_k - R_ref(t_k); u_k = max(0, u_ff,k + Kp e_k + Ki I_k), with the integrator held
 while clamped with e_k <= 0; the plants step with u_k and f(t_k) held, or, for runs with a
 PWM drive, with the mean of their PWM wave over the step for the demand u_k
-(:mod:`sma_fmu.studies.batch_pwm`; Gauss-Seidel, as the library path's default). The results
+(:mod:`sma_fmu.studies.batch.pwm`; Gauss-Seidel, as the library path's default). The results
 equal the scalar library path's to rounding (tests/test_batch.py, tests/test_pwm.py: <= 1e-10
 on every column).
 
@@ -29,11 +29,11 @@ from sma_fmu.cosim.loop import TIMESERIES_DTYPE, run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import CONTROLLERS, Scenario
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
-from sma_fmu.studies.batch_feedforward import BatchFeedforward
-from sma_fmu.studies.batch_inputs import BatchInputs
-from sma_fmu.studies.batch_metrics import MetricsAccumulator
-from sma_fmu.studies.batch_plant import BatchPlant
-from sma_fmu.studies.batch_pwm import BatchPwm
+from sma_fmu.studies.batch.feedforward import BatchFeedforward
+from sma_fmu.studies.batch.inputs import BatchInputs
+from sma_fmu.studies.batch.metrics import MetricsAccumulator
+from sma_fmu.studies.batch.plant import BatchPlant
+from sma_fmu.studies.batch.pwm import BatchPwm
 
 __all__ = ["BatchUnsupported", "BatchRun", "RECORDS", "unsupported_reason", "run_batch",
            "run_batches", "chunk_steps", "chunk_bounds"]

@@ -31,7 +31,7 @@ from sma_fmu.runtime.constant_load import BranchConstants
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
 from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, push_reversal
 from sma_fmu.runtime.sensing import invert_on_stack
-from sma_fmu.studies.batch_plant import major_fractions
+from sma_fmu.studies.batch.plant import major_fractions
 
 __all__ = ["clamp_fractions", "temperature_of_fractions", "MinorLoopMemory", "WINDOW"]
 
