@@ -1,4 +1,4 @@
-"""Scenario files (TOML): what to simulate, with which controller, for how long.
+"""Read and check a scenario file (TOML): what to simulate, with which controller, how long.
 
 Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
 
@@ -41,13 +41,13 @@ Every problem raises :class:`ScenarioError` naming the file, the key and what is
 A run may have at most :data:`MAX_STEPS` steps.
 """
 import math
-from collections import namedtuple
-from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.cosim.recording import interval_steps
+from sma_fmu.cosim.scenario.settings import (CONTROLLERS, AnalysisWindow, ControllerSettings,
+                                             DriveSettings, Scenario, ScenarioError,
+                                             default_analysis)
 from sma_fmu.wire.parameter_file import load_parameter_set
-from sma_fmu.files.package_data import shipped_file, shipped_files
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
@@ -58,15 +58,9 @@ from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
 from sma_fmu.files.toml_files import read_toml
 
-__all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "AnalysisWindow", "Scenario",
-           "CONTROLLERS",
-           "PAPER_SET", "MAX_STEPS", "load_scenario", "read_scenario_document",
-           "scenario_from_document", "check_sections", "default_analysis", "scenario_names",
-           "resolve_scenarios"]
+__all__ = ["MAX_STEPS", "load_scenario", "read_scenario_document", "scenario_from_document",
+           "check_sections"]
 
-CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")
-PAPER_SET = tuple(f"{profile}-{controller}" for profile in ("load-step", "heavy")
-                  for controller in CONTROLLERS)
 MAX_STEPS = 4_000_000  # 66 min at 1 ms; the time series (113 B per step) is held in memory
 _SECTIONS = {
     "scenario": {"description", "stop_time_s", "step_s", "model", "group", "output_interval_s"},
@@ -79,128 +73,8 @@ _SECTIONS = {
     "drive": {"kind", "frequency_Hz", "peak_W"},
 }
 
-AnalysisWindow = namedtuple("AnalysisWindow", ["metrics_start_s", "zoom_start_s", "zoom_end_s"])
-AnalysisWindow.__doc__ = """Windows of the results [s]: metrics over t >= metrics_start_s; the
-comparison figures enlarge zoom_start_s ... zoom_end_s."""
-
-
-def default_analysis(stop_time_s):
-    """The default :class:`AnalysisWindow` of a run lasting ``stop_time_s`` [s].
-
-    The paper's 30-s run gives its choices: metrics over t >= 2 s (the start-up transient
-    left out) and an enlarged window of 24-28 s (its Fig. 11). A shorter run scales them:
-    metrics from min(2 s, 10 % of the run), the window ending min(2 s, 10 %) before the end
-    and lasting min(4 s, 40 %).
-    """
-    margin = min(2.0, 0.1 * stop_time_s)
-    zoom_end = stop_time_s - margin
-    return AnalysisWindow(margin, zoom_end - min(4.0, 0.4 * stop_time_s), zoom_end)
-
-
 _GAIN_KEYS = {"Kp_W_per_ohm": "Kp", "Ki_W_per_ohm_s": "Ki", "alpha_s": "phase_lag_alpha",
               "beta_s": "beta", "model_load_kg": "model_load"}
-
-
-class ScenarioError(ValueError):
-    """A scenario file or name is wrong; the message names the file, the key and the problem."""
-
-
-@dataclass(frozen=True)
-class ControllerSettings:
-    """Controller of a scenario: kind and gains (Kp [W/ohm], Ki [W/(ohm.s)], alpha, beta [s],
-    model_load [kg] of the fixed compensator) and the compensator's inverse ("major" or
-    "minor-loop", see :class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`)."""
-
-    kind: str
-    Kp: float
-    Ki: float
-    alpha: float
-    beta: float
-    model_load: float
-    inverse: str = "major"
-
-    @property
-    def feedforward(self):
-        """True when the controller uses the compensator."""
-        return self.kind != "pi"
-
-    @property
-    def adapt_to_load(self):
-        """True when the compensator's inverse uses the measured load."""
-        return self.kind == "pi+ff-adaptive"
-
-
-@dataclass(frozen=True)
-class DriveSettings:
-    """How the loop's power reaches the wire: ``kind`` "power" (the demanded power itself) or
-    "pwm" (:class:`~sma_fmu.runtime.pwm.PwmDriver` at ``frequency_Hz`` [Hz] between 0 and
-    ``peak_W`` [W]; the plant gets the PWM wave's mean over each step)."""
-
-    kind: str = "power"
-    frequency_Hz: float = None
-    peak_W: float = None
-
-    @property
-    def pwm(self):
-        """True when the power is switched by a PWM driver."""
-        return self.kind == "pwm"
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """A validated scenario (see the module docstring for the file format)."""
-
-    name: str
-    path: Path
-    description: str
-    stop_time_s: float
-    step_s: float
-    reference: object
-    load: object
-    controller: ControllerSettings
-    hysteresis_mode: str
-    T_start: float
-    parameter_set: object
-    analysis_window: AnalysisWindow = None   # the file's [analysis]; None: from the duration
-    group_name: str = None
-    compensator_parameter_set: object = None   # the compensator's model; None: the wire's
-    drive: DriveSettings = DriveSettings()     # the file's [drive]; default: power as demanded
-    output_interval_s: float = None            # record every k-th step [s]; None: every step
-
-    @property
-    def params(self):
-        """The wire's WireParameters."""
-        return self.parameter_set.params
-
-    @property
-    def compensator_params(self):
-        """The WireParameters of the compensator's inverse model: the wire's, unless a study
-        gives the model other values than the wire (``compensator_parameter_set``)."""
-        chosen = self.compensator_parameter_set or self.parameter_set
-        return chosen.params
-
-    @property
-    def steps(self):
-        """Number of communication steps n = stop_time / step."""
-        return int(round(self.stop_time_s / self.step_s))
-
-    @property
-    def analysis(self):
-        """The :class:`AnalysisWindow`: the file's ``[analysis]``, or the duration's defaults."""
-        return self.analysis_window or default_analysis(self.stop_time_s)
-
-    @property
-    def group(self):
-        """The comparison group: ``[scenario] group``, or the name up to ``-<controller kind>``.
-
-        Scenarios of one group share a figure and a ranking (e.g. load-step-pi,
-        load-step-pi+ff-adaptive and load-step-pi+ff-adaptive-minor-loop: "load-step").
-        """
-        if self.group_name:
-            return self.group_name
-        cut = self.name.find("-" + self.controller.kind)
-        return self.name[:cut] if cut > 0 else self.name
-
 
 def _fail(path, message):
     raise ScenarioError(f"{path}: {message}")
@@ -389,34 +263,3 @@ def scenario_from_document(document, path, parameter_set=None):
         analysis_window=_analysis(path, document["analysis"], stop) if "analysis" in document else None,
         group_name=_string(path, "scenario", head, "group"), output_interval_s=interval,
         drive=_drive(path, document["drive"]) if "drive" in document else DriveSettings())
-
-
-def scenario_names():
-    """Names (file stems) of the scenarios shipped with the package, sorted."""
-    return [name[:-len(".toml")] for name in shipped_files("scenarios", ".toml")]
-
-
-def resolve_scenarios(items, everything=False):
-    """Scenario files for names, paths, ``"paper"`` (the paper's set) or ``everything``.
-
-    An item that names an existing file is that file, whatever its name; otherwise it must
-    be the name of a shipped scenario.
-    """
-    names = list(scenario_names()) if everything else []
-    for item in items:
-        names.extend(PAPER_SET if item == "paper" else [item])
-    if not names:
-        raise ScenarioError("no scenario given; name one, or use 'paper' or --all")
-    paths = []
-    for name in names:
-        candidate = Path(name)
-        if candidate.is_file():
-            paths.append(candidate)
-        elif candidate.exists():
-            raise ScenarioError(f"{candidate}: is not a file (a scenario is a .toml file)")
-        elif name in scenario_names():
-            paths.append(shipped_file("scenarios", f"{name}.toml"))
-        else:
-            raise ScenarioError(f"unknown scenario {name!r}: no such file, and not one of the "
-                                f"shipped scenarios ({', '.join(scenario_names())}) or 'paper'")
-    return list(dict.fromkeys(paths))

@@ -1,0 +1,128 @@
+"""What a validated scenario holds: the :class:`Scenario` record, its controller, drive and
+analysis settings, and :class:`ScenarioError`, the error of every scenario problem."""
+from collections import namedtuple
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "AnalysisWindow", "Scenario",
+           "CONTROLLERS", "default_analysis"]
+
+CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")
+
+AnalysisWindow = namedtuple("AnalysisWindow", ["metrics_start_s", "zoom_start_s", "zoom_end_s"])
+AnalysisWindow.__doc__ = """Windows of the results [s]: metrics over t >= metrics_start_s; the
+comparison figures enlarge zoom_start_s ... zoom_end_s."""
+
+
+def default_analysis(stop_time_s):
+    """The default :class:`AnalysisWindow` of a run lasting ``stop_time_s`` [s].
+
+    The paper's 30-s run gives its choices: metrics over t >= 2 s (the start-up transient
+    left out) and an enlarged window of 24-28 s (its Fig. 11). A shorter run scales them:
+    metrics from min(2 s, 10 % of the run), the window ending min(2 s, 10 %) before the end
+    and lasting min(4 s, 40 %).
+    """
+    margin = min(2.0, 0.1 * stop_time_s)
+    zoom_end = stop_time_s - margin
+    return AnalysisWindow(margin, zoom_end - min(4.0, 0.4 * stop_time_s), zoom_end)
+
+
+class ScenarioError(ValueError):
+    """A scenario file or name is wrong; the message names the file, the key and the problem."""
+
+
+@dataclass(frozen=True)
+class ControllerSettings:
+    """Controller of a scenario: kind and gains (Kp [W/ohm], Ki [W/(ohm.s)], alpha, beta [s],
+    model_load [kg] of the fixed compensator) and the compensator's inverse ("major" or
+    "minor-loop", see :class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`)."""
+
+    kind: str
+    Kp: float
+    Ki: float
+    alpha: float
+    beta: float
+    model_load: float
+    inverse: str = "major"
+
+    @property
+    def feedforward(self):
+        """True when the controller uses the compensator."""
+        return self.kind != "pi"
+
+    @property
+    def adapt_to_load(self):
+        """True when the compensator's inverse uses the measured load."""
+        return self.kind == "pi+ff-adaptive"
+
+
+@dataclass(frozen=True)
+class DriveSettings:
+    """How the loop's power reaches the wire: ``kind`` "power" (the demanded power itself) or
+    "pwm" (:class:`~sma_fmu.runtime.pwm.PwmDriver` at ``frequency_Hz`` [Hz] between 0 and
+    ``peak_W`` [W]; the plant gets the PWM wave's mean over each step)."""
+
+    kind: str = "power"
+    frequency_Hz: float = None
+    peak_W: float = None
+
+    @property
+    def pwm(self):
+        """True when the power is switched by a PWM driver."""
+        return self.kind == "pwm"
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario (the file format: :mod:`~sma_fmu.cosim.scenario.reading`)."""
+
+    name: str
+    path: Path
+    description: str
+    stop_time_s: float
+    step_s: float
+    reference: object
+    load: object
+    controller: ControllerSettings
+    hysteresis_mode: str
+    T_start: float
+    parameter_set: object
+    analysis_window: AnalysisWindow = None   # the file's [analysis]; None: from the duration
+    group_name: str = None
+    compensator_parameter_set: object = None   # the compensator's model; None: the wire's
+    drive: DriveSettings = DriveSettings()     # the file's [drive]; default: power as demanded
+    output_interval_s: float = None            # record every k-th step [s]; None: every step
+
+    @property
+    def params(self):
+        """The wire's WireParameters."""
+        return self.parameter_set.params
+
+    @property
+    def compensator_params(self):
+        """The WireParameters of the compensator's inverse model: the wire's, unless a study
+        gives the model other values than the wire (``compensator_parameter_set``)."""
+        chosen = self.compensator_parameter_set or self.parameter_set
+        return chosen.params
+
+    @property
+    def steps(self):
+        """Number of communication steps n = stop_time / step."""
+        return int(round(self.stop_time_s / self.step_s))
+
+    @property
+    def analysis(self):
+        """The :class:`AnalysisWindow`: the file's ``[analysis]``, or the duration's defaults."""
+        return self.analysis_window or default_analysis(self.stop_time_s)
+
+    @property
+    def group(self):
+        """The comparison group: ``[scenario] group``, or the name up to ``-<controller kind>``.
+
+        Scenarios of one group share a figure and a ranking (e.g. load-step-pi,
+        load-step-pi+ff-adaptive and load-step-pi+ff-adaptive-minor-loop: "load-step").
+        """
+        if self.group_name:
+            return self.group_name
+        cut = self.name.find("-" + self.controller.kind)
+        return self.name[:cut] if cut > 0 else self.name
