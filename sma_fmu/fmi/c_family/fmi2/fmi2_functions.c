@@ -12,6 +12,7 @@
  *  - a step that leaves the model's validity range: fmi2Warning with the model's warning
  *    (once per excursion: the runtime says when).
  * A pointer that is not a live instance gives fmi2Error (checked by a magic number). */
+#include "fp_contract.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -9,6 +9,7 @@
  * fmi2SetDebugLogging(false, 0, NULL) or by category; the categories are those of the model
  * description (logStatusWarning, logStatusDiscard, logStatusError, logStatusFatal, logAll).
  * A call returns at least the worst status it logged. */
+#include "fp_contract.h"
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

@@ -6,6 +6,7 @@
 #ifndef _WIN32
 #define _POSIX_C_SOURCE 200809L  /* stat() */
 #endif
+#include "fp_contract.h"
 #include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>

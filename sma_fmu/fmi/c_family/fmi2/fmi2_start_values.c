@@ -6,6 +6,7 @@
  * description's start attributes and the file cannot disagree for one family only.
  * A file that is not such a document, or a value that is not of the parameter's type, makes
  * fmi2Instantiate fail naming the file and the parameter, as in the pythonfmu FMUs. */
+#include "fp_contract.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -10,6 +10,7 @@
  * where str = u32 length + UTF-8 bytes. Reading refuses, with the reason, bytes of another
  * model, build (GUID: another build carries other compiled-in parameters) or stepper
  * format, truncated bytes, an entry out of range, and anything that follows the state. */
+#include "fp_contract.h"
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>

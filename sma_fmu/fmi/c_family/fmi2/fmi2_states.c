@@ -6,6 +6,7 @@
  * parameters and takes the saved doubles through the runtime's <x>_state_read, which
  * validates them as restore() does, and must write them back unchanged. A refused state
  * leaves the instance as it was: fmi2Error with the reason. */
+#include "fp_contract.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

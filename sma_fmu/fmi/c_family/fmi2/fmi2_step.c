@@ -1,6 +1,7 @@
 /* fmi2DoStep and the status functions of the native models (guard._do_step and the
  * pythonfmu FMUs' front): the model-free checks of t and h, the step, the discard, the
  * validity warning, and fmi2Terminated after the very same step was discarded twice. */
+#include "fp_contract.h"
 #include <math.h>
 #include <stdio.h>
 

@@ -4,6 +4,7 @@
  * SlaveInterface.setting_refusal / describe_reference's texts, followed by "; nothing was
  * set (value <repr>)" (guards.py: all or nothing). In Initialization Mode a get first
  * computes the outputs from what was set (guard._refresh_initial_outputs). */
+#include "fp_contract.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

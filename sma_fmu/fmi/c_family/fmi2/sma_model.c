@@ -1,4 +1,5 @@
 /* Model-free helpers the adapters share (declared in sma_model.h). */
+#include "fp_contract.h"
 #include <math.h>
 
 #include "sma_model.h"

@@ -5,6 +5,7 @@
  * are then the state at t + h. After initialization the outputs reflect T_start and the
  * load. Invalid parameters refuse fmi2ExitInitializationMode; hysteresis_mode is an Integer
  * (1 = continuous, 2 = switch); a step leaving the validity range logs fmi2Warning. */
+#include "fp_contract.h"
 #include "plant.h"
 #include "sma_choices.h"
 #include "sma_wire.h"

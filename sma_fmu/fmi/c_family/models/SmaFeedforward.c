@@ -7,6 +7,7 @@
  * initialization the outputs are those of the first sample (filter in steady state).
  * Invalid parameters refuse fmi2ExitInitializationMode; inverse is an Integer
  * (1 = major, 2 = minor-loop). */
+#include "fp_contract.h"
 #include "feedforward.h"
 #include "sma_choices.h"
 #include "sma_wire.h"

@@ -6,6 +6,7 @@
  * u_k = max(0, P_ff + Kp e_k + Ki I_k) with e_k = R - R_ref, and the integrator advances.
  * Before the first step the outputs are those the first step will give. Non-finite inputs
  * discard the step; invalid gains refuse fmi2ExitInitializationMode. */
+#include "fp_contract.h"
 #include "pi_control.h"
 #include "sma_wire.h"
 #include "SmaPiController_variables.h"

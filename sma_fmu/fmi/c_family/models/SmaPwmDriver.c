@@ -7,6 +7,7 @@
  * millionth of a step of a grid point and is h_0 long within as much is [t_k, t_k + h_0)
  * exactly. After initialization P_in is 0 W. Invalid parameters refuse
  * fmi2ExitInitializationMode; a non-finite P_demand discards the step. */
+#include "fp_contract.h"
 #include "pwm.h"
 #include "scenario_signals.h"
 #include "SmaPwmDriver_variables.h"

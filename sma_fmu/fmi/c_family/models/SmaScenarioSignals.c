@@ -8,6 +8,7 @@
  * A source: after initialization the outputs are the signals at the start time; after
  * doStep(t, h) at t + h, on the step's grid. Invalid tables refuse
  * fmi2ExitInitializationMode naming the parameter and the key. */
+#include "fp_contract.h"
 #include "scenario_signals.h"
 #include "SmaScenarioSignals_variables.h"
 

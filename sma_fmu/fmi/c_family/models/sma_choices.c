@@ -1,4 +1,5 @@
 /* Integer codes of named settings (sma_choices.h; slave_support/choices.py). */
+#include "fp_contract.h"
 #include <string.h>
 
 #include "sma_choices.h"

@@ -1,4 +1,5 @@
 /* The wire parameters of an instance (sma_wire.h). */
+#include "fp_contract.h"
 #include <stdio.h>
 
 #include "sma_wire.h"

@@ -1,4 +1,5 @@
 /* Argument checks; runtime/checks.py (see checks.h). */
+#include "fp_contract.h"
 #include "checks.h"
 
 #include <ctype.h>

@@ -1,4 +1,5 @@
 /* Constant-load model; runtime/constant_load.py (see constant_load.h). */
+#include "fp_contract.h"
 #include "constant_load.h"
 
 #include <math.h>

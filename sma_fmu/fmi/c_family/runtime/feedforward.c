@@ -1,4 +1,5 @@
 /* Stateful feedforward compensator; runtime/feedforward.py (see feedforward.h). */
+#include "fp_contract.h"
 #include "feedforward.h"
 
 #include <math.h>

@@ -6,6 +6,7 @@
  * midpoints between neighbouring doubles in big-integer arithmetic. D keeps at most
  * MAX_DIGITS digits plus a sticky digit: a midpoint between doubles has at most 767
  * significant digits, so the comparisons come out as for the full text. */
+#include "fp_contract.h"
 #include "json_number.h"
 
 #include <float.h>

@@ -1,4 +1,5 @@
 /* Python's repr() of loaded JSON values, for messages, and member look-up (json_text.h). */
+#include "fp_contract.h"
 #include "json_text.h"
 
 #include <math.h>

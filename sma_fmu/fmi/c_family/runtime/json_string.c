@@ -1,5 +1,6 @@
 /* JSON strings for json_text.c: CPython's scanstring (strict), UTF-8 in and out, and the
  * decoder's error positions (see json_string.h). */
+#include "fp_contract.h"
 #include "json_string.h"
 
 #include <stdio.h>

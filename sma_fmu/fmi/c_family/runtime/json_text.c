@@ -3,6 +3,7 @@
  * The scanner follows CPython's _json.c (scan_once, _parse_object, _parse_array,
  * scanstring, _match_number) step by step, so it accepts, refuses and positions its
  * messages as json.loads does. */
+#include "fp_contract.h"
 #include "json_text.h"
 
 #include <math.h>

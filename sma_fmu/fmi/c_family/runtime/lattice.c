@@ -1,4 +1,5 @@
 /* Crystal-lattice constants; runtime/lattice.py (see lattice.h). */
+#include "fp_contract.h"
 #include "lattice.h"
 
 #include <math.h>

@@ -1,4 +1,5 @@
 /* Minor loops with return-point memory; runtime/minor_loops.py (see minor_loops.h). */
+#include "fp_contract.h"
 #include "minor_loops.h"
 
 #include <math.h>

@@ -1,4 +1,5 @@
 /* The wire parameter set; runtime/parameters.py (see parameters.h). */
+#include "fp_contract.h"
 #include "parameters.h"
 
 #include <math.h>

@@ -1,4 +1,5 @@
 /* Phase-lag compensator Cpl(s), Tustin; runtime/phase_lag.py (see phase_lag.h). */
+#include "fp_contract.h"
 #include "phase_lag.h"
 
 #include <math.h>

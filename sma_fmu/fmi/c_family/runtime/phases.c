@@ -1,4 +1,5 @@
 /* Phase fractions and their observables; runtime/phases.py (see phases.h). */
+#include "fp_contract.h"
 #include "phases.h"
 
 #include <math.h>

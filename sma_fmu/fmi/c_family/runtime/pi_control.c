@@ -1,4 +1,5 @@
 /* PI feedback with anti-windup; runtime/pi_control.py (see pi_control.h). */
+#include "fp_contract.h"
 #include "pi_control.h"
 
 #include <math.h>

@@ -1,4 +1,5 @@
 /* Stateful plant; runtime/plant.py (see plant.h). */
+#include "fp_contract.h"
 #include "plant.h"
 
 #include <math.h>

@@ -1,4 +1,5 @@
 /* A PWM wire driver; runtime/pwm.py (see pwm.h). */
+#include "fp_contract.h"
 #include "pwm.h"
 
 #include <math.h>

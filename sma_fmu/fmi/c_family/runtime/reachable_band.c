@@ -1,4 +1,5 @@
 /* The reachable resistance band; runtime/reachable_band.py (see reachable_band.h). */
+#include "fp_contract.h"
 #include "reachable_band.h"
 
 #include "constants.h"

@@ -1,5 +1,6 @@
 /* A scenario's signals as a co-simulation source; runtime/scenario_signals.py (see
  * scenario_signals.h). */
+#include "fp_contract.h"
 #include "scenario_signals.h"
 
 #include <math.h>

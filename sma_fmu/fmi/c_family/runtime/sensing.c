@@ -1,4 +1,5 @@
 /* Temperature-sensing inverse; runtime/sensing.py (see sensing.h). */
+#include "fp_contract.h"
 #include "sensing.h"
 
 #include <math.h>

@@ -1,4 +1,5 @@
 /* Scenario signals; runtime/signals.py (see signals.h). */
+#include "fp_contract.h"
 #include "signals.h"
 
 #include <math.h>

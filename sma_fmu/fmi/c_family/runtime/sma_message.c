@@ -1,4 +1,5 @@
 /* Error messages of the C runtime (see sma_message.h). */
+#include "fp_contract.h"
 #include "sma_message.h"
 
 #include <stdarg.h>

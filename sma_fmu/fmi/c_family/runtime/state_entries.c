@@ -1,4 +1,5 @@
 /* Reading a stepper's saved state; runtime/state_entries.py (see state_entries.h). */
+#include "fp_contract.h"
 #include "state_entries.h"
 
 #include <string.h>

@@ -1,4 +1,5 @@
 /* First-order thermal model; runtime/thermal.py (see thermal.h). */
+#include "fp_contract.h"
 #include "thermal.h"
 
 #include <math.h>

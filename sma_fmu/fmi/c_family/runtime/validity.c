@@ -1,4 +1,5 @@
 /* Validity warnings; runtime/validity.py (see validity.h). */
+#include "fp_contract.h"
 #include "validity.h"
 
 #include <stdio.h>
