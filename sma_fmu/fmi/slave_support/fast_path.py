@@ -134,7 +134,7 @@ class FastPath:
         self._changing_struct = struct.Struct(f"{1 + n_changing}d")
         self._raw = memoryview(array).cast("B")
         self._log_queue = self.guard.slave._get_log_queue()  # pythonfmu's list (it empties it)
-        self._entry = self.step  # kept alive with the slave: the front holds its address
+        self._entry = self._direct_step()  # kept alive with the slave: the front holds its address
         self.write_all()
         self.view[_QUEUE] = float(id(self._log_queue))
         self.view[_ENTRY] = float(id(self._entry))
@@ -193,20 +193,39 @@ class FastPath:
             view[_STEP_COMPLETE] = 0.0
         view[_WRITTEN] = 1.0
 
-    def step(self):
+    def _direct_step(self):
         """fmi2DoStep called by the front after its checks passed (the guard's do_step
-        without them): t and h from the header; True if done. The front then looks at the
-        log queue (its address is in the header too): pythonfmu passes what is queued on
-        (see ``LOG``)."""
-        view, guard = self.view, self.guard
-        try:
-            if view[PENDING]:
-                self.take_inputs()
-            return guard.advance(view[_T], view[_H])
-        except Exception as error:  # noqa: BLE001 - nothing may reach the front
-            return guard.internal("fmi2DoStep", error, False)
-        finally:
-            self.write_step()
+        without them), as a closure over what it needs (no lookups per step): t and h from
+        the header, the pending inputs, the guard's advance(), then the time and the values
+        a step changes (:meth:`write_step`; the front saw stepComplete and nothing stale, so
+        only a change of state is written). True if done. The front then looks at the log
+        queue (its address is in the header too): pythonfmu passes what is queued on (see
+        ``LOG``)."""
+        view, raw, guard, slave, inputs = self.view, self._raw, self.guard, self.guard.slave, self._inputs
+        advance, internal, read = guard.advance, guard.internal, self._changing
+        pack_into, offset = self._changing_struct.pack_into, 8 * _TIME
+
+        def step():
+            try:
+                if view[PENDING]:  # take_inputs()
+                    for value, pending, name, convert in inputs:
+                        if view[pending]:
+                            setattr(slave, name, convert(view[value]))
+                            view[pending] = 0.0
+                    view[PENDING] = 0.0
+                return advance(view[_T], view[_H])
+            except Exception as error:  # noqa: BLE001 - nothing may reach the front
+                return internal("fmi2DoStep", error, False)
+            finally:
+                try:
+                    time = guard.time
+                    pack_into(raw, offset, _NAN if time is None else time, *read(slave))
+                    if guard.state is not STEP_COMPLETE:
+                        view[_STEP_COMPLETE] = 0.0
+                except Exception:  # noqa: BLE001 - then every call goes to the guard
+                    view[_STEP_COMPLETE] = 0.0
+                view[_WRITTEN] = 1.0
+        return step
 
     def sync(self, reference):
         """fmi2GetString(SYNC) from the front: take the pending inputs, write every value;

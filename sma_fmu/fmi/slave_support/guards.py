@@ -63,6 +63,7 @@ class CallGuard:
         self._model = {name: getattr(slave, name) for name in (
             "setup_experiment", "enter_initialization_mode", "exit_initialization_mode",
             "do_step", "terminate", "to_xml", "_get_fmu_state", "_set_fmu_state")}
+        self._model_step = self._model["do_step"]
         for name in ("setup_experiment", "enter_initialization_mode", "exit_initialization_mode",
                      "do_step", "terminate", "to_xml", "set_real", "get_real", "set_boolean",
                      "get_boolean", "set_string", "get_string", "set_integer", "get_integer"):
@@ -221,7 +222,7 @@ class CallGuard:
         finiteness, the next communication point and the validity warning."""
         function = "fmi2DoStep"
         try:
-            done = bool(self._model["do_step"](current_time, step_size))
+            done = bool(self._model_step(current_time, step_size))
         except Exception as error:  # noqa: BLE001 - a step the model rejects is discarded
             # "<model> '<instance>': step at t = ... s discarded: <why>" (no function name)
             self.interface.log(f"step at t = {current_time!r} s discarded: {error}",

@@ -39,7 +39,9 @@ class StepperSlave(Fmi2Slave):
 
     def do_step(self, current_time, step_size):
         if self.snaps_step:
-            step_size = self.interface.nominal_step(step_size)
+            interface = self.interface
+            if step_size != interface.first_step:  # (equal: nominal_step gives it back)
+                step_size = interface.nominal_step(step_size)
         self._publish(self._advance(current_time, step_size))
         return True
 
