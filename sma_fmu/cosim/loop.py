@@ -167,6 +167,11 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
     nan = math.nan
     no_compensator = (0.0, nan, False)
     rows, first_row = [], 0
+    append = rows.append
+    # the blocks' steps looked up once, not per step
+    plant_step, pi_step = plant.step, pi.step
+    compensator_step = None if compensator is None else compensator.step
+    driver_step = None if driver is None else driver.step
     resistance, temperature, length, xi_p, xi_m, xi_f, _ = plant.outputs()
     start_length = length
     if jacobi:  # what the blocks show after initialization: a Jacobi host passes it on at k = 0
@@ -178,26 +183,26 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
         time_s = k * h
         reference, load = reference_at(time_s), load_at(time_s)
         error = resistance - reference
-        if compensator is None:
+        if compensator_step is None:
             compensated = no_compensator
         else:
-            compensated = compensator.step(time_s, reference, load, h)
+            compensated = compensator_step(time_s, reference, load, h)
         p_ff, t_ref, saturated = compensated
         if jacobi:  # the PI, the driver and the plant get what their sources had at t_k
-            power, feedback = pi.step(error, held_ff[0], h)
-            if driver is None:
+            power, feedback = pi_step(error, held_ff[0], h)
+            if driver_step is None:
                 plant_power = held_power
             else:
-                plant_power, held_drive = held_drive, driver.step(time_s, held_power, h)
+                plant_power, held_drive = held_drive, driver_step(time_s, held_power, h)
             held_ff, held_power = compensated, power
         else:
-            power, feedback = pi.step(error, p_ff, h)
-            plant_power = power if driver is None else driver.step(time_s, power, h)
+            power, feedback = pi_step(error, p_ff, h)
+            plant_power = power if driver_step is None else driver_step(time_s, power, h)
         sample = (time_s, reference, resistance, temperature, t_ref, length, start_length - length,
                   xi_p, xi_m, xi_f, p_ff, feedback)
-        resistance, temperature, length, xi_p, xi_m, xi_f, applied = plant.step(
+        resistance, temperature, length, xi_p, xi_m, xi_f, applied = plant_step(
             time_s, plant_power, load, h)
-        rows.append(sample + (applied, load, saturated))
+        append(sample + (applied, load, saturated))
         if len(rows) == ROWS_PER_CHUNK:  # into the result: a tuple row costs ~5x its 113 bytes
             if sink is None:
                 data[first_row:first_row + ROWS_PER_CHUNK] = rows
@@ -207,6 +212,7 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
                 sink(data)
                 data = np.empty(ROWS_PER_CHUNK, dtype=TIMESERIES_DTYPE)
             rows = []
+            append = rows.append
     time_s = n * h
     rows.append((time_s, reference_at(time_s), resistance, temperature, nan, length,
                  start_length - length, xi_p, xi_m, xi_f, nan, nan, nan, load_at(time_s), False))

@@ -9,7 +9,9 @@ PI and before the plant in the same step: the plant gets the wave's mean over th
 Each step is one fmi2SetReal, one fmi2DoStep and one fmi2GetReal per FMU (the compensator
 also one fmi2GetBoolean), called through ctypes with argument objects built once
 (:class:`LeanStep`): no argument conversion per call, values written into and read from
-the same C arrays every step.
+the same C arrays every step. Each block's ``step`` is a closure over those objects (an
+instance attribute, built once): no attribute lookup and no call layer per step beyond the
+library path's.
 """
 import time
 from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
@@ -72,21 +74,36 @@ class LeanStep:
         self._get_flags, self.flags = bound("fmi2GetBoolean", flags, c_int) if flags else (None, None)
         self._do_step = partial(fmu._do_step_c, component)
         self._names = (inputs, outputs, flags)
+        self.step = self._closure()
 
-    def step(self, time_s, step_size):
-        """Set :attr:`inputs` (write them first), doStep, read :attr:`outputs` (and
-        :attr:`flags`); raises :class:`~sma_fmu.fmi.instance.FmuError` above fmi2Warning."""
-        status = self._set()
-        if status > 1:
-            raise self.fmu.failure(f"set {', '.join(self._names[0])}", status)
-        status = self._do_step(time_s, step_size, 1)
-        if status > 1:
-            raise self.fmu.failure("fmi2DoStep", status)
-        status = self._get()
-        if status <= 1 and self._get_flags is not None:
-            status = self._get_flags()
-        if status > 1:
-            raise self.fmu.failure(f"get {', '.join(self._names[1] + self._names[2])}", status)
+    def failed(self, stage, status):
+        """The :class:`~sma_fmu.fmi.instance.FmuError` of a call above fmi2Warning: ``stage``
+        0 set, 1 doStep, 2 get."""
+        inputs, outputs, flags = self._names
+        what = (f"set {', '.join(inputs)}", "fmi2DoStep", f"get {', '.join(outputs + flags)}")[stage]
+        return self.fmu.failure(what, status)
+
+    def _closure(self):
+        """:meth:`step` as a closure over the bound calls (the blocks below inline the same
+        calls in their own closures)."""
+        set_, do_step, get, get_flags, failed = (self._set, self._do_step, self._get,
+                                                 self._get_flags, self.failed)
+
+        def step(time_s, step_size):
+            """Set :attr:`inputs` (write them first), doStep, read :attr:`outputs` (and
+            :attr:`flags`); raises :class:`~sma_fmu.fmi.instance.FmuError` above fmi2Warning."""
+            status = set_()
+            if status > 1:
+                raise failed(0, status)
+            status = do_step(time_s, step_size, 1)
+            if status > 1:
+                raise failed(1, status)
+            status = get()
+            if status <= 1 and get_flags is not None:
+                status = get_flags()
+            if status > 1:
+                raise failed(2, status)
+        return step
 
 
 class FmuPlant:
@@ -99,20 +116,29 @@ class FmuPlant:
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
         self._outputs = self.fmu.port(PLANT_OUTPUTS)
-        self._step = LeanStep(self.fmu, ("P_in", "load"), PLANT_OUTPUTS)
-        self._inputs, self._values = self._step.inputs, self._step.outputs
+        lean = LeanStep(self.fmu, ("P_in", "load"), PLANT_OUTPUTS)
+        inputs, values = lean.inputs, lean.outputs
+        set_, do_step, get, failed = lean._set, lean._do_step, lean._get, lean.failed
+
+        def step(time_s, power, load, step_size):
+            """Set P_in and load, doStep, return the PLANT_OUTPUTS at the end of the step."""
+            inputs[0] = power
+            inputs[1] = load
+            status = set_()
+            if status > 1:
+                raise failed(0, status)
+            status = do_step(time_s, step_size, 1)
+            if status > 1:
+                raise failed(1, status)
+            status = get()
+            if status > 1:
+                raise failed(2, status)
+            return values[:]
+        self.step = step
 
     def outputs(self):
         """The loop's :data:`~sma_fmu.cosim.loop.PLANT_OUTPUTS` now."""
         return self._outputs.get()
-
-    def step(self, time_s, power, load, step_size):
-        """Set P_in and load, doStep, return the PLANT_OUTPUTS at the end of the step."""
-        inputs = self._inputs
-        inputs[0] = power
-        inputs[1] = load
-        self._step.step(time_s, step_size)
-        return self._values[:]
 
     def close(self):
         """Free the instance."""
@@ -130,18 +156,28 @@ class FmuCompensator:
                      R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
-        self._step = LeanStep(self.fmu, ("R_ref", "load"), ("P_ff", "T_ref"), ("saturated",))
-        self._inputs, self._outputs, self._saturated = (self._step.inputs, self._step.outputs,
-                                                        self._step.flags)
+        lean = LeanStep(self.fmu, ("R_ref", "load"), ("P_ff", "T_ref"), ("saturated",))
+        inputs, outputs, saturated = lean.inputs, lean.outputs, lean.flags
+        set_, do_step, get, get_flags, failed = (lean._set, lean._do_step, lean._get,
+                                                 lean._get_flags, lean.failed)
 
-    def step(self, time_s, reference, load, step_size):
-        """Set R_ref and load, doStep, return (P_ff, T_ref, saturated) for this sample."""
-        inputs = self._inputs
-        inputs[0] = reference
-        inputs[1] = load
-        self._step.step(time_s, step_size)
-        outputs = self._outputs
-        return outputs[0], outputs[1], self._saturated[0] != 0
+        def step(time_s, reference, load, step_size):
+            """Set R_ref and load, doStep, return (P_ff, T_ref, saturated) for this sample."""
+            inputs[0] = reference
+            inputs[1] = load
+            status = set_()
+            if status > 1:
+                raise failed(0, status)
+            status = do_step(time_s, step_size, 1)
+            if status > 1:
+                raise failed(1, status)
+            status = get()
+            if status <= 1:
+                status = get_flags()
+            if status > 1:
+                raise failed(2, status)
+            return outputs[0], outputs[1], saturated[0] != 0
+        self.step = step
 
     def close(self):
         """Free the instance."""
@@ -156,18 +192,19 @@ class FmuDriver:
         self.fmu = FmuInstance(fmu_path, instance_name,
                                {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W})
         self._initial = self.fmu.port(("P_in",))
-        self._step = LeanStep(self.fmu, ("P_demand",), ("P_in",))
-        self._inputs, self._outputs = self._step.inputs, self._step.outputs
+        lean = LeanStep(self.fmu, ("P_demand",), ("P_in",))
+        inputs, outputs, lean_step = lean.inputs, lean.outputs, lean.step
+
+        def step(time_s, demand, step_size):
+            """Set P_demand [W], doStep, return P_in [W]: the wave's mean over the step."""
+            inputs[0] = demand
+            lean_step(time_s, step_size)
+            return outputs[0]
+        self.step = step
 
     def initial(self):
         """P_in [W] after initialization, before the first step (0 W)."""
         return self._initial.get()[0]
-
-    def step(self, time_s, demand, step_size):
-        """Set P_demand [W], doStep, return P_in [W]: the wave's mean over the step."""
-        self._inputs[0] = demand
-        self._step.step(time_s, step_size)
-        return self._outputs[0]
 
     def close(self):
         """Free the instance."""
