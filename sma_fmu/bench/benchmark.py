@@ -33,9 +33,9 @@ TARGETS = {  # issue 6, on a 2-core machine
     "identification_s": 2.0,                   # the 4-load constant-load fit
     "c_host_vs_fmpy": 2.0,                     # issue 10: SmaActuator step in a C host / fmpy master
 }
-RATIO_TARGETS = {  # issue 22: (target, stretch or None)
+RATIO_TARGETS = {  # issue 28 (issue 22 asked 1.5 for the C host): (target, stretch or None)
     "FMU closed loop / library path": (3.0, 2.0),
-    "SmaActuator in the C host / library plant step": (1.5, None),
+    "SmaActuator in the C host / library plant step": (2.0, None),
 }
 _TRIVIAL_SLAVE = '''
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
@@ -313,7 +313,7 @@ def _c_host_lines(results):
 
 
 def _ratio_lines(results):
-    """The ratios of issue 22, with the spread of the alternating runs and their targets."""
+    """The ratios of issues 22 and 28, with the spread of the alternating runs and their targets."""
     lines = [f"Ratios (median of {results['runs']} alternating runs, min ... max)"]
     for name, row in results["ratios"].items():
         target = next((t for key, t in RATIO_TARGETS.items() if name.startswith(key)), None)
