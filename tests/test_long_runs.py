@@ -163,3 +163,19 @@ def test_peak_memory_stays_flat_as_the_run_grows(tmp_path):
         peaks.append(int(result.stdout.split()[-1]) / 1024.0)  # [MiB]
         assert len(read_timeseries(next(out.glob("*/timeseries.csv")))) == stop * 1000 + 1
     assert peaks[1] - peaks[0] < 25.0, peaks
+
+
+def test_parquet_in_several_row_groups_reads_back_in_order(tmp_path, monkeypatch):
+    import pyarrow.parquet as pq
+
+    from sma_fmu.cosim import recording
+
+    monkeypatch.setattr(recording, "PARQUET_ROW_GROUP", 5000)
+    scenario = load_scenario(resolve_scenarios([SCENARIO])[0])
+    recorder = RunRecorder(scenario, tmp_path, every=3, fmt="parquet")
+    run_library(scenario, sink=recorder)
+    recorder.close()
+    path = tmp_path / "timeseries.parquet"
+    assert pq.ParquetFile(path).num_row_groups >= 2
+    frame = read_timeseries(path)
+    np.testing.assert_allclose(frame["t_s"], np.arange(10001) * 0.003, rtol=0, atol=1e-12)
