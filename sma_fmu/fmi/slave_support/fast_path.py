@@ -130,7 +130,8 @@ class FastPath:
                         for i, name, convert in self._inputs]
         # after a step: the time and the values a step changes, in one pack (struct's "d"
         # reads a Boolean or Integer as the front does: v != 0, (int)v)
-        self._changing = attribute_reader(self._names[:n_changing])
+        self._changing_names = self._names[:n_changing]
+        self._changing = attribute_reader(self._changing_names)
         self._changing_struct = struct.Struct(f"{1 + n_changing}d")
         self._raw = memoryview(array).cast("B")
         self._log_queue = self.guard.slave._get_log_queue()  # pythonfmu's list (it empties it)
@@ -204,6 +205,11 @@ class FastPath:
         view, raw, guard, slave, inputs = self.view, self._raw, self.guard, self.guard.slave, self._inputs
         advance, internal, read = guard.advance, guard.internal, self._changing
         pack_into, offset = self._changing_struct.pack_into, 8 * _TIME
+        compiled = self._compiled_step(dict(
+            view=view, raw=raw, guard=guard, slave=slave, advance=advance, internal=internal,
+            pack_into=pack_into, offset=offset))
+        if compiled is not None:
+            return compiled
 
         def step():
             try:
@@ -226,6 +232,43 @@ class FastPath:
                     view[_STEP_COMPLETE] = 0.0
                 view[_WRITTEN] = 1.0
         return step
+
+    def _compiled_step(self, scope):
+        """The closure of :meth:`_direct_step` with the inputs and the values written out as
+        plain attribute accesses (no loop, no reader call, no tuple per step), compiled once;
+        None when a name is not an identifier (then the closure serves)."""
+        names = [name for _, _, name, _ in self._inputs] + self._changing_names
+        if not all(name.isidentifier() and not keyword.iskeyword(name) for name in names):
+            return None
+        take = "".join(
+            f"                if view[{pending}]:\n"
+            f"                    slave.{name} = {'' if convert is float else convert.__name__}"
+            f"(view[{value}])\n"
+            f"                    view[{pending}] = 0.0\n"
+            for value, pending, name, convert in self._inputs)
+        values = "".join(f", slave.{name}" for name in self._changing_names)
+        source = f"""def make({", ".join(scope)}):
+    def step():
+        try:
+            if view[{PENDING}]:
+{take}                view[{PENDING}] = 0.0
+            return advance(view[{_T}], view[{_H}])
+        except Exception as error:
+            return internal("fmi2DoStep", error, False)
+        finally:
+            try:
+                time = guard.time
+                pack_into(raw, offset, NAN if time is None else time{values})
+                if guard.state is not STEP_COMPLETE:
+                    view[{_STEP_COMPLETE}] = 0.0
+            except Exception:
+                view[{_STEP_COMPLETE}] = 0.0
+            view[{_WRITTEN}] = 1.0
+    return step
+"""
+        namespace = {"NAN": _NAN, "STEP_COMPLETE": STEP_COMPLETE}
+        exec(compile(source, "<fast path step>", "exec"), namespace)  # noqa: S102 - names checked
+        return namespace["make"](**scope)
 
     def sync(self, reference):
         """fmi2GetString(SYNC) from the front: take the pending inputs, write every value;

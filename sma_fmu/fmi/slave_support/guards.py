@@ -236,7 +236,10 @@ class CallGuard:
                                          "non-finite output; the instance is in the error state "
                                          "(restore a saved state or reset it)")
         self.time = current_time + step_size
-        warning = getattr(getattr(self.slave, "stepper", None), "warning", None)  # validity()
+        try:  # validity(), without its two getattr calls
+            warning = self.slave.stepper.warning
+        except AttributeError:
+            warning = None
         if warning:
             self.log(Fmi2Status.warning, function, warning)
         return True
