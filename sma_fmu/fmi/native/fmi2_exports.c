@@ -34,41 +34,12 @@
 
 #include "front.h"
 
-fmi2Status refuse(Instance* in, fmi2Status status, const char* function, const char* why)
-{
-    host_logf(in, status, "%s: %s", function, why);
-    return status;
-}
-
-/* Status of a forwarded call: the backend's, or worse if the slave logged worse. */
-fmi2Status finish(Instance* in, fmi2Status status)
-{
-    if (status == fmi2Fatal) in->dead = 1;
-    return in->logged_status > status ? in->logged_status : status;
-}
-
 
 /* What `sma-fmu check` finds in a binary that is this front (sma_fmu/fmi/front.py). */
 EXPORT const char sma_fmu_front[] = "sma-fmu native front";
 
 EXPORT const char* fmi2GetTypesPlatform(void) { return "default"; }
 EXPORT const char* fmi2GetVersion(void) { return "2.0"; }
-
-static void free_categories(Instance* in)
-{
-    for (size_t i = 0; i < in->n_categories; ++i) free(in->categories[i]);
-    free(in->categories);
-    in->categories = NULL;
-    in->n_categories = 0;
-}
-
-void free_instance_memory(Instance* in)
-{
-    fast_free(&in->fast);
-    free_categories(in);
-    free(in->name);
-    free(in);
-}
 
 EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                                      fmi2String fmuResourceLocation,

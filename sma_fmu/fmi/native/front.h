@@ -117,8 +117,8 @@ const FrontShare* find_owner(const unsigned char* id, size_t size);
 int load_libpython(void);
 void* python_symbol(const char* name);            /* a C-API function of that Python */
 int python_library_file(char* path, size_t size); /* its library file (for the init lock) */
-/* 1 if `version` (Py_GetVersion's text) is Python 3.PYTHON_MIN_MINOR or newer; else 0 with
- * the reason in why. */
+/* (python_version.c, below the searches:) 1 if `version` (Py_GetVersion's text) is Python
+ * 3.PYTHON_MIN_MINOR or newer; else 0 with the reason in why. */
 int python_version_supported(const char* version, char* why, size_t size);
 /* Append printf-style text to the string `text` of `size` bytes (truncating, never past it). */
 void text_append(char* text, size_t size, const char* format, ...) PRINTF_LIKE(3, 4);
@@ -196,9 +196,11 @@ void fast_after_step(Instance* in);
  * what C would not take, with its message), else the call's status. */
 int fast_step(Instance* in, double t, double h);
 
-/* ---- forwarding (fmi2_exports.c) and saved states (fmi2_states.c) ----------------------- */
+/* ---- call status (call_status.c): the lowest layer of the calls ---------------------------- */
 fmi2Status refuse(Instance* in, fmi2Status status, const char* function, const char* why);
 fmi2Status finish(Instance* in, fmi2Status status); /* the backend's status, or worse if logged */
+
+/* ---- saved states (fmi2_states.c), called by fmi2_exports.c -------------------------------- */
 FrontState* find_state(Instance* in, fmi2FMUstate state);
 void drop_state(Instance* in, FrontState* state);
 
@@ -210,7 +212,8 @@ Instance* live_instance(fmi2Component c, const char* function);
 /* fmi2FreeInstance: 1 if `c` was live (it is then a freed instance: its memory is kept for
  * a while, so a later call with it is recognized and refused). */
 int retire_instance(fmi2Component c);
-void free_instance_memory(Instance* in);
+void free_categories(Instance* in);      /* the logging categories set so far */
+void free_instance_memory(Instance* in); /* categories, name, fast-path values, the instance */
 
 /* Every forwarded call starts with this: refuse an unknown or freed instance, and after
  * fmi2Fatal; keep the thread's Python thread state; reset the worst status the slave logged. */

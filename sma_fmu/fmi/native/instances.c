@@ -19,6 +19,24 @@
 
 #include "front.h"
 
+/* The logging categories an instance was given (fmi2SetDebugLogging); then, for a freed
+ * instance, its name and fast-path values and the instance itself. */
+void free_categories(Instance* in)
+{
+    for (size_t i = 0; i < in->n_categories; ++i) free(in->categories[i]);
+    free(in->categories);
+    in->categories = NULL;
+    in->n_categories = 0;
+}
+
+void free_instance_memory(Instance* in)
+{
+    fast_free(&in->fast);
+    free_categories(in);
+    free(in->name);
+    free(in);
+}
+
 #define FREED_KEPT 1024
 #define DELETED ((Instance*)1)
 

@@ -1,0 +1,79 @@
+"""The native front's C files call each other down one way only (issue 30: no circle).
+
+fmi2_exports.c (the 34 FMI functions) is the top: nothing calls back up into it. The
+saved states (fmi2_states.c), the instance bookkeeping (instances.c) and the fast path call
+down into call_status.c (refuse, finish), which calls only the host logger. The test builds
+the graph "file A calls a function file B defines" from the sources and asserts it has no
+cycle, and that fmi2_exports.c defines nothing another file calls but its FMI exports.
+"""
+import re
+from pathlib import Path
+
+import sma_fmu.fmi as fmi
+
+NATIVE = Path(fmi.__file__).parent / "native"
+_DEFINITION = re.compile(r"^(?!static\b)[A-Za-z_][^\n;(=]*?\b([A-Za-z_]\w*)\s*\([^;{]*\)\s*\{", re.M)
+
+
+def _defined(text):
+    """Names of the non-static functions a C file defines (a head, then its body's brace)."""
+    return {match.group(1) for match in _DEFINITION.finditer(text)} - {
+        "if", "for", "while", "switch", "return", "sizeof"}
+
+
+def _unit(name):
+    """A file, or the pair of one platform's alternatives (platform_posix.c and
+    platform_windows.c define the same functions; one of them is compiled)."""
+    return re.sub(r"_(posix|windows)\.c$", "_*.c", name)
+
+
+def _graph():
+    texts = {}
+    for path in sorted(NATIVE.glob("*.c")):
+        text = re.sub(r"/\*.*?\*/|//[^\n]*", "", path.read_text(encoding="utf-8"), flags=re.S)
+        texts[_unit(path.name)] = texts.get(_unit(path.name), "") + text
+    defined = {name: _defined(text) for name, text in texts.items()}
+    calls = {}
+    for caller, text in texts.items():
+        calls[caller] = {owner for owner, names in defined.items() if owner != caller and any(
+            re.search(rf"\b{re.escape(n)}\s*\(", text) for n in names)}
+    return defined, calls
+
+
+def _cycle(calls):
+    """A cycle of files as a list, or None."""
+    state, stack = {}, []
+
+    def visit(node):
+        state[node] = "open"
+        stack.append(node)
+        for nxt in sorted(calls.get(node, ())):
+            if state.get(nxt) == "open":
+                return stack[stack.index(nxt):] + [nxt]
+            if nxt not in state:
+                found = visit(nxt)
+                if found:
+                    return found
+        stack.pop()
+        state[node] = "done"
+        return None
+
+    for node in sorted(calls):
+        if node not in state:
+            found = visit(node)
+            if found:
+                return found
+    return None
+
+
+def test_the_front_calls_down_only():
+    defined, calls = _graph()
+    assert "refuse" in defined["call_status.c"] and "free_instance_memory" in defined["instances.c"]
+    assert _cycle(calls) is None, f"C files call each other in a circle: {' -> '.join(_cycle(calls))}"
+    callers_of_exports = [name for name, targets in calls.items() if "fmi2_exports.c" in targets]
+    assert callers_of_exports == [], f"{callers_of_exports} call up into fmi2_exports.c"
+
+
+def test_the_check_finds_a_circle():
+    assert _cycle({"a.c": {"b.c"}, "b.c": {"c.c"}, "c.c": {"a.c"}}) == ["a.c", "b.c", "c.c", "a.c"]
+    assert _cycle({"a.c": {"b.c"}, "b.c": set()}) is None
