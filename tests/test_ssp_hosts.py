@@ -7,7 +7,7 @@ one, and every FMU carries all values as its defaults); fmpy's ``simulate_ssp``,
 binds nothing, running the scenario, compensator loops too; and
 ``sma-fmu check`` failing, per host, a package that a host would run differently.
 OMSimulator is on no registry: its test runs only when SMA_FMU_OMSIMULATOR names the
-executable (docs/systems.md); benchmarks/hosts.py gives its per-host table.
+executable (docs/systems.md); ``sma-fmu bench --only hosts`` gives its per-host table.
 """
 import dataclasses
 import io

@@ -1,6 +1,6 @@
 """Benchmarks: how fast the FMUs, the co-simulation and the fits run (medians of several runs).
 
-``python benchmarks/run.py`` or ``sma-fmu bench``: prints a table against the targets and
+``sma-fmu bench``: prints a table against the targets and
 writes ``benchmark.json``. Speed is measured here and never asserted in tests. The same
 run measures two baselines, so the numbers compare across machines: a trivial pythonfmu
 FMU (y = u) stepped the same way, and a plain Python loop.

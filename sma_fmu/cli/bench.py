@@ -1,7 +1,7 @@
 """Benchmark command: how fast the FMUs, the co-simulation and the fits run."""
 from pathlib import Path
 
-from .arguments import bounded_integer
+from .arguments import bounded_integer, positive_number
 
 MAX_RUNS = 1000   # choice: repetitions per measurement; more only takes longer
 
@@ -9,6 +9,14 @@ __all__ = ["register"]
 
 
 def _bench(args):
+    if args.only == "hosts":
+        from sma_fmu.bench.host_table import run_host_table
+        run_host_table(args.out, args.scenario, args.stop_time, args.omsimulator)
+        return 0
+    if args.only == "pwm":
+        from sma_fmu.bench.pwm_table import pwm_table_rows
+        pwm_table_rows()
+        return 0
     from sma_fmu.bench.benchmark import main as bench_main
     return bench_main(args.out, args.runs, args.only, args.quick)
 
@@ -20,8 +28,18 @@ def register(commands):
                        help="output folder")
     bench.add_argument("--runs", type=bounded_integer(1, MAX_RUNS), default=5,
                        help=f"repetitions per measurement, 1-{MAX_RUNS}")
-    bench.add_argument("--only", choices=("batch",),
-                       help="only this section (batch: the batch engine's throughput table)")
+    bench.add_argument("--only", choices=("batch", "hosts", "pwm"),
+                       help="only this section (batch: the batch engine's throughput table; "
+                            "hosts: every scenario in every host against the library loop, "
+                            "docs/systems.md's table; pwm: the PWM table of docs/model.md)")
+    bench.add_argument("--scenario", action="append", metavar="NAME",
+                       help="with --only hosts: a scenario (repeatable; default: the paper's six "
+                            "and the two PWM set-point ones)")
+    bench.add_argument("--stop-time", type=positive_number, metavar="S",
+                       help="with --only hosts: shorten every scenario to S s")
+    bench.add_argument("--omsimulator", metavar="EXE",
+                       help="with --only hosts: OMSimulator's executable (default: "
+                            "$SMA_FMU_OMSIMULATOR, else OMSimulator is left out)")
     bench.add_argument("--quick", action="store_true",
                        help="with --only batch: N up to 1,000 only (a quick look)")
     bench.set_defaults(handler=_bench)

@@ -7,7 +7,7 @@ column from the library run of the same coupling. The host "fmpy-ssp" is fmpy's
 ``simulate_ssp``, which records only the connectors (:mod:`.fmpy_ssp`): its deviation
 covers R_ref, load, R, P and P_ff, its RMSE R - R_ref; a loop it cannot run gets a row
 with a ``note`` and no numbers. :func:`rmse_table` and :func:`host_table` format the rows
-(``benchmarks/hosts.py`` prints them; docs/systems.md shows them).
+(``sma-fmu bench --only hosts`` prints them; docs/systems.md shows them).
 """
 import math
 import tempfile

@@ -2,7 +2,7 @@
 
 OMSimulator is on no package registry: build it from source (v3.0.0 was used,
 docs/systems.md) and name the executable in :data:`ENVIRONMENT`. Nothing of the project
-needs it; ``benchmarks/hosts.py`` adds it to the per-host table when the variable is set.
+needs it; ``sma-fmu bench --only hosts`` adds it to the per-host table when the variable is set.
 
 Its command line takes the step from the SSD's OpenModelica annotation
 (``oms:FixedStepMaster``) but the stop time only from ``--stopTime`` (1 s otherwise: for
