@@ -6,7 +6,8 @@ then:
 
     SMA_FMU_OMSIMULATOR=/path/to/OMSimulator python -m pytest tests/omsimulator_check.py
 
-Without SMA_FMU_OMSIMULATOR the check fails (it never skips).
+Without SMA_FMU_OMSIMULATOR the check fails (it never skips). It runs both FMU families:
+pythonfmu's (``sma-fmu build``) and the native C one (``sma-fmu build --native``).
 """
 import os
 import re
@@ -30,12 +31,20 @@ def omsimulator():
     return path
 
 
-def test_omsimulator_runs_the_ssp_as_the_library_jacobi_loop(fmu_dir, tmp_path):
+@pytest.fixture(params=["pythonfmu", "native"])
+def family_dir(request, fmu_dir):
+    """The folder of one FMU family's FMUs: pythonfmu's, or the native C family's."""
+    if request.param == "pythonfmu":
+        return fmu_dir
+    return next(iter(request.getfixturevalue("native_fmus").values())).parent
+
+
+def test_omsimulator_runs_the_ssp_as_the_library_jacobi_loop(family_dir, tmp_path):
     from sma_fmu.systems.comparison import deviation
     from sma_fmu.systems.omsimulator import run_ssp_omsimulator
 
     scenario = _scenario("heavy-pi+ff-adaptive", stop_time_s=2.2, load=LOAD_STEP)
-    path = write_ssp(closed_loop(scenario, fmu_dir), tmp_path / "loop.ssp")
+    path = write_ssp(closed_loop(scenario, family_dir), tmp_path / "loop.ssp")
     samples, log = run_ssp_omsimulator(path, scenario.step_s, scenario.steps, loop_outputs(scenario))
     data = loop_series(scenario, samples, scenario.steps)
     assert deviation(data, run_library(scenario, "jacobi").data) <= TOLERANCE
