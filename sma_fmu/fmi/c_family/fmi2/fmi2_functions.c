@@ -73,6 +73,7 @@ static void free_instance(Instance *in)
     layer_free_states(in);
     layer_drop_stepper(in);
     layer_values_free(in->model, in->values);
+    free(in->real_outputs);
     free(in->categories);
     free(in->resources);
     free(in->guid);

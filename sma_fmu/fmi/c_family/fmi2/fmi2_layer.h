@@ -54,6 +54,8 @@ typedef struct {
     int outputs_current;             /* Initialization Mode: outputs reflect what was set */
     char initial_error[512];         /* why the outputs cannot be computed, or "" */
     SmaValue *values;                /* one per variable of the model */
+    size_t *real_outputs;            /* the indices of the Real outputs, found once */
+    size_t real_output_count;        /* (layer_outputs_finite checks only those) */
     void *stepper;                   /* started stepper, or NULL */
     fmi2Status worst;                /* worst status logged during the present call */
     int stepped, terminated, have_discard;  /* fmi2GetXXXStatus bookkeeping (as the front) */

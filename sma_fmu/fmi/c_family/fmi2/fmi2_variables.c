@@ -35,6 +35,14 @@ int layer_values_init(Instance *in)
 {
     const SmaModel *model = in->model;
     size_t i;
+    if (!in->real_outputs) {  /* once per instance: the step checks only these */
+        in->real_outputs = (size_t *)malloc((model->count ? model->count : 1) * sizeof(size_t));
+        if (!in->real_outputs) return 0;
+        in->real_output_count = 0;
+        for (i = 0; i < model->count; ++i)
+            if (model->variables[i].kind == SMA_REAL && model->variables[i].causality == SMA_OUTPUT)
+                in->real_outputs[in->real_output_count++] = i;
+    }
     in->values = (SmaValue *)calloc(model->count ? model->count : 1, sizeof *in->values);
     if (!in->values) return 0;
     for (i = 0; i < model->count; ++i) {
@@ -82,12 +90,9 @@ SmaValue *layer_values_copy(const SmaModel *model, const SmaValue *values)
 
 int layer_outputs_finite(const Instance *in, const SmaValue *values)
 {
-    size_t i;
-    for (i = 0; i < in->model->count; ++i) {
-        const SmaVariable *v = &in->model->variables[i];
-        if (v->kind == SMA_REAL && v->causality == SMA_OUTPUT && !isfinite(values[i].real))
-            return 0;
-    }
+    const size_t *index = in->real_outputs, *end = index + in->real_output_count;
+    for (; index < end; ++index)
+        if (!isfinite(values[*index].real)) return 0;
     return 1;
 }
 
@@ -190,11 +195,36 @@ static void value_repr(SmaKind kind, const void *value, size_t i, char *text, si
     else snprintf(text, size, "'%.200s'", ((const fmi2String *)value)[i]);
 }
 
+/* The common set, inputs by their own index (pythonfmu's numbering) in a state that allows
+ * setting them, done without building any text; 0: not that case (nothing set), layer_set's
+ * full path decides. */
+static int quick_set(Instance *in, SmaKind kind, const fmi2ValueReference vr[], size_t nvr,
+                     const void *value)
+{
+    const SmaModel *model = in->model;
+    size_t i;
+    if (kind == SMA_STRING || in->state > STATE_STEP_COMPLETE) return 0;
+    for (i = 0; i < nvr; ++i) {
+        unsigned int r = vr[i];
+        if (!(r < model->count && model->variables[r].vr == r && model->variables[r].kind == kind &&
+              model->variables[r].causality == SMA_INPUT))
+            return 0;
+    }
+    for (i = 0; i < nvr; ++i) {
+        if (kind == SMA_REAL) in->values[vr[i]].real = ((const fmi2Real *)value)[i];
+        else if (kind == SMA_INTEGER) in->values[vr[i]].integer = ((const fmi2Integer *)value)[i];
+        else in->values[vr[i]].integer = ((const fmi2Boolean *)value)[i] ? 1 : 0;
+    }
+    if (in->state == STATE_INITIALIZATION) in->outputs_current = 0;
+    return 1;
+}
+
 fmi2Status layer_set(Instance *in, const char *function, SmaKind kind,
                      const fmi2ValueReference vr[], size_t nvr, const void *value)
 {
     size_t i, index = 0;
     char why[400], shown[220], text[700];
+    if (quick_set(in, kind, vr, nvr, value)) return fmi2OK;
     if (in->state != STATE_INSTANTIATED && in->state != STATE_INITIALIZATION &&
         in->state != STATE_STEP_COMPLETE) {
         snprintf(text, sizeof text, "illegal call in state '%s'", STATE_NAMES[in->state]);
@@ -246,11 +276,31 @@ static void put_missing(SmaKind kind, void *value, size_t i)
     else ((fmi2Integer *)value)[i] = 0;
 }
 
+/* The common get after initialization, every reference its own index (pythonfmu's
+ * numbering) and of `kind`; 0: not that case, layer_get's full path writes every value. */
+static int quick_get(const Instance *in, SmaKind kind, const fmi2ValueReference vr[], size_t nvr,
+                     void *value)
+{
+    const SmaModel *model = in->model;
+    size_t i;
+    if (in->state < STATE_STEP_COMPLETE) return 0;
+    for (i = 0; i < nvr; ++i) {
+        unsigned int r = vr[i];
+        if (!(r < model->count && model->variables[r].vr == r && model->variables[r].kind == kind))
+            return 0;
+        if (kind == SMA_REAL) ((fmi2Real *)value)[i] = in->values[r].real;
+        else if (kind == SMA_STRING) ((fmi2String *)value)[i] = in->values[r].text;
+        else ((fmi2Integer *)value)[i] = in->values[r].integer;
+    }
+    return 1;
+}
+
 fmi2Status layer_get(Instance *in, const char *function, SmaKind kind,
                      const fmi2ValueReference vr[], size_t nvr, void *value)
 {
     size_t i, index, used = 0;
     char text[1500];
+    if (quick_get(in, kind, vr, nvr, value)) return fmi2OK;
     if (in->state == STATE_INSTANTIATED ||
         (in->state == STATE_INITIALIZATION && !layer_refresh_outputs(in, function))) {
         for (i = 0; i < nvr; ++i) put_missing(kind, value, i);

@@ -40,30 +40,6 @@ int require_positive(const char *name, double value, SmaMessage *message)
     return 0;
 }
 
-int fast_finite(const char *name, double value, SmaMessage *message)
-{
-    if (-HUGE_VAL < value && value < HUGE_VAL) {
-        return 0;
-    }
-    return require_finite(name, value, message);
-}
-
-int fast_nonnegative(const char *name, double value, SmaMessage *message)
-{
-    if (0.0 <= value && value < HUGE_VAL) {
-        return 0;
-    }
-    return require_nonnegative(name, value, message);
-}
-
-int fast_positive(const char *name, double value, SmaMessage *message)
-{
-    if (0.0 < value && value < HUGE_VAL) {
-        return 0;
-    }
-    return require_positive(name, value, message);
-}
-
 int direction_sign(int direction, const char *name, int *sign, SmaMessage *message)
 {
     if (direction == HEATING || direction == COOLING) {

@@ -7,6 +7,8 @@
 #ifndef SMA_CHECKS_H
 #define SMA_CHECKS_H
 
+#include <math.h>
+
 #include "sma_message.h"
 
 /* HYSTERESIS_MODES = ("switch", "continuous"): a mode is its index in that tuple. */
@@ -20,9 +22,19 @@ extern const char *const HYSTERESIS_MODES[HYSTERESIS_MODE_COUNT];
 int require_finite(const char *name, double value, SmaMessage *message);
 int require_nonnegative(const char *name, double value, SmaMessage *message);
 int require_positive(const char *name, double value, SmaMessage *message);
-int fast_finite(const char *name, double value, SmaMessage *message);
-int fast_nonnegative(const char *name, double value, SmaMessage *message);
-int fast_positive(const char *name, double value, SmaMessage *message);
+/* The same checks with the passing case inline (a step checks its inputs every time). */
+SMA_INLINE int fast_finite(const char *name, double value, SmaMessage *message)
+{
+    return -HUGE_VAL < value && value < HUGE_VAL ? 0 : require_finite(name, value, message);
+}
+SMA_INLINE int fast_nonnegative(const char *name, double value, SmaMessage *message)
+{
+    return 0.0 <= value && value < HUGE_VAL ? 0 : require_nonnegative(name, value, message);
+}
+SMA_INLINE int fast_positive(const char *name, double value, SmaMessage *message)
+{
+    return 0.0 < value && value < HUGE_VAL ? 0 : require_positive(name, value, message);
+}
 
 /* direction +1 (HEATING) or -1 (COOLING) -> *sign; else refused naming `name`
  * (NULL name = "direction"). */

@@ -139,18 +139,11 @@ void branch_cache_init(BranchCache *cache)
     cache->last = -1;
 }
 
-int branch_cache_get(BranchCache *cache, const WireParameters *params, double load, int direction,
-                     BranchConstants *out, SmaMessage *message)
+int branch_cache_fill(BranchCache *cache, const WireParameters *params, double load, int direction,
+                      BranchConstants *out, SmaMessage *message)
 {
     BranchConstants constants;
     int index;
-    if (cache->last >= 0) {
-        const BranchCacheEntry *last = &cache->entries[cache->last];
-        if (load == last->load && direction == last->direction) {
-            *out = last->constants;
-            return 0;
-        }
-    }
     for (index = 0; index < cache->count; index++) {
         if (cache->entries[index].load == load && cache->entries[index].direction == direction) {
             cache->last = index;

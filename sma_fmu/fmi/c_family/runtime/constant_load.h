@@ -62,8 +62,22 @@ typedef struct BranchCache {
 } BranchCache;
 
 void branch_cache_init(BranchCache *cache);
-/* The constants for `load` [kg] and `direction` (+1/-1) -> *out (a copy). */
-int branch_cache_get(BranchCache *cache, const WireParameters *params, double load, int direction,
-                     BranchConstants *out, SmaMessage *message);
+/* branch_cache_get when the last entry is not the one: the memo's search, else a new entry. */
+int branch_cache_fill(BranchCache *cache, const WireParameters *params, double load, int direction,
+                      BranchConstants *out, SmaMessage *message);
+/* The constants for `load` [kg] and `direction` (+1/-1) -> *out (a copy); the last entry's
+ * hit, every step's case, is inline. */
+SMA_INLINE int branch_cache_get(BranchCache *cache, const WireParameters *params, double load,
+                                int direction, BranchConstants *out, SmaMessage *message)
+{
+    if (cache->last >= 0) {
+        const BranchCacheEntry *last = &cache->entries[cache->last];
+        if (load == last->load && direction == last->direction) {
+            *out = last->constants;
+            return 0;
+        }
+    }
+    return branch_cache_fill(cache, params, load, direction, out, message);
+}
 
 #endif
