@@ -11,22 +11,22 @@
 #include "thermal.h"
 #include "validity.h"
 
-static PlantOutputs evaluate(const PlantStepper *stepper, const BranchConstants *constants)
+/* The outputs of the present state into stepper->outputs (written in place: no copy). */
+static void evaluate(PlantStepper *stepper, const BranchConstants *constants)
 {
     const WireParameters *params = &stepper->params;
-    PlantOutputs outputs;
+    PlantOutputs *outputs = &stepper->outputs;
     double xi_p = stepper->xi_P;
     double xi_m = 0.5 * stepper->xi_MF;
     double xi_f = constants->xi_F_min + xi_m;
-    outputs.R = params->R_P * xi_p + params->R_M * xi_m + params->R_F * xi_f;
-    outputs.T = stepper->temperature;
-    outputs.x = params->l_P * xi_p + params->l_M * xi_m + params->l_F * xi_f;
-    outputs.xi_P = xi_p;
-    outputs.xi_M = xi_m;
-    outputs.xi_F = xi_f;
-    outputs.P = stepper->power;
-    outputs.heating = stepper->direction == HEATING;
-    return outputs;
+    outputs->R = params->R_P * xi_p + params->R_M * xi_m + params->R_F * xi_f;
+    outputs->T = stepper->temperature;
+    outputs->x = params->l_P * xi_p + params->l_M * xi_m + params->l_F * xi_f;
+    outputs->xi_P = xi_p;
+    outputs->xi_M = xi_m;
+    outputs->xi_F = xi_f;
+    outputs->P = stepper->power;
+    outputs->heating = stepper->direction == HEATING;
 }
 
 static void check_validity(PlantStepper *stepper, double before, double load_before)
@@ -81,7 +81,7 @@ int plant_stepper_init(PlantStepper *stepper, const WireParameters *params,
     stepper->load = load;
     stepper->power = 0.0;
     branch_fractions(stepper->temperature, &constants, &stepper->xi_MF, &stepper->xi_P);
-    stepper->outputs = evaluate(stepper, &constants);
+    evaluate(stepper, &constants);
     stepper->warning[0] = '\0';
     check_validity(stepper, -HUGE_VAL, -HUGE_VAL);
     return 0;
@@ -154,7 +154,7 @@ int plant_stepper_step(PlantStepper *stepper, double power, double load, double 
     stepper->power = power;
     stepper->xi_MF = xi_mf;
     stepper->xi_P = xi_p;
-    stepper->outputs = evaluate(stepper, &constants);
+    evaluate(stepper, &constants);
     stepper->warning[0] = '\0';
     if (after > params->T_max || load > params->load_max) {
         check_validity(stepper, before, load_before);
@@ -245,6 +245,6 @@ int plant_stepper_state_read(PlantStepper *stepper, const double *in, size_t cou
     stepper->xi_P = in[4];
     stepper->power = in[5];
     stepper->branch_valid = 0;
-    stepper->outputs = evaluate(stepper, &constants);
+    evaluate(stepper, &constants);
     return 0;
 }
