@@ -120,7 +120,9 @@ def plain_host_commands(refs, init=None, steps=C_HOST_STEPS):
 
 
 def _plain_host(exe, folder, refs, env, init=None):
-    """(mean, p50, p99, p99.9) [us] of set + doStep + get in fmi_host."""
+    """(mean, p50, p99, p99.9) [us] of set + doStep + get in fmi_host: the percentiles of a
+    pass timed step by step, the mean of a second pass timed as a whole (fmi_host.c's
+    ``bench``: two clock reads per step cost as much as a native C FMU step)."""
     commands = "\n".join([*plain_host_commands(refs, init), ""])
     result = subprocess.run([str(exe), str(folder)], input=commands, capture_output=True, text=True,
                             env=_environment(env), timeout=600, check=True)
