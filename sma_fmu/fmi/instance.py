@@ -3,22 +3,20 @@
 Collects the FMU's log messages per instance and turns a failed FMI call into an
 :class:`FmuError` that quotes them, so a discarded step says which input was wrong.
 The stepping calls (set/get Real, get Boolean, doStep) go straight to the FMU's exported
-C functions with preallocated arrays; everything else uses fmpy's wrappers.
+C functions with preallocated arrays; everything else uses fmpy's wrappers. Instances of
+the same FMU file share one unpacked folder per process (:mod:`sma_fmu.fmi.unpacked`).
 """
-import shutil
 import sys
 from pathlib import Path
 from ctypes import POINTER, PyDLL, byref, c_double, c_int, c_size_t, c_uint, c_void_p
 from itertools import count
 
-from fmpy import extract
 from fmpy.fmi1 import FMICallException
 from fmpy.logging import addLoggerProxy
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2CallbackFunctions,
                        fmi2CallbackLoggerTYPE)
 
-from sma_fmu.files.archives import require_safe_archive
-from sma_fmu.fmi.build import read_description
+from sma_fmu.fmi import unpacked
 
 __all__ = ["FmuError", "FmuInstance"]
 
@@ -104,14 +102,19 @@ class FmuInstance:
     def __init__(self, path, instance_name, start_values=None, start_time=0.0):
         self.path = str(path)
         self.instance_name = instance_name
-        require_safe_archive(self.path)  # fmpy unpacks it: never an archive that leaves its folder
-        description = read_description(path)
+        # inspected before it is unpacked: never an archive that leaves its folder
+        self._unpacked = unpacked.acquire(self.path)
+        self._unzipped = self._unpacked.folder
+        description = self._unpacked.description
         self.variables = {v.name: v for v in description.modelVariables}
         self.messages = []
-        self._unzipped = extract(self.path)
-        self._fmu = FMU2Slave(guid=description.guid, unzipDirectory=self._unzipped,
-                              modelIdentifier=description.coSimulation.modelIdentifier,
-                              instanceName=instance_name)
+        try:
+            self._fmu = FMU2Slave(guid=description.guid, unzipDirectory=self._unzipped,
+                                  modelIdentifier=description.coSimulation.modelIdentifier,
+                                  instanceName=instance_name)
+        except BaseException:
+            self._release()
+            raise
         self._callbacks = fmi2CallbackFunctions()
         self._key = next(_KEYS)
         _LOGGERS[self._key] = self._log
@@ -255,10 +258,12 @@ class FmuInstance:
         return self._call("fmi2DeSerializeFMUstate", self._fmu.deSerializeFMUstate, data)
 
     def close(self):
-        """Terminate, free the instance and remove the unpacked FMU.
+        """Terminate and free the instance, and end its use of the unpacked folder.
 
-        pythonfmu puts each instance's resources folder on ``sys.path`` and leaves it there;
-        it is taken off again here, as the folder is deleted.
+        The folder stays for later instances of the same file (:mod:`sma_fmu.fmi.unpacked`
+        removes it at exit, or at its last use once the file has changed). pythonfmu puts the
+        folder's ``resources`` on ``sys.path`` and leaves it there; it is taken off here,
+        so a closed instance leaves no entry behind.
         """
         if self._alive:
             self._alive = False
@@ -268,9 +273,15 @@ class FmuInstance:
                 pass
             self._fmu.freeInstance()
         _LOGGERS.pop(self._key, None)  # after the instance's last message
-        shutil.rmtree(self._unzipped, ignore_errors=True)
         resources = str(Path(self._unzipped) / "resources")
         sys.path[:] = [entry for entry in sys.path if entry.rstrip("/") != resources]
+        self._release()
+
+    def _release(self):
+        """End this instance's use of the unpacked folder (once)."""
+        if self._unpacked is not None:
+            unpacked.release(self._unpacked)
+            self._unpacked = None
 
     def __enter__(self):
         return self

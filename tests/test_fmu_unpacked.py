@@ -1,0 +1,166 @@
+"""One unpacked folder per FMU file per process (sma_fmu.fmi.unpacked), shared by FmuInstance."""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from sma_fmu.fmi import unpacked
+from sma_fmu.fmi.instance import FmuInstance
+
+PREFIX = "sma_fmu_unpacked_"
+
+
+def _resources_on_path(folder):
+    resources = str(Path(folder) / "resources")
+    return [entry for entry in sys.path if entry.rstrip("/") == resources]
+
+
+def test_a_second_instance_reuses_the_folder_and_closing_keeps_it(fmus):
+    with FmuInstance(fmus["SmaActuator"], "first", {"load": 0.05}) as first:
+        folder = first._unzipped
+        marker = Path(folder) / "marker.txt"
+        marker.write_text("written after unpacking")
+        first.step(0.0, 1e-3)
+    assert Path(folder).is_dir() and marker.is_file()  # close() leaves it for the next one
+    with FmuInstance(fmus["SmaActuator"], "second", {"load": 0.05}) as second:
+        assert second._unzipped == folder
+        second.step(0.0, 1e-3)
+        assert second.get_real(("T",))[0] > 0.0
+    assert marker.read_text() == "written after unpacking"  # not unpacked again
+
+
+def test_instances_alive_together_share_the_folder_and_close_in_any_order(fmus, params):
+    from sma_fmu.runtime.plant import PlantStepper
+    loads = [0.01, 0.1, 0.25]
+    instances = [FmuInstance(fmus["SmaActuator"], f"p{k}", {"load": f}) for k, f in enumerate(loads)]
+    libraries = [PlantStepper(params, load=f) for f in loads]
+    try:
+        assert len({fmu._unzipped for fmu in instances}) == 1
+        instances[1].close()  # one closed (its library unloaded once) while the others step on
+        for k in range(200):
+            for index in (0, 2):
+                instances[index].set_real(("P_in", "load"), (0.8, loads[index]))
+                instances[index].step(k * 1e-3, 1e-3)
+                libraries[index].step(0.8, loads[index], 1e-3)
+        again = FmuInstance(fmus["SmaActuator"], "again", {"load": loads[1]})  # loaded again
+        instances[1] = again
+        for k in range(200):
+            again.set_real(("P_in", "load"), (0.8, loads[1]))
+            again.step(k * 1e-3, 1e-3)
+            libraries[1].step(0.8, loads[1], 1e-3)
+        for fmu, library in zip(instances, libraries):
+            assert fmu.get_real(("T", "R")) == [library.outputs.T, library.outputs.R]
+    finally:
+        for fmu in instances:
+            fmu.close()
+
+
+def test_a_rebuilt_file_at_the_same_path_is_unpacked_again(fmus, tmp_path):
+    path = tmp_path / "Plant.fmu"
+    shutil.copyfile(fmus["SmaActuator"], path)
+    with FmuInstance(path, "old") as old:
+        old_folder = old._unzipped
+        shutil.copyfile(fmus["SmaFeedforward"], path)  # another FMU at the same path, in use
+        os.utime(path, ns=(1, 1))  # a different modification time even on a coarse clock
+        with FmuInstance(path, "new") as new:
+            new_folder = new._unzipped
+            assert new_folder != old_folder
+            assert "P_ff" in new.variables and "P_ff" not in old.variables
+            assert Path(old_folder).is_dir()  # still in use by "old"
+            old.step(0.0, 1e-3)
+    assert not Path(old_folder).exists()  # the last user of an outdated folder removes it
+    assert Path(new_folder).is_dir()
+    assert unpacked.folders()[str(path.resolve())] == new_folder
+
+
+def test_closing_leaves_no_resources_entry_on_sys_path(fmus):
+    instances = [FmuInstance(fmus["SmaFeedforward"], f"ff{k}") for k in range(2)]
+    folder = instances[0]._unzipped
+    for fmu in instances:
+        fmu.close()
+        assert _resources_on_path(folder) == []
+    sys.path.append(str(Path(folder) / "resources"))  # as pythonfmu's own code would leave it
+    FmuInstance(fmus["SmaFeedforward"], "ff2").close()
+    assert _resources_on_path(folder) == []
+
+
+CHILD = """
+import sys
+from sma_fmu.fmi.instance import FmuInstance
+for k in range(3):
+    with FmuInstance(sys.argv[1], f"child{k}", {"load": 0.05}) as fmu:
+        fmu.step(0.0, 1e-3)
+print(fmu._unzipped)
+"""
+
+
+def _ours(root):
+    return {entry.name for entry in Path(root).iterdir() if entry.name.startswith(PREFIX)}
+
+
+def test_a_process_removes_its_folders_when_it_exits(fmus, tmp_path):
+    environment = {**os.environ, "TMPDIR": str(tmp_path)}
+    result = subprocess.run([sys.executable, "-c", CHILD, str(fmus["SmaActuator"])],
+                            env=environment, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    folder = Path(result.stdout.strip().splitlines()[-1])
+    assert folder.parent == tmp_path and folder.name.startswith(PREFIX)  # it did unpack there
+    assert _ours(tmp_path) == set()
+
+
+FORKED = """
+import multiprocessing, sys, tempfile
+from pathlib import Path
+from sma_fmu.fmi.instance import FmuInstance
+
+def child(path, fresh):
+    with FmuInstance(path, "in-child") as fmu:  # the parent's folder
+        fmu.step(0.0, 1e-3)
+    with FmuInstance(fresh, "fresh-in-child") as fmu:  # a folder of the child's own
+        fmu.step(0.0, 1e-3)
+        print("child", fmu._unzipped, flush=True)
+
+if __name__ == "__main__":
+    path, fresh = sys.argv[1], sys.argv[2]
+    parent = FmuInstance(path, "in-parent")
+    process = multiprocessing.get_context("fork").Process(target=child, args=(path, fresh))
+    process.start(); process.join()
+    assert process.exitcode == 0
+    left = sorted(p.name for p in Path(tempfile.gettempdir()).iterdir())
+    print("after-child", " ".join(left), flush=True)
+    assert Path(parent._unzipped).is_dir()  # the child did not remove the parent's folder
+    parent.step(0.0, 1e-3)
+    parent.close()
+    print("parent", parent._unzipped, flush=True)
+"""
+
+
+def test_a_forked_child_removes_only_its_own_folders(fmus, tmp_path):
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    environment = {**os.environ, "TMPDIR": str(scratch)}
+    result = subprocess.run([sys.executable, "-c", FORKED, str(fmus["SmaActuator"]),
+                             str(fmus["SmaFeedforward"])],
+                            env=environment, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    lines = dict(line.split(" ", 1) for line in result.stdout.strip().splitlines())
+    parent, child = Path(lines["parent"]), Path(lines["child"])
+    assert parent.parent == scratch and child.parent == scratch and parent != child
+    assert lines["after-child"].split() == [parent.name]  # the child's own one removed at its exit
+    assert _ours(scratch) == set()                        # and the parent's at the parent's exit
+
+
+def test_unpack_each_gives_every_instance_its_own_folder(fmus, tmp_path, monkeypatch):
+    monkeypatch.setenv(unpacked.UNPACK_EACH_VARIABLE, "1")
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    first = FmuInstance(fmus["SmaFeedforward"], "each1")
+    second = FmuInstance(fmus["SmaFeedforward"], "each2")
+    try:
+        assert first._unzipped != second._unzipped
+        assert len(_ours(tmp_path)) == 2
+    finally:
+        first.close()
+        second.close()
+    assert _ours(tmp_path) == set()  # removed at close, as before the cache
