@@ -1,7 +1,8 @@
 """What instances leave behind: make N instances of an FMU, each unpacked into its own folder
-(as fmpy's simulate_fmu and FmuInstance do), and measure the process before and after.
+(as fmpy's simulate_fmu does, and FmuInstance with SMA_FMU_UNPACK_EACH=1, which this probe
+sets unless ``--shared``), and measure the process before and after.
 
-    python tests/instance_memory_probe.py FMU [--warm 50] [--instances 200] [--fmpy]
+    python tests/instance_memory_probe.py FMU [--warm 50] [--instances 200] [--fmpy] [--shared]
 
 Prints one JSON object: resident memory growth per instance [KiB], growth of the mappings
 of FMU binaries, of sys.path, of sys.path_importer_cache and of Python objects. ``--fmpy``
@@ -11,6 +12,7 @@ Each instance is initialized, stepped, terminated and freed, and its folder remo
 import argparse
 import gc
 import json
+import os
 import re
 import sys
 
@@ -29,7 +31,11 @@ def main(argv=None):
     parser.add_argument("--warm", type=int, default=50, help="instances before the first measurement")
     parser.add_argument("--instances", type=int, default=200, help="instances measured")
     parser.add_argument("--fmpy", action="store_true", help="plain fmpy.simulate_fmu")
+    parser.add_argument("--shared", action="store_true",
+                        help="FmuInstance's instances share one unpacked folder (its default)")
     args = parser.parse_args(argv)
+    if not args.shared:
+        os.environ["SMA_FMU_UNPACK_EACH"] = "1"  # a folder per instance, as the docstring says
     if args.fmpy:
         from fmpy import simulate_fmu
 

@@ -4,6 +4,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 from pathlib import Path
 
 from sma_fmu.fmi import unpacked
@@ -84,6 +85,27 @@ def test_closing_leaves_no_resources_entry_on_sys_path(fmus):
     sys.path.append(str(Path(folder) / "resources"))  # as pythonfmu's own code would leave it
     FmuInstance(fmus["SmaFeedforward"], "ff2").close()
     assert _resources_on_path(folder) == []
+
+
+def test_threads_acquiring_at_once_get_one_folder(fmus, tmp_path):
+    path = tmp_path / "Threads.fmu"
+    shutil.copyfile(fmus["SmaPwmDriver"], path)
+    start, got = threading.Barrier(4), []
+
+    def worker():
+        start.wait()
+        got.append(unpacked.acquire(path))
+
+    threads = [threading.Thread(target=worker) for _ in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len(got) == 4 and len({id(u) for u in got}) == 1 and got[0].users == 4
+    for one in got:
+        unpacked.release(one)
+    assert got[0].users == 0 and Path(got[0].folder).is_dir()  # current: kept for the next
+    assert unpacked.folders()[str(path.resolve())] == got[0].folder
 
 
 CHILD = """
