@@ -122,3 +122,53 @@ def test_a_good_step_bypasses_pythonfmu(fmus, monkeypatch):
         assert calls == [] and slave.P_in == 3.0 and fmu.get_real(("T",))[0] != T_before
         assert _step(fmu, 5 * STEP, STEP)[0] == ERROR  # not following: pythonfmu's route
         assert calls == [(5 * STEP, STEP)]
+
+
+def _inputs_run(path, direct, monkeypatch, steps=400):
+    """Every Real output after each of ``steps`` steps whose Real inputs follow the shared
+    signals (a new value at most steps, none at some: both forms of the inputs)."""
+    from fmu_signals import plant_power, reference
+    if direct:
+        monkeypatch.delenv("SMA_FMU_NO_DIRECT_STEP", raising=False)
+    else:
+        monkeypatch.setenv("SMA_FMU_NO_DIRECT_STEP", "1")
+    monkeypatch.delenv("SMA_FMU_NO_FAST_PATH", raising=False)
+    with FmuInstance(path, "inputs") as fmu:
+        variables = list(fmu.variables.values())
+        inputs = tuple(v.name for v in variables if v.causality == "input" and v.type == "Real")
+        outputs = tuple(v.name for v in variables if v.causality == "output" and v.type == "Real")
+        rows = []
+        for k in range(steps):
+            if inputs and k % 7 != 3:  # some steps take no new input
+                values = [plant_power(k) if i == 0 else 20.0 + reference(k) + i for i in range(len(inputs))]
+                fmu.set_real(inputs, values)
+            fmu.step(k * STEP, STEP)
+            rows.append(fmu.get_real(outputs))
+        return outputs, rows, [text for status, text in fmu.messages if status != "ok"]
+
+
+def test_every_fmu_steps_alike_with_and_without_the_direct_step(fmus, monkeypatch):
+    """The five FMUs (three with the inlined step, two with the general one) give the same
+    outputs, bit for bit, and the same warnings with the direct step as through pythonfmu."""
+    for name, path in sorted(fmus.items()):
+        names, direct, direct_log = _inputs_run(path, True, monkeypatch)
+        _, pythonfmu, pythonfmu_log = _inputs_run(path, False, monkeypatch)
+        assert names and direct == pythonfmu, name
+        assert direct_log == pythonfmu_log, name
+        assert len({tuple(row) for row in direct}) > 1, f"{name}: the outputs never moved"
+
+
+def test_three_slaves_declare_the_step_the_front_inlines():
+    """SmaActuator, SmaFeedforward and SmaPiController declare their stepper call (the direct
+    step inlines it); the PWM driver and the signal source keep their own and get the
+    general form."""
+    import importlib
+    from sma_fmu.fmi.build import FMU_SCRIPTS
+    declared = {}
+    for name, script in FMU_SCRIPTS.items():
+        module = importlib.import_module(f"sma_fmu.fmi.slaves.{script[:-3]}")
+        declared[name] = getattr(module, name).declared_step
+    assert {name for name, step in declared.items() if step} == {
+        "SmaActuator", "SmaFeedforward", "SmaPiController"}
+    assert declared["SmaActuator"][:2] == ("step", ("P_in", "load"))
+    assert declared["SmaPiController"][:2] == ("sample", ("R", "R_ref", "P_ff"))

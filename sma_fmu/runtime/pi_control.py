@@ -18,6 +18,8 @@ __all__ = ["PIController"]
 class PIController:
     """Discrete PI with anti-windup; gains Kp [W/ohm], Ki [W/(ohm.s)]."""
 
+    warning = None  # a PI has no validity range: no step ever warns (the plant's has one)
+
     def __init__(self, Kp, Ki):
         self.Kp = require_nonnegative("Kp", Kp)
         self.Ki = require_nonnegative("Ki", Ki)

@@ -38,12 +38,12 @@ void forget_resources(const char* folder)
     if (calls.forget_resources) calls.forget_resources(folder);
 }
 
-int can_call_python(void) { return calls.call_python != NULL; }
+int can_call_step(void) { return calls.call_step != NULL; }
 
-int call_python(void* callable, void* queue, long* queued)
+int call_step(void* callable, void* queue, long* queued, const StepCall* call)
 {
     *queued = 1;
-    return calls.call_python ? calls.call_python(callable, queue, queued) : -1;
+    return calls.call_step ? calls.call_step(callable, queue, queued, call) : -1;
 }
 
 #ifndef _WIN32

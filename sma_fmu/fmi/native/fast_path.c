@@ -24,8 +24,10 @@
  * stepComplete, the front makes the guard's model-free checks itself (finite t, 0 < h < inf,
  * t follows the last step up to rounding, the step's end not past stopTime: the guard's
  * _do_step, on the time and stopTime the slave writes) and, if they pass, calls the slave's
- * step (FastPath.step, its address in the header) through Python's C API: the inputs,
- * the model's step, the outputs. Messages the step queued reach the host through one more
+ * direct step (slave_support/direct_step.py, its address in the header) through Python's C
+ * API with t, h and the pending inputs as arguments (StepCall, front.h); the step returns
+ * the values it changed, which the front copies into the buffer (or writes the buffer
+ * itself in the unusual cases). Messages the step queued reach the host through one more
  * crossing (fmi2GetString of FAST_LOG_VR), after which pythonfmu passes them on as it does
  * after any call. A step the checks do not pass goes through pythonfmu's DoStep, so the
  * guard refuses it with its own message. SMA_FMU_NO_DIRECT_STEP=1 switches this off.
@@ -34,10 +36,11 @@
  * flags. Header: [0] 1 if the slave is in stepComplete, [1] 1 once the slave has written
  * the buffer (the front clears it before a crossing), [2] 1 if an input is pending, [3] the
  * front's sync request, [4] 1: the next step writes every value, not only the outputs,
- * [5] the guard's stopTime (NaN: none), [6] 1 if [5] and [12] may be checked in C, [7] t
- * and [8] h of a direct step, [9] the front's log request, [10] the direct step's address,
- * [11] pythonfmu's log queue's address, [12] the guard's time (where the next step must
- * start; NaN: none), next to the values: the slave writes both in one pack.
+ * [5] the guard's stopTime (NaN: none), [6] 1 if [5] and [11] may be checked in C, [7] the
+ * front's log request, [8] the direct step's address (0: none), [9] pythonfmu's log
+ * queue's address, [10] the number of slots a step changes (the first ones), [11] the
+ * guard's time (where the next step must start; NaN: none), next to the values: the slave
+ * writes both in one pack.
  */
 #define _GNU_SOURCE
 #include <stdio.h>
@@ -54,12 +57,11 @@
 #define H_FULL 4
 #define H_STOP 5
 #define H_CHECKABLE 6
-#define H_T 7
-#define H_H 8
-#define H_LOG 9
-#define H_ENTRY 10
-#define H_QUEUE 11
-#define H_TIME 12
+#define H_LOG 7
+#define H_ENTRY 8
+#define H_QUEUE 9
+#define H_CHANGED 10
+#define H_TIME 11
 #define MAX_TABLE_VR 65536u
 
 static int kind_index(char kind) { return kind == 'R' ? 0 : kind == 'I' ? 1 : kind == 'B' ? 2 : -1; }
@@ -68,6 +70,9 @@ void fast_free(FastPath* fast)
 {
     free(fast->buffer);
     free(fast->settable);
+    free(fast->kinds);
+    free(fast->input_slots);
+    free(fast->input_kinds);
     for (int k = 0; k < 3; ++k) free(fast->slot_of[k]);
     memset(fast, 0, sizeof *fast);
 }
@@ -116,11 +121,37 @@ static int parse_table(FastPath* fast, const char* text)
         fast->buffer = (double*)calloc(FAST_HEADER + 2 * n, sizeof(double));
         ok = fast->buffer != NULL;
     }
-    free(kinds);
     free(vrs);
     fast->settable = settable;
+    fast->kinds = kinds;
     fast->n = n;
     return ok;
+}
+
+/* The direct step, if the slave offers one: its address and the log queue's (exact in a
+ * double), the inputs it takes and the number of values it returns. */
+static void attach_direct_step(FastPath* fast)
+{
+    const double* b = fast->buffer;
+    double entry = b[H_ENTRY], queue = b[H_QUEUE], changed = b[H_CHANGED];
+    if (!(entry > 0.0 && entry < 9007199254740992.0 && queue > 0.0 && queue < 9007199254740992.0 &&
+          changed >= 0.0 && changed <= (double)fast->n && changed == (double)(size_t)changed))
+        return;
+    size_t n_inputs = 0;
+    for (size_t s = 0; s < fast->n; ++s) n_inputs += fast->settable[s];
+    if (n_inputs > STEP_MAX_INPUTS) return;
+    fast->input_slots = (int*)malloc((n_inputs ? n_inputs : 1) * sizeof(int));
+    fast->input_kinds = (char*)malloc(n_inputs ? n_inputs : 1);
+    if (!fast->input_slots || !fast->input_kinds) return; /* (freed with the rest) */
+    fast->n_inputs = 0;
+    for (size_t s = 0; s < fast->n; ++s)
+        if (fast->settable[s]) {
+            fast->input_slots[fast->n_inputs] = (int)s;
+            fast->input_kinds[fast->n_inputs++] = fast->kinds[s];
+        }
+    fast->n_changed = (size_t)changed;
+    fast->step = (void*)(size_t)entry;
+    fast->queue = (void*)(size_t)queue;
 }
 
 /* Ask the slave for its table and give it the buffer. Without them every call goes to the
@@ -143,15 +174,10 @@ void fast_attach(Instance* in)
             in->logged_status == fmi2OK && in->fast.buffer[H_FRESH] == 1.0) {
             in->fast.attached = 1;
             in->fast.maybe_step_complete = in->fast.buffer[H_STEP_COMPLETE] == 1.0;
-            double entry = in->fast.buffer[H_ENTRY], queue = in->fast.buffer[H_QUEUE];
-            int direct = can_call_python() &&
+            int direct = can_call_step() &&
                          !(environment("SMA_FMU_NO_DIRECT_STEP", off, sizeof off) &&
                            strcmp(off, "0") != 0);
-            if (direct && entry > 0.0 && entry < 9007199254740992.0 && queue > 0.0 &&
-                queue < 9007199254740992.0) { /* addresses, exact in a double */
-                in->fast.step = (void*)(size_t)entry;
-                in->fast.queue = (void*)(size_t)queue;
-            }
+            if (direct) attach_direct_step(&in->fast);
         }
     }
     if (!in->fast.attached) fast_free(&in->fast);
@@ -296,12 +322,22 @@ int fast_step(Instance* in, double t, double h)
     FastPath* fast = &in->fast;
     if (!direct_step_allowed(fast, t, h)) return -1;
     double* b = fast->buffer;
+    double* values = b + FAST_HEADER;
+    double* pending = values + fast->n;
     b[H_FRESH] = 0.0;
     b[H_FULL] = 0.0; /* not stale: the outputs are enough */
-    b[H_T] = t;
-    b[H_H] = h;
+    StepCall call = {t, h, fast->n_inputs, fast->input_slots, fast->input_kinds, values,
+                     b[H_PENDING] != 0.0 ? pending : NULL, values, fast->n_changed};
     long queued = 0;
-    int done = call_python(fast->step, fast->queue, &queued);
+    int outcome = call_step(fast->step, fast->queue, &queued, &call);
+    if (call.pending) { /* handed over */
+        for (size_t i = 0; i < fast->n_inputs; ++i) pending[fast->input_slots[i]] = 0.0;
+        b[H_PENDING] = 0.0;
+    }
+    if (outcome >= 2) { /* the step returned its values (2) or something else (3: stale) */
+        if (outcome == 3) b[H_STEP_COMPLETE] = 0.0;
+        b[H_FRESH] = 1.0;
+    }
     if (queued != 0) { /* pythonfmu passes the queued messages on after this call */
         const fmi2ValueReference vr = FAST_LOG_VR;
         fmi2String text = NULL;
@@ -311,9 +347,10 @@ int fast_step(Instance* in, double t, double h)
     }
     fast_after_step(in);
     if (in->dead) return finish(in, fmi2Fatal);
-    if (done < 0) /* a Python exception the guard lets through (never an Exception) */
+    if (outcome < 0) /* a Python exception the step lets through (never an Exception) */
         return refuse(in, fmi2Error, "fmi2DoStep", "internal error: the slave's step raised "
                       "an exception that is not an Exception (printed on stderr)");
+    int done = outcome != 0;
     in->own_last_time = 1;
     in->last_time = done ? t + h : t; /* as pythonfmu's fmi2DoStep */
     return finish(in, done ? fmi2OK : fmi2Discard);

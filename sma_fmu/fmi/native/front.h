@@ -60,16 +60,33 @@ typedef struct {
 extern Backend backend;
 
 /* ---- the runtime one process shares (backend.c) ------------------------------------------ */
+/* One direct step (fast_path.c): the slave's step(t, h, inputs...) with one argument per
+ * input settable in stepComplete (slot order): its value if the host set it since the last
+ * step, else None. The step returns the values it changed (a tuple: copied to `changed`) or
+ * a truth value (it wrote the buffer itself). call_step says: -1 it raised (printed and
+ * cleared), 0 not done, 1 done, 2 done and `changed` written, 3 done but the tuple was not
+ * n_changed numbers (the values are stale). */
+#define STEP_MAX_INPUTS 30
+typedef struct {
+    double t, h;
+    size_t n_inputs;         /* at most STEP_MAX_INPUTS */
+    const int* input_slots;  /* their slots */
+    const char* input_kinds; /* 'R', 'I' or 'B' */
+    const double* values;    /* the buffer's values, by slot */
+    const double* pending;   /* the buffer's pending flags, by slot; NULL: none is pending */
+    double* changed;         /* out: the values of the slots a step changes (the first ones) */
+    size_t n_changed;
+} StepCall;
+
 /* What the owner of the backend does for every copy of the front that shares it. */
 typedef struct {
     void (*keep_thread_state)(void);
     fmi2Component (*instantiate)(fmi2String name, fmi2Type type, fmi2String guid, fmi2String uri,
                                  const fmi2CallbackFunctions* cb, fmi2Boolean visible);
     void (*forget_resources)(const char* folder);
-    /* calls a Python callable with no arguments (GIL taken and released): 1 if the result
-     * is true, 0 if false, -1 if it raised (the exception is printed and cleared); then
+    /* calls the slave's direct step (GIL taken and released), see StepCall; then
      * *queued = the length of the Python list `queue` (1 if it is none) */
-    int (*call_python)(void* callable, void* queue, long* queued);
+    int (*call_step)(void* callable, void* queue, long* queued, const StepCall* call);
 } RuntimeCalls;
 
 /*
@@ -80,7 +97,7 @@ typedef struct {
  * loading its own, so it holds nothing the host's unloading of it would leave behind.
  */
 #define SHARE_MAGIC "SMAFRONT"
-#define SHARE_ABI 2 /* 2: RuntimeCalls.call_python */
+#define SHARE_ABI 3 /* 2: RuntimeCalls.call_python; 3: call_step */
 typedef struct {
     char magic[8];
     unsigned abi;
@@ -104,8 +121,8 @@ void keep_thread_state(void); /* the owner's: one parked Python thread state per
 fmi2Component instantiate_backend(fmi2String name, fmi2Type type, fmi2String guid, fmi2String uri,
                                   const fmi2CallbackFunctions* cb, fmi2Boolean visible);
 void forget_resources(const char* folder); /* takes pythonfmu's sys.path entry away again */
-int call_python(void* callable, void* queue, long* queued); /* RuntimeCalls.call_python; -1 without */
-int can_call_python(void);                                  /* 1 if there is one */
+int call_step(void* callable, void* queue, long* queued, const StepCall* call); /* -1 without */
+int can_call_step(void);                                                         /* 1 if there is one */
 /* The GNU build ID of an ELF file (0 elsewhere or without one: then nothing is shared). */
 int backend_build_id(const char* path, unsigned char* id, size_t* size);
 /* An owner's record for a backend with this build ID, or NULL. */
@@ -137,7 +154,7 @@ typedef struct FrontState {
 } FrontState;
 
 /* Values the front holds for the slave, so that fmi2Set/Get need no Python (fast_path.c). */
-#define FAST_HEADER 13 /* as _HEADER in slave_support/fast_path.py */
+#define FAST_HEADER 12 /* as _HEADER in slave_support/fast_path.py */
 #define FAST_DESCRIBE_VR 0xFFFFFA51u /* fmi2GetString: the slave's variable table */
 #define FAST_ATTACH_VR 0xFFFFFA52u   /* fmi2SetString: the buffer's address */
 #define FAST_SYNC_VR 0xFFFFFA53u     /* fmi2GetString: take pending inputs, write every value */
@@ -151,6 +168,11 @@ typedef struct {
     unsigned char* settable; /* per slot: settable in stepComplete */
     int* slot_of[3];         /* Real, Integer, Boolean: value reference -> slot or -1 */
     unsigned table_size[3];
+    char* kinds;             /* per slot: 'R', 'I' or 'B' */
+    int* input_slots;        /* the slots settable in stepComplete, in order */
+    char* input_kinds;
+    size_t n_inputs;
+    size_t n_changed;        /* slots a step changes (the first ones) */
     void* step;              /* the slave's direct doStep (a Python callable), or NULL */
     void* queue;             /* pythonfmu's log queue of the slave (a Python list) */
 } FastPath;

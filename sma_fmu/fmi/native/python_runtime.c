@@ -44,7 +44,15 @@ static struct {
     void (*Err_Clear)(void);
     void (*DecRef)(void*);
     /* the direct doStep (fast_path.c) */
-    void* (*Object_CallObject)(void*, void*);
+    void* (*Object_Vectorcall)(void*, void* const*, size_t, void*);
+    void* (*Float_FromDouble)(double);
+    void* (*Long_FromLong)(long);
+    void* (*Bool_FromLong)(long);
+    double (*Float_AsDouble)(void*);
+    ptrdiff_t (*Tuple_Size)(void*);
+    void* (*Tuple_GetItem)(void*, ptrdiff_t);
+    void* (*Err_Occurred)(void);
+    void* None;
     int (*Object_IsTrue)(void*);
     void (*Err_Print)(void);
 } py;
@@ -134,21 +142,59 @@ static void owner_forget_resources(const char* folder)
     py.GILState_Release(gil);
 }
 
-/* The slave's direct step (fast_path.c): one call with no arguments under the GIL. An
- * exception cannot come from the guard (it catches Exception); anything else (a
+/* A Python object for input i of a direct step: its value, or None if it is not pending;
+ * NULL if out of memory. */
+static void* step_input(const StepCall* call, size_t i)
+{
+    int slot = call->input_slots[i];
+    if (!call->pending || call->pending[slot] == 0.0) return py.None;
+    double value = call->values[slot];
+    char kind = call->input_kinds[i];
+    if (kind == 'I') return py.Long_FromLong((long)value); /* an fmi2Integer, exact */
+    if (kind == 'B') return py.Bool_FromLong(value != 0.0);
+    return py.Float_FromDouble(value);
+}
+
+/* The slave's direct step (fast_path.c, StepCall): step(t, h, inputs...) under the GIL. An
+ * exception cannot come from the step (it catches Exception); anything else (a
  * KeyboardInterrupt) is printed as Python would and cleared, and the call says -1. */
-static int owner_call_python(void* callable, void* queue, long* queued)
+static int owner_call_step(void* callable, void* queue, long* queued, const StepCall* call)
 {
     int gil = py.GILState_Ensure();
-    void* result = py.Object_CallObject(callable, NULL);
-    int truth = result ? py.Object_IsTrue(result) : -1;
-    if (result) py.DecRef(result);
-    if (truth < 0) py.Err_Print();
+    void* args[2 + STEP_MAX_INPUTS];
+    size_t n = 0, count = 2 + call->n_inputs;
+    args[n++] = py.Float_FromDouble(call->t);
+    args[n++] = py.Float_FromDouble(call->h);
+    while (n < count && args[0] && args[1] && (args[n] = step_input(call, n - 2))) ++n;
+    void* result = n == count && args[0] && args[1]
+                   ? py.Object_Vectorcall(callable, args, count, NULL) : NULL;
+    for (size_t i = 0; i < n; ++i)
+        if (args[i] && args[i] != py.None) py.DecRef(args[i]);
+    int outcome = -1;
+    if (result) {
+        ptrdiff_t size = py.Tuple_Size(result);
+        if (size < 0) { /* no tuple: the slave wrote the buffer, the result says done */
+            py.Err_Clear();
+            outcome = py.Object_IsTrue(result);
+        } else {
+            outcome = (size_t)size == call->n_changed ? 2 : 3;
+            for (ptrdiff_t i = 0; outcome == 2 && i < size; ++i) {
+                double value = py.Float_AsDouble(py.Tuple_GetItem(result, i));
+                if (value == -1.0 && py.Err_Occurred()) {
+                    py.Err_Clear();
+                    outcome = 3;
+                }
+                call->changed[i] = value;
+            }
+        }
+        py.DecRef(result);
+    }
+    if (outcome < 0) py.Err_Print();
     ptrdiff_t size = queue ? py.List_Size(queue) : 1;
     if (size < 0) py.Err_Clear();
     *queued = size < 0 ? 1 : (long)size;
     py.GILState_Release(gil);
-    return truth;
+    return outcome;
 }
 
 int start_python_runtime(RuntimeCalls* calls)
@@ -174,7 +220,15 @@ int start_python_runtime(RuntimeCalls* calls)
     LOOKUP(Object_DelItem, "PyObject_DelItem");
     LOOKUP(Err_Clear, "PyErr_Clear");
     LOOKUP(DecRef, "Py_DecRef");
-    LOOKUP(Object_CallObject, "PyObject_CallObject");
+    LOOKUP(Object_Vectorcall, "PyObject_Vectorcall");
+    LOOKUP(Float_FromDouble, "PyFloat_FromDouble");
+    LOOKUP(Long_FromLong, "PyLong_FromLong");
+    LOOKUP(Bool_FromLong, "PyBool_FromLong");
+    LOOKUP(Float_AsDouble, "PyFloat_AsDouble");
+    LOOKUP(Tuple_Size, "PyTuple_Size");
+    LOOKUP(Tuple_GetItem, "PyTuple_GetItem");
+    LOOKUP(Err_Occurred, "PyErr_Occurred");
+    LOOKUP(None, "_Py_NoneStruct");
     LOOKUP(Object_IsTrue, "PyObject_IsTrue");
     LOOKUP(Err_Print, "PyErr_Print");
 #undef LOOKUP
@@ -185,9 +239,11 @@ int start_python_runtime(RuntimeCalls* calls)
     calls->keep_thread_state = owner_keep_thread_state;
     calls->instantiate = owner_instantiate;
     calls->forget_resources = owner_forget_resources;
-    calls->call_python = py.Object_CallObject && py.Object_IsTrue && py.Err_Print &&
-                         py.List_Size && py.Err_Clear && py.DecRef && py.GILState_Release
-                         ? owner_call_python : NULL;
+    calls->call_step = py.Object_Vectorcall && py.Float_FromDouble && py.Long_FromLong &&
+                       py.Bool_FromLong && py.Float_AsDouble && py.Tuple_Size && py.Tuple_GetItem &&
+                       py.Err_Occurred && py.None && py.Object_IsTrue && py.Err_Print &&
+                       py.List_Size && py.Err_Clear && py.DecRef && py.GILState_Release
+                       ? owner_call_step : NULL;
     return py.IsInitialized && py.GILState_Ensure && py.GILState_GetThisThreadState &&
            py.Eval_SaveThread && py.Eval_RestoreThread;
 }

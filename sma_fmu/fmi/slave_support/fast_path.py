@@ -20,47 +20,37 @@ only as the only reference of a call:
 
 fmi2DoStep: the front makes the guard's model-free checks in C (stepComplete, finite t and
 h > 0, t follows the last step, stopTime; from the time, stopTime and state the slave writes
-into the header) and, when they pass, calls :meth:`FastPath.step` itself through Python's C
-API (its address is in the header): no pythonfmu DoStep, no log-queue crossing unless a
-message was queued. Otherwise the call takes pythonfmu's DoStep and the guard refuses it
-with its message, as before.
+into the header) and, when they pass, calls the slave's direct step itself through Python's
+C API (:mod:`.direct_step`; its address is in the header) with t, h and the pending inputs as
+arguments: no pythonfmu DoStep, no log-queue crossing unless a message was queued. The step
+returns the values it changed (the front copies them) or writes the buffer itself.
+Otherwise the call takes pythonfmu's DoStep and the guard refuses it with its message, as
+before.
 
 Slot order: the variables a step changes (outputs, locals) first, then inputs and parameters.
 Buffer: header (``_HEADER`` doubles: stepComplete, written, pending, sync request, write all
 at the next step; the guard's stopTime (NaN: None) and whether C may check it and the time;
-the direct step's t and h, the log request, the addresses of :meth:`FastPath.step` and of
-pythonfmu's log queue; last the guard's time (NaN: None), so that it and the values a step
-changes are written in one pack), the n values, the n pending flags. Without the front (or with
-``SMA_FMU_NO_FAST_PATH=1``) nothing is attached and every call takes the guard's path.
+the log request, the addresses of the direct step (0: none) and of pythonfmu's log queue,
+the number of slots a step changes; last the guard's time (NaN: None), so that it and the
+values a step changes are written in one pack), the n values, the n pending flags. Without
+the front (or with ``SMA_FMU_NO_FAST_PATH=1``) nothing is attached and every call takes the
+guard's path.
 """
 import ctypes
-import keyword
 import struct
 
+from .compiled import attribute_reader
+from .direct_step import direct_step
 from .lifecycle import INSTANTIATED, STEP_COMPLETE
 
-__all__ = ["FastPath", "DESCRIBE", "ATTACH", "SYNC", "LOG", "PENDING", "attribute_reader"]
+__all__ = ["FastPath", "DESCRIBE", "ATTACH", "SYNC", "LOG", "PENDING"]
 
 DESCRIBE, ATTACH, SYNC, LOG = 0xFFFFFA51, 0xFFFFFA52, 0xFFFFFA53, 0xFFFFFA54
-_HEADER = 13  # as FAST_HEADER in fmi/native/front.h
+_HEADER = 12  # as FAST_HEADER in fmi/native/front.h
 (_STEP_COMPLETE, _WRITTEN, PENDING, _SYNC, _FULL,  # PENDING: inputs set in C since the last step
- _STOP, _CHECKABLE, _T, _H, _LOG, _ENTRY, _QUEUE, _TIME) = range(_HEADER)  # _TIME: next to the values
+ _STOP, _CHECKABLE, _LOG, _ENTRY, _QUEUE, _CHANGING, _TIME) = range(_HEADER)  # _TIME: next to the values
 _NAN = float("nan")
 _KINDS = (("Real", "R", float), ("Integer", "I", int), ("Boolean", "B", bool))
-
-
-def attribute_reader(names):
-    """A function slave -> tuple of the attributes ``names`` of the slave. Compiled as plain
-    attribute reads (about 5x faster per step than ``operator.attrgetter``) when every name is
-    an identifier, else through getattr."""
-    names = tuple(names)
-    if all(name.isidentifier() and not keyword.iskeyword(name) and name != "slave"
-           for name in names):
-        source = f"def read(slave):\n    return ({''.join(f'slave.{n}, ' for n in names)})\n"
-        scope = {}
-        exec(compile(source, "<fast path reader>", "exec"), scope)  # noqa: S102 - names checked
-        return scope["read"]
-    return lambda slave: tuple(getattr(slave, name) for name in names)
 
 
 def _as_double(kind):
@@ -135,10 +125,12 @@ class FastPath:
         self._changing_struct = struct.Struct(f"{1 + n_changing}d")
         self._raw = memoryview(array).cast("B")
         self._log_queue = self.guard.slave._get_log_queue()  # pythonfmu's list (it empties it)
-        self._entry = self._direct_step()  # kept alive with the slave: the front holds its address
+        # kept alive with the slave: the front holds its address
+        self._entry = direct_step(self, _TIME)
         self.write_all()
         self.view[_QUEUE] = float(id(self._log_queue))
-        self.view[_ENTRY] = float(id(self._entry))
+        self.view[_CHANGING] = float(n_changing)
+        self.view[_ENTRY] = 0.0 if self._entry is None else float(id(self._entry))
 
     # ---- values ------------------------------------------------------------------------------
     def take_inputs(self):
@@ -182,7 +174,11 @@ class FastPath:
         if view[_FULL]:
             view[_FULL] = 0.0
             return self.write_all()
-        guard = self.guard
+        self.write_changed()
+
+    def write_changed(self):
+        """The time, the values a step changes (one pack) and the state."""
+        view, guard = self.view, self.guard
         try:
             time = guard.time
             self._changing_struct.pack_into(self._raw, 8 * _TIME, _NAN if time is None else time,
@@ -190,85 +186,9 @@ class FastPath:
             view[_STEP_COMPLETE] = 1.0 if guard.state is STEP_COMPLETE else 0.0
             if time.__class__ is not float or not view[_CHECKABLE]:
                 self._write_times()
-        except Exception:  # noqa: BLE001
+        except Exception:  # noqa: BLE001 - then every call goes to the guard
             view[_STEP_COMPLETE] = 0.0
         view[_WRITTEN] = 1.0
-
-    def _direct_step(self):
-        """fmi2DoStep called by the front after its checks passed (the guard's do_step
-        without them), as a closure over what it needs (no lookups per step): t and h from
-        the header, the pending inputs, the guard's advance(), then the time and the values
-        a step changes (:meth:`write_step`; the front saw stepComplete and nothing stale, so
-        only a change of state is written). True if done. The front then looks at the log
-        queue (its address is in the header too): pythonfmu passes what is queued on (see
-        ``LOG``)."""
-        view, raw, guard, slave, inputs = self.view, self._raw, self.guard, self.guard.slave, self._inputs
-        advance, internal, read = guard.advance, guard.internal, self._changing
-        pack_into, offset = self._changing_struct.pack_into, 8 * _TIME
-        compiled = self._compiled_step(dict(
-            view=view, raw=raw, guard=guard, slave=slave, advance=advance, internal=internal,
-            pack_into=pack_into, offset=offset))
-        if compiled is not None:
-            return compiled
-
-        def step():
-            try:
-                if view[PENDING]:  # take_inputs()
-                    for value, pending, name, convert in inputs:
-                        if view[pending]:
-                            setattr(slave, name, convert(view[value]))
-                            view[pending] = 0.0
-                    view[PENDING] = 0.0
-                return advance(view[_T], view[_H])
-            except Exception as error:  # noqa: BLE001 - nothing may reach the front
-                return internal("fmi2DoStep", error, False)
-            finally:
-                try:
-                    time = guard.time
-                    pack_into(raw, offset, _NAN if time is None else time, *read(slave))
-                    if guard.state is not STEP_COMPLETE:
-                        view[_STEP_COMPLETE] = 0.0
-                except Exception:  # noqa: BLE001 - then every call goes to the guard
-                    view[_STEP_COMPLETE] = 0.0
-                view[_WRITTEN] = 1.0
-        return step
-
-    def _compiled_step(self, scope):
-        """The closure of :meth:`_direct_step` with the inputs and the values written out as
-        plain attribute accesses (no loop, no reader call, no tuple per step), compiled once;
-        None when a name is not an identifier (then the closure serves)."""
-        names = [name for _, _, name, _ in self._inputs] + self._changing_names
-        if not all(name.isidentifier() and not keyword.iskeyword(name) for name in names):
-            return None
-        take = "".join(
-            f"                if view[{pending}]:\n"
-            f"                    slave.{name} = {'' if convert is float else convert.__name__}"
-            f"(view[{value}])\n"
-            f"                    view[{pending}] = 0.0\n"
-            for value, pending, name, convert in self._inputs)
-        values = "".join(f", slave.{name}" for name in self._changing_names)
-        source = f"""def make({", ".join(scope)}):
-    def step():
-        try:
-            if view[{PENDING}]:
-{take}                view[{PENDING}] = 0.0
-            return advance(view[{_T}], view[{_H}])
-        except Exception as error:
-            return internal("fmi2DoStep", error, False)
-        finally:
-            try:
-                time = guard.time
-                pack_into(raw, offset, NAN if time is None else time{values})
-                if guard.state is not STEP_COMPLETE:
-                    view[{_STEP_COMPLETE}] = 0.0
-            except Exception:
-                view[{_STEP_COMPLETE}] = 0.0
-            view[{_WRITTEN}] = 1.0
-    return step
-"""
-        namespace = {"NAN": _NAN, "STEP_COMPLETE": STEP_COMPLETE}
-        exec(compile(source, "<fast path step>", "exec"), namespace)  # noqa: S102 - names checked
-        return namespace["make"](**scope)
 
     def sync(self, reference):
         """fmi2GetString(SYNC) from the front: take the pending inputs, write every value;

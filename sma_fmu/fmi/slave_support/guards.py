@@ -22,7 +22,8 @@ import math
 
 from pythonfmu.enums import Fmi2Status
 
-from .fast_path import ATTACH, DESCRIBE, PENDING, FastPath, attribute_reader
+from .compiled import attribute_reader
+from .fast_path import ATTACH, DESCRIBE, PENDING, FastPath
 from .lifecycle import ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED
 from .saved_state import SavedStates
 
@@ -218,18 +219,24 @@ class CallGuard:
         return self.advance(current_time, step_size)
 
     def advance(self, current_time, step_size):
-        """A step that passed :meth:`_do_step`'s checks: the model's step, the outputs'
-        finiteness, the next communication point and the validity warning."""
-        function = "fmi2DoStep"
+        """A step that passed :meth:`_do_step`'s checks: the model's step, then :meth:`stepped`."""
         try:
             done = bool(self._model_step(current_time, step_size))
         except Exception as error:  # noqa: BLE001 - a step the model rejects is discarded
-            # "<model> '<instance>': step at t = ... s discarded: <why>" (no function name)
-            self.interface.log(f"step at t = {current_time!r} s discarded: {error}",
-                               Fmi2Status.discard)
-            return False
-        if not done:
-            return False
+            return self.discarded(current_time, error)
+        return done and self.stepped(current_time, step_size)
+
+    def discarded(self, current_time, error):
+        """A step the model rejected (``error``, before any state changed): logged as
+        fmi2Discard, "<model> '<instance>': step at t = ... s discarded: <why>"; False."""
+        self.interface.log(f"step at t = {current_time!r} s discarded: {error}", Fmi2Status.discard)
+        return False
+
+    def stepped(self, current_time, step_size):
+        """After a model step that was done: the outputs' finiteness, the next communication
+        point and the validity warning; True unless an output is not finite (then the
+        instance is in the error state)."""
+        function = "fmi2DoStep"
         if not self.outputs_finite():
             self.state = ERROR
             return self.refuse(function, f"internal error: the step at t = {current_time!r} s gave a "

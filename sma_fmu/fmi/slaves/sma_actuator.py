@@ -33,6 +33,9 @@ class SmaActuator(StepperSlave):
 
     description = "SMA wire actuator: Joule heating, first-order thermal model, resistance hysteresis under load"
 
+    published = ("R", "T", "x", "xi_P", "xi_M", "xi_F", "P", "heating")
+    step_inputs = ("P_in", "load")  # stepper.step(..., step_size)
+
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.interface = fmi = SlaveInterface(self)
@@ -48,13 +51,7 @@ class SmaActuator(StepperSlave):
         fmi.model_parameters(extra=("T_max", "stress_max"))
         self.stepper = None
 
-    def _publish(self, outputs):
-        self.R, self.T, self.x, self.xi_P, self.xi_M, self.xi_F, self.P, self.heating = outputs
-
     def _start(self):
         stepper = PlantStepper(self.interface.wire_parameters(), self.T_start,
                                choice_name("hysteresis_mode", self.hysteresis_mode), self.load)
         return stepper, stepper.outputs
-
-    def _advance(self, current_time, step_size):
-        return self.stepper.step(self.P_in, self.load, step_size)

@@ -30,6 +30,9 @@ class SmaFeedforward(StepperSlave):
 
     description = "SMA feedforward compensator: temperature-sensing inverse model + phase-lag filter"
 
+    published = ("P_ff", "T_ref", "saturated")
+    step_inputs = ("R_ref", "load")  # stepper.step(..., step_size)
+
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.interface = fmi = SlaveInterface(self)
@@ -52,9 +55,3 @@ class SmaFeedforward(StepperSlave):
                                      adapt_to_load=self.adapt_to_load,
                                      inverse=choice_name("inverse", self.inverse))
         return stepper, stepper.initial_outputs(self.R_ref, self.load)
-
-    def _publish(self, outputs):
-        self.P_ff, self.T_ref, self.saturated = outputs
-
-    def _advance(self, current_time, step_size):
-        return self.stepper.step(self.R_ref, self.load, step_size)

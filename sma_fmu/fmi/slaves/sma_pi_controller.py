@@ -21,6 +21,10 @@ class SmaPiController(StepperSlave):
 
     description = "PI resistance controller of the SMA wire: anti-windup, power clamped at 0 W"
 
+    published = ("P", "P_fb")
+    step_inputs = ("R", "R_ref", "P_ff")  # stepper.sample(..., step_size)
+    step_method = "sample"
+
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.interface = fmi = SlaveInterface(self)
@@ -37,9 +41,3 @@ class SmaPiController(StepperSlave):
         params = self.interface.wire_parameters()
         stepper = PIController(params.Kp, params.Ki)
         return stepper, stepper.preview(self.R, self.R_ref, self.P_ff)
-
-    def _publish(self, outputs):
-        self.P, self.P_fb = outputs
-
-    def _advance(self, current_time, step_size):
-        return self.stepper.sample(self.R, self.R_ref, self.P_ff, step_size)
