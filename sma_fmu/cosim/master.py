@@ -9,12 +9,14 @@ PI and before the plant in the same step: the plant gets the wave's mean over th
 Each step is one fmi2SetReal, one fmi2DoStep and one fmi2GetReal per FMU (the compensator
 also one fmi2GetBoolean), called through ctypes with argument objects built once
 (:class:`LeanStep`): no argument conversion per call, values written into and read from
-the same C arrays every step. Each block's ``step`` is a closure over those objects (an
-instance attribute, built once): no attribute lookup and no call layer per step beyond the
-library path's.
+the same C arrays every step. An FMU with sma-fmu's native front also exports
+``sma_fmu_step`` (``fmi/native/combined_step.c``): those same calls made in C, in one
+ctypes call instead of three or four; LeanStep uses it when it is there. Each block's
+``step`` is a closure over those objects (an instance attribute, built once): no attribute
+lookup per step.
 """
 import time
-from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
+from ctypes import POINTER, Structure, byref, c_double, c_int, c_size_t, c_uint, c_void_p, sizeof
 from functools import partial
 from pathlib import Path
 
@@ -43,6 +45,16 @@ def model_parameter_values(fmu_path, params, variables=None):
             if v.causality == "parameter" and v.name in values}
 
 
+class SmaFmuStep(Structure):
+    """The argument of the front's ``sma_fmu_step`` (``fmi/native/combined_step.c``)."""
+
+    _fields_ = [("size", c_size_t), ("component", c_void_p),
+                ("input_vr", POINTER(c_uint)), ("n_inputs", c_size_t), ("inputs", POINTER(c_double)),
+                ("output_vr", POINTER(c_uint)), ("n_outputs", c_size_t), ("outputs", POINTER(c_double)),
+                ("flag_vr", POINTER(c_uint)), ("n_flags", c_size_t), ("flags", POINTER(c_int)),
+                ("t", c_double), ("h", c_double), ("stage", c_int)]
+
+
 class LeanStep:
     """set inputs + doStep + get outputs of one FMU instance, with prebuilt ctypes arguments.
 
@@ -54,40 +66,73 @@ class LeanStep:
         Real inputs set and Real outputs read at every step.
     flags : tuple of str
         Boolean outputs read at every step (one fmi2GetBoolean), or none.
+    combined : bool or None
+        Make the calls through the FMU's ``sma_fmu_step`` export (one ctypes call): None
+        if it has one, False never (the separate FMI calls).
     """
 
-    def __init__(self, fmu, inputs, outputs, flags=()):
+    def __init__(self, fmu, inputs, outputs, flags=(), combined=None):
         self.fmu = fmu
         component = c_void_p(fmu.component)
         library = fmu.library
+        self._names = (inputs, outputs, flags)
 
         def bound(function, names, ctype):
-            references = [fmu.variables[name].valueReference for name in names]
+            references = (c_uint * len(names))(*(fmu.variables[name].valueReference for name in names))
             values = (ctype * len(names))()
             raw = library[function]  # a function object of its own: no argtypes, int result
             raw.restype = c_int
-            return partial(raw, component, (c_uint * len(names))(*references),
-                           c_size_t(len(names)), values), values
+            return partial(raw, component, references, c_size_t(len(names)), values), values
 
         self._set, self.inputs = bound("fmi2SetReal", inputs, c_double)
         self._get, self.outputs = bound("fmi2GetReal", outputs, c_double)
         self._get_flags, self.flags = bound("fmi2GetBoolean", flags, c_int) if flags else (None, None)
         self._do_step = partial(fmu._do_step_c, component)
-        self._names = (inputs, outputs, flags)
+        self.combined = None
+        if combined is not False:
+            self.combined = self._combined_call(library, component)
         self.step = self._closure()
+
+    def _combined_call(self, library, component):
+        """(call, arguments): ``sma_fmu_step`` bound to its :class:`SmaFmuStep`, filled
+        but for t and h; None if the library has no such export."""
+        try:
+            raw = library["sma_fmu_step"]
+        except AttributeError:  # not an FMU with sma-fmu's front
+            return None
+        raw.restype = c_int
+
+        def bound(call):  # (references, count, values) of a bound set/get, or none
+            return call.args[1:4] if call is not None else (None, c_size_t(0), None)
+        fields = [value for call in (self._set, self._get, self._get_flags) for value in bound(call)]
+        arguments = SmaFmuStep(sizeof(SmaFmuStep), component, *fields)
+        self._keep = fields  # the arrays the structure points into
+        return partial(raw, byref(arguments)), arguments
 
     def failed(self, stage, status):
         """The :class:`~sma_fmu.fmi.instance.FmuError` of a call above fmi2Warning: ``stage``
         0 set, 1 doStep, 2 get."""
         inputs, outputs, flags = self._names
-        what = (f"set {', '.join(inputs)}", "fmi2DoStep", f"get {', '.join(outputs + flags)}")[stage]
+        what = (f"set {', '.join(inputs)}", "fmi2DoStep", f"get {', '.join(outputs + flags)}")[min(stage, 2)]
         return self.fmu.failure(what, status)
 
     def _closure(self):
-        """:meth:`step` as a closure over the bound calls (the blocks below inline the same
-        calls in their own closures)."""
-        set_, do_step, get, get_flags, failed = (self._set, self._do_step, self._get,
-                                                 self._get_flags, self.failed)
+        """:meth:`step` as a closure over the bound calls."""
+        failed = self.failed
+        if self.combined is not None:
+            call, arguments = self.combined
+
+            def step(time_s, step_size):
+                """Set :attr:`inputs` (write them first), doStep, read :attr:`outputs` (and
+                :attr:`flags`), in one call; raises :class:`~sma_fmu.fmi.instance.FmuError`
+                above fmi2Warning."""
+                arguments.t = time_s
+                arguments.h = step_size
+                status = call()
+                if status > 1:
+                    raise failed(arguments.stage, status)
+            return step
+        set_, do_step, get, get_flags = self._set, self._do_step, self._get, self._get_flags
 
         def step(time_s, step_size):
             """Set :attr:`inputs` (write them first), doStep, read :attr:`outputs` (and
@@ -109,30 +154,21 @@ class LeanStep:
 class FmuPlant:
     """The SmaActuator FMU as a loop plant."""
 
-    def __init__(self, scenario, fmu_path, instance_name="plant"):
+    def __init__(self, scenario, fmu_path, instance_name="plant", combined=None):
         start = model_parameter_values(fmu_path, scenario.params)
         start.update(T_start=scenario.T_start,
                      hysteresis_mode=choice_code("hysteresis_mode", scenario.hysteresis_mode),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
         self._outputs = self.fmu.port(PLANT_OUTPUTS)
-        lean = LeanStep(self.fmu, ("P_in", "load"), PLANT_OUTPUTS)
-        inputs, values = lean.inputs, lean.outputs
-        set_, do_step, get, failed = lean._set, lean._do_step, lean._get, lean.failed
+        lean = LeanStep(self.fmu, ("P_in", "load"), PLANT_OUTPUTS, combined=combined)
+        inputs, values, lean_step = lean.inputs, lean.outputs, lean.step
 
         def step(time_s, power, load, step_size):
             """Set P_in and load, doStep, return the PLANT_OUTPUTS at the end of the step."""
             inputs[0] = power
             inputs[1] = load
-            status = set_()
-            if status > 1:
-                raise failed(0, status)
-            status = do_step(time_s, step_size, 1)
-            if status > 1:
-                raise failed(1, status)
-            status = get()
-            if status > 1:
-                raise failed(2, status)
+            lean_step(time_s, step_size)
             return values[:]
         self.step = step
 
@@ -148,7 +184,7 @@ class FmuPlant:
 class FmuCompensator:
     """The SmaFeedforward FMU as the loop's compensator."""
 
-    def __init__(self, scenario, fmu_path, instance_name="feedforward"):
+    def __init__(self, scenario, fmu_path, instance_name="feedforward", combined=None):
         c = scenario.controller
         start = model_parameter_values(fmu_path, scenario.compensator_params)
         start.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
@@ -156,26 +192,15 @@ class FmuCompensator:
                      R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))
         self.fmu = FmuInstance(fmu_path, instance_name, start)
-        lean = LeanStep(self.fmu, ("R_ref", "load"), ("P_ff", "T_ref"), ("saturated",))
-        inputs, outputs, saturated = lean.inputs, lean.outputs, lean.flags
-        set_, do_step, get, get_flags, failed = (lean._set, lean._do_step, lean._get,
-                                                 lean._get_flags, lean.failed)
+        lean = LeanStep(self.fmu, ("R_ref", "load"), ("P_ff", "T_ref"), ("saturated",),
+                        combined=combined)
+        inputs, outputs, saturated, lean_step = lean.inputs, lean.outputs, lean.flags, lean.step
 
         def step(time_s, reference, load, step_size):
             """Set R_ref and load, doStep, return (P_ff, T_ref, saturated) for this sample."""
             inputs[0] = reference
             inputs[1] = load
-            status = set_()
-            if status > 1:
-                raise failed(0, status)
-            status = do_step(time_s, step_size, 1)
-            if status > 1:
-                raise failed(1, status)
-            status = get()
-            if status <= 1:
-                status = get_flags()
-            if status > 1:
-                raise failed(2, status)
+            lean_step(time_s, step_size)
             return outputs[0], outputs[1], saturated[0] != 0
         self.step = step
 
@@ -187,12 +212,12 @@ class FmuCompensator:
 class FmuDriver:
     """The SmaPwmDriver FMU as the loop's driver (the hook of :func:`~sma_fmu.cosim.loop.run_loop`)."""
 
-    def __init__(self, scenario, fmu_path, instance_name="driver"):
+    def __init__(self, scenario, fmu_path, instance_name="driver", combined=None):
         drive = scenario.drive
         self.fmu = FmuInstance(fmu_path, instance_name,
                                {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W})
         self._initial = self.fmu.port(("P_in",))
-        lean = LeanStep(self.fmu, ("P_demand",), ("P_in",))
+        lean = LeanStep(self.fmu, ("P_demand",), ("P_in",), combined=combined)
         inputs, outputs, lean_step = lean.inputs, lean.outputs, lean.step
 
         def step(time_s, demand, step_size):
@@ -218,10 +243,11 @@ def needed_fmus(scenario):
             + (["SmaPwmDriver"] if scenario.drive.pwm else []))
 
 
-def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None):
+def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None):
     """Run ``scenario`` through the FMUs in ``fmu_dir``; returns a :class:`LoopResult`.
 
     ``sink``: see :func:`~sma_fmu.cosim.loop.run_loop` (then the result's ``data`` is None).
+    ``combined``: see :class:`LeanStep` (False: the separate FMI calls).
     """
     paths = default_fmu_paths(fmu_dir)
     for name in needed_fmus(scenario):
@@ -231,11 +257,11 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None):
     start = time.perf_counter()
     parts = {}
     try:
-        parts["plant"] = FmuPlant(scenario, paths["SmaActuator"])
+        parts["plant"] = FmuPlant(scenario, paths["SmaActuator"], combined=combined)
         if scenario.controller.feedforward:
-            parts["compensator"] = FmuCompensator(scenario, paths["SmaFeedforward"])
+            parts["compensator"] = FmuCompensator(scenario, paths["SmaFeedforward"], combined=combined)
         if scenario.drive.pwm:
-            parts["driver"] = FmuDriver(scenario, paths["SmaPwmDriver"])
+            parts["driver"] = FmuDriver(scenario, paths["SmaPwmDriver"], combined=combined)
         data = run_loop(scenario, parts["plant"], parts.get("compensator"),
                         driver=parts.get("driver"), sink=sink)
     except FmuError as error:

@@ -3,7 +3,9 @@
 A slave's variables are attributes. Code that reads or writes a fixed list of them at every
 step is fastest as plain attribute accesses (``slave.R, slave.T = values``), so it is
 generated once from the names instead of looping over ``getattr``/``setattr`` (about five
-times slower per step). Names that are not identifiers get the loop.
+times slower per step). Names that are not identifiers get the loop. Each source text is
+compiled once per process (instances of a slave share the code; compiling per instance
+costs memory the allocator keeps).
 """
 import keyword
 
@@ -15,11 +17,20 @@ def identifiers(names):
     return all(name.isidentifier() and not keyword.iskeyword(name) for name in names)
 
 
+_DEFINED = {}  # (source, name, label) -> function
+
+
 def compile_function(source, name, scope=None, label="<sma-fmu compiled>"):
-    """The function ``name`` defined by ``source`` (generated from checked identifiers)."""
-    namespace = dict(scope or {})
-    exec(compile(source, label, "exec"), namespace)  # noqa: S102 - names checked by the callers
-    return namespace[name]
+    """The function ``name`` defined by ``source`` (generated from checked identifiers) in a
+    namespace holding ``scope``: defined once per source text, so equal sources must come
+    with equal scopes (constants)."""
+    key = (source, name, label)
+    function = _DEFINED.get(key)
+    if function is None:
+        namespace = dict(scope or {})
+        exec(compile(source, label, "exec"), namespace)  # noqa: S102 - names checked by the callers
+        function = _DEFINED.setdefault(key, namespace[name])
+    return function
 
 
 def attribute_reader(names):
