@@ -67,7 +67,7 @@ def _references(fmu):
 def _environment(extra):
     """The C host's environment without the front's switches, plus ``extra``."""
     return {**host_environment(drop=("SMA_FMU_LIBPYTHON", "SMA_FMU_NO_TSTATE",
-                                     "SMA_FMU_NO_FAST_PATH")), **extra}
+                                     "SMA_FMU_NO_FAST_PATH", "SMA_FMU_NO_DIRECT_STEP")), **extra}
 
 
 def build_thermal_lag(folder, params):
