@@ -105,7 +105,7 @@ def windows_dll(plant_folder):
 def test_the_dll_is_the_front_and_exports_every_fmi2_function(windows_dll, plant_folder):
     assert FRONT_MARKER in windows_dll
     exports = pe_exports(windows_dll)
-    assert exports == FMI2_CO_SIMULATION | {"sma_fmu_front", "sma_fmu_front_share"}
+    assert exports == FMI2_CO_SIMULATION | {"sma_fmu_front", "sma_fmu_front_share", "sma_fmu_step"}
     linux = subprocess.run(["nm", "-D", "--defined-only", str(plant_folder / "binaries/linux64/SmaActuator.so")],
                            capture_output=True, text=True, check=True).stdout
     assert {line.split()[-1] for line in linux.splitlines()} == exports

@@ -4,13 +4,8 @@ Missing, a folder, unreadable, not UTF-8 (latin-1, UTF-16), not TOML, or nested 
 deeply: each raises the caller's error class with the file name and the reason. A UTF-8
 byte-order mark is accepted.
 """
-import sys
+import tomllib
 from pathlib import Path
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
 
 __all__ = ["read_toml"]
 
