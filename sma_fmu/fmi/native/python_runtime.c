@@ -43,7 +43,8 @@ static struct {
     int (*Object_DelItem)(void*, void*);
     void (*Err_Clear)(void);
     void (*DecRef)(void*);
-    /* the direct doStep (fast_path.c) */
+    /* the direct doStep (fast_path.c); the last argument is always NULL (no keywords), so
+     * PyObject_VectorcallDict serves where PyObject_Vectorcall is not exported */
     void* (*Object_Vectorcall)(void*, void* const*, size_t, void*);
     void* (*Float_FromDouble)(double);
     void* (*Long_FromLong)(long);
@@ -220,7 +221,8 @@ int start_python_runtime(RuntimeCalls* calls)
     LOOKUP(Object_DelItem, "PyObject_DelItem");
     LOOKUP(Err_Clear, "PyErr_Clear");
     LOOKUP(DecRef, "Py_DecRef");
-    LOOKUP(Object_Vectorcall, "PyObject_Vectorcall");
+    LOOKUP(Object_Vectorcall, "PyObject_Vectorcall"); /* exported by 3.11-3.13 (checked) */
+    if (!py.Object_Vectorcall) LOOKUP(Object_Vectorcall, "PyObject_VectorcallDict"); /* else */
     LOOKUP(Float_FromDouble, "PyFloat_FromDouble");
     LOOKUP(Long_FromLong, "PyLong_FromLong");
     LOOKUP(Bool_FromLong, "PyBool_FromLong");
