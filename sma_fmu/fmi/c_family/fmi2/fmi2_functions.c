@@ -11,7 +11,11 @@
  *    very same step discarded twice in a row reports fmi2Terminated;
  *  - a step that leaves the model's validity range: fmi2Warning with the model's warning
  *    (once per excursion: the runtime says when).
- * A pointer that is not a live instance gives fmi2Error (checked by a magic number). */
+ * Every call looks its fmi2Component up in the registry of instances (fmi2_instances.c)
+ * before reading through it: a pointer fmi2FreeInstance freed, or one fmi2Instantiate never
+ * returned, gives fmi2Error (fmi2FreeInstance: nothing) and one line on stderr, as the
+ * front does. A freed instance's struct stays allocated for a while (the last 1024 freed),
+ * so its address is not reused by a new instance that a stale pointer would then reach. */
 #include "fp_contract.h"
 #include <math.h>
 #include <stdio.h>
@@ -26,10 +30,10 @@ static const char NATIVE_MARKER[] = "sma-fmu native C FMU";
 const char *const STATE_NAMES[STATE_COUNT] = {
     "instantiated", "Initialization Mode", "stepComplete", "terminated", "error"};
 
-Instance *layer_instance(fmi2Component c)
+Instance *layer_instance(fmi2Component c, const char *function)
 {
-    Instance *in = (Instance *)c;
-    if (!in || in->magic != INSTANCE_MAGIC) return NULL;
+    Instance *in = layer_live(c, function);
+    if (!in) return NULL;
     in->worst = fmi2OK;
     return in;
 }
@@ -66,10 +70,10 @@ FMI2_Export fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingO
     return fmi2OK;
 }
 
-static void free_instance(Instance *in)
+/* What an instance holds, but not its name and struct (fmi2_instances.c keeps those a while
+ * after fmi2FreeInstance). */
+static void release_contents(Instance *in)
 {
-    if (!in) return;
-    in->magic = 0;
     layer_free_states(in);
     layer_drop_stepper(in);
     layer_values_free(in->model, in->values);
@@ -77,6 +81,15 @@ static void free_instance(Instance *in)
     free(in->categories);
     free(in->resources);
     free(in->guid);
+    in->values = NULL;
+    in->real_outputs = NULL;
+    in->categories = in->resources = in->guid = NULL;
+}
+
+static void free_instance(Instance *in)  /* one fmi2Instantiate refused: never registered */
+{
+    if (!in) return;
+    release_contents(in);
     free(in->name);
     free(in);
 }
@@ -160,7 +173,7 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
         goto fail;
     }
     layer_log(in, fmi2OK, "fmi2Instantiate: %s (%s)", NATIVE_MARKER, in->resources);
-    in->magic = INSTANCE_MAGIC;
+    layer_register(in);
     return in;
 fail:
     free_instance(in);
@@ -169,8 +182,10 @@ fail:
 
 FMI2_Export void fmi2FreeInstance(fmi2Component c)
 {
-    Instance *in = layer_instance(c);
-    if (in) free_instance(in);
+    Instance *in = layer_retire(c, "fmi2FreeInstance");
+    if (!in) return;
+    release_contents(in);
+    layer_keep(in);
 }
 
 FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined,

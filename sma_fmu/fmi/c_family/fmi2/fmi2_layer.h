@@ -33,10 +33,9 @@ typedef struct SavedState {
     unsigned char *bytes;
 } SavedState;
 
-#define INSTANCE_MAGIC 0x534d4132u  /* "SMA2": what a live instance holds */
-
-typedef struct {
-    unsigned int magic;
+typedef struct Instance {
+    struct Instance *chain;          /* next instance of its registry chain (fmi2_instances.c) */
+    int freed;                       /* freed by fmi2FreeInstance, kept (read under the lock) */
     const SmaModel *model;
     char *name;
     char *guid;
@@ -64,10 +63,11 @@ typedef struct {
 } Instance;
 
 /* ---- calls (fmi2_functions.c) -------------------------------------------------------------- */
-/* `c` if it is a live instance (its magic number), its worst status reset; else NULL. */
-Instance *layer_instance(fmi2Component c);
+/* `c` if it is a live instance (fmi2_instances.c), its worst status reset; else NULL, with
+ * one line on stderr naming `function`. */
+Instance *layer_instance(fmi2Component c, const char *function);
 #define ENTER                                                                                 \
-    Instance *in = layer_instance(c);                                                         \
+    Instance *in = layer_instance(c, __func__);                                               \
     if (!in) return fmi2Error
 #define IN(state) (1u << (state))
 /* The call's status: `status`, or worse if the call logged worse. */
@@ -76,6 +76,18 @@ fmi2Status layer_finish(const Instance *in, fmi2Status status);
 int layer_allowed(Instance *in, const char *function, unsigned int mask);
 /* guard.validity: the stepper's validity warning of its last start or step, as fmi2Warning. */
 void layer_validity(Instance *in, const char *function);
+
+/* ---- instances (fmi2_instances.c) -------------------------------------------------------- */
+/* Every call looks its pointer up here before reading through it (thread-safe). */
+void layer_register(Instance *in);           /* a new instance: live from now on */
+/* The live instance at `pointer`, or NULL with one stderr line naming `function` (and the
+ * instance, if it was freed); nothing is read through `pointer` unless it is registered. */
+Instance *layer_live(const void *pointer, const char *function);
+/* The same, and the instance returned is marked freed: every later lookup refuses it. The
+ * caller releases what it holds (not its name), then hands it to layer_keep. */
+Instance *layer_retire(const void *pointer, const char *function);
+/* Keeps a retired instance allocated among the last ones freed; releases the oldest. */
+void layer_keep(Instance *in);
 
 /* ---- log (fmi2_log.c) -------------------------------------------------------------------- */
 /* "<model> '<instance>': <text>" to the host's logger with `status` (which the call then

@@ -141,8 +141,7 @@ FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
 {
     unsigned char *bytes;
     size_t size = 0;
-    Instance *in = layer_instance(c);
-    if (!in) return fmi2Error;
+    ENTER;
     if (!state) return layer_reject(in, fmi2Error, "fmi2GetFMUstate", "FMUstate is NULL");
     if (*state && !find(in, *state))
         return layer_reject(in, fmi2Error, "fmi2GetFMUstate", "*FMUstate is neither NULL nor a "
@@ -155,8 +154,7 @@ FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state)
 FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
 {
     SavedState *saved;
-    Instance *in = layer_instance(c);
-    if (!in) return fmi2Error;
+    ENTER;
     saved = state ? find(in, state) : NULL;
     if (!saved)
         return layer_reject(in, fmi2Error, "fmi2SetFMUstate", "FMUstate is not a state of this "
@@ -167,8 +165,7 @@ FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state)
 FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
 {
     SavedState *saved;
-    Instance *in = layer_instance(c);
-    if (!in) return fmi2Error;
+    ENTER;
     if (!state || !*state) return fmi2OK;  /* FMI 2.0: freeing NULL does nothing */
     saved = find(in, *state);
     if (!saved)
@@ -182,8 +179,7 @@ FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state)
 FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size)
 {
     SavedState *saved;
-    Instance *in = layer_instance(c);
-    if (!in) return fmi2Error;
+    ENTER;
     saved = state ? find(in, state) : NULL;
     if (!saved || !size)
         return layer_reject(in, fmi2Error, "fmi2SerializedFMUstateSize", "FMUstate is not a state "
@@ -196,8 +192,7 @@ FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state
                                              fmi2Byte serializedState[], size_t size)
 {
     SavedState *saved;
-    Instance *in = layer_instance(c);
-    if (!in) return fmi2Error;
+    ENTER;
     saved = state ? find(in, state) : NULL;
     if (!saved || !serializedState)
         return layer_reject(in, fmi2Error, "fmi2SerializeFMUstate", "FMUstate is not a state of "
@@ -218,8 +213,7 @@ FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte s
     char why[700];
     unsigned char *bytes;
     Parsed p;
-    Instance *in = layer_instance(c);
-    if (!in) return fmi2Error;
+    ENTER;
     if (!state || (!serializedState && size))
         return layer_reject(in, fmi2Error, "fmi2DeSerializeFMUstate", "serializedState or "
                             "FMUstate is NULL");
