@@ -176,6 +176,11 @@ class FastPath:
             return self.write_all()
         self.write_changed()
 
+    def finish(self, result):
+        """:meth:`write_changed`, then ``result`` (the direct step's unusual cases)."""
+        self.write_changed()
+        return result
+
     def write_changed(self):
         """The time, the values a step changes (one pack) and the state."""
         view, guard = self.view, self.guard
