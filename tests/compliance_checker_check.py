@@ -14,13 +14,13 @@ co-simulation FMU and simulated 2 s at 1 ms with the inputs of tests/test_native
 reported: 0 Error(s)" with no error the FMU reported. Without SMA_FMU_COMPLIANCE_CHECKER
 the check fails (it never skips).
 """
-import os
 import re
 import subprocess
 
 import pytest
 
 from fmusim_check import _input_file
+from system_needs import by_hand_executable
 from test_native_hosts import INPUTS, STOP_S
 
 BAD_LINE = re.compile(r"^\s*\[(ERROR|FATAL)\]")
@@ -29,10 +29,8 @@ BAD_LINE = re.compile(r"^\s*\[(ERROR|FATAL)\]")
 @pytest.fixture(scope="module")
 def checker():
     """The executable SMA_FMU_COMPLIANCE_CHECKER names; a missing one fails the check."""
-    path = os.environ.get("SMA_FMU_COMPLIANCE_CHECKER")
-    assert path and os.access(path, os.X_OK), (
-        "set SMA_FMU_COMPLIANCE_CHECKER to the FMU Compliance Checker (fmuCheck.linux64)")
-    return path
+    return by_hand_executable("SMA_FMU_COMPLIANCE_CHECKER",
+                              "the FMU Compliance Checker (fmuCheck.linux64)")
 
 
 def _check(checker, path, model, folder):

@@ -18,13 +18,13 @@ more than 1e-12 of its own value near zero). Without
 SMA_FMU_FMUSIM the check fails (it never skips).
 """
 import csv
-import os
 import re
 import subprocess
 
 import numpy as np
 import pytest
 
+from system_needs import by_hand_executable
 from test_native_hosts import INPUTS, STOP_S, _simulate, _times
 
 BAD_CALL = re.compile(r"-> (Discard|Error|Fatal|Unknown status)")
@@ -34,10 +34,7 @@ BAD_MESSAGE = re.compile(r"^\[(Discard|Error|Fatal)\]")
 @pytest.fixture(scope="module")
 def fmusim():
     """The executable SMA_FMU_FMUSIM names; a missing one fails the check."""
-    path = os.environ.get("SMA_FMU_FMUSIM")
-    assert path and os.access(path, os.X_OK), (
-        "set SMA_FMU_FMUSIM to an fmusim executable of Reference-FMUs v0.0.39")
-    return path
+    return by_hand_executable("SMA_FMU_FMUSIM", "an fmusim executable of Reference-FMUs v0.0.39")
 
 
 def _input_file(model, folder):

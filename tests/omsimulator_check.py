@@ -9,11 +9,11 @@ then:
 Without SMA_FMU_OMSIMULATOR the check fails (it never skips). It runs both FMU families:
 pythonfmu's (``sma-fmu build``) and the native C one (``sma-fmu build --native``).
 """
-import os
 import re
 
 import pytest
 
+from system_needs import by_hand_executable
 from test_ssp_hosts import LOAD_STEP, TOLERANCE, _scenario, fmu_dir  # noqa: F401 (fixture)
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.systems.closed_loop import closed_loop
@@ -25,10 +25,8 @@ from sma_fmu.systems.ssp import write_ssp
 @pytest.fixture(scope="module", autouse=True)
 def omsimulator():
     """The executable SMA_FMU_OMSIMULATOR names; a missing one fails the check."""
-    path = os.environ.get("SMA_FMU_OMSIMULATOR")
-    assert path and os.access(path, os.X_OK), (
-        "set SMA_FMU_OMSIMULATOR to an OMSimulator v3.0.0 executable (docs/systems.md)")
-    return path
+    return by_hand_executable("SMA_FMU_OMSIMULATOR",
+                              "an OMSimulator v3.0.0 executable (docs/systems.md)")
 
 
 @pytest.fixture(params=["pythonfmu", "native"])

@@ -24,13 +24,21 @@ import pytest
 
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
 
-__all__ = ["NEEDS", "WITHOUT_VARIABLE", "need", "needs", "missing", "wine_command",
+__all__ = ["NEEDS", "WITHOUT_VARIABLE", "need", "needs", "missing", "wine_command", "by_hand_executable",
            "system_libpythons"]
 
 WITHOUT_VARIABLE = "SMA_FMU_TESTS_WITHOUT"
 DEBIAN_LIBPYTHON = Path("/usr/lib/x86_64-linux-gnu/libpython3.11.so.1.0")
 STANDARD_FOLDERS = ("/usr/local/lib", "/usr/local/lib64", "/usr/lib/x86_64-linux-gnu",
                     "/lib/x86_64-linux-gnu", "/usr/lib64", "/lib64", "/usr/lib", "/lib")
+
+
+def by_hand_executable(variable, what):
+    """The executable the environment variable ``variable`` names, for the by-hand checks
+    (tests/*_check.py: tools in no registry); a missing one fails, naming ``what`` to set."""
+    path = os.environ.get(variable)
+    assert path and os.access(path, os.X_OK), f"set {variable} to {what}"
+    return path
 
 
 def wine_command():

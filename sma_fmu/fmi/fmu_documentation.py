@@ -10,9 +10,10 @@ the files of the reference result (:mod:`.fmu_reference`).
 """
 import ast
 import html
-import io
 import json
 import zipfile
+
+from sma_fmu.files.png_output import png_bytes
 
 __all__ = ["FIGURE", "INDEX", "model_text", "figure_png", "index_html"]
 
@@ -63,9 +64,7 @@ def figure_png(result, inputs, units, title):
         axis.grid(True, alpha=0.3)
     axes[-1].set_xlabel("time [s]")
     figure.suptitle(title)
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png")
-    return buffer.getvalue()
+    return png_bytes(figure)
 
 
 def _table(head, rows):

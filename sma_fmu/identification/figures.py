@@ -2,24 +2,20 @@
 
 Drawn on :class:`matplotlib.figure.Figure` objects (no pyplot, no backend switch).
 """
-import io
-
 import numpy as np
 from matplotlib.figure import Figure
 
+from sma_fmu.files.png_output import png_bytes
 from sma_fmu.runtime.constant_load import constant_load_resistance
 from sma_fmu.runtime.sensing import sense_temperature
 
-__all__ = ["constant_load_figures", "constant_temperature_figures"]
+__all__ = ["constant_load_figures", "constant_temperature_figures", "BRANCH_STYLE"]
 
-_STYLE = {1: ("tab:red", "heating"), -1: ("tab:blue", "cooling")}
+BRANCH_STYLE = {1: ("tab:red", "heating"), -1: ("tab:blue", "cooling")}  # direction: colour, label
 
 
 def _png(figure):
-    buffer = io.BytesIO()
-    figure.tight_layout()
-    figure.savefig(buffer, format="png", dpi=100)
-    return buffer.getvalue()
+    return png_bytes(figure, dpi=100, tight=True)
 
 
 def _load_grid(count):
@@ -40,7 +36,7 @@ def constant_load_figures(params, data, sensed):
     sense_figure, sense_axes = _load_grid(len(loads))
     residual_figure, residual_axes = _load_grid(len(loads))
     for load, model_axis, sense_axis, residual_axis in zip(loads, model_axes, sense_axes, residual_axes):
-        for direction, (colour, label) in _STYLE.items():
+        for direction, (colour, label) in BRANCH_STYLE.items():
             rows = (data.load == load) & (data.direction == direction)
             curve = [constant_load_resistance(t, load, direction, params) for t in grid]
             model_axis.plot(data.temperature[rows], data.resistance[rows], ".", ms=3, color=colour,

@@ -7,7 +7,6 @@ statistics and the best run. Figures (matplotlib Figure objects, no pyplot): a h
 the mean RMSE over the first two axes of a grid, RMSE against a single axis, and for a
 Monte Carlo the distribution of the RMSE with the wire parameter it correlates most with.
 """
-import io
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,7 @@ import pandas as pd
 
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.files.png_output import png_bytes
 from sma_fmu.studies.figures import distribution_figure, heat_map_figure, line_figure
 
 __all__ = ["PARTS", "read_parts", "summary", "summary_markdown", "write_results"]
@@ -119,17 +119,11 @@ def _figures(spec, table):
     return figures
 
 
-def _png(figure):
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=100)
-    return buffer.getvalue()
-
-
 def write_results(spec, out):
     """Write results.parquet, results.csv, summary.json, summary.md and figures; return summary."""
     table = read_parts(out)
     document = summary(spec, table)
-    figures = {name: _png(figure) for name, figure in _figures(spec, table).items()}
+    figures = {name: png_bytes(figure, dpi=100) for name, figure in _figures(spec, table).items()}
     csv = table.to_csv(index=False, na_rep="")
     with staged_folder(out) as stage:
         table.to_parquet(stage / "results.parquet", index=False)

@@ -11,13 +11,14 @@
 
 Drawn on :class:`matplotlib.figure.Figure` objects (no pyplot, no backend switch).
 """
-import io
 import math
 
 import numpy as np
 from matplotlib import cm, colormaps, colors
 from matplotlib.figure import Figure
 
+from sma_fmu.files.png_output import png_bytes
+from sma_fmu.identification.figures import BRANCH_STYLE
 from sma_fmu.identification.isobaric.jacobian import file_model
 from sma_fmu.identification.isobaric.tables import model_branch_strain
 from sma_fmu.runtime.constants import HEATING
@@ -25,15 +26,11 @@ from sma_fmu.runtime.constants import HEATING
 __all__ = ["isobaric_figures", "GRID_CYCLES"]
 
 GRID_CYCLES = 12
-_STYLE = {1: ("tab:red", "heating"), -1: ("tab:blue", "cooling")}
 _MAX_POINTS = 40000   # per file drawn in an overlay (every k-th sample beyond it)
 
 
 def _png(figure):
-    buffer = io.BytesIO()
-    figure.tight_layout()
-    figure.savefig(buffer, format="png", dpi=90)
-    return buffer.getvalue()
+    return png_bytes(figure, dpi=90, tight=True)
 
 
 def _cycles(data):
@@ -69,7 +66,7 @@ def _grid(files, fit, per_cycle):
                 continue
             cycle, branches = cycles[k]
             for index, b in branches:
-                colour, label = _STYLE[b.direction]
+                colour, label = BRANCH_STYLE[b.direction]
                 of = slice(bounds[index], bounds[index + 1])
                 axis.plot(wire[of], 100 * data.strain[of], ".", ms=2, color=colour, alpha=0.4,
                           label=f"data, {label}")
@@ -155,23 +152,23 @@ def _residuals(files, fit):
         sample = data.time if data.time is not None else np.arange(data.strain.size)
         strain, _ = file_model(fit.params, data, wire, offsets, fit.directions[k],
                                fit.row_levels[k], len(offsets) > 1)
-        top, bottom = axes[2 * k], axes[2 * k + 1]
-        top.plot(sample, 100 * (strain - data.strain), ".", ms=1, alpha=0.5)
-        top.axhspan(-100 * sigma["strain"], 100 * sigma["strain"], color="tab:green", alpha=0.2,
-                    label="noise estimate")
-        top.set(ylabel="model - data [% strain]",
-                title=f"{data.path.name}: strain residuals (band: the noise estimate)")
-        top.legend(fontsize=7)
-        bottom.plot(sample, data.temperature - measured, ".", ms=1, alpha=0.5, color="tab:orange")
-        bottom.axhspan(-sigma["temperature"], sigma["temperature"], color="tab:green", alpha=0.2,
-                       label="noise estimate")
-        bottom.set(xlabel="time [s]" if data.time is not None else "sample",
-                   ylabel="measured - fitted [K]",
-                   title="thermocouple temperature: measured minus fitted profile (before the lag)")
-        bottom.legend(fontsize=7)
-        for axis in (top, bottom):
-            axis.grid(alpha=0.3)
+        _residual_panel(axes[2 * k], sample, 100 * (strain - data.strain), 100 * sigma["strain"],
+                        "tab:blue", ylabel="model - data [% strain]",
+                        title=f"{data.path.name}: strain residuals (band: the noise estimate)")
+        _residual_panel(axes[2 * k + 1], sample, data.temperature - measured, sigma["temperature"],
+                        "tab:orange", xlabel="time [s]" if data.time is not None else "sample",
+                        ylabel="measured - fitted [K]",
+                        title="thermocouple temperature: measured minus fitted profile (before the lag)")
     return figure
+
+
+def _residual_panel(axis, sample, residual, noise, colour, **labels):
+    """Residuals against sample or time, with a band of +-``noise`` (the noise estimate)."""
+    axis.plot(sample, residual, ".", ms=1, alpha=0.5, color=colour)
+    axis.axhspan(-noise, noise, color="tab:green", alpha=0.2, label="noise estimate")
+    axis.set(**labels)
+    axis.legend(fontsize=7)
+    axis.grid(alpha=0.3)
 
 
 def _resistance(files, fit):
@@ -182,7 +179,7 @@ def _resistance(files, fit):
         data, wire, direction = files[k], fit.profiles[k], fit.directions[k]
         level = np.zeros(wire.size, dtype=int)
         _, resistance = file_model(fit.params, data, wire, fit.offsets[k], direction, level, False)
-        for d, (colour, label) in _STYLE.items():
+        for d, (colour, label) in BRANCH_STYLE.items():
             rows = np.nonzero(direction == d)[0]
             order = rows[np.argsort(wire[rows])]
             axis.plot(wire[order], data.resistance[order], ".", ms=2, color=colour, alpha=0.4,
