@@ -105,8 +105,8 @@ class LeanStep:
         def bound(call):  # (references, count, values) of a bound set/get, or none
             return call.args[1:4] if call is not None else (None, c_size_t(0), None)
         fields = [value for call in (self._set, self._get, self._get_flags) for value in bound(call)]
+        # (the arrays it points into stay alive with the bound calls above)
         arguments = SmaFmuStep(sizeof(SmaFmuStep), component, *fields)
-        self._keep = fields  # the arrays the structure points into
         return partial(raw, byref(arguments)), arguments
 
     def failed(self, stage, status):

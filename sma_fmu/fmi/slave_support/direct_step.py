@@ -33,8 +33,6 @@ from .lifecycle import STEP_COMPLETE
 
 __all__ = ["direct_step"]
 
-_NAN = float("nan")
-
 _GENERAL = '''
 def make(view, guard, slave, fast):
     def step(t, h{parameters}):

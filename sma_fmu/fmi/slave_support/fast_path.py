@@ -114,10 +114,9 @@ class FastPath:
         self.slots = slots
         self._names = [name for _, _, name, _, _ in slots]
         self._to_double = [_as_double(code) for code, _, _, _, _ in slots]
-        self._inputs = [(i, name, convert) for i, (_, _, name, settable, convert) in enumerate(slots)
-                        if settable]
+        # the inputs settable in stepComplete: (value index, pending index, name, convert)
         self._inputs = [(_HEADER + i, _HEADER + count + i, name, convert)
-                        for i, name, convert in self._inputs]
+                        for i, (_, _, name, settable, convert) in enumerate(slots) if settable]
         # after a step: the time and the values a step changes, in one pack (struct's "d"
         # reads a Boolean or Integer as the front does: v != 0, (int)v)
         self._changing_names = self._names[:n_changing]

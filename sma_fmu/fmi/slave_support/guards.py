@@ -136,7 +136,10 @@ class CallGuard:
 
     def validity(self, function):
         """Log the stepper's validity-range warning, if its last step or start raised one."""
-        warning = getattr(getattr(self.slave, "stepper", None), "warning", None)
+        try:  # (no getattr with defaults: this runs after every step)
+            warning = self.slave.stepper.warning
+        except AttributeError:  # no stepper (yet), or one without a validity range
+            warning = None
         if warning:
             self.log(Fmi2Status.warning, function, warning)
 
@@ -243,12 +246,7 @@ class CallGuard:
                                          "non-finite output; the instance is in the error state "
                                          "(restore a saved state or reset it)")
         self.time = current_time + step_size
-        try:  # validity(), without its two getattr calls
-            warning = self.slave.stepper.warning
-        except AttributeError:
-            warning = None
-        if warning:
-            self.log(Fmi2Status.warning, function, warning)
+        self.validity(function)
         return True
 
     def to_xml(self, model_options=None):
