@@ -100,3 +100,19 @@ def test_check_fails_on_a_system_that_cannot_run(fmu_dir, tmp_path, capsys):
     assert main(["check", str(tmp_path / "missing.ssp")]) == 2
     assert "missing.ssp: no such file" in capsys.readouterr().err
 
+
+
+def test_check_names_a_zip_that_is_no_fmu_or_ssp(tmp_path, capsys):
+    """A zip archive without modelDescription.xml (a wheel, say) or an .ssp without
+    SystemStructure.ssd: one FAIL line saying so, no check reads further, no traceback."""
+    import zipfile
+    wheel, package = tmp_path / "some.whl", tmp_path / "empty.ssp"
+    for path in (wheel, package):
+        with zipfile.ZipFile(path, "w") as archive:
+            archive.writestr("module/__init__.py", "")
+    assert main(["check", str(wheel), str(package)]) == 1
+    captured = capsys.readouterr()
+    assert captured.out.splitlines() == [
+        f"FAIL  {wheel}: archive: not an FMU: no modelDescription.xml at the top of the archive",
+        f"FAIL  {package}: archive: not an SSP package: no SystemStructure.ssd at the top of the archive"]
+    assert captured.err == ""

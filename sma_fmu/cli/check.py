@@ -5,9 +5,8 @@ __all__ = ["register"]
 
 
 def _check(args):
-    from sma_fmu.files.archives import inspect_archive
     from sma_fmu.fmi.platforms import platform_results
-    from sma_fmu.systems.check import CheckResult, check_files, format_result
+    from sma_fmu.systems.check import CheckResult, archive_results, check_files, format_result
 
     missing = [str(path) for path in args.files if not Path(path).is_file()]
     if missing:
@@ -15,7 +14,7 @@ def _check(args):
     passed = True
     for path in args.files:
         passed = check_files([path]) and passed
-        if inspect_archive(path):  # unsafe: failed above, entry by entry; nothing else reads it
+        if archive_results(path):  # failed above (not an FMU or SSP, unsafe): nothing else reads it
             continue
         for check, status, detail in platform_results(path):  # where the FMU runs, and how well
             print(format_result(CheckResult(str(path), check, status, detail)))

@@ -39,7 +39,8 @@ from sma_fmu.systems.packed import START_VALUES_ENTRY
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
-__all__ = ["CheckResult", "SHORT_RUN_STEPS", "check_file", "check_files", "format_result"]
+__all__ = ["CheckResult", "SHORT_RUN_STEPS", "archive_results", "check_file", "check_files",
+           "format_result"]
 
 SHORT_RUN_STEPS = 100   # steps of the C-host run
 STATE_STEPS = 20        # steps before and after saving the state
@@ -190,17 +191,35 @@ def _ssp_checks(path):
     return results
 
 
+def archive_results(path):
+    """The FAIL results of a file no check should read (empty: the checks may): not a zip
+    archive, an unsafe entry (no host, library or unpacking ever sees one), or no
+    modelDescription.xml (an FMU) or SystemStructure.ssd (an SSP package)."""
+    path = Path(path)
+    if not zipfile.is_zipfile(path):
+        return [CheckResult(str(path), "archive", "FAIL", "not a zip archive (an FMU or SSP is one)")]
+    problems = inspect_archive(path)
+    if problems:
+        return [CheckResult(str(path), "archive", "FAIL", f"unsafe entry {problem.entry!r}: {problem.rule}")
+                for problem in problems]
+    ssp = path.suffix.lower() == ".ssp"
+    description = "SystemStructure.ssd" if ssp else "modelDescription.xml"
+    with zipfile.ZipFile(path) as archive:
+        if description not in archive.namelist():
+            return [CheckResult(str(path), "archive", "FAIL",
+                                f"not {'an SSP package' if ssp else 'an FMU'}: no {description} "
+                                "at the top of the archive")]
+    return []
+
+
 def check_file(path):
     """The :class:`CheckResult` list of one FMU, container FMU or SSP package."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"{path}: no such file")
-    if not zipfile.is_zipfile(path):
-        return [CheckResult(str(path), "archive", "FAIL", "not a zip archive (an FMU or SSP is one)")]
-    problems = inspect_archive(path)
-    if problems:  # no host, library or unpacking ever sees an unsafe archive
-        return [CheckResult(str(path), "archive", "FAIL", f"unsafe entry {problem.entry!r}: {problem.rule}")
-                for problem in problems]
+    unreadable = archive_results(path)
+    if unreadable:
+        return unreadable
     if path.suffix.lower() == ".ssp":
         return _ssp_checks(path)
     return _fmu_checks(path, str(path))
