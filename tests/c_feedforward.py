@@ -12,7 +12,7 @@ import re
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.reachable_band import reachable_band
 
-from c_runtime import compile_runtime
+from c_runtime import StateDoubles, load_with_signatures, with_reversals
 
 MINE = ("reachable_band", "sensing", "phase_lag", "feedforward")
 RUNTIME = ("sma_message", "checks", "state_entries", "lattice", "thermal", "phases",
@@ -113,8 +113,10 @@ class CParameters:
         self.lib.params_free(self.pointer)
 
 
-class CStepper:
+class CStepper(StateDoubles):
     """The C FeedforwardStepper with Python's method names; refusals raise ValueError."""
+
+    STATE_CALLS = ("ff_state_size", "ff_state_write", "ff_state_read")
 
     def __init__(self, lib, cparams, params, alpha=None, beta=None, model_load=None,
                  adapt_to_load=True, inverse="major"):
@@ -152,28 +154,16 @@ class CStepper:
             raise ValueError(self._error.value.decode())
         return self._outputs()
 
-    def state(self):
-        out = (ctypes.c_double * self.lib.ff_state_size(self.pointer))()
-        self.lib.ff_state_write(self.pointer, out)
-        return list(out)
-
-    def restore(self, values):
-        array = (ctypes.c_double * len(values))(*values)
-        if self.lib.ff_state_read(self.pointer, array, len(values), self._error):
-            raise ValueError(self._error.value.decode())
-
 
 def doubles_of(state):
     """Python's state() dict in the C layout (feedforward.h): None as NaN."""
     def number(value):
         return math.nan if value is None else float(value)
-    out = [float(state["direction"]), number(state["previous_reference"]),
-           number(state["previous_temperature"]), number(state["previous_fraction"]),
-           number(state["filter"]["previous_input"]), number(state["filter"]["previous_output"]),
-           float(len(state["reversals"]))]
-    for temperature, xi_mf in state["reversals"]:
-        out += [float(temperature), float(xi_mf)]
-    return out
+    return with_reversals([
+        float(state["direction"]), number(state["previous_reference"]),
+        number(state["previous_temperature"]), number(state["previous_fraction"]),
+        number(state["filter"]["previous_input"]), number(state["filter"]["previous_output"])],
+        state["reversals"])
 
 
 def same_doubles(a, b):
@@ -244,9 +234,5 @@ def reference_walk(rng, params, steps):
 
 
 def load_library(folder):
-    """The runtime and the shim compiled into ``folder``, with the shim's signatures set."""
-    library = compile_runtime(RUNTIME, folder, extra_source=SHIM)
-    for name, (restype, argtypes) in SIGNATURES.items():
-        function = getattr(library, name)
-        function.restype, function.argtypes = restype, argtypes
-    return library
+    """The runtime and the shim built into ``folder``, with the shim's signatures set."""
+    return load_with_signatures(RUNTIME, folder, SHIM, SIGNATURES)

@@ -11,7 +11,7 @@ from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.plant import STATE_FORMAT
 from sma_fmu.runtime.thermal import power_to_reach, step_decay
 
-from c_runtime import compile_runtime
+from c_runtime import StateDoubles, load_with_signatures, with_reversals
 
 RUNTIME = ("sma_message", "checks", "state_entries", "lattice", "thermal", "phases",
            "constant_load", "minor_loops", "validity", "parameters", "plant")
@@ -120,8 +120,10 @@ class CParameters:
             self.lib.params_free(self.pointer)
 
 
-class CPlant:
+class CPlant(StateDoubles):
     """The C PlantStepper with Python's method names; refusals raise ValueError."""
+
+    STATE_CALLS = ("plant_size", "plant_write", "plant_read")
 
     def __init__(self, lib, params, T_start=None, mode="continuous", load=0.0):
         self.lib, self.cparams = lib, CParameters(lib, params.values())
@@ -153,26 +155,11 @@ class CPlant:
             raise ValueError(error.value.decode())
         return self._read()
 
-    def state(self):
-        out = (ctypes.c_double * self.lib.plant_size(self.pointer))()
-        self.lib.plant_write(self.pointer, out)
-        return list(out)
-
-    def restore(self, values):
-        error = ctypes.create_string_buffer(512)
-        array = (ctypes.c_double * max(len(values), 1))(*values)
-        if self.lib.plant_read(self.pointer, array, len(values), error):
-            raise ValueError(error.value.decode())
-
 
 def doubles_of(state):
     """Python's state() dict in the C layout (plant.h)."""
-    out = [float(state[key]) for key in ("temperature", "direction", "load", "xi_MF", "xi_P",
-                                         "power")]
-    out.append(float(len(state["reversals"])))
-    for temperature, xi_mf in state["reversals"]:
-        out += [float(temperature), float(xi_mf)]
-    return out
+    return with_reversals([float(state[key]) for key in (
+        "temperature", "direction", "load", "xi_MF", "xi_P", "power")], state["reversals"])
 
 
 def state_of(values):
@@ -265,8 +252,4 @@ def power_of(instruction, python):
 
 def load_library(folder):
     """The runtime and the shim built into ``folder``, with the shim's signatures set."""
-    library = compile_runtime(RUNTIME, folder, extra_source=SHIM)
-    for name, (restype, argtypes) in SIGNATURES.items():
-        function = getattr(library, name)
-        function.restype, function.argtypes = restype, argtypes
-    return library
+    return load_with_signatures(RUNTIME, folder, SHIM, SIGNATURES)

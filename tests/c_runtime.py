@@ -48,6 +48,16 @@ def compile_runtime(modules, folder, extra_source=None, name="runtime"):
     return ctypes.CDLL(str(library))
 
 
+def load_with_signatures(modules, folder, shim, signatures):
+    """:func:`compile_runtime` of ``modules`` and the C text ``shim``, with the ctypes
+    (restype, argtypes) of each function named in ``signatures`` set."""
+    library = compile_runtime(modules, folder, extra_source=shim)
+    for name, (restype, argtypes) in signatures.items():
+        function = getattr(library, name)
+        function.restype, function.argtypes = restype, argtypes
+    return library
+
+
 def compile_win64(modules, folder):
     """Compile the runtime ``modules`` to win64 objects with mingw-w64 under the same flags
     (-c, no link); returns the object paths, or None when mingw-w64 is not installed."""
@@ -62,3 +72,31 @@ def compile_win64(modules, folder):
         _run([MINGW, *FLAGS, "-c", "-o", target, source])
         objects.append(target)
     return objects
+
+
+class StateDoubles:
+    """state()/restore() of a C stepper as a flat array of doubles, for the ctypes wrappers
+    (c_plant.CPlant, c_feedforward.CStepper): ``STATE_CALLS`` names the library's
+    (size, write, read) functions; read refuses with a message, raised as ValueError."""
+
+    STATE_CALLS = ("", "", "")
+
+    def state(self):
+        size, write, _ = (getattr(self.lib, name) for name in self.STATE_CALLS)
+        out = (ctypes.c_double * size(self.pointer))()
+        write(self.pointer, out)
+        return list(out)
+
+    def restore(self, values):
+        error = ctypes.create_string_buffer(512)
+        array = (ctypes.c_double * max(len(values), 1))(*values)
+        if getattr(self.lib, self.STATE_CALLS[2])(self.pointer, array, len(values), error):
+            raise ValueError(error.value.decode())
+
+
+def with_reversals(head, reversals):
+    """A saved state's doubles: ``head``, then the count and the (T, xi_MF) reversal points."""
+    out = list(head) + [float(len(reversals))]
+    for temperature, xi_mf in reversals:
+        out += [float(temperature), float(xi_mf)]
+    return out

@@ -31,9 +31,9 @@ def params(parameter_set):
 @pytest.fixture(scope="session")
 def fmus(tmp_path_factory):
     """The FMUs, built once per test session from the reference parameter file, with the
-    native front: the tests of them test the front too, so without a C compiler they skip."""
+    C front: the tests of them test the front too, so without a C compiler they skip."""
     need("gcc")
-    from sma_fmu.fmi.build import build_fmus
+    from sma_fmu.fmi.packaging.build import build_fmus
     return build_fmus(tmp_path_factory.mktemp("fmus"))
 
 
@@ -41,7 +41,7 @@ def fmus(tmp_path_factory):
 def native_fmus(tmp_path_factory):
     """The native (C) FMUs, built once per session (sma-fmu build --native): {name: path}."""
     need("gcc")
-    from sma_fmu.fmi.c_family.native_build import build_native_fmus
+    from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
     return build_native_fmus(tmp_path_factory.mktemp("native_fmus"))
 
 

@@ -6,7 +6,7 @@ sets unless ``--shared``), and measure the process before and after.
 
 Prints one JSON object: resident memory growth per instance [KiB], growth of the mappings
 of FMU binaries, of sys.path, of sys.path_importer_cache and of Python objects. ``--fmpy``
-uses plain ``fmpy.simulate_fmu`` instead of :class:`~sma_fmu.fmi.instance.FmuInstance`.
+uses plain ``fmpy.simulate_fmu`` instead of :class:`~sma_fmu.fmi.driving.instance.FmuInstance`.
 Each instance is initialized, stepped, terminated and freed, and its folder removed.
 """
 import argparse
@@ -42,7 +42,7 @@ def main(argv=None):
         def one(k):
             simulate_fmu(args.fmu, stop_time=0.002, step_size=0.001, start_values={"load": 0.05})
     else:
-        from sma_fmu.fmi.instance import FmuInstance
+        from sma_fmu.fmi.driving.instance import FmuInstance
 
         def one(k):
             with FmuInstance(args.fmu, f"probe{k}", {"load": 0.05}) as fmu:

@@ -18,7 +18,7 @@ import pytest
 from sma_fmu.cli import main
 from sma_fmu.files.archives import (MAX_RATIO, MAX_TOTAL_BYTES, UnsafeArchiveError,
                                     inspect_archive, safe_extract)
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 from sma_fmu.systems.c_host import run_c_host
 from sma_fmu.systems.check import check_file
 from sma_fmu.systems.hosts import run_ssp_libcosim

@@ -6,7 +6,7 @@
 - fmpy under a Python linked into its executable: Debian's /usr/bin/python3 when it is the
   running minor version, else one linked from the running Python's libpython3.X.a (the front
   must use that process's Python, not load a second libpython).
-The results equal the library steppers'. Without the native front (no C compiler at build
+The results equal the library steppers'. Without the C front (no C compiler at build
 time) the FMU's binary is pythonfmu's own, which does not load in a C host.
 """
 import re
@@ -22,8 +22,8 @@ import pytest
 from fmpy import read_model_description
 
 from fmi_host import ERROR, OK, WARNING, FmiHost, text, unpack
-from sma_fmu.fmi.build import build_fmu
-from sma_fmu.fmi.front import NativeFrontWarning, remove_front
+from sma_fmu.fmi.packaging.build import build_fmu
+from sma_fmu.fmi.packaging.front_build import FrontWarning, remove_front
 from sma_fmu.fmi.hosts import CHostError, c_compiler, compile_host
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
@@ -244,7 +244,7 @@ def test_without_a_compiler_the_build_keeps_pythonfmus_binary_and_says_so(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         path = build_fmu("SmaActuator", tmp_path / "out")
-    assert any(issubclass(w.category, NativeFrontWarning) and "no-such-compiler" in str(w.message)
+    assert any(issubclass(w.category, FrontWarning) and "no-such-compiler" in str(w.message)
                and "LD_PRELOAD" in str(w.message) for w in caught)
     names = zipfile.ZipFile(path).namelist()
     assert "binaries/linux64/SmaActuator.so" in names

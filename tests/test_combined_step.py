@@ -1,4 +1,4 @@
-"""The front's ``sma_fmu_step`` export (fmi/native/combined_step.c): fmi2SetReal + fmi2DoStep +
+"""The front's ``sma_fmu_step`` export (fmi/python_family/front/combined_step.c): fmi2SetReal + fmi2DoStep +
 fmi2GetReal (+ fmi2GetBoolean) in one call, which the fmpy master uses when an FMU has it.
 
 It must be nothing but those FMI calls: the same results to the last bit, the same
@@ -12,7 +12,7 @@ import pytest
 from sma_fmu.cosim.master import FmuPlant, LeanStep, run_fmus
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.files.package_data import shipped_file
-from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.fmi.driving.instance import FmuError, FmuInstance
 
 STEP = 1e-3
 

@@ -11,7 +11,7 @@ from sma_fmu.cosim.master import run_fmus
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.systems.runner import run_scenarios
 from sma_fmu.cosim.scenario import ScenarioError, load_scenario, scenario_names
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 from sma_fmu.files.package_data import shipped_file
 
 MINOR_LOOP = [f"{profile}{mode}-pi+ff-adaptive-minor-loop" for profile in ("load-step", "heavy")

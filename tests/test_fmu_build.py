@@ -6,10 +6,12 @@ from fmpy import read_model_description
 
 from import_roots import imported_roots
 from sma_fmu.cli import main
-from sma_fmu.fmi.build import FMU_SCRIPTS, build_fmu, code_stamp, validate_fmus
+from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.build import build_fmu, validate_fmus
+from sma_fmu.fmi.packaging.pythonfmu_build import code_stamp
 from sma_fmu.wire.parameter_file import write_parameter_file
 from sma_fmu.runtime.reachable_band import reachable_band
-from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
+from sma_fmu.fmi.python_family.slave_support.model_description import UNIT_DEFINITIONS
 
 PLANT_OUTPUTS = {"R": "ohm", "T": "degC", "x": "m", "xi_P": "1", "xi_M": "1", "xi_F": "1", "P": "W"}
 FEEDFORWARD_OUTPUTS = {"P_ff": "W", "T_ref": "degC"}

@@ -9,7 +9,8 @@ import math
 from ctypes import byref, c_double, c_int, c_size_t, c_uint, c_void_p
 
 from fmu_signals import STEP
-from sma_fmu.fmi.instance import FmuInstance
+from switched_runs import run_switched, same
+from sma_fmu.fmi.driving.instance import FmuInstance
 
 OK, DISCARD, ERROR = 0, 2, 3
 LAST_SUCCESSFUL_TIME, TERMINATED = 2, 3  # fmi2StatusKind
@@ -67,31 +68,15 @@ def _script(fmu):
 
 
 def _run(fmus, monkeypatch, direct):
-    if direct:
-        monkeypatch.delenv("SMA_FMU_NO_DIRECT_STEP", raising=False)
-    else:
-        monkeypatch.setenv("SMA_FMU_NO_DIRECT_STEP", "1")
-    monkeypatch.delenv("SMA_FMU_NO_FAST_PATH", raising=False)
-    with FmuInstance(fmus["SmaActuator"], "plant", {"load": 0.05}) as fmu:
-        results = _script(fmu)
-        fmu._alive = False  # terminated above
-        fmu._fmu.freeInstance()
-    return results
-
-
-def _same(a, b):
-    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
-        return True
-    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    return a == b
+    return run_switched(fmus, monkeypatch, "SMA_FMU_NO_DIRECT_STEP", direct, _script,
+                        cleared=("SMA_FMU_NO_FAST_PATH",))
 
 
 def test_every_refused_or_discarded_step_is_reported_alike(fmus, monkeypatch):
     direct, pythonfmu = _run(fmus, monkeypatch, True), _run(fmus, monkeypatch, False)
     assert len(direct) == len(pythonfmu)
     for index, (a, b) in enumerate(zip(direct, pythonfmu)):
-        assert _same(a, b), f"call {index}: direct {a!r}, through pythonfmu {b!r}"
+        assert same(a, b), f"call {index}: direct {a!r}, through pythonfmu {b!r}"
     steps = [r for r in direct if isinstance(r, tuple)]
     statuses = [r[0] for r in steps]
     assert statuses.count(ERROR) >= 9 and statuses.count(DISCARD) == 2 and statuses.count(OK) >= 6
@@ -163,10 +148,10 @@ def test_three_slaves_declare_the_step_the_front_inlines():
     step inlines it); the PWM driver and the signal source keep their own and get the
     general form."""
     import importlib
-    from sma_fmu.fmi.build import FMU_SCRIPTS
+    from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
     declared = {}
     for name, script in FMU_SCRIPTS.items():
-        module = importlib.import_module(f"sma_fmu.fmi.slaves.{script[:-3]}")
+        module = importlib.import_module(f"sma_fmu.fmi.python_family.slaves.{script[:-3]}")
         declared[name] = getattr(module, name).declared_step
     assert {name for name, step in declared.items() if step} == {
         "SmaActuator", "SmaFeedforward", "SmaPiController"}

@@ -1,8 +1,8 @@
 """docs/fmus.md lists every variable of every FMU exactly as the built FMUs declare it."""
 from pathlib import Path
 
-from sma_fmu.fmi.build import FMU_SCRIPTS
-from sma_fmu.fmi.variable_table import markdown_table, render_document
+from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.variable_table import markdown_table, render_document
 
 DOC = Path(__file__).parent.parent / "docs" / "fmus.md"
 
@@ -11,7 +11,7 @@ def test_variable_tables_in_docs_match_the_built_fmus(fmus):
     assert set(fmus) == set(FMU_SCRIPTS)
     text = DOC.read_text(encoding="utf-8")
     assert render_document(text, fmus) == text, (
-        "docs/fmus.md differs from the FMUs: run python -m sma_fmu.fmi.variable_table docs/fmus.md")
+        "docs/fmus.md differs from the FMUs: run python -m sma_fmu.fmi.packaging.variable_table docs/fmus.md")
 
 
 def test_the_table_has_a_row_per_variable_with_unit_and_start(fmus):

@@ -2,8 +2,8 @@
 import pytest
 
 from fmu_signals import STEP, plant_load, plant_power, wide_reference as reference
-from sma_fmu.fmi.instance import FmuInstance
-from sma_fmu.fmi.slave_support.choices import choice_code
+from sma_fmu.fmi.driving.instance import FmuInstance
+from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
 

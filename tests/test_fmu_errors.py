@@ -5,7 +5,7 @@ import math
 import pytest
 
 from fmu_signals import STEP
-from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.fmi.driving.instance import FmuError, FmuInstance
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
 

@@ -1,5 +1,5 @@
-"""FMUs that document and check themselves (sma_fmu/fmi/fmu_extras.py, fmu_reference.py,
-fmu_documentation.py, cross_check.py): every built FMU carries documentation/index.html and
+"""FMUs that document and check themselves (sma_fmu/fmi/packaging/extras.py, reference_results.py,
+documentation.py, cross_check.py): every built FMU carries documentation/index.html and
 its default experiment's result in the fmi-ls-ref layout; the result reproduces, agrees
 with the runtime stepper, and the FMI Cross-Check tree passes fmpy's validator."""
 import html
@@ -16,9 +16,9 @@ from fmpy.cross_check.validate_vendor_repo import validate_test_fmu
 
 from cli_failure import fails
 from sma_fmu.cli import main
-from sma_fmu.fmi.cross_check import cross_check_platform, model_folder
-from sma_fmu.fmi.fmu_extras import add_documentation_and_reference
-from sma_fmu.fmi.fmu_reference import (LS_REF_FOLDER, MANIFEST, output_stride, read_csv_bytes,
+from sma_fmu.fmi.packaging.cross_check import cross_check_platform, model_folder
+from sma_fmu.fmi.packaging.extras import add_documentation_and_reference
+from sma_fmu.fmi.packaging.reference_results import (LS_REF_FOLDER, MANIFEST, output_stride, read_csv_bytes,
                                        reference_check, experiment_of)
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.systems.check import check_file

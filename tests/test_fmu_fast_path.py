@@ -9,7 +9,8 @@ from ctypes import c_double, c_int, c_size_t, c_uint, c_void_p
 import pytest
 
 from fmu_signals import STEP
-from sma_fmu.fmi.instance import FmuInstance
+from switched_runs import run_switched, same
+from sma_fmu.fmi.driving.instance import FmuInstance
 
 OK, ERROR = 0, 3
 _TYPES = {"Real": c_double, "Integer": c_int, "Boolean": c_int}
@@ -74,36 +75,21 @@ def _script(fmu):
     return results
 
 
+def _warm(fmu):
+    for k in range(3):
+        _call(fmu, "Set", "Real", _refs(fmu, "P_in", "load"), [0.8, 0.05])
+        fmu.step(k * STEP, STEP)
+
+
 def _run(fmus, monkeypatch, fast):
-    if fast:
-        monkeypatch.delenv("SMA_FMU_NO_FAST_PATH", raising=False)
-    else:
-        monkeypatch.setenv("SMA_FMU_NO_FAST_PATH", "1")
-    with FmuInstance(fmus["SmaActuator"], "plant", {"load": 0.05}) as fmu:
-        for k in range(3):
-            _call(fmu, "Set", "Real", _refs(fmu, "P_in", "load"), [0.8, 0.05])
-            fmu.step(k * STEP, STEP)
-        results = _script(fmu)
-        fmu._alive = False  # terminated above
-        fmu._fmu.freeInstance()
-    return results
-
-
-def _same(a, b):
-    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
-        return True
-    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    if isinstance(a, dict) and isinstance(b, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    return a == b
+    return run_switched(fmus, monkeypatch, "SMA_FMU_NO_FAST_PATH", fast, _script, warm=_warm)
 
 
 def test_every_refused_call_is_refused_through_the_fast_path(fmus, monkeypatch):
     fast, slow = _run(fmus, monkeypatch, True), _run(fmus, monkeypatch, False)
     assert len(fast) == len(slow)
     for index, (a, b) in enumerate(zip(fast, slow)):
-        assert _same(a, b), f"call {index}: fast path {a!r}, guard {b!r}"
+        assert same(a, b), f"call {index}: fast path {a!r}, guard {b!r}"
     statuses = [result[0] for result in fast if isinstance(result, tuple)]
     assert statuses.count(ERROR) >= 10 and OK in statuses
     refused = [result for result in fast if isinstance(result, tuple) and result[0] == ERROR]

@@ -20,7 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fmi_host import DISCARD, FATAL, FmiHost, text
-from sma_fmu.fmi.build import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 
 EXAMPLES = int(os.environ.get("SMA_FMU_FUZZ_EXAMPLES", "0"))
 FUZZ = settings(max_examples=EXAMPLES or 100, derandomize=not EXAMPLES, deadline=None,

@@ -4,7 +4,7 @@ import pytest
 from fmpy import simulate_fmu
 
 from fmu_signals import STEP, plant_power, reference
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
 
@@ -66,7 +66,7 @@ def test_closing_an_instance_takes_its_resources_off_sys_path(fmus):
     import sys
     fmu = FmuInstance(fmus["SmaActuator"], "path-check")
     resources = f"{fmu._unzipped}/resources"
-    # pythonfmu puts it there; the native front takes it off again within fmi2Instantiate
+    # pythonfmu puts it there; the C front takes it off again within fmi2Instantiate
     assert not any(entry.rstrip("/") == resources for entry in sys.path)
     fmu.close()
     assert not any(entry.rstrip("/") == resources for entry in sys.path)

@@ -6,7 +6,7 @@ import zlib
 import pytest
 
 from fmu_signals import STEP, plant_load, plant_power, reference
-from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.fmi.driving.instance import FmuError, FmuInstance
 from sma_fmu.wire.parameter_file import load_parameters
 from sma_fmu.runtime.plant import PlantStepper
 

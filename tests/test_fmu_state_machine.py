@@ -13,7 +13,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 
-from sma_fmu.fmi.build import build_fmu
+from sma_fmu.fmi.packaging.build import build_fmu
 from sma_fmu.wire.parameter_file import write_parameter_file
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper

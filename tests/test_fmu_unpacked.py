@@ -1,4 +1,4 @@
-"""One unpacked folder per FMU file per process (sma_fmu.fmi.unpacked), shared by FmuInstance."""
+"""One unpacked folder per FMU file per process (sma_fmu.fmi.driving.unpacked), shared by FmuInstance."""
 import os
 import shutil
 import subprocess
@@ -7,8 +7,8 @@ import tempfile
 import threading
 from pathlib import Path
 
-from sma_fmu.fmi import unpacked
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving import unpacked
+from sma_fmu.fmi.driving.instance import FmuInstance
 
 PREFIX = "sma_fmu_unpacked_"
 
@@ -110,7 +110,7 @@ def test_threads_acquiring_at_once_get_one_folder(fmus, tmp_path):
 
 CHILD = """
 import sys
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 for k in range(3):
     with FmuInstance(sys.argv[1], f"child{k}", {"load": 0.05}) as fmu:
         fmu.step(0.0, 1e-3)
@@ -135,7 +135,7 @@ def test_a_process_removes_its_folders_when_it_exits(fmus, tmp_path):
 FORKED = """
 import multiprocessing, sys, tempfile
 from pathlib import Path
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 
 def child(path, fresh):
     with FmuInstance(path, "in-child") as fmu:  # the parent's folder

@@ -1,4 +1,5 @@
-"""The native front's C files call each other down one way only (issue 30: no circle).
+"""The C files of both families and of the hosts call each other down one way only (issues 30,
+37: no circle).
 
 fmi2_exports.c (the 34 FMI functions) is the top: nothing calls back up into it, but for
 combined_step.c above it (sma_fmu_step: nothing but FMI calls, in one call for the fmpy
@@ -6,14 +7,19 @@ master), which nothing calls. The
 saved states (fmi2_states.c), the instance bookkeeping (instances.c) and the fast path call
 down into call_status.c (refuse, finish), which calls only the host logger. The test builds
 the graph "file A calls a function file B defines" from the sources and asserts it has no
-cycle, and that fmi2_exports.c defines nothing another file calls but its FMI exports.
+cycle, and that fmi2_exports.c defines nothing another file calls but its FMI exports. The
+same check runs over the C family (its runtime, FMI layer and model adapters, compiled together
+into one binary). The C hosts are separate programs (each its own main), not one graph.
 """
 import re
 from pathlib import Path
 
 import sma_fmu.fmi as fmi
+from graph_cycles import find_cycle
 
-NATIVE = Path(fmi.__file__).parent / "native"
+FMI = Path(fmi.__file__).parent
+FRONT = FMI / "python_family" / "front"
+C_FAMILY = [FMI / "c_family" / folder for folder in ("runtime", "fmi2", "models")] + [FMI / "c_common"]
 _DEFINITION = re.compile(r"^(?!static\b)[A-Za-z_][^\n;(=]*?\b([A-Za-z_]\w*)\s*\([^;{]*\)\s*\{", re.M)
 
 
@@ -29,9 +35,9 @@ def _unit(name):
     return re.sub(r"_(posix|windows)\.c$", "_*.c", name)
 
 
-def _graph():
+def _graph(folders=(FRONT, FMI / "c_common")):
     texts = {}
-    for path in sorted(NATIVE.glob("*.c")):
+    for path in sorted(path for folder in folders for path in folder.glob("*.c")):
         text = re.sub(r"/\*.*?\*/|//[^\n]*", "", path.read_text(encoding="utf-8"), flags=re.S)
         texts[_unit(path.name)] = texts.get(_unit(path.name), "") + text
     defined = {name: _defined(text) for name, text in texts.items()}
@@ -42,36 +48,10 @@ def _graph():
     return defined, calls
 
 
-def _cycle(calls):
-    """A cycle of files as a list, or None."""
-    state, stack = {}, []
-
-    def visit(node):
-        state[node] = "open"
-        stack.append(node)
-        for nxt in sorted(calls.get(node, ())):
-            if state.get(nxt) == "open":
-                return stack[stack.index(nxt):] + [nxt]
-            if nxt not in state:
-                found = visit(nxt)
-                if found:
-                    return found
-        stack.pop()
-        state[node] = "done"
-        return None
-
-    for node in sorted(calls):
-        if node not in state:
-            found = visit(node)
-            if found:
-                return found
-    return None
-
-
 def test_the_front_calls_down_only():
     defined, calls = _graph()
     assert "refuse" in defined["call_status.c"] and "free_instance_memory" in defined["instances.c"]
-    assert _cycle(calls) is None, f"C files call each other in a circle: {' -> '.join(_cycle(calls))}"
+    assert find_cycle(calls) is None, f"C files call each other in a circle: {' -> '.join(find_cycle(calls))}"
     callers_of_exports = [name for name, targets in calls.items() if "fmi2_exports.c" in targets]
     assert callers_of_exports == ["combined_step.c"], f"{callers_of_exports} call up into fmi2_exports.c"
     assert not [name for name, targets in calls.items() if "combined_step.c" in targets]
@@ -79,5 +59,11 @@ def test_the_front_calls_down_only():
 
 
 def test_the_check_finds_a_circle():
-    assert _cycle({"a.c": {"b.c"}, "b.c": {"c.c"}, "c.c": {"a.c"}}) == ["a.c", "b.c", "c.c", "a.c"]
-    assert _cycle({"a.c": {"b.c"}, "b.c": set()}) is None
+    assert find_cycle({"a.c": {"b.c"}, "b.c": {"c.c"}, "c.c": {"a.c"}}) == ["a.c", "b.c", "c.c", "a.c"]
+    assert find_cycle({"a.c": {"b.c"}, "b.c": set()}) is None
+
+
+def test_the_c_family_calls_down_only():
+    defined, calls = _graph(C_FAMILY)
+    assert len(defined) >= 3 and any(calls.values())   # the walk sees real files and calls
+    assert find_cycle(calls) is None, f"C files call each other in a circle: {' -> '.join(find_cycle(calls))}"

@@ -132,7 +132,7 @@ def test_cli_fit_writes_a_usable_parameter_file_and_report(tmp_path, parameter_s
                  "--out", str(cycle)]) == 0
     assert main(["fit", "constant-temperature", str(cycle), "--model", str(out / "identified.toml"),
                  "--out", str(tmp_path / "fit2")]) == 0
-    from sma_fmu.fmi.build import build_fmu
+    from sma_fmu.fmi.packaging.build import build_fmu
     from fmpy import read_model_description
     fmu = build_fmu("SmaActuator", tmp_path / "fmus", out / "identified.toml")
     starts = {v.name: v.start for v in read_model_description(str(fmu)).modelVariables}

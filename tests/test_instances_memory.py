@@ -4,7 +4,7 @@ Each instance unpacked into its own folder used to leave about 353 KiB mapped af
 terminate, free and removal of the folder: a copy of the front (49 KiB) and of pythonfmu's
 binary (276 KiB) per folder, never unloaded, and a new class of the slave per instance
 (12 KiB, pythonfmu's findClass). Now the first copy of the front owns pythonfmu's binary
-and later copies share it and can be unloaded (native/backend.c, share.c); the slave
+and later copies share it and can be unloaded (front/backend.c, share.c); the slave
 module pythonfmu runs again per instance only imports its class (front.stage_slave_module);
 the front takes pythonfmu's sys.path entry off again.
 

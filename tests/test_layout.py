@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 import sma_fmu
+from graph_cycles import find_cycle
 
 ROOT = Path(sma_fmu.__file__).parent
 # lowest first; a subpackage may import only those before it (studies, analysis and
@@ -19,10 +20,12 @@ DATA = {"models", "scenarios", "examples"}   # data folders (examples are user s
 FAMILY_SIZE = 4        # modules sharing a name prefix ("isobaric_*") that make a subpackage
 MAX_LINES = 400        # a module over this is split along its seams (house style: ~300)
 # folder (relative to the package) -> (prefix, why it may stay a family)
-PREFIX_EXCEPTIONS = {"fmi/slaves": ("sma", "pythonfmu slave scripts, one FMU each, named after "
+PREFIX_EXCEPTIONS = {"fmi/python_family/slaves": ("sma", "pythonfmu slave scripts, one FMU each, named after "
                                            "their model class (SmaActuator ...); not imported")}
 LONG_MODULE_EXCEPTIONS = {}   # path -> why it may stay over MAX_LINES (none now)
 SUBPACKAGES = ("identification/isobaric", "studies/batch", "cosim/scenario")   # made in issue 30
+# the rooms of sma_fmu/fmi (issue 37), lowest first: a room imports only from rooms before it
+FMI_ROOMS = ["c_common", "python_family", "c_family", "hosts", "driving", "packaging"]
 
 
 def _imports_between_subpackages():
@@ -126,3 +129,76 @@ def test_each_concern_is_a_subpackage_with_a_public_face(folder):
                                                     for target in node.targets)
                for node in tree.body)
     assert not (ROOT / f"{folder}.py").exists()
+
+
+def _module_name(path):
+    parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _module_imports():
+    """{module: {sma_fmu modules it imports, at any depth of its code}} (a name imported from a
+    package counts as the submodule when there is one)."""
+    modules = {_module_name(path): path for path in ROOT.rglob("*.py")
+               if "__pycache__" not in path.parts and path.relative_to(ROOT).parts[0] not in DATA}
+    graph = {}
+    for name, path in modules.items():
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                targets = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    base = ".".join(package.split(".")[:len(package.split(".")) - node.level + 1]
+                                    + ([node.module] if node.module else []))
+                targets = [f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base
+                           for alias in node.names]
+            else:
+                continue
+            found |= {target for target in targets if target in modules and target != name}
+        graph[name] = found
+    return graph
+
+
+def test_the_import_check_finds_a_circle():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_no_circle_of_modules():
+    """Modules import one way, imports inside functions included (issue 37: fmi's build.py,
+    native_build.py, fmu_documentation.py and fmu_extras.py were a circle)."""
+    graph = _module_imports()
+    assert sum(map(len, graph.values())) > 200   # the walk sees the real imports
+    cycle = find_cycle(graph)
+    assert cycle is None, f"modules import each other in a circle: {' -> '.join(cycle)}"
+
+
+def test_fmi_holds_rooms_only():
+    """sma_fmu/fmi has no loose module, its rooms are the pinned ones, and no folder named
+    "native" holds the Python family's front ("native" means the C family)."""
+    fmi = ROOT / "fmi"
+    assert sorted(p.name for p in fmi.glob("*.py")) == ["__init__.py"]
+    rooms = sorted(p.name for p in fmi.iterdir() if p.is_dir() and p.name != "__pycache__")
+    assert rooms == sorted(FMI_ROOMS)
+    assert not [p for p in fmi.rglob("native") if p.is_dir()]
+    assert (fmi / "python_family" / "front" / "fmi2_exports.c").is_file()
+
+
+def test_fmi_rooms_import_down_only():
+    level = {room: index for index, room in enumerate(FMI_ROOMS)}
+    upward = []
+    for name, targets in _module_imports().items():
+        words = name.split(".")
+        if words[:2] != ["sma_fmu", "fmi"] or len(words) < 4:
+            continue
+        for target in targets:
+            other = target.split(".")
+            if other[:2] == ["sma_fmu", "fmi"] and len(other) > 2 and other[2] in level \
+                    and other[2] != words[2] and level[other[2]] > level[words[2]]:
+                upward.append(f"{name} imports {target}")
+    assert sorted(upward) == []
+    packaging = _module_imports()["sma_fmu.fmi.packaging.build"]
+    assert "sma_fmu.fmi.driving.description" in packaging   # the walk sees the rooms' imports

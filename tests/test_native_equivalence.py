@@ -31,8 +31,8 @@ LARGEST = {}  # (model, output) -> largest relative difference seen
 @pytest.fixture(scope="module")
 def families(tmp_path_factory):
     """{"py": {name: path}, "nat": {name: path}}: both families from the same parameter file."""
-    from sma_fmu.fmi.build import build_fmus
-    from sma_fmu.fmi.c_family.native_build import build_native_fmus
+    from sma_fmu.fmi.packaging.build import build_fmus
+    from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
     root = tmp_path_factory.mktemp("families")
     return {"py": build_fmus(root / "py"), "nat": build_native_fmus(root / "nat")}
 

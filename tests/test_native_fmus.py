@@ -21,7 +21,8 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 
 from native_twins import Instance
-from sma_fmu.fmi.build import FMU_SCRIPTS, validate_fmus
+from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.build import validate_fmus
 
 pytestmark = pytest.mark.needs("gcc")
 
@@ -39,7 +40,7 @@ def native(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def twins(tmp_path_factory):
-    from sma_fmu.fmi.build import build_fmus
+    from sma_fmu.fmi.packaging.build import build_fmus
     return build_fmus(tmp_path_factory.mktemp("python"))
 
 
@@ -207,8 +208,8 @@ def test_bad_state_bytes_are_refused_with_a_message(native):
 
 
 def test_build_without_mingw_warns_and_leaves_win64_out(tmp_path, monkeypatch):
-    from sma_fmu.fmi.c_family.native_build import NativeBuildWarning, build_native_fmus
-    from sma_fmu.fmi.platforms import platform_report
+    from sma_fmu.fmi.packaging.c_family_build import NativeBuildWarning, build_native_fmus
+    from sma_fmu.fmi.packaging.platforms import platform_report
     monkeypatch.setenv("SMA_FMU_WIN64_CC", "no-such-mingw-gcc")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -24,7 +24,7 @@ from native_twins import Instance
 from sma_fmu.cli import main
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
-from sma_fmu.fmi.build import read_description
+from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.systems.c_host import run_c_host
 from sma_fmu.systems.comparison import compare_hosts
 from system_needs import needs

@@ -15,9 +15,9 @@ import pytest
 from fmpy import supported_platforms
 
 from sma_fmu.cli import main
-from sma_fmu.fmi.build import build_fmu
-from sma_fmu.fmi.front import NativeFrontWarning, remove_front
-from sma_fmu.fmi.platforms import (DEGRADED, FRONT_MARKER, UnsupportedPlatformError,
+from sma_fmu.fmi.packaging.build import build_fmu
+from sma_fmu.fmi.packaging.front_build import FrontWarning, remove_front
+from sma_fmu.fmi.packaging.platforms import (DEGRADED, FRONT_MARKER, UnsupportedPlatformError,
                                    check_build_machine, platform_report)
 from system_needs import needs
 
@@ -28,7 +28,7 @@ def _build(tmp_path, monkeypatch, **environment):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         path = build_fmu("SmaActuator", tmp_path / "out")
-    return path, [str(w.message) for w in caught if issubclass(w.category, NativeFrontWarning)]
+    return path, [str(w.message) for w in caught if issubclass(w.category, FrontWarning)]
 
 
 @needs("gcc", "mingw-w64")

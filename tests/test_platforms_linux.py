@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 
 from fmi_host import ERROR, OK, FmiHost, text, unpack
-from sma_fmu.fmi.front import compile_front, libpython_path
+from sma_fmu.fmi.packaging.front_build import compile_front, libpython_path
 from sma_fmu.fmi.hosts import c_compiler
 from sma_fmu.runtime.plant import PlantStepper
 from system_needs import needs

@@ -22,7 +22,7 @@ import pytest
 
 from fmi_host import ERROR, FmiHost, text, unpack
 from sma_fmu.fmi.hosts import compile_host, windows_compiler
-from sma_fmu.fmi.platforms import FRONT_MARKER
+from sma_fmu.fmi.packaging.platforms import FRONT_MARKER
 from system_needs import need, needs, wine_command
 
 pytestmark = needs("gcc", "mingw-w64")  # the session's FMUs carry the win64 front

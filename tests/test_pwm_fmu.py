@@ -25,8 +25,8 @@ from fmu_signals import STEP
 from sma_fmu.cosim.loop import COLUMNS, run_library
 from sma_fmu.cosim.master import MissingFmuError, run_fmus
 from sma_fmu.cosim.scenario import DriveSettings, load_scenario, resolve_scenarios
-from sma_fmu.fmi.build import validate_fmus
-from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.fmi.packaging.build import validate_fmus
+from sma_fmu.fmi.driving.instance import FmuError, FmuInstance
 from sma_fmu.runtime.pwm import PwmDriver
 from sma_fmu.runtime.signals import load_from_table
 from sma_fmu.systems.closed_loop import closed_loop

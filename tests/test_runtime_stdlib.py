@@ -36,4 +36,4 @@ def test_library_runtime_runs_without_numpy_scipy_or_pythonfmu():
 
 
 def test_slave_support_needs_only_pythonfmu_besides_stdlib():
-    _run_blocked(["numpy", "scipy"], "import sma_fmu.fmi.slave_support.interface\nprint('ok')\n")
+    _run_blocked(["numpy", "scipy"], "import sma_fmu.fmi.python_family.slave_support.interface\nprint('ok')\n")

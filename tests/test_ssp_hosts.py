@@ -21,7 +21,7 @@ import pytest
 from sma_fmu.cli import main
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper

@@ -78,7 +78,7 @@ def test_the_pwm_driver_takes_a_summed_time_on_the_grid(fmus):
     """Stepped with t + h + h + ... (as Ecos and OMSimulator do), the driver FMU gives the
     runtime driver's wave at k h, to the last bit (off the grid, the edges move by the
     rounding: peak / h per second)."""
-    from sma_fmu.fmi.instance import FmuInstance
+    from sma_fmu.fmi.driving.instance import FmuInstance
     from sma_fmu.runtime.pwm import PwmDriver
 
     h, peak = 1e-3, 8.0
@@ -99,7 +99,7 @@ def test_a_step_a_rounding_error_off_the_first_is_taken_as_the_first(fmus, param
     """OMSimulator steps from t to t_next = t + h passing t_next - t, a few rounding errors
     off h: the plant integrates with h, as the library loop does (a step further off, such
     as a last short step, is taken as it is)."""
-    from sma_fmu.fmi.instance import FmuInstance
+    from sma_fmu.fmi.driving.instance import FmuInstance
     from sma_fmu.runtime.plant import PlantStepper
 
     h = 1e-3

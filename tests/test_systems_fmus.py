@@ -12,8 +12,9 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 from fmu_signals import STEP, reference
-from sma_fmu.fmi.build import FMU_SCRIPTS, validate_fmus
-from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.build import validate_fmus
+from sma_fmu.fmi.driving.instance import FmuError, FmuInstance
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.scenario_signals import SignalSource, signals_from_text, table_text

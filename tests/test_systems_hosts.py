@@ -22,7 +22,7 @@ from fmpy.ssp.ssd import read_ssd
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 from sma_fmu.files.package_data import default_parameter_file
 from sma_fmu.runtime.signals import load_from_table
 from sma_fmu.systems.c_host import run_c_host

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.driving.instance import FmuInstance
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 
 STEP = 1e-3

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from sma_fmu.fmi.build import build_fmu
-from sma_fmu.fmi.slave_support.saved_state import split_state, state_from_bytes, state_to_bytes, state_with
-from sma_fmu.fmi.slave_support.start_values import parse_start_value, start_value_text
+from sma_fmu.fmi.packaging.build import build_fmu
+from sma_fmu.fmi.python_family.slave_support.saved_state import split_state, state_from_bytes, state_to_bytes, state_with
+from sma_fmu.fmi.python_family.slave_support.start_values import parse_start_value, start_value_text
 from sma_fmu.files.json_output import json_text
 from sma_fmu.identification.measurements import read_constant_load
 from sma_fmu.identification.synthetic import write_rows

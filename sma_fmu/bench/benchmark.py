@@ -15,8 +15,8 @@ from pathlib import Path
 
 from sma_fmu.bench.c_hosts import C_HOST_STEPS, c_host_step_costs, floor_costs
 from sma_fmu.cosim.loop import run_library
-from sma_fmu.fmi.build import build_fmus
-from sma_fmu.fmi.instance import FmuInstance
+from sma_fmu.fmi.packaging.build import build_fmus
+from sma_fmu.fmi.driving.instance import FmuInstance
 from sma_fmu.cosim.master import run_fmus
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder

@@ -1,4 +1,4 @@
-"""What a SmaActuator step costs in C hosts, before and after the native front.
+"""What a SmaActuator step costs in C hosts, before and after the C front.
 
 Each host runs 30,000 steps of 1 ms (P_in = 2.6 W, load = 0.05 kg: :data:`BENCH_P_IN_W`,
 :data:`BENCH_LOAD_KG`, as the library plant step and the fmpy master it is compared with) and
@@ -11,7 +11,7 @@ times every step:
 without that keeper (SMA_FMU_NO_TSTATE=1) shows what the keeper alone is worth, and
 without the fast path (SMA_FMU_NO_FAST_PATH=1: every fmi2Set/Get crosses into Python).
 
-The floor: :func:`build_thermal_lag` compiles ``sma_fmu/fmi/native_bench/thermal_lag.c``, a
+The floor: :func:`build_thermal_lag` compiles ``sma_fmu/bench/thermal_lag.c``, a
 minimal native C FMI 2.0 co-simulation FMU of the wire's thermal first-order lag (no
 Python), with the C compiler where there is one; the bench runs it in the same C host and
 fmpy master as SmaActuator.
@@ -27,7 +27,7 @@ import zipfile
 from importlib import resources
 from pathlib import Path
 
-from sma_fmu.fmi.front import libpython_path, remove_front
+from sma_fmu.fmi.packaging.front_build import libpython_path, remove_front
 from sma_fmu.fmi.hosts import c_compiler, compile_host
 from sma_fmu.systems.c_host import host_environment
 
@@ -37,7 +37,7 @@ __all__ = ["BENCH_LOAD_KG", "BENCH_P_IN_W", "C_HOST_STEPS", "c_host_step_costs",
 THERMAL_LAG_REFERENCES = {"P_in": 0, "T": 1, "T_room": 2, "K_th": 3, "tau": 4, "T_start": 5}
 _LAG_XML = """<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="2.0" modelName="ThermalLag" guid="{guid}"
-  description="bench floor: the wire's first-order thermal lag in C (sma_fmu/fmi/native_bench)"
+  description="bench floor: the wire's first-order thermal lag in C (sma_fmu/bench)"
   generationTool="sma-fmu bench" variableNamingConvention="flat" numberOfEventIndicators="0">
   <CoSimulation modelIdentifier="ThermalLag" canHandleVariableCommunicationStepSize="true"/>
   <DefaultExperiment startTime="0" stopTime="30" stepSize="0.001"/>
@@ -60,7 +60,7 @@ BENCH_LOAD_KG = 0.05   # kg, every SmaActuator step of the bench (C hosts, fmpy,
 
 
 def _references(fmu):
-    from sma_fmu.fmi.build import read_description
+    from sma_fmu.fmi.driving.description import read_description
     return {v.name: v.valueReference for v in read_description(fmu).modelVariables}
 
 
@@ -76,13 +76,14 @@ def build_thermal_lag(folder, params):
     (None, why) where it cannot be built (not 64-bit Linux, no working C compiler)."""
     if not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
         return None, f"the native bench FMU is built on 64-bit Linux only (this is {sys.platform})"
-    source = resources.files("sma_fmu.fmi") / "native_bench" / "thermal_lag.c"
+    source = resources.files("sma_fmu.bench") / "thermal_lag.c"
     values = {"T_room": float(params.T_room), "K_th": float(params.K_th), "tau": float(params.tau_th)}
     with tempfile.TemporaryDirectory(prefix="sma_fmu_lag_") as stage:
-        native = Path(stage) / "native_bench"
+        native = Path(stage) / "bench"
         native.mkdir()
         (native / "thermal_lag.c").write_bytes(source.read_bytes())
-        shutil.copytree(Path(str(resources.files("sma_fmu.fmi") / "native")), Path(stage) / "native")
+        shutil.copytree(Path(str(resources.files("sma_fmu.fmi.python_family") / "front")),
+                        Path(stage) / "front")
         library = Path(stage) / "ThermalLag.so"
         command = [*c_compiler(), "-std=c11", "-O2", "-shared", "-fPIC", "-fvisibility=hidden",
                    f"-DLAG_T_ROOM={values['T_room']!r}", f"-DLAG_K_TH={values['K_th']!r}",
@@ -192,7 +193,7 @@ def _master_step_us(fmu, start_values, steps=C_HOST_STEPS):
     """Mean [us] of set P_in + doStep + get T through the fmpy master's :class:`LeanStep`."""
     import time
     from sma_fmu.cosim.master import LeanStep
-    from sma_fmu.fmi.instance import FmuInstance
+    from sma_fmu.fmi.driving.instance import FmuInstance
     with FmuInstance(fmu, "bench-master", start_values) as instance:
         lean = LeanStep(instance, ("P_in",), ("T",))
         inputs, step, t = lean.inputs, lean.step, 0.0

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios
 from sma_fmu.files.json_output import json_text
-from sma_fmu.fmi.build import build_fmus
+from sma_fmu.fmi.packaging.build import build_fmus
 from sma_fmu.systems.comparison import FMPY_SSP, compare_hosts, host_table
 from sma_fmu.systems.omsimulator import ENVIRONMENT, omsimulator_executable
 

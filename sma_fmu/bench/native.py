@@ -111,7 +111,7 @@ def native_section(python_paths, params, runs, folder):
     """Build the native FMUs (sma-fmu build --native) into ``folder`` and time them
     (:func:`native_costs`); the hook of :func:`~.benchmark.run_benchmarks`."""
     import warnings
-    from sma_fmu.fmi.c_family.native_build import NativeBuildWarning, build_native_fmus
+    from sma_fmu.fmi.packaging.c_family_build import NativeBuildWarning, build_native_fmus
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NativeBuildWarning)  # win64 is not timed here

@@ -29,7 +29,7 @@ def build_parser():
 
 
 def _message(error):
-    from sma_fmu.fmi.instance import FmuError
+    from sma_fmu.fmi.driving.instance import FmuError
     if isinstance(error, (ValueError, FmuError)):
         return str(error)
     if isinstance(error, OSError):

@@ -141,6 +141,6 @@ def scenario_paths(args):
 
 def add_fmus_argument(parser, help_text="folder of the built FMUs"):
     """Add ``--fmus DIR`` (default: where ``sma-fmu build`` writes) to ``parser``."""
-    from sma_fmu.fmi.build import DEFAULT_FMU_DIR
+    from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 
     parser.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR", help=help_text)

@@ -5,7 +5,7 @@ __all__ = ["register"]
 
 
 def _check(args):
-    from sma_fmu.fmi.platforms import platform_results
+    from sma_fmu.fmi.packaging.platforms import platform_results
     from sma_fmu.systems.check import CheckResult, archive_results, check_files, format_result
 
     missing = [str(path) for path in args.files if not Path(path).is_file()]
@@ -29,7 +29,7 @@ def register(commands):
         description="Per file: fmpy's validation, fmu-manipulation-toolbox's FMI checker, a short "
                     "run in a C host (libcosim) and a state save/restore round trip (the FMUs "
                     "of an SSP one by one; its C-host run is of the whole system), and per "
-                    "platform the FMU lists: whether its binary is the native front, or what "
+                    "platform the FMU lists: whether its binary is the C front, or what "
                     "is degraded without it. One line per check; exit status 1 when any "
                     "check fails.")
     check.add_argument("files", nargs="+", type=Path, metavar="FILE",

@@ -28,7 +28,7 @@ def _container(args):
 
 
 def _cross_check(args):
-    from sma_fmu.fmi.cross_check import export_cross_check
+    from sma_fmu.fmi.packaging.cross_check import export_cross_check
 
     for folder in export_cross_check(args.fmus, args.out):  # prints the FMUs it leaves out
         print(folder)

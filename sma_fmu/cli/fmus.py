@@ -3,7 +3,8 @@ import sys
 import warnings
 from pathlib import Path
 
-from sma_fmu.fmi import build as fmu_build
+from sma_fmu.fmi.packaging import build as fmu_build
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
 
 __all__ = ["register"]
 
@@ -20,7 +21,7 @@ def _build(args):
 
 
 def _validate(args):
-    paths = args.fmus or list(fmu_build.default_fmu_paths(args.out).values())
+    paths = args.fmus or list(default_fmu_paths(args.out).values())
     failed = False
     for path, problems in fmu_build.validate_fmus(paths).items():
         print(f"{path}: {'valid (fmpy: no problems)' if not problems else f'{len(problems)} problem(s)'}")
@@ -33,7 +34,7 @@ def _validate(args):
 def register(commands):
     """Add ``build`` and ``validate`` to the ``commands`` subparsers."""
     build = commands.add_parser("build", help="build the FMUs")
-    build.add_argument("--out", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
+    build.add_argument("--out", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR",
                        help="output folder")
     build.add_argument("--model", metavar="FILE",
                        help="parameter file the FMUs carry (default: the shipped reference_wire.toml)")
@@ -45,6 +46,6 @@ def register(commands):
     validate = commands.add_parser("validate", help="validate FMUs with fmpy (exit 1 on problems)")
     validate.add_argument("fmus", nargs="*", type=Path, metavar="FMU",
                           help="FMU files (default: the built FMUs in --out)")
-    validate.add_argument("--out", type=Path, default=fmu_build.DEFAULT_FMU_DIR, metavar="DIR",
+    validate.add_argument("--out", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR",
                           help="folder of the default FMUs")
     validate.set_defaults(handler=_validate)

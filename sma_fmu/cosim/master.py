@@ -1,6 +1,6 @@
 """The fmpy co-simulation master: SmaActuator (+ SmaFeedforward, + SmaPwmDriver) FMUs in the closed loop.
 
-Built on fmpy's ``FMU2Slave`` (through :class:`~sma_fmu.fmi.instance.FmuInstance`). The
+Built on fmpy's ``FMU2Slave`` (through :class:`~sma_fmu.fmi.driving.instance.FmuInstance`). The
 loop and the PI block are those of :mod:`sma_fmu.cosim.loop`; the compensator FMU is
 stepped before the plant (Gauss-Seidel), so u_ff,k reaches the plant's step k. A scenario
 with a PWM drive puts the SmaPwmDriver FMU between the PI and the plant, stepped after the
@@ -9,8 +9,8 @@ PI and before the plant in the same step: the plant gets the wave's mean over th
 Each step is one fmi2SetReal, one fmi2DoStep and one fmi2GetReal per FMU (the compensator
 also one fmi2GetBoolean), called through ctypes with argument objects built once
 (:class:`LeanStep`): no argument conversion per call, values written into and read from
-the same C arrays every step. An FMU with sma-fmu's native front also exports
-``sma_fmu_step`` (``fmi/native/combined_step.c``): those same calls made in C, in one
+the same C arrays every step. An FMU with sma-fmu's C front also exports
+``sma_fmu_step`` (``fmi/python_family/front/combined_step.c``): those same calls made in C, in one
 ctypes call instead of three or four; LeanStep uses it when it is there. Each block's
 ``step`` is a closure over those objects (an instance attribute, built once): no attribute
 lookup per step.
@@ -21,9 +21,10 @@ from functools import partial
 from pathlib import Path
 
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
-from sma_fmu.fmi.build import DEFAULT_FMU_DIR, default_fmu_paths, read_description
-from sma_fmu.fmi.slave_support.choices import choice_code
-from sma_fmu.fmi.instance import FmuError, FmuInstance
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
+from sma_fmu.fmi.driving.description import read_description
+from sma_fmu.fmi.python_family.slave_support.choices import choice_code
+from sma_fmu.fmi.driving.instance import FmuError, FmuInstance
 
 __all__ = ["FmuPlant", "FmuCompensator", "FmuDriver", "LeanStep", "needed_fmus", "run_fmus",
            "MissingFmuError", "model_parameter_values"]
@@ -46,7 +47,7 @@ def model_parameter_values(fmu_path, params, variables=None):
 
 
 class SmaFmuStep(Structure):
-    """The argument of the front's ``sma_fmu_step`` (``fmi/native/combined_step.c``)."""
+    """The argument of the front's ``sma_fmu_step`` (``fmi/python_family/front/combined_step.c``)."""
 
     _fields_ = [("size", c_size_t), ("component", c_void_p),
                 ("input_vr", POINTER(c_uint)), ("n_inputs", c_size_t), ("inputs", POINTER(c_double)),
@@ -110,7 +111,7 @@ class LeanStep:
         return partial(raw, byref(arguments)), arguments
 
     def failed(self, stage, status):
-        """The :class:`~sma_fmu.fmi.instance.FmuError` of a call above fmi2Warning: ``stage``
+        """The :class:`~sma_fmu.fmi.driving.instance.FmuError` of a call above fmi2Warning: ``stage``
         0 set, 1 doStep, 2 get."""
         inputs, outputs, flags = self._names
         what = (f"set {', '.join(inputs)}", "fmi2DoStep", f"get {', '.join(outputs + flags)}")[min(stage, 2)]
@@ -124,7 +125,7 @@ class LeanStep:
 
             def step(time_s, step_size):
                 """Set :attr:`inputs` (write them first), doStep, read :attr:`outputs` (and
-                :attr:`flags`), in one call; raises :class:`~sma_fmu.fmi.instance.FmuError`
+                :attr:`flags`), in one call; raises :class:`~sma_fmu.fmi.driving.instance.FmuError`
                 above fmi2Warning."""
                 arguments.t = time_s
                 arguments.h = step_size
@@ -136,7 +137,7 @@ class LeanStep:
 
         def step(time_s, step_size):
             """Set :attr:`inputs` (write them first), doStep, read :attr:`outputs` (and
-            :attr:`flags`); raises :class:`~sma_fmu.fmi.instance.FmuError` above fmi2Warning."""
+            :attr:`flags`); raises :class:`~sma_fmu.fmi.driving.instance.FmuError` above fmi2Warning."""
             status = set_()
             if status > 1:
                 raise failed(0, status)

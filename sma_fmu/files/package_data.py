@@ -17,7 +17,7 @@ FOLDERS = {  # name -> (package, folder inside it)
     "models": ("sma_fmu", "models"),
     "scenarios": ("sma_fmu", "scenarios"),
     "examples": ("sma_fmu", "examples"),
-    "slaves": ("sma_fmu.fmi", "slaves"),
+    "slaves": ("sma_fmu.fmi.python_family", "slaves"),
 }
 
 _kept = contextlib.ExitStack()   # real-file copies (zip installs) live as long as the process

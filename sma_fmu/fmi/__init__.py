@@ -1,7 +1,15 @@
-"""FMI glue: building the FMUs, the code they ship, and driving FMUs from Python.
+"""FMI: the two families of FMUs, building them, driving them from Python, and the C hosts.
 
-- :mod:`sma_fmu.fmi.build`: builds the FMUs with pythonfmu and validates them with fmpy;
-- :mod:`sma_fmu.fmi.instance`: one FMU instance driven through fmpy, variables by name;
-- ``slave_support/``: the FMI plumbing every FMU ships (pythonfmu + standard library);
-- ``slaves/``: the slave scripts, one per FMU (package data, built into FMUs, not imported).
+Lowest room first; each imports only from rooms before it (``tests/test_layout.py``):
+
+- ``c_common/``: C code both families compile (the resource-location URI, log categories);
+- ``python_family/``: the pythonfmu FMUs' code: ``slaves/`` (one slave script per FMU),
+  ``slave_support/`` (the FMI glue every such FMU ships) and ``front/`` (the C front, the
+  FMU's binary in front of pythonfmu's);
+- ``c_family/``: the C family ("native" FMUs, ``sma-fmu build --native``): ``runtime/`` (the
+  physics in C99), ``fmi2/`` (the FMI 2.0 layer) and ``models/`` (the five adapters);
+- ``hosts/``: small C programs that run FMUs the way non-Python tools do, and their build;
+- ``driving/``: running an FMU from Python through fmpy (:mod:`.driving.instance`);
+- ``packaging/``: building either family (:mod:`.packaging.build`), model descriptions,
+  documentation, reference results, the cross-check tree, platform tables.
 """

@@ -20,7 +20,7 @@ import pandas as pd
 from sma_fmu.cosim.loop import COLUMN_NAMES, COLUMNS, run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import Scenario
-from sma_fmu.fmi.build import DEFAULT_FMU_DIR
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 from sma_fmu.studies.batch import run_batches, unsupported_reason
 from sma_fmu.studies.overrides import StudyError, template
 

@@ -6,7 +6,7 @@ is built by :func:`sma_fmu.fmi.hosts.compile_host` with the system C compiler (`
 else ``cc``) against the libcosimc of the libcosimpy wheel, once per source and library,
 into a cache folder.
 
-The FMUs carry a native front library that loads libpython itself (docs/fmus.md), so the
+The FMUs carry a C front library that loads libpython itself (docs/fmus.md), so the
 host process needs nothing preloaded: :func:`host_environment` removes LD_PRELOAD, and the
 runs show what any C tool sees.
 """

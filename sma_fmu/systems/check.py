@@ -7,7 +7,7 @@ Per FMU (a container is an FMU; the FMUs inside an SSP are checked one by one):
 - ``state round trip``: save the state, step, restore, step again: the same outputs, bit
   for bit (serialized and read back when the FMU can); "n/a" when it does not declare it.
 - ``default experiment``: the FMU's default experiment run again in fmpy gives the
-  reference result it carries (:mod:`sma_fmu.fmi.fmu_reference`, the fmi-ls-ref layout);
+  reference result it carries (:mod:`sma_fmu.fmi.packaging.reference_results`, the fmi-ls-ref layout);
   "n/a" without one, or for an FMU an export packed with a scenario's values.
 Per SSP also ``SSD schema``: SystemStructure.ssd against the SSP 1.0 schemas (fmpy's
 copy); ``packed defaults``: the FMUs' packed start values agree with their model
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.files.archives import inspect_archive
-from sma_fmu.fmi.fmu_reference import reference_check
+from sma_fmu.fmi.packaging.reference_results import reference_check
 from sma_fmu.systems.c_host import run_c_host
 from sma_fmu.systems.host_needs import KNOWN_HOSTS, host_check, packed_defaults_check, read_ssp
 from sma_fmu.systems.packed import START_VALUES_ENTRY
@@ -72,7 +72,7 @@ def _run(file, check, function):
 
 
 def _fmpy_validation(path):
-    from sma_fmu.fmi.build import validate_fmus
+    from sma_fmu.fmi.packaging.build import validate_fmus
 
     problems = validate_fmus([path])[Path(path)]
     return ("ok", "no problems") if not problems else ("FAIL", "; ".join(problems))
@@ -106,7 +106,7 @@ def _short_run(kind, path, step_size):
 
 
 def _state_round_trip(path, description):
-    from sma_fmu.fmi.instance import FmuInstance
+    from sma_fmu.fmi.driving.instance import FmuInstance
 
     cs = description.coSimulation
     if cs is None or not cs.canGetAndSetFMUstate:

@@ -15,14 +15,15 @@ Each component's parameter values are the scenario's: every wire parameter its F
 exposes (from the scenario's parameter file), the controller's gains and filter, the
 driver's frequency and peak power, the plant's start temperature and hysteresis mode, and
 the signals as JSON tables. Choices (the hysteresis mode, the inverse) are the Integer
-codes of :mod:`sma_fmu.fmi.slave_support.choices`.
+codes of :mod:`sma_fmu.fmi.python_family.slave_support.choices`.
 """
 from dataclasses import dataclass
 
 from sma_fmu.cosim.master import MissingFmuError, model_parameter_values, needed_fmus
 from sma_fmu.files.archives import require_safe_archive
-from sma_fmu.fmi.build import default_fmu_paths, read_description
-from sma_fmu.fmi.slave_support.choices import choice_code
+from sma_fmu.fmi.packaging.fmu_names import default_fmu_paths
+from sma_fmu.fmi.driving.description import read_description
+from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
 
 __all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "identifier", "STEP_ORDER"]

@@ -15,7 +15,7 @@ import zipfile
 from pathlib import Path
 
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.fmi.slave_support.model_description import set_units
+from sma_fmu.fmi.python_family.slave_support.model_description import set_units
 from sma_fmu.files.output_folder import OutputError, write_file
 from sma_fmu.systems.closed_loop import closed_loop, identifier
 from sma_fmu.systems.packed import packed_fmu

@@ -33,7 +33,7 @@ import xml.etree.ElementTree as ET
 import zipfile
 from dataclasses import dataclass
 
-from sma_fmu.fmi.slave_support.start_values import parse_start_value
+from sma_fmu.fmi.python_family.slave_support.start_values import parse_start_value
 from sma_fmu.systems.packed import fmu_defaults
 from sma_fmu.systems.ssp import NAMESPACES, SSD_NAME
 

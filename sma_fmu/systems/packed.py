@@ -8,7 +8,7 @@ them:
 - ``modelDescription.xml``: the ``start`` attribute of each bound parameter, and a
   DefaultExperiment with the scenario's stop time and step;
 - ``resources/start_values.json``: the same values, which the slave reads when it is
-  instantiated (:mod:`sma_fmu.fmi.slave_support.start_values`).
+  instantiated (:mod:`sma_fmu.fmi.python_family.slave_support.start_values`).
 
 The bindings of the SSP and the container's start values hold the same values, so every
 host runs the scenario whatever it binds. :func:`fmu_defaults` reads both places back
@@ -20,7 +20,7 @@ import zipfile
 import xml.etree.ElementTree as ET
 
 from sma_fmu import __version__
-from sma_fmu.fmi.slave_support.start_values import (START_VALUES_FILE, parse_start_value,
+from sma_fmu.fmi.python_family.slave_support.start_values import (START_VALUES_FILE, parse_start_value,
                                                     start_value, start_value_text)
 
 __all__ = ["MODEL_DESCRIPTION", "START_VALUES_ENTRY", "FmuDefaults", "packed_fmu", "fmu_defaults"]

@@ -17,7 +17,7 @@ from sma_fmu.cosim.recording import (RunRecorder, TimeseriesWriter, interval_ste
 from sma_fmu.cosim.plots import plot_comparison, plot_run
 from sma_fmu.cosim.report import comparison_markdown, groups, summary_table
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.fmi.build import DEFAULT_FMU_DIR
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.systems.runs import run_container, run_ssp

@@ -27,8 +27,8 @@ from pathlib import Path
 
 from sma_fmu import __version__
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.fmi.slave_support.model_description import UNIT_DEFINITIONS
-from sma_fmu.fmi.slave_support.start_values import start_value_text
+from sma_fmu.fmi.python_family.slave_support.model_description import UNIT_DEFINITIONS
+from sma_fmu.fmi.python_family.slave_support.start_values import start_value_text
 from sma_fmu.files.output_folder import OutputError, check_folder, staged_folder, write_file
 from sma_fmu.systems.closed_loop import closed_loop, identifier
 from sma_fmu.systems.packed import packed_fmu

@@ -2,6 +2,9 @@
 
 - ``fmi_host.c``: a plain ``dlopen`` FMI 2.0 co-simulation host driven by commands on
   stdin (the tests' fuzz suite, C-host checks and the benchmark's per-step timing);
+- ``loop_host.c``: a sequential (Gauss-Seidel) loop of FMUs in one process, as an
+  embedded master runs them;
+- ``host_platform.h``: what the dlopen hosts share (loading a binary, the platform shim);
 - ``cosim_host.c``: sma-fmu's C host on libcosim's C API (libcosimc, from the libcosimpy
   wheel): runs an FMU or an SSP package (``sma-fmu check``, the tests, the benchmark).
 
@@ -21,9 +24,10 @@ import tempfile
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["CHostError", "HOST_PROGRAMS", "c_compiler", "windows_compiler", "compile_host"]
+__all__ = ["CHostError", "HOST_PROGRAMS", "SHARED_HEADER", "c_compiler", "windows_compiler", "compile_host"]
 
 HOST_PROGRAMS = ("fmi_host", "cosim_host", "loop_host")
+SHARED_HEADER = "host_platform.h"   # loading a binary, the platform shim (fmi_host, loop_host)
 _FLAGS = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"]
 
 
@@ -78,9 +82,10 @@ def compile_host(name, cache=None, windows=False):
     if name not in HOST_PROGRAMS:
         raise ValueError(f"C host must be one of {', '.join(HOST_PROGRAMS)}, got {name!r}")
     source = resources.files(__name__).joinpath(f"{name}.c").read_bytes()
+    shared = resources.files(__name__).joinpath(SHARED_HEADER).read_bytes()
     compiler = windows_compiler() if windows else c_compiler()
     link = _link_flags(name, windows)
-    key = hashlib.sha256(source + "\0".join([*compiler, *_FLAGS, *link]).encode()).hexdigest()[:12]
+    key = hashlib.sha256(source + shared + "\0".join([*compiler, *_FLAGS, *link]).encode()).hexdigest()[:12]
     folder = Path(cache or tempfile.gettempdir()) / f"sma-fmu-{name}-{key}"
     executable = folder / (f"{name}.exe" if windows else name)
     if executable.is_file():
@@ -89,6 +94,7 @@ def compile_host(name, cache=None, windows=False):
     with tempfile.TemporaryDirectory(dir=folder) as stage:
         source_file = Path(stage) / f"{name}.c"
         source_file.write_bytes(source)
+        (Path(stage) / SHARED_HEADER).write_bytes(shared)
         built = Path(stage) / executable.name
         command = [*compiler, *_FLAGS, "-o", str(built), str(source_file), *link]
         try:

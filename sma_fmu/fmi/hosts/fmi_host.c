@@ -23,30 +23,8 @@
  */
 #define _GNU_SOURCE
 #include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
-#ifdef _WIN32
-#define WIN32_LEAN_AND_MEAN
-#include <windows.h>
-#define PLATFORM "win64"
-#define SUFFIX ".dll"
-#else
-#include <dlfcn.h>
-#define PLATFORM "linux64"
-#define SUFFIX ".so"
-#endif
-#define PATH_SIZE 4096
 
-typedef void* Component;
-typedef struct {
-    void (*logger)(void*, const char*, int, const char*, const char*, ...);
-    void* (*allocate)(size_t, size_t);
-    void (*release)(void*);
-    void* step_finished;
-    void* environment;
-} Callbacks;
+#include "host_platform.h"  /* loading a binary, the platform shim */
 
 #define SLOTS 8
 #define MAXN 64
@@ -110,20 +88,6 @@ static char* unhex(const char* hex, size_t* length)
     return out;
 }
 
-/* The absolute path of the FMU folder, '/'-separated ("C:/dir" on Windows). */
-static int absolute_dir(char* absolute, size_t size)
-{
-#ifdef _WIN32
-    if (!_fullpath(absolute, dir, size)) return 0;
-    for (char* p = absolute; *p; ++p)
-        if (*p == '\\') *p = '/';
-    return 1;
-#else
-    (void)size;
-    return realpath(dir, absolute) != NULL;
-#endif
-}
-
 static const char* resource_uri(const char* mode)
 {
     static char uri[PATH_SIZE + 64];
@@ -133,7 +97,7 @@ static const char* resource_uri(const char* mode)
 #else
     const char* root = "";
 #endif
-    if (!absolute_dir(absolute, sizeof absolute)) return NULL;
+    if (!host_absolute_dir(dir, absolute, sizeof absolute)) return NULL;
     if (!strcmp(mode, "ok")) snprintf(uri, sizeof uri, "file://%s%s/resources", root, absolute);
     else if (!strcmp(mode, "one")) snprintf(uri, sizeof uri, "file:%s%s/resources", root, absolute);
     else if (!strcmp(mode, "localhost")) snprintf(uri, sizeof uri, "file://localhost%s%s/resources", root, absolute);
@@ -150,46 +114,16 @@ static const char* resource_uri(const char* mode)
 
 static void read_model_description(void)
 {
-    char path[PATH_SIZE + 32];
-    snprintf(path, sizeof path, "%s/modelDescription.xml", dir);
-    FILE* file = fopen(path, "r");
-    if (!file) { perror(path); exit(2); }
-    static char xml[1 << 17];
-    xml[fread(xml, 1, sizeof xml - 1, file)] = '\0';
-    fclose(file);
-    char* g = strstr(xml, " guid=\"");
-    char* m = strstr(xml, "modelIdentifier=\"");
-    if (!g || !m) { fprintf(stderr, "no guid or modelIdentifier\n"); exit(2); }
-    sscanf(g + 7, "%255[^\"]", guid);
-    sscanf(m + 17, "%255[^\"]", model);
+    char why[PATH_SIZE + 64];
+    if (host_model_description(dir, guid, model, why, sizeof why)) { fprintf(stderr, "%s\n", why); exit(2); }
 }
-
-#ifdef _WIN32
-static void* symbol(HMODULE library, const char* name)
-{
-    FARPROC address = GetProcAddress(library, name);
-    void* pointer;
-    memcpy(&pointer, &address, sizeof pointer);
-    return pointer;
-}
-#else
-#define symbol dlsym
-#endif
 
 static void load(void)
 {
-    char path[PATH_SIZE + 300];
-    snprintf(path, sizeof path, "%s/binaries/" PLATFORM "/%s" SUFFIX, dir, model);
-#ifdef _WIN32
-    for (char* p = path; *p; ++p)
-        if (*p == '/') *p = '\\';
-    HMODULE library = LoadLibraryExA(path, NULL, LOAD_WITH_ALTERED_SEARCH_PATH);
-    if (!library) { fprintf(stderr, "fmi_host: LoadLibrary %s: error %lu\n", path, GetLastError()); exit(3); }
-#else
-    void* library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!library) { fprintf(stderr, "fmi_host: dlopen: %s\n", dlerror()); exit(3); }
-#endif
-#define SYM(n) if (!(*(void**)&F.n = symbol(library, "fmi2" #n))) { fprintf(stderr, "no fmi2" #n "\n"); exit(3); }
+    char path[PATH_SIZE + 300], why[2 * PATH_SIZE];
+    void* library = host_open_library(dir, model, path, sizeof path, why, sizeof why);
+    if (!library) { fprintf(stderr, "fmi_host: %s\n", why); exit(3); }
+#define SYM(n) if (!(*(void**)&F.n = host_symbol(library, "fmi2" #n))) { fprintf(stderr, "no fmi2" #n "\n"); exit(3); }
     SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
     SYM(ExitInitializationMode) SYM(Terminate) SYM(Reset) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
     SYM(GetInteger) SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(GetString) SYM(DoStep)
@@ -199,19 +133,6 @@ static void load(void)
 #undef SYM
 }
 
-static double now(void)
-{
-#ifdef _WIN32
-    LARGE_INTEGER count, frequency;
-    QueryPerformanceCounter(&count);
-    QueryPerformanceFrequency(&frequency);
-    return (double)count.QuadPart / (double)frequency.QuadPart;
-#else
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-#endif
-}
 
 static int by_value(const void* a, const void* b)
 {
@@ -223,28 +144,28 @@ static void bench(Component c, long steps, double h, unsigned in, double value, 
 {
     double* cost = malloc(sizeof(double) * (size_t)steps), result = 0.0;
     int status = 0;
-    double start = now();
+    double start = host_now();
     for (long i = 0; i < steps && status <= 1; ++i) {
-        double before = now();
+        double before = host_now();
         status = F.SetReal(c, &in, 1, &value);
         if (status <= 1) status = F.DoStep(c, t, h, 1);
         if (status <= 1) status = F.GetReal(c, &out, 1, &result);
-        cost[i] = now() - before;
+        cost[i] = host_now() - before;
         t += h;
     }
-    double total = now() - start;
+    double total = host_now() - start;
     /* the mean from a second pass of as many steps without the per-step clock reads (two
      * reads cost 25-90 ns here: as much as a native C FMU step), timed as a whole like the
      * library step it is compared with; the percentiles are the first pass's */
     if (status <= 1) {
-        start = now();
+        start = host_now();
         for (long i = 0; i < steps && status <= 1; ++i) {
             status = F.SetReal(c, &in, 1, &value);
             if (status <= 1) status = F.DoStep(c, t, h, 1);
             if (status <= 1) status = F.GetReal(c, &out, 1, &result);
             t += h;
         }
-        total = now() - start;
+        total = host_now() - start;
     }
     qsort(cost, (size_t)steps, sizeof(double), by_value);
     printf("= %d %.17g %.3f %.3f %.3f %.6f\n", status, result, 1e6 * cost[steps / 2],

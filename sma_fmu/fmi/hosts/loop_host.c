@@ -25,33 +25,11 @@
  */
 #define _GNU_SOURCE
 #include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
-#ifdef _WIN32
-#define WIN32_LEAN_AND_MEAN
-#include <windows.h>
-#define PLATFORM "win64"
-#define SUFFIX ".dll"
-#else
-#include <dlfcn.h>
-#define PLATFORM "linux64"
-#define SUFFIX ".so"
-#endif
 
-#define PATH_SIZE 4096
+#include "host_platform.h"  /* loading a binary, the platform shim */
+
 #define MAX_COMPONENTS 8
 #define MAX_ITEMS 256
-
-typedef void* Component;
-typedef struct {
-    void (*logger)(void*, const char*, int, const char*, const char*, ...);
-    void* (*allocate)(size_t, size_t);
-    void (*release)(void*);
-    void* step_finished;
-    void* environment;
-} Callbacks;
 
 typedef struct {
     char name[64], dir[PATH_SIZE], guid[256], model[256];
@@ -118,46 +96,16 @@ static int find(const char* name)
 
 static void read_model_description(Fmu* f)
 {
-    char path[PATH_SIZE + 32];
-    snprintf(path, sizeof path, "%s/modelDescription.xml", f->dir);
-    FILE* file = fopen(path, "r");
-    if (!file) bad("cannot open", path);
-    static char xml[1 << 18];
-    xml[fread(xml, 1, sizeof xml - 1, file)] = '\0';
-    fclose(file);
-    char* g = strstr(xml, " guid=\"");
-    char* m = strstr(xml, "modelIdentifier=\"");
-    if (!g || !m) bad("no guid or modelIdentifier in", path);
-    sscanf(g + 7, "%255[^\"]", f->guid);
-    sscanf(m + 17, "%255[^\"]", f->model);
+    char why[PATH_SIZE + 64];
+    if (host_model_description(f->dir, f->guid, f->model, why, sizeof why)) bad("model description", why);
 }
-
-#ifdef _WIN32
-static void* symbol(HMODULE library, const char* name)
-{
-    FARPROC address = GetProcAddress(library, name);
-    void* pointer;
-    memcpy(&pointer, &address, sizeof pointer);
-    return pointer;
-}
-#else
-#define symbol dlsym
-#endif
 
 static void load(Fmu* f)
 {
-    char path[2 * PATH_SIZE];
-    snprintf(path, sizeof path, "%s/binaries/" PLATFORM "/%s" SUFFIX, f->dir, f->model);
-#ifdef _WIN32
-    for (char* p = path; *p; ++p)
-        if (*p == '/') *p = '\\';
-    HMODULE library = LoadLibraryExA(path, NULL, LOAD_WITH_ALTERED_SEARCH_PATH);
-    if (!library) { fprintf(stderr, "loop_host: LoadLibrary %s: error %lu\n", path, GetLastError()); exit(1); }
-#else
-    void* library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!library) { fprintf(stderr, "loop_host: dlopen: %s\n", dlerror()); exit(1); }
-#endif
-#define SYM(n) if (!(*(void**)&f->n = symbol(library, "fmi2" #n))) bad("no fmi2" #n " in", path);
+    char path[2 * PATH_SIZE], why[3 * PATH_SIZE];
+    void* library = host_open_library(f->dir, f->model, path, sizeof path, why, sizeof why);
+    if (!library) { fprintf(stderr, "loop_host: %s\n", why); exit(1); }
+#define SYM(n) if (!(*(void**)&f->n = host_symbol(library, "fmi2" #n))) bad("no fmi2" #n " in", path);
     SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
     SYM(ExitInitializationMode) SYM(Terminate) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
     SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(DoStep)
@@ -168,30 +116,14 @@ static void load(Fmu* f)
 static void resource_uri(const char* dir, char* uri, size_t size)
 {
     char absolute[PATH_SIZE];
+    if (!host_absolute_dir(dir, absolute, sizeof absolute)) bad("no absolute path for", dir);
 #ifdef _WIN32
-    if (!_fullpath(absolute, dir, sizeof absolute)) bad("no absolute path for", dir);
-    for (char* p = absolute; *p; ++p)
-        if (*p == '\\') *p = '/';
     snprintf(uri, size, "file:///%s/resources", absolute);
 #else
-    if (!realpath(dir, absolute)) bad("no absolute path for", dir);
     snprintf(uri, size, "file://%s/resources", absolute);
 #endif
 }
 
-static double now(void)
-{
-#ifdef _WIN32
-    LARGE_INTEGER count, frequency;
-    QueryPerformanceCounter(&count);
-    QueryPerformanceFrequency(&frequency);
-    return (double)count.QuadPart / (double)frequency.QuadPart;
-#else
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-#endif
-}
 
 static void check(int status, const Fmu* f, const char* call)
 {
@@ -270,18 +202,18 @@ static void run(double h, long steps, int timing)
     double* cost = timing ? malloc(sizeof(double) * (size_t)steps) : NULL;
     if (timing && !cost) bad("out of memory for", "the timings");
     if (!timing) print_row();
-    const double begin = now();
+    const double begin = host_now();
     for (long k = 0; k < steps; ++k) {
-        const double t = (double)k * h, before = timing ? now() : 0.0;
+        const double t = (double)k * h, before = timing ? host_now() : 0.0;
         for (int j = 0; j < ordered; ++j) {
             Fmu* f = &fmu[order[j]];
             feed(order[j]);
             check(f->DoStep(f->c, t, h, 1), f, "fmi2DoStep");
         }
-        if (timing) cost[k] = now() - before;
+        if (timing) cost[k] = host_now() - before;
         else print_row();
     }
-    const double total = now() - begin;
+    const double total = host_now() - begin;
     if (timing) {
         qsort(cost, (size_t)steps, sizeof(double), by_value);
         printf("timing %.4f %.4f %.4f %.4f %.6f\n", 1e6 * cost[steps / 2],

@@ -1,7 +1,7 @@
 /* The FMI 2.0 co-simulation functions of the native models: the calling sequence.
  *
  * The states, refusals and messages are the pythonfmu FMUs' (slave_support/guards.py and
- * the front in fmi/native/fmi2_exports.c), so the two families answer every call alike:
+ * the front in fmi/python_family/front/fmi2_exports.c), so the two families answer every call alike:
  *  - a call in a state where it is illegal: fmi2Error, "illegal call in state '<state>'";
  *  - fmi2ExitInitializationMode with parameters the model refuses: fmi2Error naming the
  *    reason, the instance stays in Initialization Mode (fix them and call it again);
@@ -24,7 +24,7 @@
 
 #include "fmi2_layer.h"
 
-/* What `sma-fmu check` finds in a native binary (c_family/native_build.py). */
+/* What `sma-fmu check` finds in a native binary (fmi/packaging/c_family_build.py). */
 static const char NATIVE_MARKER[] = "sma-fmu native C FMU";
 
 const char *const STATE_NAMES[STATE_COUNT] = {

@@ -4,7 +4,7 @@
  * logger as the argument of a "%s" format, never as the format: a '%' in an instance name
  * or a String parameter is printed as it is by every host (FMI 2.0 gives the message as a
  * printf format with arguments).
- * Filtering (as the pythonfmu FMUs' front, fmi/native/host_log.c): with loggingOn = false
+ * Filtering (as the pythonfmu FMUs' front, fmi/python_family/front/host_log.c): with loggingOn = false
  * the host still gets warnings, discards and errors, unless it switches them off with
  * fmi2SetDebugLogging(false, 0, NULL) or by category; the categories are those of the model
  * description (logStatusWarning, logStatusDiscard, logStatusError, logStatusFatal, logAll).
@@ -16,18 +16,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "log_category.h"
 #include "fmi2_layer.h"
-
-static const char *status_category(fmi2Status status)
-{
-    switch (status) {
-    case fmi2Warning: return "logStatusWarning";
-    case fmi2Discard: return "logStatusDiscard";
-    case fmi2Error: return "logStatusError";
-    case fmi2Fatal: return "logStatusFatal";
-    default: return "logAll";
-    }
-}
 
 static int category_enabled(const Instance *in, const char *category)
 {
@@ -43,7 +33,7 @@ static int category_enabled(const Instance *in, const char *category)
 
 static int wanted(const Instance *in, fmi2Status status)
 {
-    const char *category = status_category(status);
+    const char *category = log_status_category((int)status);
     if (status >= fmi2Warning && in->log_problems) return 1;
     return in->log_all || category_enabled(in, "logAll") || category_enabled(in, category);
 }
@@ -61,7 +51,7 @@ static void emit(Instance *in, fmi2Status status, int prefixed, const char *form
         if (used < 0 || (size_t)used >= sizeof text) used = 0;
     }
     vsnprintf(text + used, sizeof text - (size_t)used, format, arguments);
-    in->logger(in->environment, in->name, status, status_category(status), "%s", text);
+    in->logger(in->environment, in->name, status, log_status_category((int)status), "%s", text);
 }
 
 void layer_log(Instance *in, fmi2Status status, const char *format, ...)

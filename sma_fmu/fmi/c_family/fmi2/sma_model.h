@@ -4,7 +4,7 @@
  * (a generated table, <Model>_variables.h) and a few functions over its runtime stepper;
  * the layer (FMI 2.0 today, an FMI 3.0 one could follow) owns the values, the calling
  * sequence, the checks, the log and the saved states. The adapters are as thin as the
- * pythonfmu slaves (fmi/slaves/) and keep their semantics: a failing start refuses
+ * pythonfmu slaves (fmi/python_family/slaves/) and keep their semantics: a failing start refuses
  * fmi2ExitInitializationMode, a failing step discards it (slave_support/guards.py). */
 #ifndef SMA_MODEL_H
 #define SMA_MODEL_H

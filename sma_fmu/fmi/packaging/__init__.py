@@ -1,0 +1,11 @@
+"""Building the FMUs of either family and what they carry.
+
+- :mod:`.build`: ``sma-fmu build`` (either family) and fmpy's validation;
+- :mod:`.pythonfmu_build`, :mod:`.front_build`: the Python family and its C front;
+- :mod:`.c_family_build`, :mod:`.c_family_description`: the C family (``--native``);
+- :mod:`.fmu_names`: the five models and their slave scripts;
+- :mod:`.documentation`, :mod:`.reference_results`, :mod:`.extras`: ``documentation/`` and
+  the fmi-ls-ref reference results every FMU carries;
+- :mod:`.cross_check`: the FMI Cross-Check tree; :mod:`.platforms`: the platform tables;
+  :mod:`.variable_table`: the variable tables of docs/fmus.md.
+"""

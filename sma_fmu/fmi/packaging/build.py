@@ -1,0 +1,43 @@
+"""``sma-fmu build``: either family's FMUs, and fmpy's validation of any FMU.
+
+- the Python family (pythonfmu, behind the C front): :mod:`.pythonfmu_build`;
+- the C family (``--native``: no Python inside): :mod:`.c_family_build`.
+"""
+from pathlib import Path
+
+from sma_fmu.fmi.driving.description import read_description
+from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, FMU_SCRIPTS
+from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
+
+__all__ = ["build_fmus", "build_fmu", "validate_fmus"]
+
+
+def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False):
+    """Build FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``; return {name: path}.
+
+    They are built in a temporary folder beside ``out_dir`` and moved there at the end, so
+    a failed build leaves ``out_dir`` as it was. ``native``: the C family instead
+    (:mod:`sma_fmu.fmi.packaging.c_family_build`: same interface, no Python inside).
+    """
+    if native:
+        return build_native_fmus(out_dir, parameter_file, names)
+    return build_pythonfmu_fmus(out_dir, parameter_file, names)
+
+def build_fmu(model_name, out_dir=DEFAULT_FMU_DIR, parameter_file=None):
+    """Build one FMU (a key of :data:`FMU_SCRIPTS`) into ``out_dir``; return its path."""
+    return build_fmus(out_dir, parameter_file, [model_name])[model_name]
+
+
+def validate_fmus(paths):
+    """fmpy's validation of each FMU: {path: list of problems} (empty list = valid).
+
+    A file that is not an FMU at all (missing, a folder, not a zip archive, no model
+    description) raises :class:`FmuFileError` before anything is validated.
+    """
+    from fmpy.validation import validate_fmu
+
+    paths = [Path(path) for path in paths]
+    for path in paths:
+        read_description(path)
+    return {path: validate_fmu(str(path)) for path in paths}

@@ -1,0 +1,164 @@
+"""``documentation/index.html`` of an FMU, and the figure of its default experiment.
+
+FMI 2.0 names ``documentation/index.html`` as the entry point of an FMU's documentation.
+Ours says what the model is (the slave script's docstring, the one text of it), lists
+every variable with its causality, type, unit, start value and description, the wire's
+parameters the FMU was built with (``resources/parameters.json``), its platforms
+(:func:`~sma_fmu.fmi.packaging.platforms.platform_report`, else its ``binaries/`` folders), the
+calling sequence, and a figure of its default experiment (``result.png``, matplotlib) with
+the files of the reference result (:mod:`.reference_results`).
+"""
+import ast
+import html
+import json
+import zipfile
+
+from sma_fmu.files.package_data import shipped_file
+from sma_fmu.files.png_output import png_bytes
+from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+
+__all__ = ["FIGURE", "INDEX", "model_text", "figure_png", "index_html"]
+
+INDEX = "documentation/index.html"
+FIGURE = "documentation/result.png"
+
+_CALLING_SEQUENCE = (
+    "fmi2Instantiate(instanceName, fmi2CoSimulation, GUID, resourceURI, ...)",
+    "fmi2SetupExperiment(startTime, [stopTime])",
+    "fmi2EnterInitializationMode; set parameters and inputs (fmi2SetReal/Integer/Boolean/String)",
+    "fmi2ExitInitializationMode: the parameters are checked here; the outputs are those at startTime",
+    "repeat: set the inputs at t_k; fmi2DoStep(t_k, h) (t_k must be where the last step ended); "
+    "get the outputs at t_k + h",
+    "optionally fmi2GetFMUstate / fmi2SetFMUstate / fmi2SerializeFMUstate to go back",
+    "fmi2Terminate; fmi2FreeInstance",
+)
+
+
+def model_text(model_name):
+    """What the model is: the module docstring of its slave script ("" for another model)."""
+    script = FMU_SCRIPTS.get(model_name)
+    if script is None:
+        return ""
+    return ast.get_docstring(ast.parse(shipped_file("slaves", script).read_text(encoding="utf-8"))) or ""
+
+
+def figure_png(result, inputs, units, title):
+    """PNG bytes: the inputs (if any) and each output of the result over time, one axis each.
+
+    ``result``/``inputs``: structured arrays with ``time`` first; ``units``: {name: unit}.
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    outputs = list(result.dtype.names[1:])
+    panels = ([("inputs", list(inputs.dtype.names[1:]), inputs)] if inputs is not None else []) + \
+        [(name, [name], result) for name in outputs]
+    figure = Figure(figsize=(8.0, 1.5 * len(panels) + 0.8), dpi=80, layout="constrained")
+    axes = figure.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    for axis, (label, names, data) in zip(axes, panels):
+        for name in names:
+            axis.plot(data["time"], data[name], label=f"{name} [{units.get(name) or '1'}]")
+        axis.legend(loc="upper right", fontsize="small")
+        axis.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    figure.suptitle(title)
+    return png_bytes(figure)
+
+
+def _table(head, rows):
+    cells = "".join(f"<th>{html.escape(str(cell))}</th>" for cell in head)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(cell))}</td>" for cell in row) + "</tr>"
+                   for row in rows)
+    return f"<table>\n<tr>{cells}</tr>\n{body}\n</table>"
+
+
+def _unit(variable):
+    if variable.unit:
+        return variable.unit
+    declared = variable.declaredType
+    return declared.unit if declared is not None and getattr(declared, "unit", None) else ""
+
+
+def _wire_rows(archive):
+    """(source, rows) of resources/parameters.json, or (None, []) without one."""
+    if "resources/parameters.json" not in archive.namelist():
+        return None, []
+    document = json.loads(archive.read("resources/parameters.json"))
+    rows = [(name, entry.get("value"), entry.get("unit", ""), entry.get("meaning", ""))
+            for name, entry in document.get("parameters", {}).items()]
+    return f"{document.get('name', '')} ({document.get('description', '')})", rows
+
+
+def _platform_rows(fmu_path, archive):
+    from sma_fmu.fmi.packaging.platforms import platform_report
+
+    report = platform_report(fmu_path)
+    if report and report[0][0] != "n/a":
+        return [(name, status, detail) for status, name, detail in report]
+    folders = {}
+    for name in archive.namelist():
+        parts = name.split("/")
+        if parts[0] == "binaries" and len(parts) == 3 and parts[2]:
+            folders.setdefault(parts[1], []).append(parts[2])
+    return [(folder, "", ", ".join(sorted(files))) for folder, files in sorted(folders.items())]
+
+
+def index_html(fmu_path, description, experiment, files):
+    """The text of documentation/index.html of the FMU ``fmu_path``.
+
+    ``description``: fmpy's model description; ``experiment``: its
+    :class:`~.reference_results.Experiment`; ``files``: {role: archive path} of the reference
+    files ("manifest", "result", and "stimuli" when it has inputs).
+    """
+    name = description.modelName
+    text = model_text(name) or description.description or ""
+    variables = [(v.name, v.causality, v.variability, v.type, _unit(v) or "–",
+                  "" if v.start is None else v.start, v.description or "")
+                 for v in description.modelVariables]
+    with zipfile.ZipFile(fmu_path) as archive:
+        source, wire = _wire_rows(archive)
+        platforms = _platform_rows(fmu_path, archive)
+    e = html.escape
+    stimuli = files.get("stimuli")
+    run = (f"import numpy as np\nfrom fmpy import simulate_fmu\n"
+           + (f"inputs = np.genfromtxt('{stimuli}', delimiter=',', names=True)  # unpacked\n"
+              if stimuli else "inputs = None\n")
+           + f"result = simulate_fmu('{name}.fmu', start_time={experiment.start!r}, "
+             f"stop_time={experiment.stop!r}, output_interval={experiment.step!r}, input=inputs)\n")
+    parts = [
+        "<!DOCTYPE html>", "<html lang=\"en\">", "<head>", "<meta charset=\"utf-8\">",
+        f"<title>{e(name)}</title>",
+        "<style>body{font-family:sans-serif;max-width:60em;margin:auto}table{border-collapse:"
+        "collapse}td,th{border:1px solid #bbb;padding:2px 6px;text-align:left;vertical-align:top}"
+        "pre{background:#f4f4f4;padding:6px;white-space:pre-wrap}</style>",
+        "</head>", "<body>",
+        f"<h1>{e(name)}</h1>",
+        f"<p>{e(description.description or '')}</p>",
+        f"<p>FMI {e(description.fmiVersion)} co-simulation, generated by {e(description.generationTool or '')}"
+        f" ({e(description.generationDateAndTime or '')}), GUID {e(description.guid)}.</p>",
+        "<h2>What the model is</h2>", f"<pre>{e(text)}</pre>",
+        "<h2>Variables</h2>",
+        _table(("name", "causality", "variability", "type", "unit", "start", "description"), variables),
+        "<h2>The wire's parameters</h2>",
+        (f"<p>Built from the parameter file {e(source)} (resources/parameters.json); the FMU's "
+         "parameters above start at these values.</p>" + _table(("name", "value", "unit", "meaning"), wire))
+        if wire else "<p>This FMU carries no parameter file: its parameters are in the table above.</p>",
+        "<h2>Platforms</h2>", _table(("platform", "status", "binary and notes"), platforms),
+        "<h2>Calling sequence</h2>",
+        "<ol>" + "".join(f"<li><code>{e(step)}</code></li>" for step in _CALLING_SEQUENCE) + "</ol>",
+        "<p>Invalid inputs make fmi2DoStep return fmi2Discard with a log message and change "
+        "nothing; the instance goes on with valid ones. Log categories: logStatusWarning, "
+        "logStatusDiscard, logStatusError (see the model description).</p>",
+        "<h2>Default experiment and reference result</h2>",
+        f"<p>startTime = {experiment.start!r} s, stopTime = {experiment.stop!r} s, communication "
+        f"step {experiment.step!r} s. "
+        + (f"Inputs: piecewise linear, from <code>{e(stimuli)}</code> (linear in between). "
+           if stimuli else "No inputs. ")
+        + f"The result, every output at the rows of <code>{e(files['result'])}</code>, is listed in "
+          f"<code>{e(files['manifest'])}</code> (FMI-LS-REF layout); <code>sma-fmu check</code> "
+          "runs the experiment again and compares. With fmpy:</p>",
+        f"<pre>{e(run)}</pre>",
+        f"<img src=\"result.png\" alt=\"{e(name)}: the default experiment\">",
+        "</body>", "</html>", ""]
+    return "\n".join(parts)
