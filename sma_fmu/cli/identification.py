@@ -10,7 +10,8 @@ from .arguments import bounded_integer, bounded_number, finite_number, number_li
 __all__ = ["register"]
 
 EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
-_ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag")
+_ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag",
+                  "stages", "keep_outliers")
 _SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit",
                         "lag_s", "drift_decay")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
@@ -44,7 +45,8 @@ def _fit_isobaric(args, out):
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
                               args.residual_strain or "per-cycle", args.reference_length,
                               progress=lambda text: print(text, flush=True), cycles=args.cycles,
-                              lag=args.lag or "fit")
+                              lag=args.lag or "fit", stages=args.stages or 2,
+                              outliers="keep" if args.keep_outliers else "leave-out")
     print(format_isobaric_report(report))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
           f"figures")
@@ -185,6 +187,13 @@ def register(commands):
                      help="isobaric: fit the wire's first-order lag behind the thermocouple (in "
                           "seconds, or samples without a time column), or assume none "
                           "(default: fit)")
+    fit.add_argument("--stages", type=int, choices=(1, 2),
+                     help="isobaric: transformation stages, each a logistic with its own centres "
+                          "and widths on heating and cooling; 2 fits the second from the "
+                          "one-stage fit (default: 2)")
+    fit.add_argument("--keep-outliers", action="store_true",
+                     help="isobaric: keep cycles whose strain residual RMS exceeds 3x the median "
+                          "cycle's (default: they are named and left out)")
     fit.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
                      help="isobaric: length the strain is measured from [m] (default: the base "
                           "file's x0)")

@@ -13,6 +13,7 @@ import numpy as np
 from scipy import stats
 
 from sma_fmu.identification.isobaric.fit import LAG_OPTIONS, RESIDUAL_OPTIONS, fit_isobaric
+from sma_fmu.identification.isobaric.summary import format_isobaric_report, half_strain_table
 from sma_fmu.identification.isobaric.cycles import parse_cycles, splitting_note
 from sma_fmu.identification.isobaric.figures import isobaric_figures
 from sma_fmu.identification.isobaric.files import read_isobaric
@@ -76,8 +77,9 @@ def _lag_note(lag):
     return note
 
 
-def isobaric_report(files, fit, base_set, residual, rows):
+def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
     """The JSON-ready report of an isobaric fit."""
+    halfway = half_strain_table(files, fit)
     params = fit.params
     half = stats.t.ppf(0.975, fit.dof)
     loads = sorted({d.load for d in files})
@@ -86,11 +88,13 @@ def isobaric_report(files, fit, base_set, residual, rows):
         for name, v, e in zip(fit.wire_names, fit.wire_values, fit.wire_std_errors)}
     unknowns = {name: {"value": float(v), "std_error": float(e), "start": float(s)}
                 for name, v, e, s in zip(fit.names, fit.values, fit.std_errors, fit.starts)}
-    fixed = ["eps_T", "xi_F_inf", "f_F"] + [n for n in ("b_h", "b_c", "x_min", "R_P", "R_M", "R_F")
+    fixed = ["eps_T", "xi_F_inf", "f_F"] + [n for n in ("b_h", "b_c", "x_min", "R_P", "R_M", "R_F",
+                                                        "T_alpha", "span_ratio_sat",
+                                                        "span_stress")
                                           if n not in fit.wire_names]
     per_file = []
-    for data, offsets, sigma, lag, knots in zip(files, fit.offsets, fit.sigma, fit.lags,
-                                                fit.knots_per_branch):
+    for data, offsets, sigma, lag, knots, rms_of_file in zip(
+            files, fit.offsets, fit.sigma, fit.lags, fit.knots_per_branch, fit.file_rms):
         per_file.append({
             "file": str(data.path), "load_kg": data.load,
             "cycles_found": splitting_note(data.splitting, data.branches, data.time is not None),
@@ -102,14 +106,18 @@ def isobaric_report(files, fit, base_set, residual, rows):
             "branches": len(data.branches),
             "cycles": len({b.cycle for b in data.branches if b.complete}),
             "noise_estimates": sigma,
+            "residual_rms": rms_of_file,
             "strain_offsets_per_level": offsets,
             "residual_strain_per_cycle": list(np.diff(offsets)) if residual == "per-cycle" else []})
     widths = {}
     for load in loads:
-        energy = domain_energy(load, params)
         centre_K = hysteresis_centre(load, HEATING, params) + KELVIN_OFFSET
-        widths[f"{load:g} kg"] = {"dH_J": energy, "width_25_75_K_heating": 2 * np.log(3) * BOLTZMANN
-                                  * centre_K ** 2 / energy}
+        entry = {}
+        for word, nu in (("heating", params.terms.nu_h), ("cooling", params.terms.nu_c)):
+            energy = domain_energy(load, params, nu)
+            entry[f"dH_J_{word}"] = energy
+            entry[f"width_25_75_K_{word}"] = 2 * np.log(3) * BOLTZMANN * centre_K ** 2 / energy
+        widths[f"{load:g} kg"] = entry
     return {
         "experiment": "isobaric",
         "files": per_file,
@@ -123,7 +131,15 @@ def isobaric_report(files, fit, base_set, residual, rows):
                                 "matrix": [[float(v) for v in r] for r in fit.covariance]},
         "hysteresis_centres_degC": _centres(fit, loads),
         "transition": widths,
-        "fixed_from_base": {name: getattr(params, name) for name in fixed},
+        "fixed_from_base": {name: getattr(params.terms, name, None) if getattr(params, name) is None
+                            else getattr(params, name) for name in fixed},
+        "stages": fit.stages,
+        "stage_note": fit.stage_note,
+        "on_bound": fit.on_bound,
+        "outlier_cycles": [{k: v for k, v in c.items() if k != "name"} | {"note": c["name"]}
+                           for c in fit.outlier_cycles],
+        "outliers": outliers,
+        "half_strain": halfway,
         "residual_rms": fit.residual_rms,
         "noise_estimates": fit.noise,
         "verdict": fit.verdict,
@@ -138,7 +154,8 @@ def isobaric_report(files, fit, base_set, residual, rows):
 
 
 def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
-                     reference_length=None, progress=lambda text: None, cycles=None, lag="fit"):
+                     reference_length=None, progress=lambda text: None, cycles=None, lag="fit",
+                     stages=2, outliers="leave-out"):
     """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report.
 
     ``cycles``: the text of ``--cycles`` (``5:``, ``3:10``, ``:20``, ``4``) or None for all;
@@ -162,13 +179,14 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
     for d in data:
         progress(f"{d.path.name}: {splitting_note(d.splitting, d.branches, d.time is not None)}")
     progress(f"fitting {len(data)} file(s), {sum(d.strain.size for d in data)} points ...")
-    fit = fit_isobaric(data, base, residual, lag, progress=progress)
+    fit = fit_isobaric(data, base, residual, lag, progress=progress, stages=stages,
+                       outliers=outliers)
     progress("transformation temperatures and figures ...")
     per_cycle = residual == "per-cycle"
     rows = [row for d, offsets, profile, bounds in zip(data, fit.offsets, fit.profiles,
                                                        fit.wire_bounds)
             for row in cycle_rows(d, fit.params, offsets, profile, per_cycle, bounds)]
-    report = isobaric_report(data, fit, base_set, residual, rows)
+    report = isobaric_report(data, fit, base_set, residual, rows, outliers)
     figures = isobaric_figures(data, fit, per_cycle, rows)
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     names = ", ".join(Path(f).name for f in files)
@@ -187,31 +205,3 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         for name, png in figures.items():
             (folder / name).write_bytes(png)
     return report
-
-
-def format_isobaric_report(report):
-    """A short text summary of an isobaric fit report."""
-    rms = report["residual_rms"]
-    solver = report["solver"]
-    noise = report["noise_estimates"]
-    lines = [f"isobaric fit: {report['points']} points in {len(report['files'])} file(s); "
-             f"{solver['seconds']:.2f} s ({solver['evaluations']} evaluations)",
-             f"residual RMS (noise estimate): strain {rms['strain']:.3g} ({noise['strain']:.3g}), "
-             f"temperature {rms['temperature_K']:.3g} K ({noise['temperature_K']:.3g} K)"
-             + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
-                if rms["resistance_ohm"] else ""),
-             report["verdict"]]
-    for entry in report["files"]:
-        lines.append(f"{Path(entry['file']).name}: {entry['cycles_found']}")
-        if entry["lag"]:
-            lag = entry["lag"]
-            lines.append(f"{Path(entry['file']).name}: lag {lag['value']:.4g} +- "
-                         f"{lag['std_error']:.2g} {lag['unit']} ({lag['note']})")
-    lines.append(f"{'parameter':<12}{'value':>14}{'std error':>12}")
-    for name, row in report["parameters"].items():
-        lines.append(f"{name:<12}{row['value']:>14.6g}{row['std_error']:>12.3g}")
-    for load, centre in report["hysteresis_centres_degC"].items():
-        lines.append(f"centres at {load}: heating {centre['heating']['value']:.2f} +- "
-                     f"{centre['heating']['std_error']:.2f} degC, cooling "
-                     f"{centre['cooling']['value']:.2f} +- {centre['cooling']['std_error']:.2f} degC")
-    return "\n".join(lines)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sma_fmu.identification.isobaric.lag import lagged
-from sma_fmu.identification.isobaric.model import branch_share, branch_levels
+from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.runtime.constants import COOLING, HEATING, STANDARD_GRAVITY
 
 __all__ = ["IsobaricProgramme", "temperature_programme", "wire_temperature", "isobaric_table", "isobaric_text",
@@ -141,13 +141,12 @@ def isobaric_table(params, load, programme, strain_unit="percent", with_time=Tru
                                                * programme.decay ** np.arange(programme.cycles))])
     for d in (HEATING, COOLING):
         rows = direction == d
-        levels = branch_levels(load, d, params, reference)
-        share = branch_share(true_t[rows], levels.constants)
+        model, ohm, share = branch_curve(true_t[rows], load, d, params, reference)
         drift = offsets[cycle[rows]]
         if d == COOLING:
             drift = drift + (offsets[cycle[rows] + 1] - offsets[cycle[rows]]) * share
-        strain[rows] = levels.strain_hot + levels.strain_span * share + drift
-        resistance[rows] = levels.resistance_hot + levels.resistance_span * share
+        strain[rows] = model + drift
+        resistance[rows] = ohm
     columns = {}
     if with_time:
         columns["time_s"] = time
