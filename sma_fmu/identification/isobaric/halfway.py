@@ -3,7 +3,8 @@
 On one branch, the baselines are the tangent construction's sloped lines through the
 martensite (cold) and austenite (hot) ends
 (:func:`sma_fmu.identification.transformation_temperatures.branch_tangents`); the progress of
-a sample is (strain - hot line)/(cold line - hot line) at its temperature, and the
+a sample is (strain - hot line)/(cold line - hot line) at its temperature (lines through the
+coldest and hottest 15 % of the samples where the tangent construction cannot be made), and the
 half-strain temperature is the median temperature of the samples within 5 % of progress 1/2
 (a noise-free curve: linear interpolation of the crossing). Used by ``fit isobaric`` (data and
 model at every stress, and their slopes against stress) and by ``predict isobaric``.
@@ -14,19 +15,56 @@ import numpy as np
 
 from sma_fmu.identification.transformation_temperatures import branch_tangents
 
-__all__ = ["half_strain_temperature", "stress_slope"]
+__all__ = ["baselines", "half_strain_temperature", "transformation_strain", "stress_slope",
+           "ENDS"]
+
+ENDS = 0.15   # share of a branch's samples at each end for the fallback baselines
+
+
+def baselines(temperature, strain, direction):
+    """((intercept [1], slope [1/K]) of the cold baseline, the same of the hot one), or None.
+
+    The tangent construction's; where it cannot be made because the transformation is too
+    steep for its 40-60 % band (a stepped strain), lines through the coldest and hottest
+    ENDS of the samples."""
+    found = branch_tangents(temperature, strain, direction)
+    if found is not None:
+        return found["cold"], found["hot"]
+    order = np.argsort(temperature, kind="stable")
+    t = np.asarray(temperature, dtype=float)[order]
+    e = np.asarray(strain, dtype=float)[order]
+    count = max(5, int(ENDS * t.size))
+    if t.size < 4 * count:
+        return None
+    lines = []
+    for rows in (slice(0, count), slice(t.size - count, t.size)):
+        slope, intercept = np.polyfit(t[rows], e[rows], 1)
+        lines.append((float(intercept), float(slope)))
+    if not lines[0][0] + lines[0][1] * t.mean() > lines[1][0] + lines[1][1] * t.mean():
+        return None
+    return lines[0], lines[1]
+
+
+def transformation_strain(temperature, strain, direction):
+    """Strain between the baselines at the half-strain temperature [1], or NaN."""
+    lines = baselines(temperature, strain, direction)
+    at = half_strain_temperature(temperature, strain, direction)
+    if lines is None or not math.isfinite(at):
+        return math.nan
+    (c0, c1), (h0, h1) = lines
+    return float(c0 + c1 * at - h0 - h1 * at)
 
 
 def half_strain_temperature(temperature, strain, direction):
     """Half-strain temperature [degC] of one branch, or NaN when it shows no transformation."""
-    found = branch_tangents(temperature, strain, direction)
-    if found is None:
+    lines = baselines(temperature, strain, direction)
+    if lines is None:
         return math.nan
     order = np.argsort(temperature, kind="stable")
     t = np.asarray(temperature, dtype=float)[order]
     e = np.asarray(strain, dtype=float)[order]
-    cold = found["cold"][0] + found["cold"][1] * t
-    hot = found["hot"][0] + found["hot"][1] * t
+    cold = lines[0][0] + lines[0][1] * t
+    hot = lines[1][0] + lines[1][1] * t
     progress = (e - hot) / (cold - hot)
     near = np.abs(progress - 0.5) <= 0.05
     if near.sum() >= 5:

@@ -103,6 +103,8 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
             "stress_MPa": stress_of_load(data.load, params.diameter),
             "points": int(data.strain.size),
             "columns": {q: list(v) for q, v in data.columns.items()},
+            "strain_column_note": data.strain_note,
+            "stress_column_MPa": data.stress_column,
             "branches": len(data.branches),
             "cycles": len({b.cycle for b in data.branches if b.complete}),
             "noise_estimates": sigma,

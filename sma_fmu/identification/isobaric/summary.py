@@ -4,7 +4,8 @@ from pathlib import Path
 
 import numpy as np
 
-from sma_fmu.identification.isobaric.halfway import half_strain_temperature, stress_slope
+from sma_fmu.identification.isobaric.halfway import (half_strain_temperature, stress_slope,
+                                                     transformation_strain)
 from sma_fmu.identification.isobaric.synthetic import stress_of_load
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.runtime.constants import COOLING, HEATING
@@ -27,13 +28,15 @@ def half_strain_table(files, fit):
     Data: the median over the file's complete branches of each direction, against the
     measured (smoothed) temperature; model: the model branch over the same temperature range
     (no lag: what a lab's own construction gives). Transformation strain: the span between
-    the model's (the data's) sloped baselines at the half-strain temperature."""
+    the model's (the data's) sloped baselines at the half-strain temperature, the median over
+    the file's complete branches of both directions."""
     rows = []
     for data, wire in zip(files, fit.profiles):
         entry = {"file": data.path.name,
                  "stress_MPa": stress_of_load(data.load, fit.params.diameter)}
+        spans_data, spans_model = [], []
         for d in (HEATING, COOLING):
-            found_data, found_model, spans_data, spans_model = [], [], [], []
+            found_data, found_model = [], []
             for b in data.branches:
                 if not b.complete or b.direction != d:
                     continue
@@ -42,12 +45,12 @@ def half_strain_table(files, fit):
                 grid = np.linspace(float(t.min()), float(t.max()), GRID_POINTS)
                 model, _, _ = branch_curve(grid, data.load, d, fit.params, data.reference_length)
                 found_model.append(half_strain_temperature(grid, model, d))
-                spans_data.append(_span(t, e, d))
-                spans_model.append(_span(grid, model, d))
+                spans_data.append(transformation_strain(t, e, d))
+                spans_model.append(transformation_strain(grid, model, d))
             entry[f"data_{_WORD[d]}_degC"] = _median(found_data)
             entry[f"model_{_WORD[d]}_degC"] = _median(found_model)
-            entry[f"data_{_WORD[d]}_span"] = _median(spans_data)
-            entry[f"model_{_WORD[d]}_span"] = _median(spans_model)
+        entry["data_transformation_strain"] = _median(spans_data)
+        entry["model_transformation_strain"] = _median(spans_model)
         rows.append(entry)
     slopes = {}
     for source in ("data", "model"):
@@ -58,15 +61,6 @@ def half_strain_table(files, fit):
             "note": "half-strain temperatures: half way between the sloped baselines of the "
                     "tangent construction, on the measured (smoothed) temperature; spans: the "
                     "transformation strain between the baselines at that temperature [1]"}
-
-
-def _span(temperature, strain, direction):
-    from sma_fmu.identification.transformation_temperatures import branch_tangents
-    found = branch_tangents(temperature, strain, direction)
-    if found is None:
-        return float("nan")
-    at = found["midpoint"]
-    return float((found["cold"][0] + found["cold"][1] * at) - (found["hot"][0] + found["hot"][1] * at))
 
 
 def format_isobaric_report(report):
@@ -95,8 +89,8 @@ def format_isobaric_report(report):
                          f"{row['data_heating_degC']:.2f} data / {row['model_heating_degC']:.2f} "
                          f"model degC, cooling {row['data_cooling_degC']:.2f} / "
                          f"{row['model_cooling_degC']:.2f} degC; transformation strain "
-                         f"{100 * row['data_heating_span']:.3g} / "
-                         f"{100 * row['model_heating_span']:.3g} %; strain RMS "
+                         f"{100 * row['data_transformation_strain']:.3g} / "
+                         f"{100 * row['model_transformation_strain']:.3g} %; strain RMS "
                          f"{report['files'][half['per_file'].index(row)]['residual_rms']['strain']:.3g}")
         slopes = half["slopes_K_per_MPa"]
         if np.isfinite(slopes["data"]["heating"]):
