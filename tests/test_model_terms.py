@@ -195,21 +195,3 @@ def test_sensing_with_a_two_stage_branch_inverts_the_plant(params):
             if not sensed.saturated:
                 assert abs(sensed.temperature - out.T) < 1e-9 * max(1.0, abs(out.T)) * 10
 
-
-def test_the_batch_engine_refuses_the_terms_it_lacks_never_computes_the_old_model(params):
-    import dataclasses
-    from sma_fmu.studies import BatchUnsupported, run_batch, template
-    from sma_fmu.studies.batch.engine import unsupported_reason
-    from sma_fmu.wire.parameter_file import ParameterSet
-    base = template("load-step-pi+ff-adaptive").scenario({"scenario.stop_time_s": 0.5})
-    assert unsupported_reason(base) is None
-    at_default = dataclasses.replace(base, parameter_set=ParameterSet(params.replace(**AT_DEFAULT),
-                                                                      "at-default", ""))
-    assert unsupported_reason(at_default) is None
-    wire = ParameterSet(params.replace(**TWO_STAGE, **STRAIN), "terms", "")
-    with_terms = dataclasses.replace(base, parameter_set=wire)
-    reason = unsupported_reason(with_terms)
-    for name in ("nu_h", "nu_c", "second_stage", "strain"):
-        assert name in reason
-    with pytest.raises(BatchUnsupported, match="second_stage"):
-        run_batch([base, with_terms])

@@ -101,23 +101,7 @@ def unsupported_reason(scenario):
         return f"{scenario.name}: controller kind {controller.kind!r} is not implemented"
     if scenario.hysteresis_mode not in HYSTERESIS_MODES:
         return f"{scenario.name}: hysteresis mode {scenario.hysteresis_mode!r} is not implemented"
-    for which, params in (("wire", scenario.params), ("compensator", scenario.compensator_params)):
-        terms = _terms_on(params)
-        if terms:
-            return (f"{scenario.name}: the {which} parameters' {', '.join(terms)} "
-                    f"(issue 36) are not implemented in the batch engine")
     return None
-
-
-def _terms_on(params):
-    """The optional model terms (runtime/model_terms.py) ``params`` switches on: [names]."""
-    terms = params.terms
-    names = [name for name in ("nu_h", "nu_c") if getattr(terms, name) != params.nu]
-    if terms.two_stage:
-        names.append("second_stage")
-    if terms.strain:
-        names.append("strain")
-    return names
 
 
 def chunk_steps(runs, steps):
