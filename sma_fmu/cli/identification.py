@@ -161,8 +161,23 @@ def _synth(args):
     return 0
 
 
+def _predict(args):
+    from sma_fmu.identification.isobaric.predict_runner import (format_predict_report,
+                                                                run_isobaric_predict)
+    for name, value, high, unit in (("--load", args.load, MAX_FIT_LOAD_KG, "kg"),
+                                    ("--stress", args.stress, MAX_FIT_STRESS_MPA, "MPa")):
+        if value is not None and not 0.0 < value <= high:
+            raise ValueError(f"predict: {name} {value!r} {unit} is outside (0, {high:g}] {unit}")
+    out = args.out or Path("results") / "predict-isobaric"
+    report = run_isobaric_predict(args.file, out, args.model, args.load, args.stress,
+                                  args.reference_length)
+    print(format_predict_report(report))
+    print(f"written: {out}/report.json, predicted.csv, predict_isobaric.png")
+    return 0
+
+
 def register(commands):
-    """Add ``fit`` and ``synth`` to the ``commands`` subparsers."""
+    """Add ``fit``, ``predict`` and ``synth`` to the ``commands`` subparsers."""
     fit = commands.add_parser("fit", help="identify parameters from measurements (CSV)")
     fit.add_argument("experiment", choices=EXPERIMENTS)
     fit.add_argument("files", nargs="+", metavar="FILE", help="measurement CSV file(s)")
@@ -198,6 +213,24 @@ def register(commands):
                      help="isobaric: length the strain is measured from [m] (default: the base "
                           "file's x0)")
     fit.set_defaults(handler=_fit)
+
+    predict = commands.add_parser(
+        "predict", help="run the plant runtime (the FMU's code) through a lab file's measured "
+                        "temperature and compare the strain")
+    predict.add_argument("experiment", choices=("isobaric",))
+    predict.add_argument("file", metavar="FILE", help="isobaric measurement file")
+    predict.add_argument("--model", required=True, metavar="PARAMS",
+                         help="parameter file, e.g. the identified.toml of sma-fmu fit isobaric")
+    loads = predict.add_mutually_exclusive_group()
+    loads.add_argument("--stress", type=finite_number, metavar="MPA",
+                       help="the file's stress [MPa] (default: its stress column or header)")
+    loads.add_argument("--load", type=finite_number, metavar="KG",
+                       help="the file's hung mass [kg] instead of --stress")
+    predict.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
+                         help="length the strain is measured from [m] (default: the model's x0)")
+    predict.add_argument("--out", type=Path, metavar="DIR",
+                         help="output folder (default: results/predict-isobaric)")
+    predict.set_defaults(handler=_predict)
 
     synth = commands.add_parser("synth", help="synthetic measurement CSV from a parameter file")
     synth.add_argument("experiment", choices=EXPERIMENTS)
