@@ -195,3 +195,13 @@ def test_sensing_with_a_two_stage_branch_inverts_the_plant(params):
             if not sensed.saturated:
                 assert abs(sensed.temperature - out.T) < 1e-9 * max(1.0, abs(out.T)) * 10
 
+
+
+def test_a_second_stage_out_of_range_is_named_when_the_file_is_read(tmp_path):
+    """Each value passes its rule, but the stage-2 heating centre falls below 0 K at the
+    validity limit's load: the file is refused, naming the second stage."""
+    text = GOOD.replace('a2_h = { value = 95.0', 'b2_h = { value = -1000.0, unit = "degC/kg", '
+                        'meaning = "x" }\na2_h = { value = 95.0')
+    with pytest.raises(ParameterError, match="second-stage centre.*second_stage.a2_h") as caught:
+        load_parameters(_write(tmp_path, text))
+    assert "terms.toml" in str(caught.value)
