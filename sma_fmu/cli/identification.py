@@ -13,7 +13,7 @@ EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
 _ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag",
                   "stages", "keep_outliers")
 _SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit",
-                        "lag_s", "drift_decay")
+                        "lag_s", "drift_decay", "first_cycle_shift")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
 # choice: synth's limits, wide for any real test file and checked before anything is made
 MAX_ROWS = 1_000_000          # rows (or samples) one synth call may write
@@ -79,7 +79,7 @@ def _synth_isobaric(args, params, t_min, t_max):
         noise_ohm=0.05 if args.noise_ohm is None else args.noise_ohm,
         residual=1.5e-3 if args.drift is None else args.drift, seed=args.seed,
         decay=0.5 if args.drift_decay is None else args.drift_decay,
-        lag_s=args.lag_s or 0.0)
+        lag_s=args.lag_s or 0.0, first_shift_K=args.first_cycle_shift or 0.0)
     texts = {}
     for index, load in enumerate(loads):
         run = dataclasses.replace(programme, seed=programme.seed + index)
@@ -94,6 +94,7 @@ def _synth_isobaric(args, params, t_min, t_max):
             f"{run.cycles} cycles, dwell {run.dwell:g} s, {run.points} samples",
             f"noise: temperature {run.noise_K:g} K, strain {run.noise_strain:g}, resistance "
             f"{run.noise_ohm:g} ohm; seed {run.seed}",
+            f"first cycle: transformation {run.first_shift_K:g} K hotter than the rest",
             f"wire lag behind the thermocouple: {run.lag_s:g} s = {truth['lag_samples']:.6g} "
             f"samples (first order)",
             "true residual-strain levels: " + ", ".join(f"{v:.6g}" for v in truth["offsets"])]
@@ -170,7 +171,7 @@ def _predict(args):
             raise ValueError(f"predict: {name} {value!r} {unit} is outside (0, {high:g}] {unit}")
     out = args.out or Path("results") / "predict-isobaric"
     report = run_isobaric_predict(args.file, out, args.model, args.load, args.stress,
-                                  args.reference_length)
+                                  args.reference_length, args.lag)
     print(format_predict_report(report))
     print(f"written: {out}/report.json, predicted.csv, predict_isobaric.png")
     return 0
@@ -228,6 +229,10 @@ def register(commands):
                        help="the file's hung mass [kg] instead of --stress")
     predict.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
                          help="length the strain is measured from [m] (default: the model's x0)")
+    predict.add_argument("--lag", type=bounded_number(0.0, 1e6, closed=True), default=0.0,
+                         metavar="TAU",
+                         help="the wire's first-order lag behind the thermocouple [s, or samples "
+                              "without a time column], as fit isobaric reports it")
     predict.add_argument("--out", type=Path, metavar="DIR",
                          help="output folder (default: results/predict-isobaric)")
     predict.set_defaults(handler=_predict)
@@ -272,6 +277,9 @@ def register(commands):
                             "[s] (default: 0). A lab-like file: --cycles 100 --points 26000 "
                             "--dwell 0 --rate 20 --t-min 20 --t-max 115 --noise-K 10 --lag-s 20 "
                             "--drift 1e-3 --drift-decay 0.97 --no-time")
+    synth.add_argument("--first-cycle-shift", type=bounded_number(0.0, 100.0, "K", closed=True),
+                       help="isobaric: the first cycle's transformation this much hotter [K], a "
+                            "first cycle unlike the rest (default: 0)")
     synth.add_argument("--strain-unit", choices=("percent", "fraction", "length"),
                        help="isobaric: strain_percent, strain or length_m column (default: percent)")
     synth.add_argument("--no-time", action="store_true", help="isobaric: leave out the time column")

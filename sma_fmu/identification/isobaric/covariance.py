@@ -8,16 +8,21 @@ __all__ = ["reported_covariance", "named", "named_values", "wire_covariance"]
 
 
 def reported_covariance(jac, factor, count, order):
-    """s^2 (J^T J)^-1 restricted to the first ``count`` unknowns (sparse LU of the scaled
-    normal matrix; a tiny ridge keeps unvisited levels from making it singular)."""
+    """(s^2 (J^T J)^-1 restricted to the first ``count`` unknowns, the boolean mask of those
+    no residual touches) (sparse LU of the scaled normal matrix; a tiny ridge keeps unvisited
+    levels from making it singular). An unknown no residual touches (the level of a left-out
+    cycle) is decoupled and gets a unit diagonal; the caller reports it as undetermined."""
     normal = (jac.T @ jac).tocsc()
+    dead = normal.diagonal() == 0.0
+    if dead.any():
+        normal = normal + sparse.diags(dead.astype(float))
     scale = np.sqrt(np.clip(normal.diagonal(), 1e-300, None))
     scaled = sparse.diags(1 / scale) @ normal @ sparse.diags(1 / scale)
     scaled = scaled + 1e-12 * sparse.identity(scaled.shape[0])
     unit = np.zeros((scaled.shape[0], count))
     unit[np.arange(count), np.arange(count)] = 1.0
     inverse = OrderedLU(scaled, order).solve(unit)[:count]
-    return factor * inverse / np.outer(scale[:count], scale[:count])
+    return factor * inverse / np.outer(scale[:count], scale[:count]), dead[:count]
 
 
 def named(layout, vector):

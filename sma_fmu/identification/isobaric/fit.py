@@ -126,6 +126,7 @@ class IsobaricFit:
     outlier_cycles: list = None   # [{"file", "cycle", "rms", "name"}] left out of the fit
     stages: int = 1
     stage_note: str = ""      # why a second stage asked for was not kept
+    undetermined: list = None  # unknowns no residual touches (levels of left-out cycles)
     file_rms: list = None     # per file: {"temperature_K", "strain"(, "resistance_ohm")} RMS
 
 
@@ -300,13 +301,15 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     dof = max(m - n - sum(int(np.sum(f.weight == 0)) for f in prepared), 1)
     factor = float(np.sum(solution.fun ** 2)) / dof
     k = len(layout.reported)
-    cov = reported_covariance(jac, factor, k, order)
+    cov, dead = reported_covariance(jac, factor, k, order)
     names, to_names = named(layout, solution.x)
     on_bound = bound_names(layout, solution.x, lower, upper)
     if not np.all(np.isfinite(cov)):
         raise MeasurementError(f"{layout.paths}: the fit's covariance is not finite; the data do "
                                f"not determine the unknowns")
     params = layout.params(solution.x)
+    cov[dead, :], cov[:, dead] = 0.0, 0.0    # undetermined: reported as a zero error, named
+    undetermined = [layout.reported[i] for i in np.nonzero(dead)[0]]
     errors = np.sqrt(np.clip(np.diag(cov), 0, None))
     cov_named = to_names @ cov @ to_names.T
     values = named_values(layout, solution.x, names)
@@ -348,4 +351,5 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         knots_per_branch=[f.profile.knots_per_branch for f in prepared],
         evaluations=int(clock["evaluations"]), converged=bool(solution.status > 0),
         message=str(solution.message), seconds=seconds, on_bound=on_bound,
-        outlier_cycles=left_out, stages=stages, file_rms=file_rms, stage_note=stage_note)
+        outlier_cycles=left_out, stages=stages, file_rms=file_rms, stage_note=stage_note,
+        undetermined=undetermined)

@@ -1,6 +1,7 @@
 """Outlier cycles and unknowns that end on a bound, for the isobaric fit's report.
 
-An outlier cycle is one whose strain residual RMS exceeds OUTLIER_RATIO times the median
+An outlier cycle is one whose strain residual RMS (the model at the thermocouple's own
+temperature profile, lagged by the fitted lag) exceeds OUTLIER_RATIO times the median
 cycle's (over every cycle of every file fitted together; with fewer than MIN_CYCLES cycles
 none is called an outlier). By default such cycles are left out: their strain rows get
 weight 0 and the fit runs again (their temperature rows stay, so the profile stays whole);
@@ -17,12 +18,20 @@ MIN_CYCLES = 3
 
 
 def cycle_rms(prepared, layout, x):
-    """[(file index, cycle, strain residual RMS [1], rows)] of every cycle with samples."""
-    from sma_fmu.identification.isobaric.jacobian import file_model, file_state
+    """[(file index, cycle, strain residual RMS [1], rows)] of every cycle with samples.
+
+    The model runs at the thermocouple's own temperature profile (fitted to the temperature
+    alone), lagged by the fitted lag: the fit's joint profile may move a cycle's temperature
+    within the thermocouple noise to explain an odd cycle, and would hide it."""
+    from sma_fmu.identification.isobaric.jacobian import file_model
+    from sma_fmu.identification.isobaric.lag import lagged
+    from sma_fmu.identification.isobaric.profile import wire_rows
     params = layout.params(x)
     out = []
     for f in prepared:
-        _, _, wire, direction, level, bounds = file_state(x, layout, f)
+        tau = x[layout.lags[f.index]] if layout.lags[f.index] is not None else 0.0
+        wire = lagged(f.profile.values, tau, f.step)
+        direction, level, bounds = wire_rows(wire, f.data.branches, f.per_cycle)
         strain, _ = file_model(params, f.data, wire, layout.levels(x, f.index), direction, level,
                                f.per_cycle)
         residual = strain - f.data.strain

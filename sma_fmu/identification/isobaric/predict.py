@@ -11,7 +11,9 @@ issue-36 terms, is the FMU's own code, in its default ("continuous") hysteresis 
 
 The temperature fed is the file's temperature profile (the piecewise-linear curve the fit
 also starts from, :mod:`~.profile`): thermocouple noise would otherwise make the plant
-reverse at every sample and walk minor loops the wire never saw. Strain = length /
+reverse at every sample and walk minor loops the wire never saw. ``--lag`` delays it by the
+wire's first-order lag behind the thermocouple (the value ``fit isobaric`` reports; default
+0: the FMU itself has no thermocouple). Strain = length /
 reference length - 1, shifted by one constant, the median difference from the measured
 strain (a lab's strain zero is its own; the fit gives each file its offset too).
 """
@@ -22,6 +24,7 @@ import numpy as np
 
 from sma_fmu.identification.isobaric.halfway import (half_strain_temperature,
                                                      transformation_strain)
+from sma_fmu.identification.isobaric.lag import lagged
 from sma_fmu.identification.isobaric.profile import temperature_profile
 from sma_fmu.identification.isobaric.synthetic import stress_of_load
 from sma_fmu.identification.transformation_temperatures import branch_tangents_or_reason
@@ -82,12 +85,15 @@ def _tangents(temperature, strain, branches):
     return out
 
 
-def predict_file(data, params):
-    """{"predicted" [1], "measured" [1], "temperature" [degC], "report"} of one file."""
+def predict_file(data, params, lag=0.0):
+    """{"predicted" [1], "measured" [1], "temperature" [degC], "report"} of one file;
+    ``lag``: the wire's first-order lag behind the thermocouple [s, or samples without a
+    time column] applied to the temperature fed (the fit's, from its report)."""
     began = time.perf_counter()
     window = data.splitting.window_samples if data.splitting is not None else 5
     profile = temperature_profile(data.temperature, data.branches, data.time, window).values
     step = float(np.median(np.diff(data.time))) if data.time is not None else 1.0
+    profile = lagged(profile, lag, step)
     length, deviation = drive_plant(params, profile, data.load, step)
     raw = length / data.reference_length - 1.0
     offset = float(np.median(data.strain - raw))
@@ -111,10 +117,12 @@ def predict_file(data, params):
         "drive": {"temperature": "the file's temperature profile (piecewise linear, knots by "
                                  "AIC), fed to the plant runtime sample by sample",
                   "step_s": step, "largest_temperature_deviation_K": deviation,
+                  "lag": {"value": lag, "unit": "s" if data.time is not None else "samples"},
                   "hysteresis_mode": "continuous", "seconds": seconds},
         "note": "strain = plant length / reference length - 1 + strain_offset (the median "
-                "difference from the measured strain); tangent-line and half-strain "
-                "temperatures of both against the measured (smoothed) temperature",
+                "difference from the measured strain; the plant has no residual-strain drift "
+                "from cycle to cycle); tangent-line and half-strain temperatures of both "
+                "against the measured (smoothed) temperature",
     }
     return {"predicted": predicted, "measured": data.strain, "temperature": profile,
             "report": report}

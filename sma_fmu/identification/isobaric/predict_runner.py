@@ -59,7 +59,8 @@ def _csv(result):
     return "\n".join(lines) + "\n"
 
 
-def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference_length=None):
+def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference_length=None,
+                         lag=0.0):
     """Predict one file's strain with the plant runtime; write the outputs; return the report."""
     if load is not None and stress is not None:
         raise ValueError("predict: give --load or --stress, not both")
@@ -74,7 +75,7 @@ def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference
         raise MeasurementError(f"{path}: load {data.load:.4g} kg is above the model's validity "
                                f"limit {params.load_max:.4g} kg (validity.stress_max of "
                                f"{params_set.path})")
-    result = predict_file(data, params)
+    result = predict_file(data, params, lag)
     report = dict(result["report"], model=str(params_set.path))
     png = _figure(data, result)
     with staged_folder(out_dir) as folder:

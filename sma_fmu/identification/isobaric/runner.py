@@ -138,6 +138,9 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
         "stages": fit.stages,
         "stage_note": fit.stage_note,
         "on_bound": fit.on_bound,
+        "undetermined": {"unknowns": fit.undetermined,
+                         "note": "touched by no residual (the strain levels of left-out cycles): "
+                                 "kept at their starting values, standard error reported as 0"},
         "outlier_cycles": [{k: v for k, v in c.items() if k != "name"} | {"note": c["name"]}
                            for c in fit.outlier_cycles],
         "outliers": outliers,
