@@ -182,7 +182,7 @@ def test_command_line_on_a_lab_file(tmp_path, capsys):
                  "--dwell", "0", "--rate", "20", "--t-min", "20", "--t-max", "115", "--noise-K",
                  "10", "--lag-s", "20", "--drift", "1e-3", "--drift-decay", "0.97",
                  "--no-time"]) == 0
-    header = lab.read_text().splitlines()[:9]
+    header = lab.read_text().splitlines()[:10]
     assert any("lag behind the thermocouple: 20 s" in line for line in header)
     assert header[-1] == "temperature_C,strain_percent"
     out = tmp_path / "fit"
