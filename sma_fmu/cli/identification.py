@@ -11,7 +11,7 @@ __all__ = ["register"]
 
 EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
 _ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag",
-                  "stages", "keep_outliers")
+                  "stages", "keep_outliers", "widths")
 _SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit",
                         "lag_s", "drift_decay", "first_cycle_shift")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
@@ -46,7 +46,8 @@ def _fit_isobaric(args, out):
                               args.residual_strain or "per-cycle", args.reference_length,
                               progress=lambda text: print(text, flush=True), cycles=args.cycles,
                               lag=args.lag or "fit", stages=args.stages or 2,
-                              outliers="keep" if args.keep_outliers else "leave-out")
+                              outliers="keep" if args.keep_outliers else "leave-out",
+                              widths=args.widths or "auto")
     print(format_isobaric_report(report))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
           f"figures")
@@ -207,6 +208,10 @@ def register(commands):
                      help="isobaric: transformation stages, each a logistic with its own centres "
                           "and widths on heating and cooling; 2 fits the second from the "
                           "one-stage fit (default: 2)")
+    fit.add_argument("--widths", choices=("auto", "shared", "separate"),
+                     help="isobaric: one transition width (nu) for heating and cooling, one each "
+                          "(nu_h, nu_c), or auto: one, then one each kept only when it lowers "
+                          "the cost by 1 %% (default: auto)")
     fit.add_argument("--keep-outliers", action="store_true",
                      help="isobaric: keep cycles whose strain residual RMS exceeds 3x the median "
                           "cycle's (default: they are named and left out)")

@@ -33,6 +33,7 @@ closed-form Jacobian (:mod:`jacobian`), so a 26,000-sample, 100-cycle file fits 
 seconds; a short scan of starting lags picks the valley first.
 """
 import time
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,7 +58,7 @@ __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "OUTLIER_OPTIONS", "IsobaricFit", 
 
 RESIDUAL_OPTIONS = ("per-cycle", "none")
 LAG_OPTIONS = ("fit", "none")
-WIDTH_OPTIONS = ("separate", "shared")
+WIDTH_OPTIONS = ("auto", "separate", "shared")
 STAGE_SHARE_MIN = 1e-3  # a second stage holding less than this share of M is not kept
 STAGE_GAIN_MIN = 0.01   # nor one that lowers the cost by less than this fraction
 EXPLAINED_RATIO = 1.5   # residual RMS above this many noise estimates: not explained
@@ -213,10 +214,17 @@ def _solver(prepared, layout, lower, upper, progress, clock):
     return residuals, jacobian, solve, order
 
 
+_State = namedtuple("_State", ["layout", "solution", "jacobian", "solve", "order", "lower",
+                               "upper", "first"])
+
+
 def _carry(old_layout, old_x, layout, vector):
-    """``vector`` with every unknown the two layouts share taken from ``old_x``."""
+    """``vector`` with every unknown the two layouts share taken from ``old_x`` (one width
+    nu gives both nu_h and nu_c)."""
     out = vector.copy()
     old = {name: i for i, name in enumerate(old_layout.phys)}
+    if "nu" in old:
+        old["nu_h"] = old["nu_c"] = old["nu"]
     for i, name in enumerate(layout.phys):
         if name in old:
             out[i] = old_x[old[name]]
@@ -226,11 +234,13 @@ def _carry(old_layout, old_x, layout, vector):
 
 
 def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=300,
-                 progress=None, stages=1, outliers="leave-out", widths="separate"):
+                 progress=None, stages=1, outliers="leave-out", widths="auto"):
     """Fit the isobaric files (list of IsobaricData) jointly; returns :class:`IsobaricFit`.
 
     ``stages``: 1, or 2 (a second stage, fitted from the one-stage fit); ``widths``:
-    "separate" (nu_h, nu_c) or "shared" (one nu for both directions); ``outliers``:
+    "separate" (nu_h, nu_c), "shared" (one nu for both directions) or "auto" (shared, then
+    separate kept only when it lowers the cost by STAGE_GAIN_MIN: with a fitted lag, separate
+    widths blur the lag against the centres); ``outliers``:
     "leave-out" (cycles whose strain residual RMS exceeds OUTLIER_RATIO times the median
     cycle's are named and fitted again without their strain) or "keep".
     ``progress`` (callable taking a line of text, or None) hears from long fits.
@@ -246,19 +256,31 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     if outliers not in OUTLIER_OPTIONS:
         raise ValueError(f"outliers must be one of {', '.join(OUTLIER_OPTIONS)}, got {outliers!r}")
     prepared = [prepare(data, index, residual) for index, data in enumerate(files)]
-    stage_note = ""
     loads = sorted({data.load for data in files})
 
-    def layout_of(count):
+    def layout_of(count, kind):
         return Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
                       any(d.resistance is not None for d in files), lag == "fit", count, loads,
-                      widths)
-    layout = layout_of(1)
-    vector, lower, upper = starts(prepared, layout, base)
-    first = vector.copy()
+                      kind)
     began = time.perf_counter()
     clock = {"last": began, "evaluations": 0, "began": began}
+
+    def attempt(state, count, kind):
+        """A richer layout started from ``state``'s solution."""
+        layout = layout_of(count, kind)
+        vector, lower, upper = starts(prepared, layout, base)
+        first = _carry(state.layout, state.first, layout, vector)
+        vector = _carry(state.layout, state.solution.x, layout, vector)
+        residuals, jacobian, solve, order = _solver(prepared, layout, lower, upper, progress,
+                                                    clock)
+        solution = solve(np.clip(vector, lower, upper), max_evaluations)
+        return _State(layout, solution, jacobian, solve, order, lower, upper, first)
+
+    kind = "separate" if widths == "separate" else "shared"
+    layout = layout_of(1, kind)
+    vector, lower, upper = starts(prepared, layout, base)
     residuals, jacobian, solve, order = _solver(prepared, layout, lower, upper, progress, clock)
+    notes = []
     # the sparse solves gain nothing from BLAS threads, which only contend for the cores
     with threadpool_limits(limits=1, user_api="blas"):
         firsts = [vector] if lag != "fit" else _lag_scan(
@@ -271,27 +293,30 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
                 if progress is not None:
                     progress("  outlier cycles left out: " + "; ".join(c["name"] for c in left_out))
                 solution = solve(solution.x, max_evaluations)
+        state = _State(layout, solution, jacobian, solve, order, lower, upper, vector.copy())
+        if widths == "auto":
+            richer = attempt(state, 1, "separate")
+            if richer.solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
+                state, kind = richer, "separate"
+            else:
+                notes.append(f"separate heating and cooling widths do not fit these data better "
+                             f"(cost {richer.solution.cost:.6g} against "
+                             f"{state.solution.cost:.6g} with one): one width kept")
         if stages == 2:
-            old_layout, old_x = layout, solution.x
-            old_lower, old_upper, old_first = lower, upper, first
-            layout = layout_of(2)
-            vector, lower, upper = starts(prepared, layout, base)
-            first = _carry(old_layout, first, layout, vector)
-            vector = _carry(old_layout, old_x, layout, vector)
-            saved = (old_layout, solution, residuals, jacobian, solve, order, old_lower,
-                     old_upper, old_first)
-            residuals, jacobian, solve, order = _solver(prepared, layout, lower, upper, progress,
-                                                        clock)
-            solution = solve(np.clip(vector, lower, upper), max_evaluations)
-            w2 = solution.x[layout.phys.index("w2")]
-            if w2 <= STAGE_SHARE_MIN or solution.cost > (1.0 - STAGE_GAIN_MIN) * saved[1].cost:
-                stage_note = (f"a second stage does not fit these data better (w2 = {w2:.3g}, cost "
-                              f"{solution.cost:.6g} against {saved[1].cost:.6g} with one stage): "
-                              f"one stage kept")
-                layout, solution, residuals, jacobian, solve, order, lower, upper, first = saved
+            richer = attempt(state, 2, kind)
+            w2 = richer.solution.x[richer.layout.phys.index("w2")]
+            if w2 > STAGE_SHARE_MIN and \
+                    richer.solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
+                state = richer
+            else:
+                notes.append(f"a second stage does not fit these data better (w2 = {w2:.3g}, "
+                             f"cost {richer.solution.cost:.6g} against "
+                             f"{state.solution.cost:.6g} with one stage): one stage kept")
                 stages = 1
-                if progress is not None:
-                    progress("  " + stage_note)
+    for note in notes if progress is not None else ():
+        progress("  " + note)
+    stage_note = "; ".join(notes)
+    layout, solution, jacobian, solve, order, lower, upper, first = state
     first = first[:len(layout.reported)]
     if not np.all(np.isfinite(solution.x)):
         layout.params(np.where(np.isfinite(solution.x), solution.x, np.nan))

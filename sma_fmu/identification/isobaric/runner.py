@@ -25,7 +25,20 @@ from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file
 from sma_fmu.runtime.constant_load import domain_energy, hysteresis_centre
 from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
 
-__all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report"]
+__all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report",
+           "TERM_MEANINGS"]
+
+TERM_MEANINGS = {
+    "nu_h": "cells per cooperative domain on heating (sets the heating transition width)",
+    "nu_c": "cells per cooperative domain on cooling (sets the cooling transition width)",
+    "w2": "share of the transformable fraction that transforms in the second stage",
+    "a2_h": "second-stage heating centre at no load", "b2_h": "its load slope",
+    "a2_c": "second-stage cooling centre at no load", "b2_c": "its load slope",
+    "nu2_h": "second-stage domain size on heating", "nu2_c": "second-stage domain size on cooling",
+    "alpha_P": "linear thermal expansion of the P phase",
+    "alpha_MF": "linear thermal expansion of the M and F phases",
+    "span_ratio_0": "transformation-strain factor s at no stress (s = 1 at saturation)",
+    "span_stress": "stress scale of the transformation-strain law s(sigma)"}
 
 
 def file_loads(files, loads=None, stresses=None, diameter=None):
@@ -160,7 +173,7 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
 
 def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
                      reference_length=None, progress=lambda text: None, cycles=None, lag="fit",
-                     stages=2, outliers="leave-out"):
+                     stages=2, outliers="leave-out", widths="auto"):
     """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report.
 
     ``cycles``: the text of ``--cycles`` (``5:``, ``3:10``, ``:20``, ``4``) or None for all;
@@ -185,7 +198,7 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         progress(f"{d.path.name}: {splitting_note(d.splitting, d.branches, d.time is not None)}")
     progress(f"fitting {len(data)} file(s), {sum(d.strain.size for d in data)} points ...")
     fit = fit_isobaric(data, base, residual, lag, progress=progress, stages=stages,
-                       outliers=outliers)
+                       outliers=outliers, widths=widths)
     progress("transformation temperatures and figures ...")
     per_cycle = residual == "per-cycle"
     rows = [row for d, offsets, profile, bounds in zip(data, fit.offsets, fit.profiles,
@@ -199,7 +212,7 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         write_parameter_file(
             folder / "identified.toml", fit.params, f"{base_set.name}-isobaric",
             f"isobaric fit of {names}; strain RMS {fit.residual_rms['strain']:.3g}",
-            base_set.meanings,
+            {**TERM_MEANINGS, **(base_set.meanings or {})},
             header=[f"Identified by sma-fmu fit isobaric on {stamp}.",
                     f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}.",
                     f"Data: {', '.join(str(f) for f in files)} at "
