@@ -162,3 +162,28 @@ def test_bad_terms_are_refused_alike(plant_lib, params, changes):
     python = refusal(lambda: PlantStepper(WireParameters.from_values(values), load=0.0))
     c = refusal(lambda: CPlant(plant_lib, WireParameters.from_values(values), load=0.0))
     assert normalized(c) == normalized(python) and "dH(f) overflows" in python
+
+
+def test_a_diverging_second_stage_inverse_is_refused_alike(ff_lib, terms_params):
+    """A broad stage 2 (nu2 = 5) whose closed form leaves 1/T_K > 0 at the clamp: both refuse
+    with the same message, naming the second stage."""
+    params = terms_params.replace(nu2_h=5.0, nu2_c=5.0)
+    cparams = c_feedforward.CParameters(ff_lib, params)
+    temperature, saturated = ctypes.c_double(), ctypes.c_int()
+    error = ctypes.create_string_buffer(512)
+    empty = (ctypes.c_double * 1)()
+    refused = 0
+    for resistance in (33.0, 34.0, 40.0, 48.0, 50.0):
+        try:
+            expected = sense_temperature(resistance, 0.1, 1, params)
+        except ValueError as caught:
+            assert ff_lib.sense(cparams.pointer, resistance, 0.1, 1, empty, 0,
+                                ctypes.byref(temperature), ctypes.byref(saturated), error) != 0
+            assert normalized(error.value.decode()) == normalized(str(caught))
+            assert "second stage" in str(caught)
+            refused += 1
+            continue
+        assert ff_lib.sense(cparams.pointer, resistance, 0.1, 1, empty, 0,
+                            ctypes.byref(temperature), ctypes.byref(saturated), error) == 0
+        assert (temperature.value, bool(saturated.value)) == tuple(expected)
+    assert refused > 0
