@@ -17,7 +17,6 @@ from sma_fmu.files.png_output import png_bytes
 from sma_fmu.identification.isobaric.files import read_isobaric
 from sma_fmu.identification.isobaric.predict import predict_file
 from sma_fmu.identification.isobaric.synthetic import load_of_stress
-from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constants import HEATING
 from sma_fmu.wire.parameter_file import load_parameter_set
 
@@ -71,12 +70,12 @@ def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference
         load = load_of_stress(stress, params.diameter)
     reference = params.x0 if reference_length is None else reference_length
     data = read_isobaric(Path(path), load, reference, params.diameter)
-    if data.load > params.load_max:
-        raise MeasurementError(f"{path}: load {data.load:.4g} kg is above the model's validity "
-                               f"limit {params.load_max:.4g} kg (validity.stress_max of "
-                               f"{params_set.path})")
     result = predict_file(data, params, lag)
     report = dict(result["report"], model=str(params_set.path))
+    if data.load > params.load_max:   # the FMU warns there too, and runs on
+        report["warning"] = (f"load {data.load:.4g} kg is above the model's validity limit "
+                             f"{params.load_max:.4g} kg (validity.stress_max of "
+                             f"{params_set.path})")
     png = _figure(data, result)
     with staged_folder(out_dir) as folder:
         (folder / "report.json").write_text(json_text(report), encoding="utf-8")
@@ -97,6 +96,8 @@ def format_predict_report(report):
     for key in ("A_s", "A_f", "M_s", "M_f", "half_heating", "half_cooling"):
         m, p = tt["measured"][key], tt["predicted"][key]
         lines.append(f"{key + ' [degC]':<14}{m:>10.2f}{p:>11.2f}{p - m:>12.2f}")
+    if report.get("warning"):
+        lines.insert(1, f"warning: {report['warning']}")
     m, p = tt["measured"]["transformation_strain"], tt["predicted"]["transformation_strain"]
     lines.append(f"{'strain span %':<14}{100 * m:>10.3f}{100 * p:>11.3f}{100 * (p - m):>12.3f}")
     return "\n".join(lines)

@@ -204,6 +204,12 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
     rows = [row for d, offsets, profile, bounds in zip(data, fit.offsets, fit.profiles,
                                                        fit.wire_bounds)
             for row in cycle_rows(d, fit.params, offsets, profile, per_cycle, bounds)]
+    top = max(stress_of_load(d.load, base.diameter) for d in data)
+    hottest = max(float(d.temperature.max()) for d in data)
+    if top > fit.params.stress_max:    # the fitted model is valid as far as its data go
+        fit.params = fit.params.replace(stress_max=float(np.ceil(top)))
+    if hottest > fit.params.T_max:
+        fit.params = fit.params.replace(T_max=float(np.ceil(hottest)))
     report = isobaric_report(data, fit, base_set, residual, rows, outliers)
     figures = isobaric_figures(data, fit, per_cycle, rows)
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
@@ -214,7 +220,9 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
             f"isobaric fit of {names}; strain RMS {fit.residual_rms['strain']:.3g}",
             {**TERM_MEANINGS, **(base_set.meanings or {})},
             header=[f"Identified by sma-fmu fit isobaric on {stamp}.",
-                    f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}.",
+                    f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}"
+                    f" (validity.stress_max and T_max raised to the largest fitted stress and "
+                    f"temperature where they were lower).",
                     f"Data: {', '.join(str(f) for f in files)} at "
                     f"{', '.join(f'{d.load:g}' for d in data)} kg"])
         (folder / "report.json").write_text(json_text(report), encoding="utf-8")
