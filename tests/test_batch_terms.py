@@ -55,3 +55,30 @@ def test_random_sets_with_the_terms_equal_the_library_path(seed):
 def test_nested_minor_loops_with_the_terms_equal_the_library_path():
     scenarios = [with_terms(s) for s in nested_scenarios(stop_time_s=4.0, depths=(4,))]
     check(scenarios)
+
+
+def test_a_broad_second_stage_equals_the_library_path_or_fails_with_its_error():
+    """nu2 = 8: the two-stage inverse starts from 1/T_K = 0 where stage 2's closed form has no
+    temperature; a reference no temperature reaches fails the run, in the batch as on the
+    library path (same message), and the other runs equal it."""
+    broad = {**TERMS, "nu2_h": 8.0, "nu2_c": 8.0, "w2": 0.02}
+
+    def changed(parameter_set):
+        return dataclasses.replace(parameter_set, params=parameter_set.params.replace(**broad))
+    scenarios = [dataclasses.replace(s, parameter_set=changed(s.parameter_set),
+                                     compensator_parameter_set=None if s.compensator_parameter_set
+                                     is None else changed(s.compensator_parameter_set))
+                 for s in mixed_set(12, 9, stop_time_s=2.0)]
+    outcomes = {"batch": 0, "failed": 0}
+    for scenario, result in zip(scenarios, run_batch(scenarios, "timeseries")):
+        try:
+            scalar = run_library(scenario).data
+        except ValueError as error:
+            assert result.path == "library" and result.error == str(error)
+            outcomes["failed"] += 1
+            continue
+        assert result.path == "batch" and result.error is None
+        assert_same_series(result.data, scalar, scenario.name)
+        outcomes["batch"] += 1
+    print(f"\nbroad second stage: {outcomes}")
+    assert outcomes["batch"] >= 6, outcomes

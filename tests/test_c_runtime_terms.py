@@ -12,6 +12,7 @@ from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.minor_loops import ReversalPoint
 from sma_fmu.runtime.parameters import WireParameters
 from sma_fmu.runtime.plant import PlantStepper
+from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.runtime.sensing import sense_temperature
 
 import c_feedforward
@@ -187,3 +188,29 @@ def test_a_diverging_second_stage_inverse_is_refused_alike(ff_lib, terms_params)
                             ctypes.byref(temperature), ctypes.byref(saturated), error) == 0
         assert (temperature.value, bool(saturated.value)) == tuple(expected)
     assert refused > 0
+
+
+def test_a_broad_second_stage_senses_and_refuses_alike(ff_lib, terms_params):
+    """nu2 = 8: hot targets whose stage-2 closed form diverges (inverted from 1/T_K = 0) and
+    targets no temperature reaches (refused): C and Python alike, bit for bit."""
+    params = terms_params.replace(nu2_h=8.0, nu2_c=8.0, saturation_margin=1e-9)
+    cparams = c_feedforward.CParameters(ff_lib, params)
+    temperature, saturated = ctypes.c_double(), ctypes.c_int()
+    error = ctypes.create_string_buffer(512)
+    empty = (ctypes.c_double * 1)()
+    rng, counts = random.Random(4), {"sensed": 0, "refused": 0}
+    for _ in range(1500):
+        load, direction = rng.choice([0.0, 0.05, 0.2]), rng.choice((1, -1))
+        band = reachable_band(load, params)
+        resistance = band.hot + (band.cold - band.hot) * 10.0 ** rng.uniform(-8.0, 0.0)
+        got = ff_lib.sense(cparams.pointer, resistance, load, direction, empty, 0,
+                           ctypes.byref(temperature), ctypes.byref(saturated), error)
+        try:
+            expected = sense_temperature(resistance, load, direction, params)
+        except ValueError as caught:
+            assert got != 0 and normalized(error.value.decode()) == normalized(str(caught))
+            counts["refused"] += 1
+            continue
+        assert got == 0 and (temperature.value, bool(saturated.value)) == tuple(expected)
+        counts["sensed"] += 1
+    assert counts["sensed"] > 500 and counts["refused"] > 50, counts

@@ -205,3 +205,24 @@ def test_a_second_stage_out_of_range_is_named_when_the_file_is_read(tmp_path):
     with pytest.raises(ParameterError, match="second-stage centre.*second_stage.a2_h") as caught:
         load_parameters(_write(tmp_path, text))
     assert "terms.toml" in str(caught.value)
+
+
+def test_a_broad_second_stage_inverts_where_its_own_closed_form_diverges(params):
+    """nu2 = 8, w2 = 0.02: stage 2 alone never falls below 0.2 % of M, so its closed form has
+    no temperature for a smaller target; the two-stage branch (2 % of M in stage 2) still
+    reaches it, hot, and the inverse finds that temperature. Below what the branch reaches
+    even infinitely hot, the inverse diverges and says so."""
+    p = params.replace(**{**TWO_STAGE, "nu2_h": 8.0, "nu2_c": 8.0, "w2": 0.02})
+    constants = branch_constants(0.05, 1, p)
+    floor = constants.M * p.w2 / (1.0 + math.exp(constants.energy2_over_kB * constants.inv_centre2_K))
+    checked = 0
+    for T in (350.0, 450.0, 700.0, 1000.0):
+        xi_mf, xi_p = branch_fractions(T, constants)
+        stage2_alone = constants.inv_centre2_K - math.log(xi_p / xi_mf) / constants.energy2_over_kB
+        assert stage2_alone <= 0.0 and xi_mf > floor        # the case meant
+        sensed = temperature_of_fractions(xi_mf, xi_p, constants, p.saturation_margin)
+        assert not sensed.saturated and abs(sensed.temperature - T) < 1e-9 * T
+        checked += 1
+    assert checked == 4
+    with pytest.raises(ValueError, match="does not reach the target at any temperature"):
+        temperature_of_fractions(0.5 * floor, constants.M - 0.5 * floor, constants, 1e-9)

@@ -68,12 +68,12 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin):
         xi_mf, xi_p, saturated = _clamped(xi_mf, constants.M, delta)
     exponent = math.log(xi_p / xi_mf)
     inverse_kelvin = constants.inv_centre_K - exponent / constants.energy_over_kB
-    if not inverse_kelvin > 0.0:
+    if constants.w2 != 0.0:
+        inverse_kelvin = two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants)
+    elif not inverse_kelvin > 0.0:
         raise ValueError(
             f"temperature-sensing inverse diverges at Lambda = {exponent!r}: dH(f)/k_B = "
             f"{constants.energy_over_kB!r} K is too small for the hysteresis centre")
-    if constants.w2 != 0.0:
-        inverse_kelvin = two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants)
     return _new_tuple(SensedTemperature, (1.0 / inverse_kelvin - KELVIN_OFFSET, saturated))
 
 
@@ -82,17 +82,24 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants):
 
     ``exponent`` = ln(xi_P/xi_MF) and ``inverse_kelvin`` is stage 1's closed-form inverse;
     stage 2's is the other end of the bracket (the branch is a weighted mean of the two
-    stages, each monotone in 1/T_K, so the root lies between them). The midpoint halves the
-    bracket until it equals an end (at most :data:`BISECTION_CAP` times); the fraction
-    compared is the smaller one, for digits. The C family runs the same operations.
+    stages, each monotone in 1/T_K, so the root lies between them). Where a closed form is
+    <= 0 (that stage alone never falls to the target), the low end is 1/T_K = 0: the root
+    exists if the branch is below the target there, infinitely hot; else the inverse
+    diverges (ValueError, as the one-stage inverse). The midpoint halves the bracket until it
+    equals an end (at most :data:`BISECTION_CAP` times); the fraction compared is the smaller
+    one, for digits. The C family runs the same operations.
     """
     other = constants.inv_centre2_K - exponent / constants.energy2_over_kB
-    if not other > 0.0:
-        raise ValueError(
-            f"temperature-sensing inverse diverges at Lambda = {exponent!r}: the second stage's "
-            f"dH(f)/k_B = {constants.energy2_over_kB!r} K is too small for its centre")
     low, high = (inverse_kelvin, other) if inverse_kelvin <= other else (other, inverse_kelvin)
     by_mf = xi_mf <= xi_p
+    if not low > 0.0:
+        low = 0.0
+        mf, p = two_stage_fractions(0.0, constants)
+        if not (high > 0.0 and ((mf < xi_mf) if by_mf else (p > xi_p))):
+            raise ValueError(
+                f"temperature-sensing inverse diverges at Lambda = {exponent!r}: the two-stage "
+                f"branch does not reach the target at any temperature (dH(f)/k_B = "
+                f"{constants.energy_over_kB!r} K, second stage {constants.energy2_over_kB!r} K)")
     middle = 0.5 * (low + high)
     for _ in range(BISECTION_CAP):
         if middle <= low or middle >= high:

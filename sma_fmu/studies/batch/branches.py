@@ -51,13 +51,20 @@ def two_stage_fractions(temperature, c):
 
 
 def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, c):
-    """1/T_K [1/K] of two-stage branches and ``bad`` (stage 2's closed form <= 0), as
-    :func:`sma_fmu.runtime.sensing.two_stage_inverse`: bisection between the two closed
-    forms, per element until its midpoint equals an end (at most BISECTION_CAP rounds)."""
+    """1/T_K [1/K] of two-stage branches and ``bad`` (the branch does not reach the target
+    at any temperature), as :func:`sma_fmu.runtime.sensing.two_stage_inverse`: bisection
+    between the two closed forms (from 0 where one is <= 0), per element until its midpoint
+    equals an end (at most BISECTION_CAP rounds)."""
     other = c["inverse2"] - exponent / -c["minus_energy2"]
-    bad = ~(other > 0.0)
     low, high = np.minimum(inverse_kelvin, other), np.maximum(inverse_kelvin, other)
     by_mf = xi_mf <= xi_p
+    open_end = ~(low > 0.0)              # a stage alone never falls to the target: from 0
+    bad = np.zeros(low.shape, dtype=bool)
+    if open_end.any():
+        low = np.where(open_end, 0.0, low)
+        mf, p = two_stage_at_inverse(np.zeros(low.shape), c)
+        reaches = (high > 0.0) & np.where(by_mf, mf < xi_mf, p > xi_p)
+        bad = open_end & ~reaches
     middle = 0.5 * (low + high)
     for _ in range(BISECTION_CAP):
         active = (middle > low) & (middle < high)
@@ -82,7 +89,7 @@ def wire_lengths(temperature, xi_p, xi_m, xi_f, l_P, length_M, length_F, terms):
 
 def two_stage_temperatures(xi_mf, xi_p, exponent, inverse, energy, stages, mask, T, bad):
     """In place, for the columns ``mask`` (bool, one per column) of two-stage inverses: T
-    [degC] from :func:`two_stage_inverse` and ``bad`` |= stage 2's divergence. The other
+    [degC] and ``bad`` from :func:`two_stage_inverse`. The other
     arguments are (c, k) or broadcast to it: the clamped fractions, Lambda, 1/tau_K, dH/k_B,
     and ``stages`` {M1, M2, minus_energy, minus_energy2, inverse, inverse2}."""
     columns = np.flatnonzero(mask)
@@ -96,5 +103,6 @@ def two_stage_temperatures(xi_mf, xi_p, exponent, inverse, energy, stages, mask,
     first = sub(inverse) - sub(exponent) / sub(energy)      # stage 1's closed form, 1/T_K
     middle, diverged = two_stage_inverse(sub(xi_mf), sub(xi_p), sub(exponent), first,
                                          {name: sub(values) for name, values in stages.items()})
-    T[:, columns] = 1.0 / middle - KELVIN_OFFSET
-    bad[:, columns] |= diverged
+    with np.errstate(divide="ignore"):              # a diverged element: 1/0, flagged bad
+        T[:, columns] = 1.0 / middle - KELVIN_OFFSET
+    bad[:, columns] = diverged                      # in place of stage 1's closed-form test
