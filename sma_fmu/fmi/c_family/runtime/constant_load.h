@@ -2,7 +2,9 @@
  * runtime/constant_load.py.
  *   tau(f, d) = a_h + b_h f (heating), a_c + b_c f (cooling)   [degC]
  *   xi_Fmin(f) = xi_F_inf (1 - exp(-f/f_F)),  dH(f) = nu (eps_T - g f x_T / N)  [J]
- *   Lambda = (dH/k_B)(1/tau_K - 1/T_K),  xi_MF = M/(1 + e^Lambda),  xi_P = M - xi_MF */
+ *   Lambda = (dH/k_B)(1/tau_K - 1/T_K),  xi_MF = M/(1 + e^Lambda),  xi_P = M - xi_MF
+ * With the issue-36 terms (runtime/model_terms.py): dH with nu_h / nu_c, a second stage
+ * xi_MF = M (1 - w2)/(1 + e^Lambda1) + M w2/(1 + e^Lambda2), the stress law and expansion. */
 #ifndef SMA_CONSTANT_LOAD_H
 #define SMA_CONSTANT_LOAD_H
 
