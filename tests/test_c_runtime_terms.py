@@ -69,6 +69,10 @@ def test_the_c_plant_equals_python_with_every_term_on(plant_lib, terms_params, s
         reversals += len(python.reversals) != before
         if index % 200 == 0:
             assert same(c.state(), doubles_of(python.state())), index
+        if index == STEPS // 2:        # go on from Python's saved state in a fresh C plant
+            c = CPlant(plant_lib, params, mode=mode)
+            c.restore(doubles_of(python.state()))
+            assert same(c.outputs, tuple(python.outputs))
     if mode == "continuous":
         assert reversals > 50   # the minor-loop branches were exercised
 
