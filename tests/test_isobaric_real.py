@@ -55,7 +55,7 @@ def test_the_shared_files_read_as_they_are(params):
 def flexinol_fit(tmp_path_factory, parameter_set):
     out = tmp_path_factory.mktemp("flex") / "fit"
     files = [str(_flexinol(s)) for s in FLEXINOL]
-    assert main(["fit", "isobaric", *files, "--lag", "none", "--out", str(out)]) == 0
+    assert main(["fit", "isobaric", *files, "--out", str(out)]) == 0   # every option its default
     return json.loads((out / "report.json").read_text()), out
 
 
@@ -63,6 +63,8 @@ def test_flexinol_four_stresses_jointly(flexinol_fit):
     """Strain residual RMS <= 5e-4 in every file; the model's half-strain temperatures move
     with stress within 10 % of the data's own slopes (0.124 and 0.134 K/MPa)."""
     report, out = flexinol_fit
+    assert report["lag_choice"]["option"] == "none"     # one cycle per file: --lag auto
+    assert "single complete cycle" in report["lag_choice"]["note"]
     assert report["stages"] == 2
     for entry in report["files"]:
         assert entry["residual_rms"]["strain"] <= 5e-4, entry["file"]

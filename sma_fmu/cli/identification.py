@@ -45,7 +45,7 @@ def _fit_isobaric(args, out):
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
                               args.residual_strain or "per-cycle", args.reference_length,
                               progress=lambda text: print(text, flush=True), cycles=args.cycles,
-                              lag=args.lag or "fit", stages=args.stages or 2,
+                              lag=args.lag or "auto", stages=args.stages or 2,
                               outliers="keep" if args.keep_outliers else "leave-out",
                               widths=args.widths or "auto")
     print(format_isobaric_report(report))
@@ -200,10 +200,11 @@ def register(commands):
                      help="isobaric: the cycles to fit, numbered from 1 as found in the file: "
                           "'5:' drops the first four (unstabilised) cycles, '3:10', ':20', '4' "
                           "(default: all)")
-    fit.add_argument("--lag", choices=("fit", "none"),
+    fit.add_argument("--lag", choices=("auto", "fit", "none"),
                      help="isobaric: fit the wire's first-order lag behind the thermocouple (in "
-                          "seconds, or samples without a time column), or assume none "
-                          "(default: fit)")
+                          "seconds, or samples without a time column), assume none, or auto: "
+                          "fit it when every file holds two complete cycles or more "
+                          "(default: auto)")
     fit.add_argument("--stages", type=int, choices=(1, 2),
                      help="isobaric: transformation stages, each a logistic with its own centres "
                           "and widths on heating and cooling; 2 fits the second from the "

@@ -286,13 +286,12 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         firsts = [vector] if lag != "fit" else _lag_scan(
             lambda fraction: starts(prepared, layout, base, fraction)[0], solve, progress)
         solution = min((solve(x, max_evaluations) for x in firsts), key=lambda s: s.cost)
-        left_out = []
-        if outliers == "leave-out":
-            left_out = mark_outliers(prepared, layout, solution.x)
-            if left_out:
-                if progress is not None:
-                    progress("  outlier cycles left out: " + "; ".join(c["name"] for c in left_out))
-                solution = solve(solution.x, max_evaluations)
+        left_out = mark_outliers(prepared, layout, solution.x, outliers == "leave-out")
+        if left_out and progress is not None:
+            progress(f"  outlier cycles {'left out' if outliers == 'leave-out' else 'kept'}: "
+                     + "; ".join(c["name"] for c in left_out))
+        if left_out and outliers == "leave-out":
+            solution = solve(solution.x, max_evaluations)
         state = _State(layout, solution, jacobian, solve, order, lower, upper, vector.copy())
         if widths == "auto":
             richer = attempt(state, 1, "separate")

@@ -45,9 +45,9 @@ def cycle_rms(prepared, layout, x):
     return out
 
 
-def mark_outliers(prepared, layout, x):
-    """Give the strain rows of outlier cycles weight 0; returns [{"file", "cycle",
-    "rms", "ratio", "name"}] of those cycles (empty: none)."""
+def mark_outliers(prepared, layout, x, leave_out=True):
+    """[{"file", "cycle", "rms", "ratio", "name"}] of the outlier cycles (empty: none); with
+    ``leave_out`` their strain rows get weight 0."""
     cycles = cycle_rms(prepared, layout, x)
     if len(cycles) < MIN_CYCLES:
         return []
@@ -55,7 +55,8 @@ def mark_outliers(prepared, layout, x):
     out = []
     for index, cycle, rms, rows in cycles:
         if median > 0 and rms > OUTLIER_RATIO * median:
-            prepared[index].weight[rows] = 0.0
+            if leave_out:
+                prepared[index].weight[rows] = 0.0
             name = prepared[index].data.path.name
             out.append({"file": str(prepared[index].data.path), "cycle": cycle, "rms": rms,
                         "ratio": rms / median,
