@@ -1,36 +1,40 @@
-"""Identify the constant-load model (spec sections 2-4) from isobaric thermal cycling.
+"""Identify the constant-load model (spec sections 2-4, with the issue-36 terms) from
+isobaric thermal cycling.
 
 The data: strain eps (and, where a file has it, resistance R) against a noisy thermocouple
-temperature, from two to a thousand heating and cooling branches per file, one load per
-file. The model of every sample i of a file at load f, on the branch of its direction d:
-
-    eps_i = eps_hot(f) + span(f) q(T_i; tau_d(f), dH(f)) + offset_i             [1]
-    R_i   = R_hot(f)   + R_span(f) q(T_i; tau_d(f), dH(f))                       [ohm]
-
-(:mod:`sma_fmu.identification.isobaric.model`). Fitted:
-- the hysteresis centres: a_h, a_c at one load (b_h, b_c from the base file), or
-  a_h, b_h, a_c, b_c when the files hold two loads or more;
-- nu, the domain size that sets the transition width (eps_T from the base file: only
-  nu eps_T is identifiable, as for the constant-load fit);
+temperature, from one to a thousand heating and cooling branches per file, one load per
+file. The model of every sample i of a file at load f, on the branch of its direction d,
+is :func:`sma_fmu.identification.isobaric.terms.branch_curve` (two logistic stages, thermal
+expansion, the stress law of the transformation strain) plus a strain offset. Fitted
+(:mod:`~.layout` lists the unknowns, :mod:`~.starts` their starts and bounds):
+- the hysteresis centres of each stage, held as the cooling line and the heating centre's
+  lead over it (>= 0) at no load and at the largest load; slopes b with two loads or more;
+- the domain sizes: one nu, or nu_h and nu_c (``widths``), and nu2_h, nu2_c, w2 with a
+  second stage (``stages=2``); richer models are kept only when they lower the cost by
+  STAGE_GAIN_MIN;
+- alpha_P, alpha_MF; span_ratio_0 with two stresses or more, span_stress with three;
 - l_MF = (l_M + l_F)/2 [m] (l_F - l_M kept from the base file), x_min too when a file gives
   absolute lengths; R_P and R_MF when a file has resistance;
 - strain offsets per file: one per residual-strain level with ``residual="per-cycle"``
   (heating branch k sits on level k; the cooling branch after it moves from level k to
   k + 1 in proportion to the transformed share q), or one per file with ``residual="none"``;
 - the lag of the wire behind the thermocouple, one time constant per file [s, or samples
-  when the file has no time column] (``lag="fit"``; ``lag="none"`` holds it at zero).
+  when the file has no time column] (``lag="fit"``, bounded by starts.LAG_LIMIT of a cycle;
+  ``lag="none"`` holds it at zero).
 
-The wire temperature T_i is lagged(profile): the profile is piecewise linear with few knots
-per branch, chosen from the measured temperature alone (:mod:`profile`), and its
-knots are fitted jointly with the parameters against the residuals (profile - measured
-temperature)/sigma_T, (model strain - measured strain)/sigma_eps (and resistance), each sigma
-the data's own scatter (median absolute second difference). So the profile can move only
-as far as the thermocouple noise allows: a wire that lags is explained by the lag, and a
-temperature residual much larger than the noise says the model does not explain the data
-(``verdict``). The covariance s^2 (J^T J)^-1 of all unknowns accounts for the temperature
-noise. Levenberg-Marquardt with sparse direct steps (:mod:`solver`) runs on a sparse
-closed-form Jacobian (:mod:`jacobian`), so a 26,000-sample, 100-cycle file fits in
-seconds; a short scan of starting lags picks the valley first.
+Outlier cycles (:mod:`~.outliers`) are named and, by default, left out; unknowns that end on
+a bound are named. The wire temperature T_i is lagged(profile): the profile is piecewise
+linear with few knots per branch, chosen from the measured temperature alone
+(:mod:`profile`), and its knots are fitted jointly with the parameters against the
+residuals (profile - measured temperature)/sigma_T, (model strain - measured
+strain)/sigma_eps (and resistance), each sigma the data's own scatter (median absolute
+second difference). So the profile can move only as far as the thermocouple noise allows:
+a wire that lags is explained by the lag, and a temperature residual much larger than the
+noise says the model does not explain the data (``verdict``). The covariance
+s^2 (J^T J)^-1 of all unknowns (:mod:`~.covariance`) accounts for the temperature noise.
+Levenberg-Marquardt with sparse direct steps (:mod:`solver`) runs on a sparse Jacobian
+(:mod:`jacobian`), so a 26,000-sample, 100-cycle file fits in seconds; a short scan of
+starting lags picks the valley first.
 """
 import time
 from collections import namedtuple
