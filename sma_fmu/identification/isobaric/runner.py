@@ -158,6 +158,10 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
                            for c in fit.outlier_cycles],
         "outliers": outliers,
         "half_strain": halfway,
+        "centre_slopes_K_per_MPa": {
+            name: float(getattr(params, name) if getattr(params, name) is not None
+                        else getattr(params.terms, name)) * load_of_stress(1.0, params.diameter)
+            for name in ("b_h", "b_c") + (("b2_h", "b2_c") if params.terms.two_stage else ())},
         "residual_rms": fit.residual_rms,
         "noise_estimates": fit.noise,
         "verdict": fit.verdict,

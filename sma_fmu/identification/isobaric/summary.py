@@ -92,6 +92,12 @@ def format_isobaric_report(report):
                          f"{100 * row['data_transformation_strain']:.3g} / "
                          f"{100 * row['model_transformation_strain']:.3g} %; strain RMS "
                          f"{report['files'][half['per_file'].index(row)]['residual_rms']['strain']:.3g}")
+        first = report["files"][0]
+        per_mpa = first["load_kg"] / first["stress_MPa"] if first["stress_MPa"] else 0.0
+        centres = [f"{name} {report['parameters'][name]['value'] * per_mpa:.4g}"
+                   for name in ("b_h", "b_c", "b2_h", "b2_c") if name in report["parameters"]]
+        if centres:
+            lines.append("fitted centre slopes [K/MPa]: " + ", ".join(centres))
         slopes = half["slopes_K_per_MPa"]
         if np.isfinite(slopes["data"]["heating"]):
             lines.append(f"half-strain temperature against stress [K/MPa]: heating "
