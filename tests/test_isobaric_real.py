@@ -109,3 +109,14 @@ def test_a_held_out_stress_is_predicted_by_the_plant_runtime(tmp_path):
     rows = np.loadtxt(out / "predicted.csv", delimiter=",", skiprows=1)
     assert rows.shape == (report["points"], 3)
     assert (out / "predict_isobaric.png").stat().st_size > 10_000
+
+
+def test_a_missing_data_folder_skips_naming_it_and_fails_under_ci(monkeypatch, tmp_path):
+    import test_isobaric_real as here
+    monkeypatch.setattr(here, "REAL", tmp_path / "absent")
+    monkeypatch.delenv("CI", raising=False)
+    with pytest.raises(pytest.skip.Exception, match="absent"):
+        here._folder("flexinol-niti")
+    monkeypatch.setenv("CI", "true")
+    with pytest.raises(pytest.fail.Exception, match="absent"):
+        here._folder("flexinol-niti")
