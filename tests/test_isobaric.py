@@ -85,10 +85,12 @@ def test_single_load_recovery_with_noise_and_drift(tmp_path, params):
     fit = fit_isobaric([read_isobaric(path)], params, lag="none")
     assert fit.converged
     assert 0.8 < fit.variance_factor < 1.25       # the noise estimates describe the residuals
-    known = {"a_h": truth.a_h + (params.b_h - truth.b_h) * 0.15, "a_c": truth.a_c, "nu": truth.nu,
+    known = {"a_h": truth.a_h + (params.b_h - truth.b_h) * 0.15, "a_c": truth.a_c,
+             "nu_h": truth.nu, "nu_c": truth.nu, "alpha_P": 0.0, "alpha_MF": 0.0,
              "l_MF": 0.5 * (truth.l_M + truth.l_F), "R_P": truth.R_P, "R_MF": truth.R_MF}
     known.update({f"offset_0_{k}": v for k, v in enumerate(synthetic["offsets"])})
-    _check(fit, known, {"a_h": 0.4, "a_c": 0.4, "nu": 0.02 * truth.nu, "l_MF": 2e-5,
+    _check(fit, known, {"a_h": 0.4, "a_c": 0.4, "nu_h": 0.03 * truth.nu, "nu_c": 0.03 * truth.nu,
+                        "alpha_P": 1e-5, "alpha_MF": 1e-5, "l_MF": 2e-5,
                         "R_P": 0.01, "R_MF": 0.01, "offset_0_1": 3e-5, "offset_0_2": 3e-5})
 
 
@@ -99,8 +101,9 @@ def test_two_loads_give_the_load_slopes(tmp_path, params):
     fit = fit_isobaric(files, params, lag="none")
     assert fit.converged
     known = {"a_h": truth.a_h, "b_h": truth.b_h, "a_c": truth.a_c, "b_c": truth.b_c,
-             "nu": truth.nu, "l_MF": 0.5 * (truth.l_M + truth.l_F)}
-    _check(fit, known, {"a_h": 0.5, "a_c": 0.5, "b_h": 4.0, "b_c": 4.0, "nu": 0.02 * truth.nu})
+             "nu_h": truth.nu, "nu_c": truth.nu, "l_MF": 0.5 * (truth.l_M + truth.l_F)}
+    _check(fit, known, {"a_h": 0.5, "a_c": 0.5, "b_h": 4.0, "b_c": 4.0, "nu_h": 0.03 * truth.nu,
+                        "nu_c": 0.03 * truth.nu})
     assert [n for n in fit.wire_names if n.startswith("b_")] == ["b_h", "b_c"]
 
 
@@ -114,20 +117,24 @@ def test_noise_free_recovery_is_exact(tmp_path, params):
     fit = fit_isobaric([read_isobaric(path)], params, residual="none", lag="none")
     assert fit.params.a_c == pytest.approx(truth.a_c, abs=1e-3)
     assert fit.params.a_h == pytest.approx(truth.a_h + (truth.b_h - params.b_h) * 0.1, abs=1e-3)
-    assert fit.params.nu == pytest.approx(truth.nu, rel=1e-5)
+    assert fit.params.terms.nu_h == pytest.approx(truth.nu, rel=1e-5)
+    assert fit.params.terms.nu_c == pytest.approx(truth.nu, rel=1e-5)
     assert 0.5 * (fit.params.l_M + fit.params.l_F) == pytest.approx(
         0.5 * (truth.l_M + truth.l_F), abs=1e-8)
 
 
-def test_analytic_jacobian_matches_finite_differences(tmp_path, params):
-    """Every kind of column: physical, offsets, the lag and the profile's knots (the wire
-    temperature lags the profile by 4 samples, so the knots act through the lagged basis)."""
+@pytest.mark.parametrize("stages", [1, 2])
+def test_analytic_jacobian_matches_finite_differences(tmp_path, params, stages):
+    """Every kind of column: physical (with a second stage too), offsets, the lag and the
+    profile's knots (the wire temperature lags the profile by 4 samples, so the knots act
+    through the lagged basis)."""
     from sma_fmu.identification.isobaric.fit import prepare, residual_blocks
     from sma_fmu.identification.isobaric.jacobian import file_jacobian
-    from sma_fmu.identification.isobaric.layout import Layout, starts
+    from sma_fmu.identification.isobaric.layout import Layout
+    from sma_fmu.identification.isobaric.starts import starts
     path, _ = _file(tmp_path, _truth(params), 0.15, resistance=True, points=400)
     f = prepare(read_isobaric(path), 0)
-    layout = Layout([f], params, False, False, True, True)
+    layout = Layout([f], params, False, False, True, True, stages, [0.15])
     vector, _, _ = starts([f], layout, params)
     vector[layout.lags[0]] = 4.0
     analytic = sparse.vstack(file_jacobian(vector, layout, f)).toarray()

@@ -67,7 +67,7 @@ def test_lab_files_give_the_lag_and_the_centres(tmp_path, params, cycles, per_cy
     data = read_isobaric(path)
     assert data.time is None and data.splitting.cycles_in_file == cycles
     assert sum(b.complete for b in data.branches) == 2 * cycles
-    fit = fit_isobaric([data], params)
+    fit = fit_isobaric([data], params, widths="shared")
     lag = fit.lags[0]
     assert lag["unit"] == "samples"
     assert lag["std_error"] < lag_bound * truth["lag_samples"], lag
@@ -90,7 +90,7 @@ def test_a_lagging_wire_is_fitted_by_the_lag_not_by_moving_the_temperature(tmp_p
     Without a lag the centres take it up: the loop comes out wider than it is."""
     path, truth = _lab_file(tmp_path, params, 30, 200, seed=4)
     data = read_isobaric(path)
-    fit = fit_isobaric([data], params)
+    fit = fit_isobaric([data], params, widths="shared")
     alone = temperature_profile(data.temperature, data.branches, None, data.splitting.window_samples)
     moved = np.sqrt(np.mean((fit.measured_profiles[0] - alone.values) ** 2))
     assert moved <= 1.5 * alone.sigma * np.sqrt(alone.knot_count / data.temperature.size)
@@ -98,7 +98,7 @@ def test_a_lagging_wire_is_fitted_by_the_lag_not_by_moving_the_temperature(tmp_p
     ahead = np.sqrt(np.mean((fit.measured_profiles[0] - wire) ** 2))
     assert ahead > 4.0                                     # the thermocouple leads the wire
     assert np.sqrt(np.mean((fit.profiles[0] - wire) ** 2)) < ahead / 4.0
-    without = fit_isobaric([data], params, lag="none")
+    without = fit_isobaric([data], params, lag="none", widths="shared")
     index = {name: i for i, name in enumerate(without.names)}
     width = without.params.a_h - without.params.a_c
     gradient = np.zeros(len(without.names))
@@ -182,7 +182,7 @@ def test_command_line_on_a_lab_file(tmp_path, capsys):
                  "--dwell", "0", "--rate", "20", "--t-min", "20", "--t-max", "115", "--noise-K",
                  "10", "--lag-s", "20", "--drift", "1e-3", "--drift-decay", "0.97",
                  "--no-time"]) == 0
-    header = lab.read_text().splitlines()[:9]
+    header = lab.read_text().splitlines()[:10]
     assert any("lag behind the thermocouple: 20 s" in line for line in header)
     assert header[-1] == "temperature_C,strain_percent"
     out = tmp_path / "fit"

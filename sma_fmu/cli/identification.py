@@ -10,9 +10,10 @@ from .arguments import bounded_integer, bounded_number, finite_number, number_li
 __all__ = ["register"]
 
 EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
-_ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag")
+_ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag",
+                  "stages", "keep_outliers", "widths")
 _SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit",
-                        "lag_s", "drift_decay")
+                        "lag_s", "drift_decay", "first_cycle_shift")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
 # choice: synth's limits, wide for any real test file and checked before anything is made
 MAX_ROWS = 1_000_000          # rows (or samples) one synth call may write
@@ -44,7 +45,9 @@ def _fit_isobaric(args, out):
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
                               args.residual_strain or "per-cycle", args.reference_length,
                               progress=lambda text: print(text, flush=True), cycles=args.cycles,
-                              lag=args.lag or "fit")
+                              lag=args.lag or "auto", stages=args.stages or 2,
+                              outliers="keep" if args.keep_outliers else "leave-out",
+                              widths=args.widths or "auto")
     print(format_isobaric_report(report))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
           f"figures")
@@ -77,7 +80,7 @@ def _synth_isobaric(args, params, t_min, t_max):
         noise_ohm=0.05 if args.noise_ohm is None else args.noise_ohm,
         residual=1.5e-3 if args.drift is None else args.drift, seed=args.seed,
         decay=0.5 if args.drift_decay is None else args.drift_decay,
-        lag_s=args.lag_s or 0.0)
+        lag_s=args.lag_s or 0.0, first_shift_K=args.first_cycle_shift or 0.0)
     texts = {}
     for index, load in enumerate(loads):
         run = dataclasses.replace(programme, seed=programme.seed + index)
@@ -92,6 +95,7 @@ def _synth_isobaric(args, params, t_min, t_max):
             f"{run.cycles} cycles, dwell {run.dwell:g} s, {run.points} samples",
             f"noise: temperature {run.noise_K:g} K, strain {run.noise_strain:g}, resistance "
             f"{run.noise_ohm:g} ohm; seed {run.seed}",
+            f"first cycle: transformation {run.first_shift_K:g} K hotter than the rest",
             f"wire lag behind the thermocouple: {run.lag_s:g} s = {truth['lag_samples']:.6g} "
             f"samples (first order)",
             "true residual-strain levels: " + ", ".join(f"{v:.6g}" for v in truth["offsets"])]
@@ -159,8 +163,23 @@ def _synth(args):
     return 0
 
 
+def _predict(args):
+    from sma_fmu.identification.isobaric.predict_runner import (format_predict_report,
+                                                                run_isobaric_predict)
+    for name, value, high, unit in (("--load", args.load, MAX_FIT_LOAD_KG, "kg"),
+                                    ("--stress", args.stress, MAX_FIT_STRESS_MPA, "MPa")):
+        if value is not None and not 0.0 < value <= high:
+            raise ValueError(f"predict: {name} {value!r} {unit} is outside (0, {high:g}] {unit}")
+    out = args.out or Path("results") / "predict-isobaric"
+    report = run_isobaric_predict(args.file, out, args.model, args.load, args.stress,
+                                  args.reference_length, args.lag)
+    print(format_predict_report(report))
+    print(f"written: {out}/report.json, predicted.csv, predict_isobaric.png")
+    return 0
+
+
 def register(commands):
-    """Add ``fit`` and ``synth`` to the ``commands`` subparsers."""
+    """Add ``fit``, ``predict`` and ``synth`` to the ``commands`` subparsers."""
     fit = commands.add_parser("fit", help="identify parameters from measurements (CSV)")
     fit.add_argument("experiment", choices=EXPERIMENTS)
     fit.add_argument("files", nargs="+", metavar="FILE", help="measurement CSV file(s)")
@@ -181,14 +200,48 @@ def register(commands):
                      help="isobaric: the cycles to fit, numbered from 1 as found in the file: "
                           "'5:' drops the first four (unstabilised) cycles, '3:10', ':20', '4' "
                           "(default: all)")
-    fit.add_argument("--lag", choices=("fit", "none"),
+    fit.add_argument("--lag", choices=("auto", "fit", "none"),
                      help="isobaric: fit the wire's first-order lag behind the thermocouple (in "
-                          "seconds, or samples without a time column), or assume none "
-                          "(default: fit)")
+                          "seconds, or samples without a time column), assume none, or auto: "
+                          "fit it when every file holds two complete cycles or more "
+                          "(default: auto)")
+    fit.add_argument("--stages", type=int, choices=(1, 2),
+                     help="isobaric: transformation stages, each a logistic with its own centres "
+                          "and widths on heating and cooling; 2 fits the second from the "
+                          "one-stage fit (default: 2)")
+    fit.add_argument("--widths", choices=("auto", "shared", "separate"),
+                     help="isobaric: one transition width (nu) for heating and cooling, one each "
+                          "(nu_h, nu_c), or auto: one, then one each kept only when it lowers "
+                          "the cost by 1 %% (default: auto)")
+    fit.add_argument("--keep-outliers", action="store_true",
+                     help="isobaric: keep cycles whose strain residual RMS exceeds 3x the median "
+                          "cycle's (default: they are named and left out)")
     fit.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
                      help="isobaric: length the strain is measured from [m] (default: the base "
                           "file's x0)")
     fit.set_defaults(handler=_fit)
+
+    predict = commands.add_parser(
+        "predict", help="run the plant runtime (the FMU's code) through a lab file's measured "
+                        "temperature and compare the strain")
+    predict.add_argument("experiment", choices=("isobaric",))
+    predict.add_argument("file", metavar="FILE", help="isobaric measurement file")
+    predict.add_argument("--model", required=True, metavar="PARAMS",
+                         help="parameter file, e.g. the identified.toml of sma-fmu fit isobaric")
+    loads = predict.add_mutually_exclusive_group()
+    loads.add_argument("--stress", type=finite_number, metavar="MPA",
+                       help="the file's stress [MPa] (default: its stress column or header)")
+    loads.add_argument("--load", type=finite_number, metavar="KG",
+                       help="the file's hung mass [kg] instead of --stress")
+    predict.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
+                         help="length the strain is measured from [m] (default: the model's x0)")
+    predict.add_argument("--lag", type=bounded_number(0.0, 1e6, closed=True), default=0.0,
+                         metavar="TAU",
+                         help="the wire's first-order lag behind the thermocouple [s, or samples "
+                              "without a time column], as fit isobaric reports it")
+    predict.add_argument("--out", type=Path, metavar="DIR",
+                         help="output folder (default: results/predict-isobaric)")
+    predict.set_defaults(handler=_predict)
 
     synth = commands.add_parser("synth", help="synthetic measurement CSV from a parameter file")
     synth.add_argument("experiment", choices=EXPERIMENTS)
@@ -230,6 +283,9 @@ def register(commands):
                             "[s] (default: 0). A lab-like file: --cycles 100 --points 26000 "
                             "--dwell 0 --rate 20 --t-min 20 --t-max 115 --noise-K 10 --lag-s 20 "
                             "--drift 1e-3 --drift-decay 0.97 --no-time")
+    synth.add_argument("--first-cycle-shift", type=bounded_number(0.0, 100.0, "K", closed=True),
+                       help="isobaric: the first cycle's transformation this much hotter [K], a "
+                            "first cycle unlike the rest (default: 0)")
     synth.add_argument("--strain-unit", choices=("percent", "fraction", "length"),
                        help="isobaric: strain_percent, strain or length_m column (default: percent)")
     synth.add_argument("--no-time", action="store_true", help="isobaric: leave out the time column")

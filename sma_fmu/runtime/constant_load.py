@@ -7,6 +7,13 @@
     xi_MF      = M/(1 + e^Lambda),  xi_P = M - xi_MF,  M = 1 - xi_Fmin
     xi_M = xi_MF/2,  xi_F = xi_Fmin + xi_MF/2
 
+With the optional terms of issue 36 (:mod:`.model_terms`) dH uses nu_d of the direction, and
+with a second stage (w2 > 0) the major branch is a weighted sum of two logistics,
+
+    xi_MF = M (1 - w2)/(1 + e^Lambda1) + M w2/(1 + e^Lambda2),   Lambda2 with nu2_d, a2_d + b2_d f
+
+each half split as :func:`logistic_split` does (xi_P from the other half, for digits).
+
 The load-dependent constants of one branch are bundled in :class:`BranchConstants`
 so a stepper computes them once per load, not once per step.
 """
@@ -15,16 +22,21 @@ from collections import namedtuple
 
 from .checks import direction_sign, require_finite, require_nonnegative
 from .constants import BOLTZMANN, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
+from .model_terms import stressed_lengths
 from .phases import PhaseFractions, resistance_of
 
 __all__ = [
-    "BranchConstants", "hysteresis_centre", "residual_f_fraction", "domain_energy",
-    "branch_constants", "logistic_split", "branch_fractions", "phase_fractions",
+    "BranchConstants", "hysteresis_centre", "second_centre", "residual_f_fraction",
+    "domain_energy", "branch_constants", "logistic_split", "branch_fractions",
+    "two_stage_fractions", "phase_fractions",
     "constant_load_fractions", "constant_load_resistance", "require_temperature", "BranchCache",
 ]
 
 BranchConstants = namedtuple(
-    "BranchConstants", ["M", "xi_F_min", "energy_over_kB", "inv_centre_K", "centre"])
+    "BranchConstants", ["M", "xi_F_min", "energy_over_kB", "inv_centre_K", "centre",
+                        "w2", "M1", "M2", "energy2_over_kB", "inv_centre2_K", "centre2",
+                        "length_M", "length_F"],
+    defaults=(0.0, None, None, None, None, None, None, None))
 BranchConstants.__doc__ = """Constants of one major branch at one load.
 
 M : 1 - xi_Fmin, the fraction that can transform [1]
@@ -32,6 +44,10 @@ xi_F_min : residual F fraction [1]
 energy_over_kB : dH(f)/k_B [K]
 inv_centre_K : 1/tau_K [1/K]
 centre : hysteresis centre tau [degC]
+w2 : share of M in the second stage [1] (0: one stage; the rest of the fields are then None)
+M1, M2 : M (1 - w2) and M w2 [1]; energy2_over_kB [K], inv_centre2_K [1/K], centre2 [degC]:
+    the second stage's dH/k_B, 1/tau2_K and tau2
+length_M, length_F : l_M and l_F at this load and T_alpha [m] (None without strain terms)
 """
 
 
@@ -50,14 +66,34 @@ def hysteresis_centre(load, direction, params):
     return params.a_c + params.b_c * load
 
 
+def second_centre(load, direction, params):
+    """Second-stage centre tau2 [degC] = a2_d + b2_d f for a load [kg] and direction."""
+    terms = params.terms
+    if direction_sign(direction) == HEATING:
+        return terms.a2_h + terms.b2_h * load
+    return terms.a2_c + terms.b2_c * load
+
+
+def _checked_centre(centre, load, what):
+    if not centre < math.inf:
+        raise ValueError(f"load = {load!r} kg is beyond the model's range: the {what} "
+                         f"{centre!r} degC is not finite")
+    if centre <= -KELVIN_OFFSET:
+        raise ValueError(f"{what} {centre!r} degC at load {load!r} kg is below 0 K")
+    return centre
+
+
 def residual_f_fraction(load, params):
     """Residual F fraction xi_Fmin(f) [1] left when the wire under ``load`` [kg] is fully heated."""
     return params.xi_F_inf * (1.0 - math.exp(-load / params.f_F))
 
 
-def domain_energy(load, params):
-    """Transformation energy per cooperative domain dH(f) [J]; must stay positive."""
-    energy = params.nu * (params.eps_T - STANDARD_GRAVITY * load * params.x_T / params.N)
+def domain_energy(load, params, nu=None):
+    """Transformation energy per cooperative domain dH(f) [J]; must stay positive.
+
+    ``nu`` [1]: the domain size (default ``params.nu``; nu_h, nu_c, nu2_d for the terms)."""
+    nu = params.nu if nu is None else nu
+    energy = nu * (params.eps_T - STANDARD_GRAVITY * load * params.x_T / params.N)
     if not energy < math.inf or not energy / BOLTZMANN < math.inf:
         raise ValueError(f"load = {load!r} kg is beyond the model's range: dH(f) overflows")
     if not energy > 0.0:
@@ -69,20 +105,32 @@ def domain_energy(load, params):
 def branch_constants(load, direction, params):
     """The :class:`BranchConstants` of the major branch for ``load`` [kg] and ``direction``."""
     load = require_nonnegative("load", load)
-    centre = hysteresis_centre(load, direction, params)
-    if not centre < math.inf:
-        raise ValueError(f"load = {load!r} kg is beyond the model's range: the hysteresis "
-                         f"centre {centre!r} degC is not finite")
-    if centre <= -KELVIN_OFFSET:
-        raise ValueError(f"hysteresis centre {centre!r} degC at load {load!r} kg is below 0 K")
+    heating = direction_sign(direction) == HEATING
+    terms = params.terms
+    centre = _checked_centre(hysteresis_centre(load, direction, params), load,
+                             "hysteresis centre")
     xi_f_min = residual_f_fraction(load, params)
-    return BranchConstants(
-        M=1.0 - xi_f_min,
+    total = 1.0 - xi_f_min
+    constants = BranchConstants(
+        M=total,
         xi_F_min=xi_f_min,
-        energy_over_kB=domain_energy(load, params) / BOLTZMANN,
+        energy_over_kB=domain_energy(load, params, terms.nu_h if heating else terms.nu_c)
+        / BOLTZMANN,
         inv_centre_K=1.0 / (centre + KELVIN_OFFSET),
         centre=centre,
     )
+    if terms.two_stage:
+        centre2 = _checked_centre(second_centre(load, direction, params), load,
+                                  "second-stage centre")
+        energy2 = domain_energy(load, params, terms.nu2_h if heating else terms.nu2_c)
+        constants = constants._replace(
+            w2=terms.w2, M1=total * (1.0 - terms.w2), M2=total * terms.w2,
+            energy2_over_kB=energy2 / BOLTZMANN, inv_centre2_K=1.0 / (centre2 + KELVIN_OFFSET),
+            centre2=centre2)
+    if terms.strain:
+        length_m, length_f = stressed_lengths(load, params)
+        constants = constants._replace(length_M=length_m, length_F=length_f)
+    return constants
 
 
 def logistic_split(total, exponent):
@@ -96,9 +144,21 @@ def logistic_split(total, exponent):
 
 def branch_fractions(temperature, constants):
     """(xi_MF, xi_P) [1] on a major branch at ``temperature`` [degC] (no argument checks)."""
+    if constants.w2 != 0.0:
+        return two_stage_fractions(1.0 / (temperature + KELVIN_OFFSET), constants)
     exponent = constants.energy_over_kB * (
         constants.inv_centre_K - 1.0 / (temperature + KELVIN_OFFSET))
     return logistic_split(constants.M, exponent)
+
+
+def two_stage_fractions(inverse_kelvin, constants):
+    """(xi_MF, xi_P) [1] of a two-stage major branch at 1/T_K = ``inverse_kelvin`` [1/K]:
+    each stage split by :func:`logistic_split`, the halves added (stage 1 first)."""
+    mf1, p1 = logistic_split(constants.M1, constants.energy_over_kB * (
+        constants.inv_centre_K - inverse_kelvin))
+    mf2, p2 = logistic_split(constants.M2, constants.energy2_over_kB * (
+        constants.inv_centre2_K - inverse_kelvin))
+    return mf1 + mf2, p1 + p2
 
 
 def phase_fractions(xi_mf, xi_p, xi_f_min):

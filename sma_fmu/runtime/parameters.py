@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from .constants import BOLTZMANN, STANDARD_GRAVITY
 from .minor_loops import DEFAULT_DEPTH
 from .lattice import lattice_constants
+from .model_terms import ModelTerms, model_terms
 from .thermal import thermal_gain, thermal_time_constant
 
 __all__ = ["ParameterError", "ParameterSpec", "PARAMETER_SPECS", "WireParameters", "DEFAULT_STRESS_MAX"]
@@ -45,6 +46,21 @@ PARAMETER_SPECS = (
     ParameterSpec("f_F", "constant_load", "kg", "positive", True),
     ParameterSpec("eps_T", "constant_load", "J", "positive", True),
     ParameterSpec("nu", "constant_load", "1", "positive", True),
+    ParameterSpec("nu_h", "constant_load", "1", "positive", False),
+    ParameterSpec("nu_c", "constant_load", "1", "positive", False),
+    ParameterSpec("w2", "second_stage", "1", "fraction", False),
+    ParameterSpec("a2_h", "second_stage", "degC", "finite", False),
+    ParameterSpec("b2_h", "second_stage", "degC/kg", "finite", False),
+    ParameterSpec("a2_c", "second_stage", "degC", "finite", False),
+    ParameterSpec("b2_c", "second_stage", "degC/kg", "finite", False),
+    ParameterSpec("nu2_h", "second_stage", "1", "positive", False),
+    ParameterSpec("nu2_c", "second_stage", "1", "positive", False),
+    ParameterSpec("alpha_P", "strain", "1/K", "finite", False),
+    ParameterSpec("alpha_MF", "strain", "1/K", "finite", False),
+    ParameterSpec("T_alpha", "strain", "degC", "finite", False),
+    ParameterSpec("span_ratio_0", "strain", "1", "positive", False),
+    ParameterSpec("span_ratio_sat", "strain", "1", "positive", False),
+    ParameterSpec("span_stress", "strain", "MPa", "positive", False),
     ParameterSpec("eps_f", "constant_temperature", "J", "finite", True),
     ParameterSpec("nu_f", "constant_temperature", "1", "positive", True),
     ParameterSpec("A_s", "thermal", "m2", "positive", True),
@@ -106,6 +122,10 @@ class WireParameters:
     optional in a file, default 64). ``load_max`` [kg] = stress_max pi d^2/4 / g is the
     largest load the model is valid for (``stress_max`` [MPa], optional, default
     :data:`DEFAULT_STRESS_MAX`): the steppers warn above it.
+
+    The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``) are
+    None when not given; ``terms`` (:class:`~.model_terms.ModelTerms`) holds the values in
+    use, defaults filled in (nu_h = nu_c = nu, w2 = 0, ...: today's model bit for bit).
     """
 
     x0: float
@@ -141,6 +161,21 @@ class WireParameters:
     alpha: float = None
     memory_depth: int = DEFAULT_DEPTH
     stress_max: float = DEFAULT_STRESS_MAX
+    nu_h: float = None
+    nu_c: float = None
+    w2: float = None
+    a2_h: float = None
+    b2_h: float = None
+    a2_c: float = None
+    b2_c: float = None
+    nu2_h: float = None
+    nu2_c: float = None
+    alpha_P: float = None
+    alpha_MF: float = None
+    T_alpha: float = None
+    span_ratio_0: float = None
+    span_ratio_sat: float = None
+    span_stress: float = None
     source: str = field(default="<parameters>", compare=False, repr=False)
 
     lattice: tuple = field(init=False, repr=False, compare=False)
@@ -154,6 +189,7 @@ class WireParameters:
     tau_th: float = field(init=False, repr=False, compare=False)
     phase_lag_alpha: float = field(init=False, repr=False, compare=False)
     load_max: float = field(init=False, repr=False, compare=False)
+    terms: ModelTerms = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         for spec in PARAMETER_SPECS:
@@ -221,6 +257,7 @@ class WireParameters:
                 "validity load limit stress_max * pi diameter^2 / 4 / g", "kg",
                 ("stress_max", "diameter"),
                 lambda: self.stress_max * 1e6 * math.pi * self.diameter ** 2 / 4.0 / STANDARD_GRAVITY),
+            terms=model_terms(self, self._fail),
         )
 
     def _check_consistency(self):

@@ -19,6 +19,7 @@ from collections import namedtuple
 from .checks import fast_finite, fast_nonnegative, fast_positive, require_mode, require_nonnegative
 from .constant_load import BranchCache, branch_fractions, require_temperature
 from .constants import COOLING, HEATING
+from .model_terms import wire_length
 from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_points,
                           wipe_out)
 from .state_entries import (StateError, check_format, read_direction, read_entries, read_number,
@@ -140,11 +141,16 @@ class PlantStepper:
         xi_p = self.xi_P
         xi_m = 0.5 * self.xi_MF
         xi_f = constants.xi_F_min + xi_m
+        if constants.length_M is None:
+            length = params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f
+        else:   # the strain terms (model_terms): stress law and thermal expansion
+            length = wire_length(self.temperature, xi_p, xi_m, xi_f, constants.length_M,
+                                 constants.length_F, params)
         # tuple.__new__ builds the namedtuple in C: a third of the cost of PlantOutputs(...)
         return _new_tuple(PlantOutputs, (
             params.R_P * xi_p + params.R_M * xi_m + params.R_F * xi_f,
             self.temperature,
-            params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f,
+            length,
             xi_p, xi_m, xi_f,
             self.power,
             self.direction == HEATING,

@@ -111,7 +111,18 @@ def check_load_range(params, source):
                     f"constant_load.eps_T = {params.eps_T!r} J, x_T = {params.x_T!r} m "
                     f"(phases.l_M, phases.l_F, geometry.x_min) and N = {params.N!r} "
                     f"(geometry.mass = {params.mass!r} kg, x0, diameter, theta), and the "
-                    f"centres hysteresis.a_h + b_h f, a_c + b_c f") from None
+                    f"centres hysteresis.a_h + b_h f, a_c + b_c f{_terms_note(params)}") from None
+
+
+def _terms_note(params):
+    """What the issue-36 terms add to the range of the model (empty when they are off)."""
+    terms, parts = params.terms, []
+    if terms.nu_h != params.nu or terms.nu_c != params.nu:
+        parts.append(f"constant_load.nu_h = {terms.nu_h!r}, nu_c = {terms.nu_c!r} in place of nu")
+    if terms.two_stage:
+        parts.append(f"the second stage's centres second_stage.a2_h + b2_h f, a2_c + b2_c f "
+                     f"and nu2_h = {terms.nu2_h!r}, nu2_c = {terms.nu2_c!r}")
+    return "; with " + " and ".join(parts) if parts else ""
 
 
 def _parse_entry(entry, spec, source):

@@ -5,10 +5,16 @@ The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` w
 
 - :mod:`~.files`: read lab files (columns, units, preamble) into branches and cycles
   (:func:`read_isobaric`), splitting them with :mod:`~.cycles`;
+- :mod:`~.columns`: separators, a strain given twice, a stress column;
 - :mod:`~.fit`: the joint fit of parameters, temperature profile and lag (:func:`fit_isobaric`),
-  on :mod:`~.model` (the model along the cycles), :mod:`~.profile` and :mod:`~.lag` (the wire's
-  temperature), :mod:`~.layout` (the unknowns), :mod:`~.jacobian` and :mod:`~.solver`
-  (sparse Levenberg-Marquardt);
+  on :mod:`~.terms` (the model with the issue-36 terms, vectorised), :mod:`~.profile` and
+  :mod:`~.lag` (the wire's temperature), :mod:`~.layout` and :mod:`~.starts` (the unknowns,
+  their starts and bounds), :mod:`~.jacobian` and :mod:`~.solver` (sparse
+  Levenberg-Marquardt), :mod:`~.covariance`, :mod:`~.outliers` (outlier cycles, bounds);
+- :mod:`~.halfway` and :mod:`~.summary`: half-strain temperatures and transformation strain
+  of data and model per stress, and the text summary;
+- :mod:`~.predict` and :mod:`~.predict_runner`: ``sma-fmu predict isobaric``, the plant
+  runtime through a lab file's temperature history;
 - :mod:`~.runner`: ``sma-fmu fit isobaric`` (the parameter file, report, per-cycle
   :mod:`~.tables` and :mod:`~.figures`); not imported here, so reading and fitting need no
   matplotlib;

@@ -4,7 +4,8 @@
   Up to ``GRID_CYCLES`` cycles per file: one panel per cycle in a grid of at most four
   columns; more: one panel per file, every cycle overlaid and coloured by its number.
 - ``fit_isobaric_stabilisation.png``: per-cycle A_s, A_f, M_s, M_f and residual strain
-  against cycle number, data (markers) and model (lines): the stabilisation plot labs use.
+  against cycle number, data (markers) and model (lines): the stabilisation plot labs use;
+  outlier cycles shaded grey.
 - ``fit_isobaric_residuals.png``: strain and temperature residuals against sample or time,
   with their noise estimates.
 - ``fit_isobaric_resistance.png`` when a file has resistance.
@@ -111,11 +112,16 @@ def _overlay(files, fit, per_cycle):
     return figure
 
 
-def _stabilisation(files, rows):
+def _stabilisation(files, rows, outliers=()):
     figure = Figure(figsize=(9.0, 6.4 * len(files)))
     axes = figure.subplots(2 * len(files), 1, squeeze=False)[:, 0]
     for k, data in enumerate(files):
         top, bottom = axes[2 * k], axes[2 * k + 1]
+        odd = [c["cycle"] for c in outliers if c["file"] == str(data.path)]
+        for axis in (top, bottom):
+            for n, cycle in enumerate(odd):
+                axis.axvspan(cycle - 0.5, cycle + 0.5, color="0.85", zorder=0,
+                             label="outlier cycle" if n == 0 else None)
         mine = [r for r in rows if r["file"] == data.path.name and r["load_kg"] == data.load]
         for quantity, colour in (("A_s", "tab:orange"), ("A_f", "tab:red"), ("M_s", "tab:cyan"),
                                  ("M_f", "tab:blue")):
@@ -196,7 +202,8 @@ def isobaric_figures(files, fit, per_cycle=True, rows=()):
     """{file name: PNG bytes} of the fit; ``rows`` are the transformation-table rows."""
     many = max(len(_cycles(d)) for d in files) > GRID_CYCLES
     out = {"fit_isobaric_cycles.png": _png((_overlay if many else _grid)(files, fit, per_cycle)),
-           "fit_isobaric_stabilisation.png": _png(_stabilisation(files, list(rows))),
+           "fit_isobaric_stabilisation.png": _png(_stabilisation(files, list(rows),
+                                                                 fit.outlier_cycles or ())),
            "fit_isobaric_residuals.png": _png(_residuals(files, fit))}
     if any(d.resistance is not None for d in files):
         out["fit_isobaric_resistance.png"] = _png(_resistance(files, fit))

@@ -13,8 +13,11 @@ Columns are found by their names (case and brackets ignored; other columns are i
 | extension | ``extension``, ``elongation``, ``displacement`` | m, mm (added to the reference length) |
 | resistance (optional) | ``resistance``, ``R_`` | ohm |
 | time (optional) | ``time`` | s, ms, min, h |
+| stress (optional) | ``stress`` | MPa (per row; the file's load from its median) |
 
-Exactly one of strain, length or extension. Values are checked against their unit
+Exactly one of strain, length or extension; a strain both in percent (``Strain_p``, ``%``)
+and as a fraction is read twice and the finer one used (:mod:`~.columns`, which also checks
+separators and the stress column). Values are checked against their unit
 ("mismatched units"): degC readings all >= 200 look like kelvin, kelvin readings below
 150 like degC, a fraction beyond +-1 like percent, a percentage spanning under 0.05 % like a
 fraction, a length [m] far from the reference length like millimetres (and back).
@@ -32,6 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from sma_fmu.identification.isobaric.columns import check_separators, choose_strain, file_stress
 from sma_fmu.identification.isobaric.cycles import (Branch, select_cycles, smooth,
                                                    split_branches)
 from sma_fmu.identification.isobaric.synthetic import load_of_stress
@@ -46,8 +50,9 @@ _QUANTITIES = {
     "temperature": (("temp",), ("t",), {"": "C", "c": "C", "degc": "C", "celsius": "C",
                                         "k": "K", "kelvin": "K", "f": "F", "degf": "F"}),
     "strain": (("strain", "eps"), (), {"": "fraction", "1": "fraction", "mm/mm": "fraction",
-                                       "fraction": "fraction", "%": "percent",
+                                       "fraction": "fraction", "%": "percent", "p": "percent",
                                        "percent": "percent", "pct": "percent"}),
+    "stress": (("stress",), (), {"": "MPa", "mpa": "MPa"}),
     "length": (("length",), ("l",), {"": "m", "m": "m", "mm": "mm"}),
     "extension": (("extension", "elongation", "displacement"), (), {"": "m", "m": "m", "mm": "mm"}),
     "resistance": (("resist",), ("r",), {"": "ohm", "ohm": "ohm", "ohms": "ohm", "Ω": "ohm"}),
@@ -72,6 +77,8 @@ class IsobaricData:
     smoothed: np.ndarray        # smoothed temperature [degC]
     branches: list
     splitting: object = None    # cycles.Splitting: how the branches were found
+    strain_note: str = ""       # which of two strain columns was used, and why
+    stress_column: float = None  # median of the file's stress column [MPa], if it has one
 
     @property
     def levels(self):
@@ -163,6 +170,7 @@ def _table(path):
         following = _split(content[i + 1][1], delimiter) if i + 1 < len(content) else []
         if (len(names) >= 2 and len(following) == len(names)
                 and sum(_is_number(c, True) for c in following) >= 2):
+            check_separators(path, delimiter, content[i + 1:])
             rows = [(n, _split(row, delimiter)) for n, row in content[i + 1:]]
             return preamble, names, rows, delimiter == ";"
         if len(names) < 2 and i + 1 < len(content) and len(following) < 2 \
@@ -180,6 +188,10 @@ def _columns(path, names):
         if kind is None:
             continue
         quantity, unit = kind
+        if quantity == "strain" and "strain" in found and "strain_other" not in found \
+                and unit != found["strain"][1]:
+            found["strain_other"] = (index, unit)   # the strain twice: % and fraction
+            continue
         if quantity in found:
             raise MeasurementError(f"{path}: line 1: two {quantity} columns, "
                                    f"{names[found[quantity][0]]!r} and {name!r}; keep one")
@@ -289,6 +301,20 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     shape = next(q for q in ("strain", "length", "extension") if q in columns)
     s_index, s_unit = columns[shape]
     strain = _strain(path, shape, names[s_index], s_unit, column(shape), reference_length)
+    strain_note = ""
+    if "strain_other" in columns:
+        o_index, o_unit = columns["strain_other"]
+        other = _strain(path, "strain", names[o_index], o_unit, column("strain_other"),
+                        reference_length)
+        strain, chosen, strain_note = choose_strain(path, (names[s_index], strain),
+                                                    (names[o_index], other))
+        if chosen != names[s_index]:
+            columns["strain"] = columns.pop("strain_other")
+        else:
+            columns.pop("strain_other")
+    stress = None
+    if "stress" in columns:
+        stress = file_stress(path, names[columns["stress"][0]], column("stress"))
     resistance = column("resistance") if "resistance" in columns else None
     if resistance is not None and not (resistance > 0).all():
         bad = int(np.argmin(resistance))
@@ -304,11 +330,14 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
                                    f"{time[k]!r} does not increase; rows must be in time order")
     if len(rows) < 50:
         raise MeasurementError(f"{path}: only {len(rows)} data rows; a thermal cycle needs more")
+    if load is None and stress is not None:
+        load = load_of_stress(stress, diameter if diameter else 0.15e-3)
     if load is None:
         load = _metadata_load(preamble, diameter if diameter else 0.15e-3)
         if load is None:
-            raise MeasurementError(f"{path}: no load given: pass --load KG or --stress MPa, or "
-                                   f"state it in the header (# load: 0.15 kg)")
+            raise MeasurementError(f"{path}: no load given: pass --load KG or --stress MPa, give "
+                                   f"a stress column (stress_MPa), or state it in the header "
+                                   f"(# load: 0.15 kg)")
     if not load >= 0:
         raise MeasurementError(f"{path}: load = {load!r} kg must be >= 0")
     branches, _, splitting = split_branches(temperature, path)
@@ -330,7 +359,8 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
                 f"{np.ptp(strain[b.start:b.stop]):.3g} (at least {MIN_STRAIN_SPAN:g} needed)")
     units = {q: (names[i], u) for q, (i, u) in columns.items()}
     return IsobaricData(path, float(load), float(reference_length), shape == "length", units,
-                        temperature, strain, resistance, time, smoothed, branches, splitting)
+                        temperature, strain, resistance, time, smoothed, branches, splitting,
+                        strain_note, stress)
 
 
 _NAMES = {HEATING: "heating", COOLING: "cooling"}

@@ -1,38 +1,43 @@
-"""Identify the constant-load model (spec sections 2-4) from isobaric thermal cycling.
+"""Identify the constant-load model (spec sections 2-4, with the issue-36 terms) from
+isobaric thermal cycling.
 
 The data: strain eps (and, where a file has it, resistance R) against a noisy thermocouple
-temperature, from two to a thousand heating and cooling branches per file, one load per
-file. The model of every sample i of a file at load f, on the branch of its direction d:
-
-    eps_i = eps_hot(f) + span(f) q(T_i; tau_d(f), dH(f)) + offset_i             [1]
-    R_i   = R_hot(f)   + R_span(f) q(T_i; tau_d(f), dH(f))                       [ohm]
-
-(:mod:`sma_fmu.identification.isobaric.model`). Fitted:
-- the hysteresis centres: a_h, a_c at one load (b_h, b_c from the base file), or
-  a_h, b_h, a_c, b_c when the files hold two loads or more;
-- nu, the domain size that sets the transition width (eps_T from the base file: only
-  nu eps_T is identifiable, as for the constant-load fit);
+temperature, from one to a thousand heating and cooling branches per file, one load per
+file. The model of every sample i of a file at load f, on the branch of its direction d,
+is :func:`sma_fmu.identification.isobaric.terms.branch_curve` (two logistic stages, thermal
+expansion, the stress law of the transformation strain) plus a strain offset. Fitted
+(:mod:`~.layout` lists the unknowns, :mod:`~.starts` their starts and bounds):
+- the hysteresis centres of each stage, held as the cooling line and the heating centre's
+  lead over it (>= 0) at no load and at the largest load; slopes b with two loads or more;
+- the domain sizes: one nu, or nu_h and nu_c (``widths``), and nu2_h, nu2_c, w2 with a
+  second stage (``stages=2``); richer models are kept only when they lower the cost by
+  STAGE_GAIN_MIN;
+- alpha_P, alpha_MF; span_ratio_0 with two stresses or more, span_stress with three;
 - l_MF = (l_M + l_F)/2 [m] (l_F - l_M kept from the base file), x_min too when a file gives
   absolute lengths; R_P and R_MF when a file has resistance;
 - strain offsets per file: one per residual-strain level with ``residual="per-cycle"``
   (heating branch k sits on level k; the cooling branch after it moves from level k to
   k + 1 in proportion to the transformed share q), or one per file with ``residual="none"``;
 - the lag of the wire behind the thermocouple, one time constant per file [s, or samples
-  when the file has no time column] (``lag="fit"``; ``lag="none"`` holds it at zero).
+  when the file has no time column] (``lag="fit"``, bounded by starts.LAG_LIMIT of a cycle;
+  ``lag="none"`` holds it at zero).
 
-The wire temperature T_i is lagged(profile): the profile is piecewise linear with few knots
-per branch, chosen from the measured temperature alone (:mod:`profile`), and its
-knots are fitted jointly with the parameters against the residuals (profile - measured
-temperature)/sigma_T, (model strain - measured strain)/sigma_eps (and resistance), each sigma
-the data's own scatter (median absolute second difference). So the profile can move only
-as far as the thermocouple noise allows: a wire that lags is explained by the lag, and a
-temperature residual much larger than the noise says the model does not explain the data
-(``verdict``). The covariance s^2 (J^T J)^-1 of all unknowns accounts for the temperature
-noise. Levenberg-Marquardt with sparse direct steps (:mod:`solver`) runs on a sparse
-closed-form Jacobian (:mod:`jacobian`), so a 26,000-sample, 100-cycle file fits in
-seconds; a short scan of starting lags picks the valley first.
+Outlier cycles (:mod:`~.outliers`) are named and, by default, left out; unknowns that end on
+a bound are named. The wire temperature T_i is lagged(profile): the profile is piecewise
+linear with few knots per branch, chosen from the measured temperature alone
+(:mod:`profile`), and its knots are fitted jointly with the parameters against the
+residuals (profile - measured temperature)/sigma_T, (model strain - measured
+strain)/sigma_eps (and resistance), each sigma the data's own scatter (median absolute
+second difference). So the profile can move only as far as the thermocouple noise allows:
+a wire that lags is explained by the lag, and a temperature residual much larger than the
+noise says the model does not explain the data (``verdict``). The covariance
+s^2 (J^T J)^-1 of all unknowns (:mod:`~.covariance`) accounts for the temperature noise.
+Levenberg-Marquardt with sparse direct steps (:mod:`solver`) runs on a sparse Jacobian
+(:mod:`jacobian`), so a 26,000-sample, 100-cycle file fits in seconds; a short scan of
+starting lags picks the valley first.
 """
 import time
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,17 +47,24 @@ from threadpoolctl import threadpool_limits
 from sma_fmu.identification.isobaric.files import noise_level
 from sma_fmu.identification.isobaric.jacobian import file_jacobian, file_model, file_state
 from sma_fmu.identification.isobaric.lag import uniform_step
-from sma_fmu.identification.isobaric.layout import Layout, starts
+from sma_fmu.identification.isobaric.covariance import (named, named_values,
+                                                        reported_covariance, wire_covariance)
+from sma_fmu.identification.isobaric.layout import Layout
+from sma_fmu.identification.isobaric.outliers import OUTLIER_OPTIONS, bound_names, mark_outliers
+from sma_fmu.identification.isobaric.starts import starts
 from sma_fmu.identification.isobaric.profile import temperature_profile
-from sma_fmu.identification.isobaric.solver import OrderedLU, levenberg_marquardt
+from sma_fmu.identification.isobaric.solver import levenberg_marquardt
 from sma_fmu.identification.measurements import MeasurementError
 
-__all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "IsobaricFit", "fit_isobaric", "prepare",
+__all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "OUTLIER_OPTIONS", "IsobaricFit", "fit_isobaric", "prepare",
            "residual_blocks",
            "EXPLAINED_RATIO"]
 
 RESIDUAL_OPTIONS = ("per-cycle", "none")
 LAG_OPTIONS = ("fit", "none")
+WIDTH_OPTIONS = ("auto", "separate", "shared")
+STAGE_SHARE_MIN = 1e-3  # a second stage holding less than this share of M is not kept
+STAGE_GAIN_MIN = 0.01   # nor one that lowers the cost by less than this fraction
 EXPLAINED_RATIO = 1.5   # residual RMS above this many noise estimates: not explained
 _FLOOR = 1e-9           # relative floor of the noise estimates (noise-free data)
 _PROGRESS_S = 5.0       # seconds between progress lines
@@ -71,6 +83,11 @@ class PreparedFile:
     step_spread: float      # largest relative deviation of a time step from the median
     sigma: dict             # noise estimates: temperature [K], strain [1], resistance [ohm]
     per_cycle: bool
+    weight: np.ndarray = None   # per sample: 1, or 0 for the strain of a left-out cycle
+
+    def __post_init__(self):
+        if self.weight is None:
+            self.weight = np.ones(self.data.strain.size)
 
     @property
     def lag_unit(self):
@@ -110,6 +127,12 @@ class IsobaricFit:
     converged: bool
     message: str
     seconds: float
+    on_bound: list = None     # "name = value (lower/upper bound)" of unknowns on a bound
+    outlier_cycles: list = None   # [{"file", "cycle", "rms", "name"}] left out of the fit
+    stages: int = 1
+    stage_note: str = ""      # why a second stage asked for was not kept
+    undetermined: list = None  # unknowns no residual touches (levels of left-out cycles)
+    file_rms: list = None     # per file: {"temperature_K", "strain"(, "resistance_ohm")} RMS
 
 
 def prepare(data, index, residual="per-cycle"):
@@ -157,19 +180,6 @@ def _lag_scan(start, solve, progress):
     return [trial.x for trial in trials[:2]]
 
 
-def _reported_covariance(jac, factor, count, order):
-    """s^2 (J^T J)^-1 restricted to the first ``count`` unknowns (sparse LU of the scaled
-    normal matrix; a tiny ridge keeps unvisited levels from making it singular)."""
-    normal = (jac.T @ jac).tocsc()
-    scale = np.sqrt(np.clip(normal.diagonal(), 1e-300, None))
-    scaled = sparse.diags(1 / scale) @ normal @ sparse.diags(1 / scale)
-    scaled = scaled + 1e-12 * sparse.identity(scaled.shape[0])
-    unit = np.zeros((scaled.shape[0], count))
-    unit[np.arange(count), np.arange(count)] = 1.0
-    inverse = OrderedLU(scaled, order).solve(unit)[:count]
-    return factor * inverse / np.outer(scale[:count], scale[:count])
-
-
 def residual_blocks(x, layout, prepared):
     """Weighted residuals of every file: [temperature, strain(, resistance)] per file."""
     params = layout.params(x)
@@ -179,43 +189,24 @@ def residual_blocks(x, layout, prepared):
         strain, resistance = file_model(params, f.data, wire, layout.levels(x, f.index),
                                         direction, level, f.per_cycle)
         out.append((profile - f.data.temperature) / f.sigma["temperature"])
-        out.append((strain - f.data.strain) / f.sigma["strain"])
+        out.append(f.weight * (strain - f.data.strain) / f.sigma["strain"])
         if resistance is not None:
-            out.append((resistance - f.data.resistance) / f.sigma["resistance"])
+            out.append(f.weight * (resistance - f.data.resistance) / f.sigma["resistance"])
     return out
 
 
-def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=300,
-                 progress=None):
-    """Fit the isobaric files (list of IsobaricData) jointly; returns :class:`IsobaricFit`.
-
-    ``progress`` (callable taking a line of text, or None) hears from long fits.
-    """
-    if residual not in RESIDUAL_OPTIONS:
-        raise ValueError(f"residual must be one of {', '.join(RESIDUAL_OPTIONS)}, got {residual!r}")
-    if lag not in LAG_OPTIONS:
-        raise ValueError(f"lag must be one of {', '.join(LAG_OPTIONS)}, got {lag!r}")
-    prepared = [prepare(data, index, residual) for index, data in enumerate(files)]
-    loads = sorted({data.load for data in files})
-    layout = Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
-                    any(d.resistance is not None for d in files), lag == "fit")
-    vector, lower, upper = starts(prepared, layout, base)
+def _solver(prepared, layout, lower, upper, progress, clock):
+    """(residuals, jacobian, solve) of one layout."""
     order = layout.time_order(prepared)
-    first = vector[:len(layout.reported)].copy()
-    began = time.perf_counter()
-    clock = {"last": began, "evaluations": 0}
-
-    def pieces(x):
-        return residual_blocks(x, layout, prepared)
 
     def residuals(x):
-        out = np.concatenate(pieces(x))
+        out = np.concatenate(residual_blocks(x, layout, prepared))
         clock["evaluations"] += 1
         now = time.perf_counter()
         if progress is not None and now - clock["last"] > _PROGRESS_S:
             clock["last"] = now
             progress(f"  fit: {clock['evaluations']} evaluations, cost {0.5 * out @ out:.6g}, "
-                     f"{now - began:.0f} s")
+                     f"{now - clock['began']:.0f} s")
         return out
 
     def jacobian(x):
@@ -224,49 +215,160 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     def solve(x0, evaluations):
         return levenberg_marquardt(residuals, jacobian, x0, lower, upper, evaluations, ftol=1e-8,
                                    order=order)
+    return residuals, jacobian, solve, order
 
+
+_State = namedtuple("_State", ["layout", "solution", "jacobian", "solve", "order", "lower",
+                               "upper", "first"])
+
+
+def _carry(old_layout, old_x, layout, vector):
+    """``vector`` with every unknown the two layouts share taken from ``old_x`` (one width
+    nu gives both nu_h and nu_c)."""
+    out = vector.copy()
+    old = {name: i for i, name in enumerate(old_layout.phys)}
+    if "nu" in old:
+        old["nu_h"] = old["nu_c"] = old["nu"]
+    for i, name in enumerate(layout.phys):
+        if name in old:
+            out[i] = old_x[old[name]]
+    k_old, k = len(old_layout.phys), len(layout.phys)
+    out[k:layout.size] = old_x[k_old:old_layout.size]
+    return out
+
+
+def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=300,
+                 progress=None, stages=1, outliers="leave-out", widths="auto"):
+    """Fit the isobaric files (list of IsobaricData) jointly; returns :class:`IsobaricFit`.
+
+    ``stages``: 1, or 2 (a second stage, fitted from the one-stage fit); ``widths``:
+    "separate" (nu_h, nu_c), "shared" (one nu for both directions) or "auto" (shared, then
+    separate kept only when it lowers the cost by STAGE_GAIN_MIN: with a fitted lag, separate
+    widths blur the lag against the centres); ``outliers``:
+    "leave-out" (cycles whose strain residual RMS exceeds OUTLIER_RATIO times the median
+    cycle's are named and fitted again without their strain) or "keep".
+    ``progress`` (callable taking a line of text, or None) hears from long fits.
+    """
+    if residual not in RESIDUAL_OPTIONS:
+        raise ValueError(f"residual must be one of {', '.join(RESIDUAL_OPTIONS)}, got {residual!r}")
+    if lag not in LAG_OPTIONS:
+        raise ValueError(f"lag must be one of {', '.join(LAG_OPTIONS)}, got {lag!r}")
+    if widths not in WIDTH_OPTIONS:
+        raise ValueError(f"widths must be one of {', '.join(WIDTH_OPTIONS)}, got {widths!r}")
+    if stages not in (1, 2):
+        raise ValueError(f"stages must be 1 or 2, got {stages!r}")
+    if outliers not in OUTLIER_OPTIONS:
+        raise ValueError(f"outliers must be one of {', '.join(OUTLIER_OPTIONS)}, got {outliers!r}")
+    prepared = [prepare(data, index, residual) for index, data in enumerate(files)]
+    loads = sorted({data.load for data in files})
+
+    def layout_of(count, kind):
+        return Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
+                      any(d.resistance is not None for d in files), lag == "fit", count, loads,
+                      kind)
+    began = time.perf_counter()
+    clock = {"last": began, "evaluations": 0, "began": began}
+
+    def attempt(state, count, kind):
+        """A richer layout started from ``state``'s solution."""
+        layout = layout_of(count, kind)
+        vector, lower, upper = starts(prepared, layout, base)
+        first = _carry(state.layout, state.first, layout, vector)
+        vector = _carry(state.layout, state.solution.x, layout, vector)
+        residuals, jacobian, solve, order = _solver(prepared, layout, lower, upper, progress,
+                                                    clock)
+        solution = solve(np.clip(vector, lower, upper), max_evaluations)
+        return _State(layout, solution, jacobian, solve, order, lower, upper, first)
+
+    kind = "separate" if widths == "separate" else "shared"
+    layout = layout_of(1, kind)
+    vector, lower, upper = starts(prepared, layout, base)
+    residuals, jacobian, solve, order = _solver(prepared, layout, lower, upper, progress, clock)
+    notes = []
     # the sparse solves gain nothing from BLAS threads, which only contend for the cores
     with threadpool_limits(limits=1, user_api="blas"):
         firsts = [vector] if lag != "fit" else _lag_scan(
             lambda fraction: starts(prepared, layout, base, fraction)[0], solve, progress)
         solution = min((solve(x, max_evaluations) for x in firsts), key=lambda s: s.cost)
+        left_out = mark_outliers(prepared, layout, solution.x, outliers == "leave-out")
+        if left_out and progress is not None:
+            progress(f"  outlier cycles {'left out' if outliers == 'leave-out' else 'kept'}: "
+                     + "; ".join(c["name"] for c in left_out))
+        if left_out and outliers == "leave-out":
+            solution = solve(solution.x, max_evaluations)
+        state = _State(layout, solution, jacobian, solve, order, lower, upper, vector.copy())
+        if widths == "auto":
+            richer = attempt(state, 1, "separate")
+            if richer.solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
+                state, kind = richer, "separate"
+            else:
+                notes.append(f"separate heating and cooling widths do not fit these data better "
+                             f"(cost {richer.solution.cost:.6g} against "
+                             f"{state.solution.cost:.6g} with one): one width kept")
+        if stages == 2:
+            richer = attempt(state, 2, kind)
+            w2 = richer.solution.x[richer.layout.phys.index("w2")]
+            if w2 > STAGE_SHARE_MIN and \
+                    richer.solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
+                state = richer
+            else:
+                notes.append(f"a second stage does not fit these data better (w2 = {w2:.3g}, "
+                             f"cost {richer.solution.cost:.6g} against "
+                             f"{state.solution.cost:.6g} with one stage): one stage kept")
+                stages = 1
+    for note in notes if progress is not None else ():
+        progress("  " + note)
+    stage_note = "; ".join(notes)
+    layout, solution, jacobian, solve, order, lower, upper, first = state
+    first = first[:len(layout.reported)]
     if not np.all(np.isfinite(solution.x)):
         layout.params(np.where(np.isfinite(solution.x), solution.x, np.nan))
     seconds = time.perf_counter() - began
     jac = jacobian(solution.x)
     m, n = solution.fun.size, layout.size
-    dof = max(m - n, 1)
+    dof = max(m - n - sum(int(np.sum(f.weight == 0)) for f in prepared), 1)
     factor = float(np.sum(solution.fun ** 2)) / dof
     k = len(layout.reported)
-    cov = _reported_covariance(jac, factor, k, order)
+    cov, dead = reported_covariance(jac, factor, k, order)
+    names, to_names = named(layout, solution.x)
+    on_bound = bound_names(layout, solution.x, lower, upper)
     if not np.all(np.isfinite(cov)):
         raise MeasurementError(f"{layout.paths}: the fit's covariance is not finite; the data do "
                                f"not determine the unknowns")
     params = layout.params(solution.x)
+    cov[dead, :], cov[:, dead] = 0.0, 0.0    # undetermined: reported as a zero error, named
+    undetermined = [layout.reported[i] for i in np.nonzero(dead)[0]]
     errors = np.sqrt(np.clip(np.diag(cov), 0, None))
-    parts, states = pieces(solution.x), [file_state(solution.x, layout, f) for f in prepared]
+    cov_named = to_names @ cov @ to_names.T
+    values = named_values(layout, solution.x, names)
+    parts, states = residual_blocks(solution.x, layout, prepared), \
+        [file_state(solution.x, layout, f) for f in prepared]
     rms, noise = {"temperature_K": [], "strain": [], "resistance_ohm": []}, \
         {"temperature_K": [], "strain": [], "resistance_ohm": []}
-    i = 0
+    i, file_rms = 0, []
     for f in prepared:
+        file_rms.append({})
         for key, sigma_key in (("temperature_K", "temperature"), ("strain", "strain"),
                                ("resistance_ohm", "resistance")):
             if sigma_key in f.sigma:
-                rms[key].append(parts[i] * f.sigma[sigma_key])
-                noise[key].append(np.full(parts[i].size, f.sigma[sigma_key]))
+                kept = f.weight > 0 if sigma_key != "temperature" else slice(None)
+                rms[key].append(parts[i][kept] * f.sigma[sigma_key])
+                noise[key].append(np.full(parts[i][kept].size, f.sigma[sigma_key]))
+                file_rms[-1][key] = float(np.sqrt(np.mean(rms[key][-1] ** 2)))
                 i += 1
     rms = {key: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) if v else None
            for key, v in rms.items()}
     noise = {key: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) if v else None
              for key, v in noise.items()}
-    wire_names, wire_values, wire_cov = _wire_covariance(layout, solution.x, cov)
+    wire_names, wire_values, wire_cov = wire_covariance(names, values, cov_named, layout)
     lags = [None if c is None else {"value": float(solution.x[c]), "std_error": float(errors[c]),
                                     "unit": f.lag_unit, "step": f.step,
                                     "step_spread": f.step_spread}
             for f, c in zip(prepared, layout.lags)]
     return IsobaricFit(
-        params=params, names=list(layout.reported), values=solution.x[:k].copy(),
-        std_errors=errors, covariance=cov, starts=first,
+        params=params, names=names, values=values,
+        std_errors=np.sqrt(np.clip(np.diag(cov_named), 0, None)), covariance=cov_named,
+        starts=named_values(layout, first, names),
         wire_names=wire_names, wire_values=wire_values,
         wire_std_errors=np.sqrt(np.clip(np.diag(wire_cov), 0, None)), wire_covariance=wire_cov,
         offsets=[layout.levels(solution.x, f.index).tolist() for f in prepared], lags=lags,
@@ -276,19 +378,6 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         verdict=_verdict(rms, noise), variance_factor=factor, dof=dof, profile_unknowns=n - k,
         knots_per_branch=[f.profile.knots_per_branch for f in prepared],
         evaluations=int(clock["evaluations"]), converged=bool(solution.status > 0),
-        message=str(solution.message), seconds=seconds)
-
-
-def _wire_covariance(layout, vector, cov):
-    """Names, values and covariance of the parameter-file entries the unknowns set."""
-    names, rows = [], []
-    for i, name in enumerate(layout.phys):
-        for target in {"l_MF": ("l_M", "l_F"), "R_MF": ("R_M", "R_F")}.get(name, (name,)):
-            row = np.zeros(cov.shape[0])
-            row[i] = 1.0
-            names.append(target)
-            rows.append(row)
-    transform = np.array(rows)
-    params = layout.params(vector)
-    values = np.array([getattr(params, name) for name in names])
-    return names, values, transform @ cov @ transform.T
+        message=str(solution.message), seconds=seconds, on_bound=on_bound,
+        outlier_cycles=left_out, stages=stages, file_rms=file_rms, stage_note=stage_note,
+        undetermined=undetermined)

@@ -1,24 +1,33 @@
-"""The isobaric fit's model of one file and its sparse closed-form Jacobian.
+"""The isobaric fit's model of one file and its sparse Jacobian.
 
-With q = 1/(1 + e^Lambda), Lambda = E (1/tau_K - 1/T_K), E = nu (eps_T - g f x_T/N)/k_B and
-x_T = x_min - l_MF, the strain residual eps_hot + (span + d_offset) q + offset - data
-differentiates through q (dq/dLambda = -q(1-q)) into the centres (a, b), E (nu, l_MF,
-x_min) and the wire temperature T; T = lagged(B c) (the profile's knots c, the lag's time
-constant), so dT/dc = lagged(B) (sparse: each hat function's decaying response) and dT/dtau
-comes from :func:`sma_fmu.identification.isobaric.lag.lag_derivative`. The levels
-(l_MF, x_min, R_P, R_MF) and the offsets enter directly. Rows: temperature (profile -
-measured)/sigma_T, strain, resistance. tests/test_isobaric.py checks it against central
-differences.
+The model (:func:`sma_fmu.identification.isobaric.terms.branch_curve`) at the wire
+temperature T of each sample, on the branch of its direction, plus the strain offset of its
+residual-strain level (on cooling, with ``per_cycle``, moving from level k to k + 1 in
+proportion to the transformed share q). T = lagged(B c): the profile's knots c and the lag's
+time constant, so dT/dc = lagged(B) (sparse: each hat function's decaying response) and
+dT/dtau comes from :func:`sma_fmu.identification.isobaric.lag.lag_derivative`.
+
+Derivatives: d model/d T per sample and d model/d (physical unknown) by central
+differences of the vectorised model (the model is smooth, each column costs two model
+evaluations of the file, and a new model term needs no new derivative code); the offsets
+enter linearly with weights 1 (heating), 1 - q and q (cooling). Rows: temperature
+(profile - measured)/sigma_T, strain, resistance, each times the sample's weight (0 for a
+left-out cycle's strain). tests/test_isobaric.py checks it against central differences of
+the whole residual.
 """
 import numpy as np
 from scipy import sparse
 
 from sma_fmu.identification.isobaric.lag import lag_derivative, lagged
-from sma_fmu.identification.isobaric.model import branch_levels, branch_share
 from sma_fmu.identification.isobaric.profile import lagged_basis, wire_rows
-from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
+from sma_fmu.identification.isobaric.terms import branch_curve
+from sma_fmu.identification.measurements import MeasurementError
+from sma_fmu.runtime.constants import COOLING, HEATING
 
 __all__ = ["file_state", "file_model", "file_jacobian", "through_temperature"]
+
+_DT_K = 1e-3          # temperature step of the central difference [K]
+_RELATIVE = 1e-6      # relative step of the parameters' central differences
 
 
 def file_state(x, layout, f):
@@ -30,99 +39,72 @@ def file_state(x, layout, f):
     return profile, tau, wire, direction, level, bounds
 
 
-def file_model(params, data, wire, levels, direction, level, per_cycle=True):
-    """(strain [1], resistance [ohm] or None) of the model at the ``wire`` temperatures
+def file_model(params, data, wire, levels, direction, level, per_cycle=True, share=False):
+    """(strain [1], resistance [ohm] or None[, q]) of the model at the ``wire`` temperatures
     [degC], per-row branch ``direction`` and residual-strain ``level``."""
     strain = np.empty(wire.size)
-    resistance = np.empty(wire.size) if data.resistance is not None else None
+    resistance = np.empty(wire.size)
+    q_all = np.empty(wire.size)
     levels = np.asarray(levels, dtype=float)
     for d in (HEATING, COOLING):
         rows = direction == d
         if not rows.any():
             continue
-        lv = branch_levels(data.load, d, params, data.reference_length)
-        q = branch_share(wire[rows], lv.constants)
+        e, r, q = branch_curve(wire[rows], data.load, d, params, data.reference_length)
         at = level[rows]
         offset = levels[np.minimum(at, levels.size - 1)]
         if d == COOLING and per_cycle:
             offset = offset + (levels[np.minimum(at + 1, levels.size - 1)] - offset) * q
-        strain[rows] = lv.strain_hot + lv.strain_span * q + offset
-        if resistance is not None:
-            resistance[rows] = lv.resistance_hot + lv.resistance_span * q
-    return strain, resistance
+        strain[rows] = e + offset
+        resistance[rows] = r
+        q_all[rows] = q
+    resistance = resistance if data.resistance is not None else None
+    return (strain, resistance, q_all) if share else (strain, resistance)
 
 
 def through_temperature(params, f, wire, levels, direction, level):
     """(d strain/dT [1/K], d resistance/dT [ohm/K] or None) per sample at the wire temperature."""
-    d_strain = np.zeros(wire.size)
-    d_resistance = np.zeros(wire.size) if f.data.resistance is not None else None
-    for d in (HEATING, COOLING):
-        rows = np.nonzero(direction == d)[0]
-        if rows.size == 0:
-            continue
-        lv = branch_levels(f.data.load, d, params, f.data.reference_length)
-        c = lv.constants
-        q = branch_share(wire[rows], c)
-        dq_dt = -q * (1.0 - q) * c.energy_over_kB / (wire[rows] + KELVIN_OFFSET) ** 2
-        gain = np.full(rows.size, lv.strain_span)
-        if d == COOLING and f.per_cycle:
-            at = level[rows]
-            gain = gain + levels[np.minimum(at + 1, levels.size - 1)] - levels[at]
-        d_strain[rows] = gain * dq_dt
-        if d_resistance is not None:
-            d_resistance[rows] = lv.resistance_span * dq_dt
-    return d_strain, d_resistance
+    up = file_model(params, f.data, wire + _DT_K, levels, direction, level, f.per_cycle)
+    down = file_model(params, f.data, wire - _DT_K, levels, direction, level, f.per_cycle)
+    d_r = None if up[1] is None else (up[1] - down[1]) / (2 * _DT_K)
+    return (up[0] - down[0]) / (2 * _DT_K), d_r
 
 
 def _parameter_columns(x, layout, f, wire, direction, level):
     """Dense (samples x physical) derivatives of strain and resistance, and the offset entries."""
-    params = layout.params(x)
-    col = {name: i for i, name in enumerate(layout.phys)}
-    n, k = wire.size, len(layout.phys)
+    k = len(layout.phys)
+    n = wire.size
+    levels = layout.levels(x, f.index)
     strain = np.zeros((n, k))
     resistance = np.zeros((n, k)) if f.data.resistance is not None else None
-    levels = layout.levels(x, f.index)
+    for i in range(k):
+        h = 1e-9 if layout.phys[i].startswith("alpha") else _RELATIVE * max(abs(x[i]), 1.0)
+        moved, steps = [], []
+        for sign in (1.0, -1.0):
+            y = x.copy()
+            y[i] += sign * h
+            try:
+                params = layout.params(y)
+            except MeasurementError:      # on the edge of a parameter's range: one-sided
+                y[i], params = x[i], layout.params(x)
+            steps.append(y[i])
+            moved.append(file_model(params, f.data, wire, levels, direction, level, f.per_cycle))
+        width = steps[0] - steps[1]
+        strain[:, i] = (moved[0][0] - moved[1][0]) / width
+        if resistance is not None:
+            resistance[:, i] = (moved[0][1] - moved[1][1]) / width
+    _, _, q = file_model(layout.params(x), f.data, wire, levels, direction, level, f.per_cycle,
+                         share=True)
     first, count, fixed = layout.offsets[f.index]
     off_rows, off_cols, off_values = [], [], []
-    per_kb = STANDARD_GRAVITY * f.data.load / (params.N * BOLTZMANN)
-    reference = f.data.reference_length
-    for d, a, b in ((HEATING, "a_h", "b_h"), (COOLING, "a_c", "b_c")):
+    for d in (HEATING, COOLING):
         rows = np.nonzero(direction == d)[0]
         if rows.size == 0:
             continue
-        lv = branch_levels(f.data.load, d, params, reference)
-        c = lv.constants
-        energy = c.energy_over_kB
-        q = branch_share(wire[rows], c)
-        slope_q = -q * (1.0 - q)
-        dq_tau = slope_q * (-energy * c.inv_centre_K ** 2)
-        dq_e = slope_q * (c.inv_centre_K - 1.0 / (wire[rows] + KELVIN_OFFSET))
         at = level[rows]
-        gain = np.full(rows.size, lv.strain_span)
         weights = {0: np.ones(rows.size)}
         if d == COOLING and f.per_cycle:
-            gain = gain + levels[np.minimum(at + 1, levels.size - 1)] - levels[at]
-            weights = {0: 1.0 - q, 1: q}
-        d_energy = {"nu": energy / params.nu, "l_MF": params.nu * per_kb,
-                    "x_min": -params.nu * per_kb}
-        xi = c.xi_F_min
-        d_hot = {"l_MF": xi / reference, "x_min": (1.0 - xi) / reference}
-        d_span = {"l_MF": c.M / reference, "x_min": -c.M / reference}
-        for name, i in col.items():
-            if name in (a, b):
-                factor = 1.0 if name == a else f.data.load
-                strain[rows, i] = gain * dq_tau * factor
-                if resistance is not None:
-                    resistance[rows, i] = lv.resistance_span * dq_tau * factor
-            elif name in d_energy:
-                through_e = dq_e * d_energy[name]
-                strain[rows, i] = gain * through_e + d_hot.get(name, 0.0) + d_span.get(name, 0.0) * q
-                if resistance is not None:
-                    resistance[rows, i] = lv.resistance_span * through_e
-            elif name == "R_P" and resistance is not None:
-                resistance[rows, i] = (1.0 - xi) - c.M * q
-            elif name == "R_MF" and resistance is not None:
-                resistance[rows, i] = xi + c.M * q
+            weights = {0: 1.0 - q[rows], 1: q[rows]}
         for shift, weight in weights.items():
             target = np.minimum(at + shift, levels.size - 1) - fixed
             ok = target >= 0
@@ -157,6 +139,7 @@ def file_jacobian(x, layout, f):
                                  (temperature.row, knots.start + temperature.col)),
                                 shape=(n, size))]
     d_wire_d_tau = lag_derivative(profile, tau, f.step) if layout.lags[f.index] is not None else None
+    weight = f.weight
     for dense, slope, sigma, offs in ((strain, d_strain, f.sigma["strain"], offsets),
                                       (resistance, d_resistance, f.sigma.get("resistance"), None)):
         if dense is None:
@@ -164,5 +147,5 @@ def file_jacobian(x, layout, f):
         extra = [(lag_b.row, knots.start + lag_b.col, slope[lag_b.row] * lag_b.data)]
         if d_wire_d_tau is not None:
             extra.append((np.arange(n), np.full(n, layout.lags[f.index]), slope * d_wire_d_tau))
-        blocks.append(_block(dense, offs, extra, n, size) / sigma)
+        blocks.append(sparse.diags(weight / sigma) @ _block(dense, offs, extra, n, size))
     return blocks

@@ -13,6 +13,7 @@ import numpy as np
 from scipy import stats
 
 from sma_fmu.identification.isobaric.fit import LAG_OPTIONS, RESIDUAL_OPTIONS, fit_isobaric
+from sma_fmu.identification.isobaric.summary import format_isobaric_report, half_strain_table
 from sma_fmu.identification.isobaric.cycles import parse_cycles, splitting_note
 from sma_fmu.identification.isobaric.figures import isobaric_figures
 from sma_fmu.identification.isobaric.files import read_isobaric
@@ -24,7 +25,20 @@ from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file
 from sma_fmu.runtime.constant_load import domain_energy, hysteresis_centre
 from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
 
-__all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report"]
+__all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report",
+           "TERM_MEANINGS"]
+
+TERM_MEANINGS = {
+    "nu_h": "cells per cooperative domain on heating (sets the heating transition width)",
+    "nu_c": "cells per cooperative domain on cooling (sets the cooling transition width)",
+    "w2": "share of the transformable fraction that transforms in the second stage",
+    "a2_h": "second-stage heating centre at no load", "b2_h": "its load slope",
+    "a2_c": "second-stage cooling centre at no load", "b2_c": "its load slope",
+    "nu2_h": "second-stage domain size on heating", "nu2_c": "second-stage domain size on cooling",
+    "alpha_P": "linear thermal expansion of the P phase",
+    "alpha_MF": "linear thermal expansion of the M and F phases",
+    "span_ratio_0": "transformation-strain factor s at no stress (s = 1 at saturation)",
+    "span_stress": "stress scale of the transformation-strain law s(sigma)"}
 
 
 def file_loads(files, loads=None, stresses=None, diameter=None):
@@ -76,8 +90,9 @@ def _lag_note(lag):
     return note
 
 
-def isobaric_report(files, fit, base_set, residual, rows):
+def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
     """The JSON-ready report of an isobaric fit."""
+    halfway = half_strain_table(files, fit)
     params = fit.params
     half = stats.t.ppf(0.975, fit.dof)
     loads = sorted({d.load for d in files})
@@ -86,11 +101,13 @@ def isobaric_report(files, fit, base_set, residual, rows):
         for name, v, e in zip(fit.wire_names, fit.wire_values, fit.wire_std_errors)}
     unknowns = {name: {"value": float(v), "std_error": float(e), "start": float(s)}
                 for name, v, e, s in zip(fit.names, fit.values, fit.std_errors, fit.starts)}
-    fixed = ["eps_T", "xi_F_inf", "f_F"] + [n for n in ("b_h", "b_c", "x_min", "R_P", "R_M", "R_F")
+    fixed = ["eps_T", "xi_F_inf", "f_F"] + [n for n in ("b_h", "b_c", "x_min", "R_P", "R_M", "R_F",
+                                                        "T_alpha", "span_ratio_sat",
+                                                        "span_stress")
                                           if n not in fit.wire_names]
     per_file = []
-    for data, offsets, sigma, lag, knots in zip(files, fit.offsets, fit.sigma, fit.lags,
-                                                fit.knots_per_branch):
+    for data, offsets, sigma, lag, knots, rms_of_file in zip(
+            files, fit.offsets, fit.sigma, fit.lags, fit.knots_per_branch, fit.file_rms):
         per_file.append({
             "file": str(data.path), "load_kg": data.load,
             "cycles_found": splitting_note(data.splitting, data.branches, data.time is not None),
@@ -99,17 +116,23 @@ def isobaric_report(files, fit, base_set, residual, rows):
             "stress_MPa": stress_of_load(data.load, params.diameter),
             "points": int(data.strain.size),
             "columns": {q: list(v) for q, v in data.columns.items()},
+            "strain_column_note": data.strain_note,
+            "stress_column_MPa": data.stress_column,
             "branches": len(data.branches),
             "cycles": len({b.cycle for b in data.branches if b.complete}),
             "noise_estimates": sigma,
+            "residual_rms": rms_of_file,
             "strain_offsets_per_level": offsets,
             "residual_strain_per_cycle": list(np.diff(offsets)) if residual == "per-cycle" else []})
     widths = {}
     for load in loads:
-        energy = domain_energy(load, params)
         centre_K = hysteresis_centre(load, HEATING, params) + KELVIN_OFFSET
-        widths[f"{load:g} kg"] = {"dH_J": energy, "width_25_75_K_heating": 2 * np.log(3) * BOLTZMANN
-                                  * centre_K ** 2 / energy}
+        entry = {}
+        for word, nu in (("heating", params.terms.nu_h), ("cooling", params.terms.nu_c)):
+            energy = domain_energy(load, params, nu)
+            entry[f"dH_J_{word}"] = energy
+            entry[f"width_25_75_K_{word}"] = 2 * np.log(3) * BOLTZMANN * centre_K ** 2 / energy
+        widths[f"{load:g} kg"] = entry
     return {
         "experiment": "isobaric",
         "files": per_file,
@@ -123,7 +146,22 @@ def isobaric_report(files, fit, base_set, residual, rows):
                                 "matrix": [[float(v) for v in r] for r in fit.covariance]},
         "hysteresis_centres_degC": _centres(fit, loads),
         "transition": widths,
-        "fixed_from_base": {name: getattr(params, name) for name in fixed},
+        "fixed_from_base": {name: getattr(params.terms, name, None) if getattr(params, name) is None
+                            else getattr(params, name) for name in fixed},
+        "stages": fit.stages,
+        "stage_note": fit.stage_note,
+        "on_bound": fit.on_bound,
+        "undetermined": {"unknowns": fit.undetermined,
+                         "note": "touched by no residual (the strain levels of left-out cycles): "
+                                 "kept at their starting values, standard error reported as 0"},
+        "outlier_cycles": [{k: v for k, v in c.items() if k != "name"} | {"note": c["name"]}
+                           for c in fit.outlier_cycles],
+        "outliers": outliers,
+        "half_strain": halfway,
+        "centre_slopes_K_per_MPa": {
+            name: float(getattr(params, name) if getattr(params, name) is not None
+                        else getattr(params.terms, name)) * load_of_stress(1.0, params.diameter)
+            for name in ("b_h", "b_c") + (("b2_h", "b2_c") if params.terms.two_stage else ())},
         "residual_rms": fit.residual_rms,
         "noise_estimates": fit.noise,
         "verdict": fit.verdict,
@@ -137,8 +175,26 @@ def isobaric_report(files, fit, base_set, residual, rows):
     }
 
 
+def resolve_lag(lag, data):
+    """("fit" or "none", note): ``auto`` fits the lag only when every file holds two complete
+    cycles or more. With one cycle at one ramp rate, a lag shifts heating up and cooling
+    down just as a wider hysteresis does, and only the one turn could tell them apart (the
+    shared Flexinol files: lags of 8-12 samples, stress slopes 0.17/0.11 K/MPa instead of
+    0.124/0.134)."""
+    if lag != "auto":
+        return lag, ""
+    fewest = min(sum(1 for b in d.branches if b.complete and b.direction == HEATING)
+                 for d in data)
+    if fewest >= 2:
+        return "fit", ""
+    return "none", ("--lag auto: no lag fitted, as a file holds a single complete cycle (one "
+                    "ramp rate: a lag cannot be told from a wider hysteresis); --lag fit "
+                    "fits it anyway")
+
+
 def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
-                     reference_length=None, progress=lambda text: None, cycles=None, lag="fit"):
+                     reference_length=None, progress=lambda text: None, cycles=None, lag="auto",
+                     stages=2, outliers="leave-out", widths="auto"):
     """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report.
 
     ``cycles``: the text of ``--cycles`` (``5:``, ``3:10``, ``:20``, ``4``) or None for all;
@@ -149,8 +205,8 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
     if residual not in RESIDUAL_OPTIONS:
         raise ValueError(f"--residual-strain must be one of {', '.join(RESIDUAL_OPTIONS)}, "
                          f"got {residual!r}")
-    if lag not in LAG_OPTIONS:
-        raise ValueError(f"--lag must be one of {', '.join(LAG_OPTIONS)}, got {lag!r}")
+    if lag not in LAG_OPTIONS + ("auto",):
+        raise ValueError(f"--lag must be one of {', '.join(LAG_OPTIONS + ('auto',))}, got {lag!r}")
     selection = parse_cycles(cycles) if cycles is not None else None
     check_folder(out_dir)
     base_set = load_parameter_set(model)
@@ -161,14 +217,25 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
             for f, load in zip(files, per_file)]
     for d in data:
         progress(f"{d.path.name}: {splitting_note(d.splitting, d.branches, d.time is not None)}")
+    lag, lag_note = resolve_lag(lag, data)
+    if lag_note:
+        progress(lag_note)
     progress(f"fitting {len(data)} file(s), {sum(d.strain.size for d in data)} points ...")
-    fit = fit_isobaric(data, base, residual, lag, progress=progress)
+    fit = fit_isobaric(data, base, residual, lag, progress=progress, stages=stages,
+                       outliers=outliers, widths=widths)
     progress("transformation temperatures and figures ...")
     per_cycle = residual == "per-cycle"
     rows = [row for d, offsets, profile, bounds in zip(data, fit.offsets, fit.profiles,
                                                        fit.wire_bounds)
             for row in cycle_rows(d, fit.params, offsets, profile, per_cycle, bounds)]
-    report = isobaric_report(data, fit, base_set, residual, rows)
+    top = max(stress_of_load(d.load, base.diameter) for d in data)
+    hottest = max(float(d.temperature.max()) for d in data)
+    if top > fit.params.stress_max:    # the fitted model is valid as far as its data go
+        fit.params = fit.params.replace(stress_max=float(np.ceil(top)))
+    if hottest > fit.params.T_max:
+        fit.params = fit.params.replace(T_max=float(np.ceil(hottest)))
+    report = isobaric_report(data, fit, base_set, residual, rows, outliers)
+    report["lag_choice"] = {"option": lag, "note": lag_note}
     figures = isobaric_figures(data, fit, per_cycle, rows)
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     names = ", ".join(Path(f).name for f in files)
@@ -176,9 +243,11 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         write_parameter_file(
             folder / "identified.toml", fit.params, f"{base_set.name}-isobaric",
             f"isobaric fit of {names}; strain RMS {fit.residual_rms['strain']:.3g}",
-            base_set.meanings,
+            {**TERM_MEANINGS, **(base_set.meanings or {})},
             header=[f"Identified by sma-fmu fit isobaric on {stamp}.",
-                    f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}.",
+                    f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}"
+                    f" (validity.stress_max and T_max raised to the largest fitted stress and "
+                    f"temperature where they were lower).",
                     f"Data: {', '.join(str(f) for f in files)} at "
                     f"{', '.join(f'{d.load:g}' for d in data)} kg"])
         (folder / "report.json").write_text(json_text(report), encoding="utf-8")
@@ -187,31 +256,3 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         for name, png in figures.items():
             (folder / name).write_bytes(png)
     return report
-
-
-def format_isobaric_report(report):
-    """A short text summary of an isobaric fit report."""
-    rms = report["residual_rms"]
-    solver = report["solver"]
-    noise = report["noise_estimates"]
-    lines = [f"isobaric fit: {report['points']} points in {len(report['files'])} file(s); "
-             f"{solver['seconds']:.2f} s ({solver['evaluations']} evaluations)",
-             f"residual RMS (noise estimate): strain {rms['strain']:.3g} ({noise['strain']:.3g}), "
-             f"temperature {rms['temperature_K']:.3g} K ({noise['temperature_K']:.3g} K)"
-             + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
-                if rms["resistance_ohm"] else ""),
-             report["verdict"]]
-    for entry in report["files"]:
-        lines.append(f"{Path(entry['file']).name}: {entry['cycles_found']}")
-        if entry["lag"]:
-            lag = entry["lag"]
-            lines.append(f"{Path(entry['file']).name}: lag {lag['value']:.4g} +- "
-                         f"{lag['std_error']:.2g} {lag['unit']} ({lag['note']})")
-    lines.append(f"{'parameter':<12}{'value':>14}{'std error':>12}")
-    for name, row in report["parameters"].items():
-        lines.append(f"{name:<12}{row['value']:>14.6g}{row['std_error']:>12.3g}")
-    for load, centre in report["hysteresis_centres_degC"].items():
-        lines.append(f"centres at {load}: heating {centre['heating']['value']:.2f} +- "
-                     f"{centre['heating']['std_error']:.2f} degC, cooling "
-                     f"{centre['cooling']['value']:.2f} +- {centre['cooling']['std_error']:.2f} degC")
-    return "\n".join(lines)

@@ -16,7 +16,9 @@ temperature has turned. The file reports:
 - a residual strain that grows during each cooling transformation, in proportion to the
   transformed share q = xi_MF/M: cycle k leaves ``residual * decay**k`` behind (the
   training drift of a fresh wire), so each cycle's loop is open by that amount,
-- optionally time [s] and resistance [ohm] with noise ``noise_ohm``.
+- optionally time [s] and resistance [ohm] with noise ``noise_ohm``,
+- optionally a first cycle unlike the rest: its transformation ``first_shift_K`` [K] hotter
+  (a fresh wire's first cycle).
 
 A header of ``#`` lines states the load, the programme, the noise and the true drift.
 A lab-like file (issue 26): ``IsobaricProgramme(t_low=20, t_high=115, rate=20, cycles=100,
@@ -29,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sma_fmu.identification.isobaric.lag import lagged
-from sma_fmu.identification.isobaric.model import branch_share, branch_levels
+from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.runtime.constants import COOLING, HEATING, STANDARD_GRAVITY
 
 __all__ = ["IsobaricProgramme", "temperature_programme", "wire_temperature", "isobaric_table", "isobaric_text",
@@ -66,6 +68,7 @@ class IsobaricProgramme:
     decay: float = 0.5             # ratio of one cycle's residual strain to the previous
     seed: int = 0
     lag_s: float = 0.0             # time constant of the wire behind the thermocouple [s]
+    first_shift_K: float = 0.0     # the first cycle's transformation this much hotter [K]
 
     def __post_init__(self):
         if not self.t_high > self.t_low:
@@ -76,7 +79,8 @@ class IsobaricProgramme:
         for name in ("rate",):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
-        for name in ("dwell", "noise_K", "noise_strain", "noise_ohm", "residual", "decay", "lag_s"):
+        for name in ("dwell", "noise_K", "noise_strain", "noise_ohm", "residual", "decay", "lag_s",
+                     "first_shift_K"):
             if not getattr(self, name) >= 0:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be >= 0")
 
@@ -141,13 +145,13 @@ def isobaric_table(params, load, programme, strain_unit="percent", with_time=Tru
                                                * programme.decay ** np.arange(programme.cycles))])
     for d in (HEATING, COOLING):
         rows = direction == d
-        levels = branch_levels(load, d, params, reference)
-        share = branch_share(true_t[rows], levels.constants)
+        shift = np.where(cycle[rows] == 0, programme.first_shift_K, 0.0)
+        model, ohm, share = branch_curve(true_t[rows] - shift, load, d, params, reference)
         drift = offsets[cycle[rows]]
         if d == COOLING:
             drift = drift + (offsets[cycle[rows] + 1] - offsets[cycle[rows]]) * share
-        strain[rows] = levels.strain_hot + levels.strain_span * share + drift
-        resistance[rows] = levels.resistance_hot + levels.resistance_span * share
+        strain[rows] = model + drift
+        resistance[rows] = ohm
     columns = {}
     if with_time:
         columns["time_s"] = time

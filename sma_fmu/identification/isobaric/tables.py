@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from sma_fmu.identification.isobaric.model import branch_levels, branch_share
+from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.identification.transformation_temperatures import (QUANTITIES,
                                                                 branch_tangents_or_reason,
                                                                 cycle_numbers)
@@ -29,13 +29,13 @@ SOURCES = ("data", "data_wire", "model")
 
 def model_branch_strain(temperature, branch, data, params, offsets, per_cycle=True):
     """Model strain [1] of one branch at ``temperature`` [degC], with its offsets [1]."""
-    levels = branch_levels(data.load, branch.direction, params, data.reference_length)
-    q = branch_share(temperature, levels.constants)
+    strain, _, q = branch_curve(temperature, data.load, branch.direction, params,
+                                data.reference_length)
     level = branch.level if per_cycle else 0
     offset = offsets[min(level, len(offsets) - 1)]
     if branch.direction == COOLING and per_cycle:
         offset = offset + (offsets[min(level + 1, len(offsets) - 1)] - offset) * q
-    return levels.strain_hot + levels.strain_span * q + offset
+    return strain + offset
 
 
 _NEEDS = {"A_s": (HEATING,), "A_f": (HEATING,), "actuation_strain": (HEATING,),

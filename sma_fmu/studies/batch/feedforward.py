@@ -17,10 +17,13 @@ several times slower), in place (``out=``) where it can.
 import numpy as np
 
 from sma_fmu.runtime.phase_lag import tustin_coefficients
+from sma_fmu.studies.batch.branches import two_stage_temperatures
 from sma_fmu.studies.batch.minor_loops import (MinorLoopMemory, clamp_fractions,
                                                temperature_of_fractions)
 
-__all__ = ["BatchFeedforward", "FeedforwardChunk"]
+__all__ = ["BatchFeedforward", "FeedforwardChunk", "STAGE_FIELDS"]
+
+STAGE_FIELDS = ("M1", "M2", "energy2_heating", "energy2_cooling", "inv2_heating", "inv2_cooling")
 
 
 class FeedforwardChunk:
@@ -80,7 +83,8 @@ class BatchFeedforward:
         self.split = sum(1 for key in keys if key[2] != "minor-loop")   # first minor column
         minor = [scenarios[run].compensator_params for run in chosen[self.split:]]
         self.minor = (MinorLoopMemory([q.saturation_margin for q in minor],
-                                      [q.memory_depth for q in minor]) if minor else None)
+                                      [q.memory_depth for q in minor],
+                                      [q.terms.two_stage for q in minor]) if minor else None)
         coefficients = [tustin_coefficients(scenarios[run].controller.alpha,
                                             scenarios[run].controller.beta, inputs.step_s)
                         for run in self.runs]
@@ -104,9 +108,14 @@ class BatchFeedforward:
             [q.R_F - q.R_P for q in p])
         delta = column([q.saturation_margin for q in p]) * M
         self._terms = {"hot": hot, "cold": hot + M * self.span, "delta": delta,
-                       "upper": M - delta, "M": M, "energy": table["energy_over_kB"][:, runs],
+                       "upper": M - delta, "M": M,
+                       "energy_heating": table["energy_over_kB"][:, runs],
+                       "energy_cooling": table["energy_cooling"][:, runs],
                        "inv_heating": table["inv_centre_heating"][:, runs],
                        "inv_cooling": table["inv_centre_cooling"][:, runs]}
+        for name in STAGE_FIELDS:               # the issue-36 second stage (0: one stage)
+            self._terms[name] = table[name][:, runs]
+        self.two_stage = np.array([q.terms.two_stage for q in p], dtype=bool)
 
     def chunk(self, start, stop):
         """The :class:`FeedforwardChunk` of steps ``start`` ... ``stop - 1`` (in order)."""
@@ -197,21 +206,33 @@ class BatchFeedforward:
         # temperature_of_fractions: clamp into [delta, M - delta] and flag it
         delta, upper = take("delta"), take("upper")
         saturated = clamp_fractions(xi_mf, xi_p, delta, upper)
-        energy = take("energy")
+        energy = np.where(heating, take("energy_heating"), take("energy_cooling"))
         inverse = np.where(heating, take("inv_heating"), take("inv_cooling"))
         shape = xi_mf.shape
         sensed, exponent, bad = np.empty(shape), np.empty(shape), np.empty(shape, dtype=bool)
+        two_stage = self.two_stage[part]
+        stages = None
+        if two_stage.any():
+            stages = {"M1": take("M1"), "M2": take("M2"), "minus_energy": -energy,
+                      "minus_energy2": -np.where(heating, take("energy2_heating"),
+                                                 take("energy2_cooling")),
+                      "inverse": inverse,
+                      "inverse2": np.where(heating, take("inv2_heating"), take("inv2_cooling"))}
         if memory is None:
             temperature_of_fractions(xi_mf, xi_p, inverse, energy, sensed, exponent, bad)
+            if stages is not None:
+                two_stage_temperatures(xi_mf, xi_p, exponent, inverse, energy, stages,
+                                       two_stage, sensed, bad)
         else:                          # the minor-loop inverse, with its reversal stacks
-            memory.invert({"raw_mf": raw[0], "raw_p": raw[1], "mf": xi_mf, "p": xi_p,
-                           "clamped": saturated.copy(), "delta": delta, "upper": upper,
-                           "M": take("M"), "energy": energy, "inverse": inverse,
-                           "inv_heating": take("inv_heating"),
-                           "inv_cooling": take("inv_cooling"),
-                           "heating": np.broadcast_to(heating, shape)},
-                          {"T_ref": sensed, "saturated": saturated, "bad": bad,
-                           "exponent": exponent})
+            stage = {"raw_mf": raw[0], "raw_p": raw[1], "mf": xi_mf, "p": xi_p,
+                     "clamped": saturated.copy(), "delta": delta, "upper": upper,
+                     "M": take("M"), "energy": energy, "inverse": inverse,
+                     "heating": np.broadcast_to(heating, shape)}
+            for name in ("energy_heating", "energy_cooling", "inv_heating", "inv_cooling",
+                         *STAGE_FIELDS):
+                stage[name] = take(name)
+            memory.invert(stage, {"T_ref": sensed, "saturated": saturated, "bad": bad,
+                                  "exponent": exponent})
         return sensed, saturated, bad, exponent, np.broadcast_to(energy, shape)
 
     def _filter(self, values):

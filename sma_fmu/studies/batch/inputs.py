@@ -22,7 +22,24 @@ from sma_fmu.runtime.thermal import step_decay
 __all__ = ["BatchInputs", "CONSTANT_FIELDS", "LOAD_TOLERANCE_S"]
 
 LOAD_TOLERANCE_S = 1e-9   # LoadProfile.value's: a switching time this close counts as reached
-CONSTANT_FIELDS = ("M", "xi_F_min", "energy_over_kB", "inv_centre_heating", "inv_centre_cooling")
+CONSTANT_FIELDS = ("M", "xi_F_min", "energy_over_kB", "inv_centre_heating", "inv_centre_cooling",
+                   "energy_cooling", "M1", "M2", "energy2_heating", "energy2_cooling",
+                   "inv2_heating", "inv2_cooling", "length_M", "length_F")
+# energy_over_kB is the heating branch's (nu_h); the rest are the issue-36 terms
+# (runtime/model_terms.py): 0 for the second stage of a one-stage wire (M1 = M, M2 = 0, so
+# the two-stage sum equals the one-stage split exactly) and l_M, l_F without strain terms
+
+
+def _row(heating, cooling, params):
+    """The CONSTANT_FIELDS of one load: the heating and cooling BranchConstants."""
+    two = heating.w2 != 0.0
+    return (heating.M, heating.xi_F_min, heating.energy_over_kB, heating.inv_centre_K,
+            cooling.inv_centre_K, cooling.energy_over_kB,
+            heating.M1 if two else heating.M, heating.M2 if two else 0.0,
+            heating.energy2_over_kB if two else 0.0, cooling.energy2_over_kB if two else 0.0,
+            heating.inv_centre2_K if two else 0.0, cooling.inv_centre2_K if two else 0.0,
+            params.l_M if heating.length_M is None else heating.length_M,
+            params.l_F if heating.length_F is None else heating.length_F)
 
 
 def _reference_key(reference):
@@ -190,8 +207,7 @@ class BatchInputs:
                         if heating is not None:
                             heating[key] = branch
                         cooling = branch_constants(load, COOLING, params)
-                        memo[key] = (branch.M, branch.xi_F_min, branch.energy_over_kB,
-                                     branch.inv_centre_K, cooling.inv_centre_K)
+                        memo[key] = _row(branch, cooling, params)
                     rows.append(memo[key])
             except ValueError as error:
                 self.failures[run] = str(error)

@@ -31,11 +31,15 @@ from sma_fmu.runtime.constant_load import BranchConstants
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
 from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, push_reversal
 from sma_fmu.runtime.sensing import invert_on_stack
-from sma_fmu.studies.batch.plant import major_fractions
+from sma_fmu.studies.batch.branches import (major_fractions, two_stage_fractions,
+                                            two_stage_temperatures)
 
 __all__ = ["clamp_fractions", "temperature_of_fractions", "MinorLoopMemory", "WINDOW"]
 
 WINDOW = 64      # samples per round after the first (which takes the whole chunk)
+# what an event needs of a sample (the last sample of a chunk is carried to the next)
+_CARRIED = ("raw_mf", "raw_p", "M", "energy", "inverse", "heating", "M1", "M2",
+            "energy2_heating", "energy2_cooling", "inv2_heating", "inv2_cooling")
 
 
 def clamp_fractions(xi_mf, xi_p, delta, upper):
@@ -80,8 +84,12 @@ class MinorLoopMemory:
     ``FeedforwardStepper.reversals``.
     """
 
-    def __init__(self, margins, depths):
+    def __init__(self, margins, depths, two_stage=None):
         count = len(margins)
+        # which columns have an issue-36 second stage (their branches: branches.py)
+        self.two_stage = np.zeros(count, dtype=bool) if two_stage is None else np.array(
+            two_stage, dtype=bool)
+        self.any_two_stage = bool(self.two_stage.any())
         self.margins, self.depths = [float(m) for m in margins], [int(d) for d in depths]
         self.points = [[] for _ in range(count)]
         # the top pair of each stack: A = the top, B = the point below (if any)
@@ -125,7 +133,7 @@ class MinorLoopMemory:
                         reversing)
         last = rows - 1
         self._carry = {name: np.array(np.broadcast_to(stage[name][-1], (columns,)))
-                       for name in ("raw_mf", "raw_p", "M", "energy", "inverse", "heating")}
+                       for name in _CARRIED if name in stage}
         self.last_heating = np.array(heating[last])
         self._offset += rows
 
@@ -176,14 +184,16 @@ class MinorLoopMemory:
         mf, p, clamped = pick("mf"), pick("p"), pick("clamped")
         M, energy, delta, upper = pick("M"), pick("energy"), pick("delta"), pick("upper")
         inverse = np.where(heating, pick("inv_heating"), pick("inv_cooling"))
+        own = np.where(heating, pick("energy_heating"), pick("energy_cooling"))   # dH/k_B of d
+        stages = self._stages(pick, heating, own, inverse) if self.any_two_stage else None
         T_A, xi_A = self.T_A[columns], self.xi_A[columns]
         T_B, xi_B = self.T_B[columns], self.xi_B[columns]
         target = np.where(heating, mf, p)
         value_A = np.where(heating, xi_A, M - xi_A)
         value_B = np.where(nested, np.where(heating, xi_B, M - xi_B), 0.0)
-        xi_mf, xi_p = major_fractions(T_A, M, -energy, inverse)
+        xi_mf, xi_p = self._major(T_A, M, own, inverse, stages)
         major_A = np.where(heating, xi_mf, xi_p)
-        xi_mf, xi_p = major_fractions(T_B, M, -energy, inverse)
+        xi_mf, xi_p = self._major(T_B, M, own, inverse, stages)
         major_B = np.where(nested, np.where(heating, xi_mf, xi_p), 0.0)
         spread, span = major_A - major_B, value_A - value_B
         offset = target - value_B
@@ -197,11 +207,33 @@ class MinorLoopMemory:
         shape = new_mf.shape
         T, exponent, bad = np.empty(shape), np.empty(shape), np.empty(shape, dtype=bool)
         temperature_of_fractions(new_mf, new_p, pick("inverse"), energy, T, exponent, bad)
+        if stages is not None:
+            sample = self._stages(pick, None, energy, pick("inverse"))   # d_ref of the sample
+            two_stage_temperatures(new_mf, new_p, exponent, pick("inverse"), energy, sample,
+                                   self.two_stage[columns], T, bad)
         if flat.any():                                  # flat: T_A, saturated
             np.copyto(T, np.broadcast_to(T_A, shape), where=flat)
             bad &= ~flat
         saturated = clamped | second | flat
         return T, saturated, bad, exponent, pops
+
+    def _stages(self, pick, heating, energy, inverse):
+        """The two-stage constants of the picked samples, in the direction ``heating`` (each
+        column's) or, with None, in each sample's d_ref (``pick("heating")``)."""
+        if heating is None:
+            heating = pick("heating")
+        return {"M1": pick("M1"), "M2": pick("M2"), "minus_energy": -energy,
+                "minus_energy2": -np.where(heating, pick("energy2_heating"),
+                                           pick("energy2_cooling")),
+                "inverse": inverse,
+                "inverse2": np.where(heating, pick("inv2_heating"), pick("inv2_cooling"))}
+
+    @staticmethod
+    def _major(temperature, M, energy, inverse, stages):
+        """(xi_MF, xi_P) of the major branches at ``temperature`` [degC] (one or two stages)."""
+        if stages is None:
+            return major_fractions(temperature, M, -energy, inverse)
+        return two_stage_fractions(temperature, stages)
 
     def _event(self, column, row, stage, out, reversal):
         """Sample ``row`` of ``column`` with the runtime's functions (FeedforwardStepper._invert):
@@ -216,18 +248,16 @@ class MinorLoopMemory:
             if self._event_sample[column] == sample - 1:      # the previous sample was an event
                 assumed = self._event_assumed[column]
             elif row > 0:
-                assumed = self._assumed(column, points, *(at(name, row - 1) for name in (
-                    "raw_mf", "raw_p", "M", "energy", "inverse", "heating")))
+                assumed = self._assumed(column, points, {name: at(name, row - 1)
+                                                         for name in _CARRIED if name in stage})
             else:                                             # the previous chunk's last sample
-                assumed = self._assumed(column, points, *(float(self._carry[name][column])
-                                                          for name in ("raw_mf", "raw_p", "M",
-                                                                       "energy", "inverse",
-                                                                       "heating")))
+                assumed = self._assumed(column, points, {
+                    name: float(values[column]) for name, values in self._carry.items()})
             points = list(points)
             push_reversal(points, assumed[0], assumed[1], self.depths[column])
         xi_mf, xi_p = at("raw_mf", row), at("raw_p", row)
-        constants = BranchConstants(at("M", row), None, at("energy", row), at("inverse", row),
-                                    None)
+        constants = self._constants(column, {name: at(name, row) for name in _CARRIED
+                                             if name in stage})
         direction = HEATING if at("heating", row) else COOLING
         try:
             sensed, points, fraction = invert_on_stack(xi_mf, xi_p, constants, direction, points,
@@ -241,11 +271,23 @@ class MinorLoopMemory:
         out["T_ref"][row, column], out["saturated"][row, column] = T, saturated
         out["bad"][row, column], out["exponent"][row, column] = bad, math.nan
 
-    def _assumed(self, column, points, xi_mf, xi_p, M, energy, inverse, heating):
+    def _constants(self, column, sample):
+        """The BranchConstants of one sample (``sample``: {name: float} of _CARRIED)."""
+        constants = BranchConstants(sample["M"], None, sample["energy"], sample["inverse"], None)
+        if not self.two_stage[column]:
+            return constants
+        heating = sample["heating"]
+        return constants._replace(
+            w2=1.0, M1=sample["M1"], M2=sample["M2"],
+            energy2_over_kB=sample["energy2_heating" if heating else "energy2_cooling"],
+            inv_centre2_K=sample["inv2_heating" if heating else "inv2_cooling"])
+
+    def _assumed(self, column, points, sample):
         """(T_ref, xi_MF) the compensator assumed at a sample that was no event (its stack
         ``points`` unchanged by it): FeedforwardStepper._invert's state."""
-        constants = BranchConstants(M, None, energy, inverse, None)
-        direction = HEATING if heating else COOLING
+        xi_mf, xi_p = sample["raw_mf"], sample["raw_p"]
+        constants = self._constants(column, sample)
+        direction = HEATING if sample["heating"] else COOLING
         try:
             sensed, _, xi_mf = invert_on_stack(xi_mf, xi_p, constants, direction, points,
                                                self.margins[column])

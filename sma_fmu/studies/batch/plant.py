@@ -28,6 +28,12 @@ Each run's branch is cached until its stack or its load changes, as the scalar p
 caches it; the per-step check for wiping out is a product and a comparison,
 sign(d) T+ >= sign(d) T_B, against a cached bound (+inf below two points). Per step the minor branches then cost
 v = value_B + ratio (L_d(T+) - major_B), the clamp into [0, M] and the selection.
+
+The terms of issue 36 (runtime/model_terms.py): dH/k_B of each run's direction (nu_h, nu_c)
+is selected with the direction masks; when some run has a second stage, every run's major
+branch is the two-stage sum of :mod:`.branches` (exact for one-stage runs: M2 = 0); when
+some run has strain terms, every run's length is the expanded, stress-scaled one (exact for
+runs without: alpha = 0, the given lengths).
 """
 import numpy as np
 
@@ -35,30 +41,15 @@ from sma_fmu.runtime.constant_load import BranchConstants
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
 from sma_fmu.runtime.minor_loops import (DENOMINATOR_FLOOR, ReversalPoint, branch_of, push_reversal,
                                          wipe_out)
+from sma_fmu.studies.batch.branches import major_fractions, two_stage_fractions, wire_lengths
+from sma_fmu.studies.batch.terms import PlantTerms
 
 __all__ = ["BatchPlant", "major_fractions", "FEW_RUNS"]
 
 FEW_RUNS = 8     # events of at most this many runs in a step are handled one run at a time
 
 
-def major_fractions(temperature, M, minus_energy, inv_centre):
-    """(xi_MF, xi_P) [1] on major branches, as :func:`branch_fractions` computes them.
-
-    ``temperature`` [degC]; ``M`` [1]; ``minus_energy`` = -dH/k_B [K]; ``inv_centre`` =
-    1/tau_K [1/K]. With z = E (1/tau_K - 1/T_K) and e = exp(-|z|) (no overflow; -|z| =
-    (-E) |1/tau_K - 1/T_K| exactly, as E > 0): xi_MF = M e/(1 + e) and xi_P = M/(1 + e)
-    for z > 0, swapped otherwise. The swap takes max(e, [z <= 0]) and max(e, [z > 0]) as
-    numerators, exact because 0 < e <= 1. (:meth:`BatchPlant.step` inlines the same calls.)
-    """
-    x = inv_centre - 1.0 / (temperature + KELVIN_OFFSET)
-    positive = (x > 0.0).astype(float)
-    e = np.exp(minus_energy * np.abs(x))
-    denominator = 1.0 + e
-    return (M * np.maximum(e, 1.0 - positive) / denominator,
-            M * np.maximum(e, positive) / denominator)
-
-
-class BatchPlant:
+class BatchPlant(PlantTerms):
     """The plants of a batch; state and outputs are arrays of N (one entry per run).
 
     Parameters
@@ -111,11 +102,14 @@ class BatchPlant:
         self.M, self.xi_F_min, self.minus_energy = np.empty(n), np.empty(n), np.empty(n)
         self._centres = np.empty((2, n))               # [1/tau_K heating; cooling]
         self.inv_heating, self.inv_cooling = self._centres
+        self._energies = np.empty((2, n))              # [-dH/k_B heating; cooling]
+        self._terms_arrays(p, n)
         self._set(inputs.segment_row(0), np.arange(n))
+        np.copyto(self.lengths, self._segment_lengths)
         # state [xi_MF; xi_P; xi_M], and a spare the next step writes into
         self._state, self._spare = np.empty((3, n)), np.empty((3, n))
-        self._state[0], self._state[1] = major_fractions(
-            self.temperature, self.M, self.minus_energy, self.inv_heating)
+        np.copyto(self.minus_energy, self._energies[0])
+        self._state[0], self._state[1] = self._major(self.temperature, slice(None), True)
         self._next_T = np.empty(n)
         self.xi_F, self.R = np.empty(n), np.empty(n)
         self._directions()
@@ -135,9 +129,10 @@ class BatchPlant:
         at, rows = self.inputs.constants, segments[runs]
         self.M[runs] = at["M"][rows, runs]
         self.xi_F_min[runs] = at["xi_F_min"][rows, runs]
-        self.minus_energy[runs] = -at["energy_over_kB"][rows, runs]
+        self._energies[0, runs] = -at["energy_over_kB"][rows, runs]
         self.inv_heating[runs] = at["inv_centre_heating"][rows, runs]
         self.inv_cooling[runs] = at["inv_centre_cooling"][rows, runs]
+        self._set_terms(at, rows, runs)
         self._new_constants = True
 
     def set_segments(self, segments, previous):
@@ -156,6 +151,7 @@ class BatchPlant:
         pair = self._pairs[0]
         np.multiply(self._centres, masks, pair)
         np.add(pair[0], pair[1], self.inverse)     # exactly one term is nonzero
+        self._direct_terms(masks, pair)
         self._new_constants = False
 
     def step(self, power):
@@ -199,10 +195,14 @@ class BatchPlant:
         np.maximum(e, numerators, out=numerators)
         mul(self.M, numerators, fractions)
         div(fractions, denominator, fractions)
+        if self.two_stage:                             # the issue-36 second stage
+            fractions[0], fractions[1] = two_stage_fractions(after, self._stages(slice(None)))
         if self.any_continuous:
             self._minor_branches(before, after, turned if changed else None, fractions)
         self._spare, self._state = self._state, state
         self._next_T, self.temperature = before, after
+        if self.strain:                                # the lengths of the load just held
+            np.copyto(self.lengths, self._segment_lengths)
         self._evaluate()
 
     def _minor_branches(self, before, after, turned, fractions):
@@ -295,6 +295,11 @@ class BatchPlant:
         constants = BranchConstants(
             float(self.M[run]), None, -float(self.minus_energy[run]),
             float(self.inv_heating[run] if heating else self.inv_cooling[run]), None)
+        if self.M2[run] != 0.0:                         # a second stage (w2 > 0)
+            constants = constants._replace(
+                w2=1.0, M1=float(self.M1[run]), M2=float(self.M2[run]),
+                energy2_over_kB=-float(self.minus_energy2[run]),
+                inv_centre2_K=float(self.inverse2[run]))
         branch = branch_of(points, c, constants, HEATING if heating else COOLING)
         self._value_B[run], self._ratio[run], self._major_B[run] = branch
 
@@ -357,16 +362,15 @@ class BatchPlant:
         if runs.size == 0:
             return
         heating, M = self.heating[runs], self.M[runs]
-        minus_energy, inverse = self.minus_energy[runs], self.inverse[runs]
         nested = c >= 2
         below = np.maximum(c - 2, 0)
         T_A, xi_A = self._stack_T[runs, c - 1], self._stack_xi[runs, c - 1]
         T_B, xi_B = self._stack_T[runs, below], self._stack_xi[runs, below]
         value_A = np.where(heating, xi_A, M - xi_A)
-        xi_mf, xi_p = major_fractions(T_A, M, minus_energy, inverse)
+        xi_mf, xi_p = self._major(T_A, runs)
         major_A = np.where(heating, xi_mf, xi_p)
         value_B = np.where(nested, np.where(heating, xi_B, M - xi_B), 0.0)
-        xi_mf, xi_p = major_fractions(T_B, M, minus_energy, inverse)
+        xi_mf, xi_p = self._major(T_B, runs)
         major_B = np.where(nested, np.where(heating, xi_mf, xi_p), 0.0)
         denominator = major_A - major_B
         flat = np.abs(denominator) < DENOMINATOR_FLOOR       # the branch stays at A
@@ -386,5 +390,9 @@ class BatchPlant:
         np.add(self.R, w, self.R)
 
     def length(self):
-        """Wire length x [m] now: l_P xi_P + l_M xi_M + l_F xi_F."""
+        """Wire length x [m] now: l_P xi_P + l_M xi_M + l_F xi_F (with the strain terms:
+        :func:`~.branches.wire_lengths`)."""
+        if self.strain:
+            return wire_lengths(self.temperature, self.xi_P, self.xi_M, self.xi_F, self.l_P,
+                                self.lengths[0], self.lengths[1], self._expansion)
         return self.l_P * self.xi_P + self.l_M * self.xi_M + self.l_F * self.xi_F

@@ -2,7 +2,9 @@
  * runtime/constant_load.py.
  *   tau(f, d) = a_h + b_h f (heating), a_c + b_c f (cooling)   [degC]
  *   xi_Fmin(f) = xi_F_inf (1 - exp(-f/f_F)),  dH(f) = nu (eps_T - g f x_T / N)  [J]
- *   Lambda = (dH/k_B)(1/tau_K - 1/T_K),  xi_MF = M/(1 + e^Lambda),  xi_P = M - xi_MF */
+ *   Lambda = (dH/k_B)(1/tau_K - 1/T_K),  xi_MF = M/(1 + e^Lambda),  xi_P = M - xi_MF
+ * With the issue-36 terms (runtime/model_terms.py): dH with nu_h / nu_c, a second stage
+ * xi_MF = M (1 - w2)/(1 + e^Lambda1) + M w2/(1 + e^Lambda2), the stress law and expansion. */
 #ifndef SMA_CONSTANT_LOAD_H
 #define SMA_CONSTANT_LOAD_H
 
@@ -11,13 +13,19 @@
 #include "sma_message.h"
 
 /* Constants of one major branch at one load: M = 1 - xi_Fmin [1], xi_F_min [1],
- * energy_over_kB = dH/k_B [K], inv_centre_K = 1/tau_K [1/K], centre = tau [degC]. */
+ * energy_over_kB = dH/k_B [K] (nu_d of the direction), inv_centre_K = 1/tau_K [1/K],
+ * centre = tau [degC]; the second stage (w2 > 0, else w2 = 0 and the rest 0): M1 = M (1 - w2),
+ * M2 = M w2 [1], energy2_over_kB [K], inv_centre2_K [1/K], centre2 [degC]; the strain terms
+ * (has_lengths): length_M, length_F = l_P + s(sigma) (l_i - l_P) [m] at T_alpha. */
 typedef struct BranchConstants {
     double M;
     double xi_F_min;
     double energy_over_kB;
     double inv_centre_K;
     double centre;
+    double w2, M1, M2, energy2_over_kB, inv_centre2_K, centre2;
+    int has_lengths;
+    double length_M, length_F;
 } BranchConstants;
 
 /* `value` [degC] finite and above absolute zero, else refused naming `name`. */
@@ -26,14 +34,24 @@ int require_temperature(const char *name, double value, SmaMessage *message);
 double hysteresis_centre(double load, int direction, const WireParameters *params);
 /* Residual F fraction xi_Fmin(f) [1]. */
 double residual_f_fraction(double load, const WireParameters *params);
-/* dH(f) [J] -> *energy; refused when it overflows or is <= 0 (load beyond the model). */
-int domain_energy(double load, const WireParameters *params, double *energy,
+/* Second-stage centre tau2 [degC] = a2_d + b2_d f. */
+double second_centre(double load, int direction, const WireParameters *params);
+/* dH(f) [J] with domain size `nu` [1] -> *energy; refused when it overflows or is <= 0. */
+int domain_energy(double load, const WireParameters *params, double nu, double *energy,
                   SmaMessage *message);
+/* s(sigma) [1] of the stress law at `load` [kg] (model_terms.stress_ratio). */
+double stress_ratio(double load, const ModelTerms *terms);
+/* x [m] at `temperature` [degC] with the strain terms (model_terms.wire_length). */
+double wire_length(double temperature, double xi_p, double xi_m, double xi_f, double length_m,
+                   double length_f, const WireParameters *params);
 /* The BranchConstants for `load` [kg] and `direction`; refused as Python's ValueError. */
 int branch_constants(double load, int direction, const WireParameters *params,
                      BranchConstants *out, SmaMessage *message);
 /* Split `total` into (total/(1+e^z), total e^z/(1+e^z)) without overflow. */
 void logistic_split(double total, double exponent, double *first, double *second);
+/* (xi_MF, xi_P) [1] of a two-stage branch at 1/T_K = `inverse_kelvin` [1/K]. */
+void two_stage_fractions(double inverse_kelvin, const BranchConstants *constants, double *xi_mf,
+                         double *xi_p);
 /* (xi_MF, xi_P) [1] on a major branch at `temperature` [degC] (no argument checks). */
 void branch_fractions(double temperature, const BranchConstants *constants, double *xi_mf,
                       double *xi_p);

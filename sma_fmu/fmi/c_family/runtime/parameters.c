@@ -29,6 +29,21 @@ const ParameterSpec PARAMETER_SPECS[PARAM_COUNT] = {
     {"f_F", "constant_load", "kg", RULE_POSITIVE, 1},
     {"eps_T", "constant_load", "J", RULE_POSITIVE, 1},
     {"nu", "constant_load", "1", RULE_POSITIVE, 1},
+    {"nu_h", "constant_load", "1", RULE_POSITIVE, 0},
+    {"nu_c", "constant_load", "1", RULE_POSITIVE, 0},
+    {"w2", "second_stage", "1", RULE_FRACTION, 0},
+    {"a2_h", "second_stage", "degC", RULE_FINITE, 0},
+    {"b2_h", "second_stage", "degC/kg", RULE_FINITE, 0},
+    {"a2_c", "second_stage", "degC", RULE_FINITE, 0},
+    {"b2_c", "second_stage", "degC/kg", RULE_FINITE, 0},
+    {"nu2_h", "second_stage", "1", RULE_POSITIVE, 0},
+    {"nu2_c", "second_stage", "1", RULE_POSITIVE, 0},
+    {"alpha_P", "strain", "1/K", RULE_FINITE, 0},
+    {"alpha_MF", "strain", "1/K", RULE_FINITE, 0},
+    {"T_alpha", "strain", "degC", RULE_FINITE, 0},
+    {"span_ratio_0", "strain", "1", RULE_POSITIVE, 0},
+    {"span_ratio_sat", "strain", "1", RULE_POSITIVE, 0},
+    {"span_stress", "strain", "MPa", RULE_POSITIVE, 0},
     {"eps_f", "constant_temperature", "J", RULE_FINITE, 1},
     {"nu_f", "constant_temperature", "1", RULE_POSITIVE, 1},
     {"A_s", "thermal", "m2", RULE_POSITIVE, 1},
@@ -101,6 +116,51 @@ static int derived_failure(const WireParameters *p, const double *values, const 
                            reason, inputs);
 }
 
+/* The value in use of an optional parameter: `value`, or `fallback` when not given (NaN). */
+static double given(double value, double fallback)
+{
+    return isnan(value) ? fallback : value;
+}
+
+/* ModelTerms of the checked values v[] (model_terms.py's model_terms, same messages). */
+static int model_terms(const WireParameters *p, const double v[], ModelTerms *t,
+                       SmaMessage *message)
+{
+    double a2_h = v[PARAM_a2_h], a2_c = v[PARAM_a2_c];
+    t->nu_h = given(v[PARAM_nu_h], p->nu);
+    t->nu_c = given(v[PARAM_nu_c], p->nu);
+    t->w2 = given(v[PARAM_w2], 0.0);
+    if (t->w2 > 0.0) {
+        if (isnan(a2_h) || isnan(a2_c)) {
+            return sma_message_set(message, "%s: parameter second_stage.%s is required when "
+                                   "second_stage.w2 = %.17g > 0", p->source,
+                                   isnan(a2_h) ? "a2_h" : "a2_c", t->w2);
+        }
+    }
+    if (!isnan(a2_h) && !isnan(a2_c) && !(a2_h >= a2_c)) {
+        return sma_message_set(message, "%s: parameter second_stage.a2_h = %.17g degC must be >= "
+                               "second_stage.a2_c = %.17g degC: the heating centre may not lie "
+                               "below the cooling one", p->source, a2_h, a2_c);
+    }
+    t->a2_h = a2_h;
+    t->a2_c = a2_c;
+    t->b2_h = given(v[PARAM_b2_h], p->b_h);
+    t->b2_c = given(v[PARAM_b2_c], p->b_c);
+    t->nu2_h = given(v[PARAM_nu2_h], t->nu_h);
+    t->nu2_c = given(v[PARAM_nu2_c], t->nu_c);
+    t->alpha_P = given(v[PARAM_alpha_P], 0.0);
+    t->alpha_MF = given(v[PARAM_alpha_MF], 0.0);
+    t->T_alpha = given(v[PARAM_T_alpha], DEFAULT_T_ALPHA);
+    t->span_ratio_0 = given(v[PARAM_span_ratio_0], 1.0);
+    t->span_ratio_sat = given(v[PARAM_span_ratio_sat], 1.0);
+    t->span_stress = given(v[PARAM_span_stress], DEFAULT_SPAN_STRESS);
+    t->two_stage = t->w2 > 0.0;
+    t->strain = t->alpha_P != 0.0 || t->alpha_MF != 0.0 || t->span_ratio_0 != 1.0
+                || t->span_ratio_sat != 1.0;
+    t->area = SMA_PI * p->diameter * p->diameter / 4.0;
+    return 0;
+}
+
 /* The parameter values as checked (defaults for optional ones not given), in spec order. */
 static int check_values(WireParameters *p, const double values[], double checked[],
                         SmaMessage *message)
@@ -115,7 +175,7 @@ static int check_values(WireParameters *p, const double values[], double checked
             } else if (index == PARAM_stress_max) {
                 value = DEFAULT_STRESS_MAX;
             } else {
-                checked[index] = value;   /* alpha: None */
+                checked[index] = value;   /* alpha and the terms: None */
                 continue;
             }
         }
@@ -204,6 +264,9 @@ int wire_parameters_from_values_source(WireParameters *out, const double values[
     p.load_max = p.stress_max * 1e6 * SMA_PI * square / 4.0 / STANDARD_GRAVITY;
     if (derived_failure(&p, v, "validity load limit stress_max * pi diameter^2 / 4 / g", "kg",
                         STRESS, 2, &p.load_max, 1, failure, message)) {
+        return 1;
+    }
+    if (model_terms(&p, v, &p.terms, message)) {
         return 1;
     }
     if (!(p.R_MF > p.R_P)) {

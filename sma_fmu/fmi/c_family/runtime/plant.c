@@ -21,7 +21,12 @@ static void evaluate(PlantStepper *stepper, const BranchConstants *constants)
     double xi_f = constants->xi_F_min + xi_m;
     outputs->R = params->R_P * xi_p + params->R_M * xi_m + params->R_F * xi_f;
     outputs->T = stepper->temperature;
-    outputs->x = params->l_P * xi_p + params->l_M * xi_m + params->l_F * xi_f;
+    if (!constants->has_lengths) {
+        outputs->x = params->l_P * xi_p + params->l_M * xi_m + params->l_F * xi_f;
+    } else {   /* the strain terms: stress law and thermal expansion */
+        outputs->x = wire_length(stepper->temperature, xi_p, xi_m, xi_f, constants->length_M,
+                                 constants->length_F, params);
+    }
     outputs->xi_P = xi_p;
     outputs->xi_M = xi_m;
     outputs->xi_F = xi_f;

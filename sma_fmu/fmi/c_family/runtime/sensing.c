@@ -29,6 +29,48 @@ static void clamped(double *xi_mf, double *xi_p, double total, double delta)
     *xi_p = delta;
 }
 
+int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *inverse_kelvin,
+                      const BranchConstants *constants, SmaMessage *message)
+{
+    double other = constants->inv_centre2_K - exponent / constants->energy2_over_kB;
+    double low, high, middle, mf, p;
+    int by_mf = xi_mf <= xi_p, i;
+    if (*inverse_kelvin <= other) {
+        low = *inverse_kelvin;
+        high = other;
+    } else {
+        low = other;
+        high = *inverse_kelvin;
+    }
+    if (!(low > 0.0)) {   /* a stage alone never falls to the target: from 1/T_K = 0 */
+        low = 0.0;
+        two_stage_fractions(0.0, constants, &mf, &p);
+        if (!(high > 0.0 && (by_mf ? (mf < xi_mf) : (p > xi_p)))) {
+            return sma_message_set(message, "temperature-sensing inverse diverges at Lambda = "
+                                   "%.17g: the two-stage branch does not reach the target at "
+                                   "any temperature (dH(f)/k_B = %.17g K, second stage %.17g K)",
+                                   exponent, constants->energy_over_kB,
+                                   constants->energy2_over_kB);
+        }
+    }
+    middle = 0.5 * (low + high);
+    for (i = 0; i < BISECTION_CAP; i++) {
+        if (middle <= low || middle >= high) {
+            break;
+        }
+        two_stage_fractions(middle, constants, &mf, &p);
+        /* xi_MF rises and xi_P falls with 1/T_K: below the target, the root is colder */
+        if (by_mf ? (mf < xi_mf) : (p > xi_p)) {
+            low = middle;
+        } else {
+            high = middle;
+        }
+        middle = 0.5 * (low + high);
+    }
+    *inverse_kelvin = middle;
+    return 0;
+}
+
 int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *constants,
                              double margin, SensedTemperature *sensed, SmaMessage *message)
 {
@@ -40,7 +82,11 @@ int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *c
     }
     exponent = log(xi_p / xi_mf);
     inverse_kelvin = constants->inv_centre_K - exponent / constants->energy_over_kB;
-    if (!(inverse_kelvin > 0.0)) {
+    if (constants->w2 != 0.0) {
+        if (two_stage_inverse(xi_mf, xi_p, exponent, &inverse_kelvin, constants, message)) {
+            return 1;
+        }
+    } else if (!(inverse_kelvin > 0.0)) {
         return sma_message_set(message, "temperature-sensing inverse diverges at Lambda = %.17g: "
                                "dH(f)/k_B = %.17g K is too small for the hysteresis centre",
                                exponent, constants->energy_over_kB);

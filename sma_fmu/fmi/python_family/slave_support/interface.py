@@ -141,6 +141,8 @@ class SlaveInterface:
             if spec.section in sections or spec.name in extra:
                 entry = entries.get(spec.name, {})
                 start = getattr(self.defaults, "phase_lag_alpha" if spec.name == "alpha" else spec.name)
+                if start is None:   # an optional term the file omits (nu_h, nu_c): not exposed
+                    continue
                 meaning = entry.get("meaning") or (
                     "phase-lag lead time (default: thermal time constant)" if spec.name == "alpha" else spec.name)
                 if spec.rule == "depth":  # a count: an Integer (FMI 2.0 Integers have no unit)

@@ -1,0 +1,103 @@
+"""``sma-fmu predict isobaric FILE --model PARAMS [--stress MPA | --load KG] --out DIR``.
+
+Writes into DIR: ``predicted.csv`` (temperature fed [degC], measured and predicted strain
+[1] per sample), ``report.json`` (``residual_rms.strain``, the tangent-line and half-strain
+temperatures of both, how the plant was driven) and ``predict_isobaric.png`` (strain against
+temperature, measured and predicted, and the residual against sample). Everything is
+computed first; a failure leaves DIR as it was.
+"""
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from sma_fmu.files.json_output import json_text
+from sma_fmu.files.output_folder import check_folder, staged_folder
+from sma_fmu.files.png_output import png_bytes
+from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.predict import predict_file
+from sma_fmu.identification.isobaric.synthetic import load_of_stress
+from sma_fmu.runtime.constants import HEATING
+from sma_fmu.wire.parameter_file import load_parameter_set
+
+__all__ = ["run_isobaric_predict", "format_predict_report"]
+
+
+def _figure(data, result):
+    figure = Figure(figsize=(11, 4.2))
+    left, right = figure.subplots(1, 2)
+    t = data.smoothed
+    for b in data.branches:
+        rows = slice(b.start, b.stop)
+        colour = "tab:red" if b.direction == HEATING else "tab:blue"
+        left.plot(t[rows], 100 * result["measured"][rows], ".", ms=2, color=colour, alpha=0.35)
+        left.plot(t[rows], 100 * result["predicted"][rows], "-", lw=1.2, color="k"
+                  if b.direction == HEATING else "0.45")
+    left.plot([], [], ".", color="tab:red", label="measured, heating")
+    left.plot([], [], ".", color="tab:blue", label="measured, cooling")
+    left.plot([], [], "-", color="k", label="predicted (plant runtime), heating")
+    left.plot([], [], "-", color="0.45", label="predicted, cooling")
+    report = result["report"]
+    left.set(title=f"{data.path.name}, {report['stress_MPa']:.4g} MPa: strain RMS "
+                   f"{report['residual_rms']['strain']:.3g}",
+             xlabel="temperature [degC]", ylabel="strain [%]")
+    left.legend(fontsize=7)
+    sample = data.time if data.time is not None else np.arange(data.strain.size)
+    right.plot(sample, 100 * (result["predicted"] - result["measured"]), ".", ms=1.5)
+    right.set(title="predicted - measured", xlabel="time [s]" if data.time is not None
+              else "sample", ylabel="strain [%]")
+    for axis in (left, right):
+        axis.grid(alpha=0.3)
+    return png_bytes(figure, dpi=90, tight=True)
+
+
+def _csv(result):
+    lines = ["temperature_C,strain_measured,strain_predicted"]
+    for t, m, p in zip(result["temperature"], result["measured"], result["predicted"]):
+        lines.append(f"{t:.6f},{m:.9g},{p:.9g}")
+    return "\n".join(lines) + "\n"
+
+
+def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference_length=None,
+                         lag=0.0):
+    """Predict one file's strain with the plant runtime; write the outputs; return the report."""
+    if load is not None and stress is not None:
+        raise ValueError("predict: give --load or --stress, not both")
+    check_folder(out_dir)
+    params_set = load_parameter_set(model)
+    params = params_set.params
+    if stress is not None:
+        load = load_of_stress(stress, params.diameter)
+    reference = params.x0 if reference_length is None else reference_length
+    data = read_isobaric(Path(path), load, reference, params.diameter)
+    result = predict_file(data, params, lag)
+    report = dict(result["report"], model=str(params_set.path))
+    if data.load > params.load_max:   # the FMU warns there too, and runs on
+        report["warning"] = (f"load {data.load:.4g} kg is above the model's validity limit "
+                             f"{params.load_max:.4g} kg (validity.stress_max of "
+                             f"{params_set.path})")
+    png = _figure(data, result)
+    with staged_folder(out_dir) as folder:
+        (folder / "report.json").write_text(json_text(report), encoding="utf-8")
+        (folder / "predicted.csv").write_text(_csv(result), encoding="utf-8")
+        (folder / "predict_isobaric.png").write_bytes(png)
+    return report
+
+
+def format_predict_report(report):
+    """A short text summary of a predict report."""
+    tt = report["transformation_temperatures"]
+    lines = [f"predict isobaric: {Path(report['file']).name}, {report['points']} points at "
+             f"{report['stress_MPa']:.4g} MPa ({report['load_kg']:.4g} kg); plant runtime "
+             f"{report['drive']['seconds']:.2f} s",
+             f"strain residual RMS {report['residual_rms']['strain']:.3g} (offset "
+             f"{report['strain_offset']:.3g})",
+             f"{'':<14}{'measured':>10}{'predicted':>11}{'difference':>12}"]
+    for key in ("A_s", "A_f", "M_s", "M_f", "half_heating", "half_cooling"):
+        m, p = tt["measured"][key], tt["predicted"][key]
+        lines.append(f"{key + ' [degC]':<14}{m:>10.2f}{p:>11.2f}{p - m:>12.2f}")
+    if report.get("warning"):
+        lines.insert(1, f"warning: {report['warning']}")
+    m, p = tt["measured"]["transformation_strain"], tt["predicted"]["transformation_strain"]
+    lines.append(f"{'strain span %':<14}{100 * m:>10.3f}{100 * p:>11.3f}{100 * (p - m):>12.3f}")
+    return "\n".join(lines)

@@ -1,0 +1,96 @@
+"""The optional model terms of issue 36: what is in use when a file omits them, the stress
+law of the transformation strain, and the wire length with thermal expansion.
+
+    nu_d                 domain size on heating / cooling (omitted: nu)
+    [second_stage]       share w2 of M transforms by a second logistic, centre a2_d + b2_d f,
+                         domain size nu2_d (omitted: b2_d = b_d, nu2_d = nu_d); w2 = 0: off
+    [strain]             s(sigma) = span_ratio_sat + (span_ratio_0 - span_ratio_sat) e^(-sigma/span_stress)
+                         sigma = g f / (pi d^2/4) [MPa]   (Lagoudas' H_cur form)
+                         l_P(T)   = l_P (1 + alpha_P (T - T_alpha))
+                         l_i(T,f) = [l_P + s (l_i - l_P)] (1 + alpha_MF (T - T_alpha)),  i = M, F
+
+Every default reproduces the paper's model bit for bit: the steppers take the old code path
+when ``two_stage`` or ``strain`` is False. The C family has the same numbers
+(c_family/runtime/parameters.c, constant_load.c).
+"""
+import math
+from collections import namedtuple
+
+from .constants import STANDARD_GRAVITY
+
+__all__ = ["ModelTerms", "model_terms", "stress_of_load", "stress_ratio", "stressed_lengths",
+           "wire_length", "DEFAULT_T_ALPHA", "DEFAULT_SPAN_STRESS"]
+
+DEFAULT_T_ALPHA = 20.0        # degC: where l_P, l_M, l_F are the given lengths
+DEFAULT_SPAN_STRESS = 100.0   # MPa
+
+ModelTerms = namedtuple("ModelTerms", [
+    "nu_h", "nu_c", "w2", "a2_h", "b2_h", "a2_c", "b2_c", "nu2_h", "nu2_c",
+    "alpha_P", "alpha_MF", "T_alpha", "span_ratio_0", "span_ratio_sat", "span_stress",
+    "two_stage", "strain", "area"])
+ModelTerms.__doc__ = """The optional terms' values in use (defaults filled in).
+
+nu_h, nu_c, nu2_h, nu2_c [1]; w2 [1]; a2_h, a2_c [degC] (None when stage 2 is off and they
+are not given); b2_h, b2_c [degC/kg]; alpha_P, alpha_MF [1/K]; T_alpha [degC]; span_ratio_0,
+span_ratio_sat [1]; span_stress [MPa]; two_stage: w2 > 0; strain: a thermal expansion or a
+stress law is on; area: the wire's cross-section pi d^2/4 [m2].
+"""
+
+
+def _given(value, default):
+    return default if value is None else value
+
+
+def model_terms(params, fail):
+    """:class:`ModelTerms` of a :class:`~.parameters.WireParameters` whose own values are
+    checked; ``fail(message)`` raises the ParameterError (the file is named by it)."""
+    nu_h, nu_c = _given(params.nu_h, params.nu), _given(params.nu_c, params.nu)
+    w2 = _given(params.w2, 0.0)
+    if w2 > 0.0:
+        for key in ("a2_h", "a2_c"):
+            if getattr(params, key) is None:
+                fail(f"parameter second_stage.{key} is required when second_stage.w2 = {w2!r} > 0")
+    if params.a2_h is not None and params.a2_c is not None and not params.a2_h >= params.a2_c:
+        fail(f"parameter second_stage.a2_h = {params.a2_h!r} degC must be >= second_stage.a2_c = "
+             f"{params.a2_c!r} degC: the heating centre may not lie below the cooling one")
+    alpha_p, alpha_mf = _given(params.alpha_P, 0.0), _given(params.alpha_MF, 0.0)
+    ratio_0, ratio_sat = _given(params.span_ratio_0, 1.0), _given(params.span_ratio_sat, 1.0)
+    return ModelTerms(
+        nu_h=nu_h, nu_c=nu_c, w2=w2, a2_h=params.a2_h, b2_h=_given(params.b2_h, params.b_h),
+        a2_c=params.a2_c, b2_c=_given(params.b2_c, params.b_c),
+        nu2_h=_given(params.nu2_h, nu_h), nu2_c=_given(params.nu2_c, nu_c),
+        alpha_P=alpha_p, alpha_MF=alpha_mf, T_alpha=_given(params.T_alpha, DEFAULT_T_ALPHA),
+        span_ratio_0=ratio_0, span_ratio_sat=ratio_sat,
+        span_stress=_given(params.span_stress, DEFAULT_SPAN_STRESS),
+        two_stage=w2 > 0.0,
+        strain=alpha_p != 0.0 or alpha_mf != 0.0 or ratio_0 != 1.0 or ratio_sat != 1.0,
+        area=math.pi * params.diameter * params.diameter / 4.0,
+    )
+
+
+def stress_of_load(load, terms):
+    """Tensile stress sigma [MPa] of ``load`` [kg] on the wire's cross-section."""
+    return STANDARD_GRAVITY * load / terms.area / 1e6
+
+
+def stress_ratio(load, terms):
+    """s(sigma) [1]: how the phases' length deviations from l_P scale at ``load`` [kg]."""
+    sigma = stress_of_load(load, terms)
+    return terms.span_ratio_sat + (terms.span_ratio_0 - terms.span_ratio_sat) * math.exp(
+        -sigma / terms.span_stress)
+
+
+def stressed_lengths(load, params):
+    """(l_M, l_F) [m] at ``load`` [kg] and T_alpha: l_P + s (l_i - l_P)."""
+    s = stress_ratio(load, params.terms)
+    return params.l_P + s * (params.l_M - params.l_P), params.l_P + s * (params.l_F - params.l_P)
+
+
+def wire_length(temperature, xi_p, xi_m, xi_f, length_m, length_f, params):
+    """x [m] at ``temperature`` [degC] of the fractions [1], with the stressed lengths
+    ``length_m``, ``length_f`` [m] (:func:`stressed_lengths`) and thermal expansion."""
+    terms = params.terms
+    offset = temperature - terms.T_alpha
+    grow = 1.0 + terms.alpha_MF * offset
+    return (params.l_P * (1.0 + terms.alpha_P * offset) * xi_p
+            + length_m * grow * xi_m + length_f * grow * xi_f)
