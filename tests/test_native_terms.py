@@ -53,8 +53,8 @@ def terms_file(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def families(tmp_path_factory, terms_file):
-    from sma_fmu.fmi.build import build_fmus
-    from sma_fmu.fmi.c_family.native_build import build_native_fmus
+    from sma_fmu.fmi.packaging.build import build_fmus
+    from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
     root = tmp_path_factory.mktemp("families_terms")
     names = ["SmaActuator", "SmaFeedforward"]
     return {"py": build_fmus(root / "py", terms_file, names=names),

@@ -115,7 +115,7 @@ def acquire(path):
     """The :class:`Unpacked` FMU file ``path``, unpacked now or earlier; counts one user.
 
     Raises :class:`~sma_fmu.files.archives.UnsafeArchiveError` for an unsafe or unreadable
-    archive, :class:`~sma_fmu.fmi.build.FmuFileError` for a zip that is no usable FMU.
+    archive, :class:`~sma_fmu.fmi.driving.description.FmuFileError` for a zip that is no usable FMU.
     """
     path = str(path)
     key = _key(path)

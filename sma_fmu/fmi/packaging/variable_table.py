@@ -1,6 +1,6 @@
 """Tables of every FMU variable for docs/fmus.md, generated from the built model descriptions.
 
-Each FMU of :data:`~sma_fmu.fmi.build.FMU_SCRIPTS` has a section in docs/fmus.md between
+Each FMU of :data:`~sma_fmu.fmi.packaging.fmu_names.FMU_SCRIPTS` has a section in docs/fmus.md between
 ``<!-- variables:NAME -->`` and ``<!-- /variables:NAME -->``; this module rewrites those
 sections, so the documented interface cannot drift from what the FMUs declare (a test
 compares them). Regenerate after changing a slave or the parameter file::
