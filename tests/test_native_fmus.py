@@ -186,8 +186,9 @@ def test_bad_state_bytes_are_refused_with_a_message(native):
         blob = fmu.fmu.serializeFMUstate(fmu.fmu.getFMUstate())
         cases = {
             blob[:-3]: "truncated",
-            blob + b"\0": "bytes follow the state",
-            b"XX" + blob[2:]: "no SMAFMU2S header",
+            blob + b"\0": "extended",
+            b"XX" + blob[2:]: "does not start with SMAF",
+            blob[:20] + b"XX" + blob[22:]: "checksum does not match",
             other.fmu.serializeFMUstate(other.fmu.getFMUstate()): "model 'SmaPiController'",
         }
         for bad, words in cases.items():

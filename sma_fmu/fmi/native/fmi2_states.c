@@ -133,9 +133,12 @@ EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serial
     if (*state && !find_state(in, *state))
         return refuse(in, fmi2Error, "fmi2DeSerializeFMUstate", "*FMUstate is neither NULL nor a "
                       "state of this instance");
-    if (!state_header_valid(serializedState, size))
-        return refuse(in, fmi2Error, "fmi2DeSerializeFMUstate", "these bytes are not a state "
-                      "serialized by this FMU (bad header, length or checksum)");
+    char why[300];
+    if (!state_header_check(serializedState, size, why, sizeof why)) {
+        host_logf(in, fmi2Error, "fmi2DeSerializeFMUstate: these bytes are not a state "
+                  "serialized by this FMU: %s", why);
+        return fmi2Error;
+    }
     fmi2FMUstate saved = NULL;
     fmi2Status status = finish(in, backend.DeSerializeFMUstate(
         in->backend, serializedState + STATE_HEADER_SIZE, size - STATE_HEADER_SIZE, &saved));

@@ -271,6 +271,7 @@ int guid_matches(const char* resources, const char* guid, char* err, size_t errl
 /* ---- serialized states (state_bytes.c) --------------------------------------------------- */
 #define STATE_HEADER_SIZE 20
 void write_state_header(fmi2Byte* bytes, size_t payload_size);
-int state_header_valid(const fmi2Byte* bytes, size_t size);
+/* 1 if `bytes` are a whole header + body whose CRC-32 matches; else 0, what failed in `why`. */
+int state_header_check(const fmi2Byte* bytes, size_t size, char* why, size_t why_size);
 
 #endif

@@ -146,7 +146,14 @@ typedef struct {
     double *doubles;
     uint32_t count;
 } Parsed;
-/* The serialized state of `in` (malloc'd) and its size; NULL: out of memory. */
+/* The frame of a serialized state (fmi2_state_frame.c): header, then the body. */
+#define STATE_FRAME_SIZE 20
+uint32_t layer_crc32(const unsigned char *data, size_t n);
+/* Write the header into bytes[0..STATE_FRAME_SIZE) for the body that follows it. */
+void layer_frame_write(unsigned char *bytes, size_t body_size);
+/* 1 if `bytes` are a whole frame whose checksum matches, else 0 with what failed in `why`. */
+int layer_frame_check(const unsigned char *bytes, size_t size, char *why, size_t why_size);
+/* The serialized state of `in` (malloc'd, framed) and its size; NULL: out of memory. */
 unsigned char *layer_serialize(const Instance *in, size_t *size);
 /* 1 with *p filled (free it with layer_parsed_free), or 0 with the reason in `why`. */
 int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, Parsed *p,
