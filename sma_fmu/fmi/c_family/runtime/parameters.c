@@ -101,15 +101,17 @@ static int derived_failure(const WireParameters *p, const double *values, const 
                            reason, inputs);
 }
 
-/* The parameter values as checked (defaults for optional ones not given), in spec order. */
-static int check_values(WireParameters *p, const double values[], double checked[],
-                        SmaMessage *message)
+/* The parameter values as checked (defaults for optional ones not given), in spec order.
+ * `given` NULL: an optional parameter's NaN means "not given"; else given[i] says it, and a
+ * NaN that was given is refused by name like any value that breaks its rule. */
+static int check_values(WireParameters *p, const double values[], const unsigned char *given,
+                        double checked[], SmaMessage *message)
 {
     int index;
     for (index = 0; index < PARAM_COUNT; index++) {
         const ParameterSpec *spec = &PARAMETER_SPECS[index];
         double value = values[index];
-        if (!spec->required && isnan(value)) {
+        if (!spec->required && (given != NULL ? !given[index] : isnan(value))) {
             if (index == PARAM_memory_depth) {
                 value = DEFAULT_DEPTH;
             } else if (index == PARAM_stress_max) {
@@ -132,6 +134,13 @@ static int check_values(WireParameters *p, const double values[], double checked
 int wire_parameters_from_values_source(WireParameters *out, const double values[],
                                        const char *source, SmaMessage *message)
 {
+    return wire_parameters_from_given(out, values, NULL, source, message);
+}
+
+int wire_parameters_from_given(WireParameters *out, const double values[],
+                               const unsigned char *given, const char *source,
+                               SmaMessage *message)
+{
     static const ParameterIndex MASS_X0[] = {PARAM_mass, PARAM_x0};
     static const ParameterIndex GEOMETRY[] = {PARAM_x0, PARAM_x_min, PARAM_diameter,
                                               PARAM_theta, PARAM_mass};
@@ -145,7 +154,7 @@ int wire_parameters_from_values_source(WireParameters *out, const double values[
 
     memset(&p, 0, sizeof p);
     snprintf(p.source, sizeof p.source, "%s", source != NULL ? source : "<parameters>");
-    if (check_values(&p, values, v, message)) {
+    if (check_values(&p, values, given, v, message)) {
         return 1;
     }
     p.x0 = v[PARAM_x0]; p.x_min = v[PARAM_x_min]; p.diameter = v[PARAM_diameter];
@@ -198,7 +207,7 @@ int wire_parameters_from_values_source(WireParameters *out, const double values[
     p.x_T = p.x_min - 0.5 * (p.l_M + p.l_F);
     p.x_f = p.l_F - 0.5 * (p.x_min + p.l_M);
     p.R_MF = 0.5 * (p.R_M + p.R_F);
-    p.phase_lag_alpha = isnan(p.alpha) ? p.tau_th : p.alpha;
+    p.phase_lag_alpha = isnan(p.alpha) ? p.tau_th : p.alpha;  /* checked: NaN only if not given */
     square = pow(p.diameter, 2.0);
     failure = isinf(square) ? SMA_POW_OVERFLOW : NULL;
     p.load_max = p.stress_max * 1e6 * SMA_PI * square / 4.0 / STANDARD_GRAVITY;
