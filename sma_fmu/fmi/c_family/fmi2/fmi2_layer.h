@@ -164,6 +164,9 @@ void layer_parsed_free(const SmaModel *model, Parsed *p);
 /* The folder of a file: URI (or a plain absolute path) in `folder` (malloc'd), or 0 with the
  * reason in `why`; *plain = 1 for a plain path. */
 int layer_resource_folder(const char *uri, char **folder, int *plain, char *why, size_t size);
+/* The checked text of the start-values file at `path` (fmi2_start_file.c; malloc'd), or NULL
+ * with the reason in `why`, or NULL with *missing = 1 when there is no such file. */
+char *layer_start_file(const char *path, int *missing, char *why, size_t size);
 /* Packed start values (resources/start_values.json), if the FMU has them. */
 int layer_packed_start_values(Instance *in, char *why, size_t size);
 
