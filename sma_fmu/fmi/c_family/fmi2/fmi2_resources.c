@@ -2,7 +2,7 @@
  * (fmi/native/resource_uri.c, which is tied to pythonfmu's layout: slavemodule.txt):
  * file:///abs, file:/abs and file://localhost/abs, percent-decoded, and with a warning a
  * plain absolute path; anything else is refused with the reason. On Windows the path is a
- * drive path (file:///C:/dir). The folder must exist. */
+ * drive path (file:///C:/dir). The folder must exist and hold the FMU's parameters.json. */
 #ifndef _WIN32
 #define _POSIX_C_SOURCE 200809L  /* stat() */
 #endif
@@ -17,8 +17,10 @@
 
 #ifdef _WIN32
 #define IS_FOLDER(mode) (((mode) & _S_IFMT) == _S_IFDIR)
+#define IS_REGULAR(mode) (((mode) & _S_IFMT) == _S_IFREG)
 #else
 #define IS_FOLDER(mode) S_ISDIR(mode)
+#define IS_REGULAR(mode) S_ISREG(mode)
 #endif
 
 static int same_text(const char *a, const char *b, size_t n)  /* ASCII, ignoring case */
@@ -91,6 +93,21 @@ static const char *uri_path(const char *uri, size_t *length, int *plain, char *w
     return p;
 }
 
+/* Is `folder` an unpacked FMU's resources folder? Every FMU of this project ships
+ * parameters.json there (the pythonfmu family's front asks for its slave module), so a
+ * location such as file:///tmp is refused instead of silently running without the FMU's
+ * files (its packed start_values.json among them). */
+static int owns_folder(const char *folder, const char *uri, char *why, size_t size)
+{
+    struct stat info;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/parameters.json", folder);
+    if (stat(path, &info) == 0 && IS_REGULAR(info.st_mode)) return 1;
+    snprintf(why, size, "resource folder '%.300s' (from fmuResourceLocation '%.300s') is not this "
+             "FMU's resources folder: it holds no parameters.json", folder, uri);
+    return 0;
+}
+
 int layer_resource_folder(const char *uri, char **folder, int *plain, char *why, size_t size)
 {
     size_t length = 0, i, j = 0;
@@ -124,6 +141,10 @@ int layer_resource_folder(const char *uri, char **folder, int *plain, char *why,
     if (!layer_valid_utf8(out) || stat(out, &info) != 0 || !IS_FOLDER(info.st_mode)) {
         snprintf(why, size, "resource folder '%.300s' (from fmuResourceLocation '%.300s') does not "
                  "exist", out, uri);
+        free(out);
+        return 0;
+    }
+    if (!owns_folder(out, uri, why, size)) {
         free(out);
         return 0;
     }
