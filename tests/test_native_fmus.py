@@ -298,12 +298,14 @@ def test_resource_locations_taken_and_refused_as_the_front_does(native, tmp_path
                                         ctypes.c_char_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
     library.fmi2FreeInstance.argtypes = [ctypes.c_void_p]
     folder = str(tmp_path / "SmaPiController" / "resources")
-    spaced = tmp_path / "with space" / "resources"
+    spaced = tmp_path / "with space" / "resources"  # the FMU's resources, in a spaced path
     spaced.mkdir(parents=True)
+    (spaced / "parameters.json").write_bytes((Path(folder) / "parameters.json").read_bytes())
     taken = [uri, f"file:{folder}", f"file://localhost{folder}", folder,
              "file://" + str(spaced).replace(" ", "%20")]
     refused = ["http://example.com/resources", "file://elsewhere" + folder, "file:resources",
-               f"file://{folder}/missing", "file://" + folder + "%zz", ""]
+               f"file://{folder}/missing", "file://" + folder + "%zz", "",
+               (tmp_path / "with space").as_uri()]  # exists, but holds no parameters.json
     for text in taken:
         component = library.fmi2Instantiate(b"u", 1, guid, text if isinstance(text, bytes) else text.encode(),
                                             None, 0, 0)
