@@ -155,9 +155,10 @@ void layer_frame_write(unsigned char *bytes, size_t body_size);
 int layer_frame_check(const unsigned char *bytes, size_t size, char *why, size_t why_size);
 /* The serialized state of `in` (malloc'd, framed) and its size; NULL: out of memory. */
 unsigned char *layer_serialize(const Instance *in, size_t *size);
-/* 1 with *p filled (free it with layer_parsed_free), or 0 with the reason in `why`. */
-int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, Parsed *p,
-                      char *why, size_t why_size);
+/* 1 with *p filled (free it with layer_parsed_free), or 0 with the reason in `why`.
+ * `framed`: the frame was checked already (bytes the instance wrote or deserialized). */
+int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, int framed,
+                      Parsed *p, char *why, size_t why_size);
 void layer_parsed_free(const SmaModel *model, Parsed *p);
 
 /* ---- resources (fmi2_resources.c) -------------------------------------------------------- */

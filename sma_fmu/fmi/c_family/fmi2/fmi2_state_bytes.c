@@ -282,13 +282,14 @@ static int parse(const Instance *in, Reader *r, Parsed *p)
 }
 
 
-int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, Parsed *p,
-                      char *why, size_t why_size)
+int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, int framed,
+                      Parsed *p, char *why, size_t why_size)
 {
     Reader r;
     memset(p, 0, sizeof *p);
     why[0] = '\0';
-    if (!layer_frame_check(bytes, size, why, why_size)) return 0;
+    if (!framed && !layer_frame_check(bytes, size, why, why_size)) return 0;
+    if (size < STATE_FRAME_SIZE) return 0;  /* framed: never (the instance's own bytes) */
     r.bytes = bytes + STATE_FRAME_SIZE; r.size = size - STATE_FRAME_SIZE; r.at = 0;
     r.why = why; r.why_size = why_size;
     return parse(in, &r, p);
