@@ -86,35 +86,40 @@ def parse_start_value(kind, text):
 
 def _file_bytes(path):
     """The bytes of the regular file ``path``, None if there is none; ``ValueError`` naming it
-    when it is not a regular file or is too large (opened without blocking: a FIFO never
-    hangs the instantiation)."""
+    when it is not a regular file or is too large. Its type is checked before it is opened
+    (Windows cannot open a folder) and again on the descriptor, opened without blocking: a
+    FIFO never hangs the instantiation."""
+    def refuse(reason):
+        return ValueError(f"{path}: cannot be read ({reason})")
+    too_large = f"larger than {MAX_BYTES} bytes, the limit for {START_VALUES_FILE}"
     try:
-        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            raise refuse("not a regular file")
+        flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+        descriptor = os.open(path, flags)
     except FileNotFoundError:
         return None
     except OSError as error:
-        raise ValueError(f"{path}: cannot be read ({error.strerror})") from None
+        raise refuse(error.strerror) from None
     try:
         info = os.fstat(descriptor)
         if not stat.S_ISREG(info.st_mode):
-            raise ValueError(f"{path}: cannot be read (not a regular file)")
+            raise refuse("not a regular file")
         if info.st_size > MAX_BYTES:
-            raise ValueError(f"{path}: cannot be read (larger than {MAX_BYTES} bytes, the limit "
-                             f"for {START_VALUES_FILE})")
+            raise refuse(too_large)
         chunks = []
         while sum(map(len, chunks)) <= MAX_BYTES:
             chunk = os.read(descriptor, 1 << 20)
             if not chunk:
                 break
             chunks.append(chunk)
-        data = b"".join(chunks)
     except OSError as error:
-        raise ValueError(f"{path}: cannot be read ({error.strerror})") from None
+        raise refuse(error.strerror) from None
     finally:
         os.close(descriptor)
+    data = b"".join(chunks)
     if len(data) > MAX_BYTES:
-        raise ValueError(f"{path}: cannot be read (larger than {MAX_BYTES} bytes, the limit for "
-                         f"{START_VALUES_FILE})")
+        raise refuse(too_large)
     return data
 
 
