@@ -30,26 +30,16 @@
 #define START_FILE_MAX_DEPTH JSON_TEXT_MAX_DEPTH
 #define START_FILE_NAME "start_values.json"
 
-/* Reads all of the open `stream`/`fd` into a malloc'd, NUL-terminated buffer, at most
- * START_FILE_MAX_BYTES + 1 bytes; NULL when out of memory. */
-#ifdef _WIN32
+/* All of `stream` in a malloc'd, NUL-terminated buffer, at most START_FILE_MAX_BYTES + 1
+ * bytes of it (more is refused by the caller); NULL when out of memory. */
 static char *read_all(FILE *stream, size_t *used)
-#else
-static char *read_all(int fd, size_t *used)
-#endif
 {
     size_t room = 4096;
     char *text = (char *)malloc(room);
     *used = 0;
     while (text && *used <= START_FILE_MAX_BYTES) {
-        char *grown;
-#ifdef _WIN32
         size_t n = fread(text + *used, 1, room - *used - 1, stream);
-#else
-        ssize_t got = read(fd, text + *used, room - *used - 1);
-        size_t n = got > 0 ? (size_t)got : 0;
-        if (got < 0 && errno == EINTR) continue;
-#endif
+        char *grown;
         *used += n;
         if (n == 0) break;
         if (room - *used - 1 > 0) continue;
@@ -62,56 +52,60 @@ static char *read_all(int fd, size_t *used)
     return text;
 }
 
-/* The file's bytes (malloc'd, NUL-terminated), or NULL: *missing = 1 when there is none. */
+/* The bytes of the open `stream` of the file at `path` whose type is in `info`, or NULL with
+ * why (not a regular file, too large, out of memory). Closes the stream. */
+static char *checked_bytes(FILE *stream, const struct stat *info, const char *path, size_t *used,
+                           char *why, size_t size)
+{
+    char *text = NULL;
+    int too_large = 0;
+    if (!IS_REGULAR(info->st_mode)) {
+        snprintf(why, size, "%.300s: cannot be read (not a regular file)", path);
+    } else if ((unsigned long long)info->st_size > START_FILE_MAX_BYTES) {
+        too_large = 1;
+    } else if (!(text = read_all(stream, used))) {
+        snprintf(why, size, "%.300s: cannot be read (out of memory)", path);
+    } else if (*used > START_FILE_MAX_BYTES) {  /* it grew while it was read */
+        free(text);
+        text = NULL;
+        too_large = 1;
+    }
+    fclose(stream);
+    if (too_large)
+        snprintf(why, size, "%.300s: cannot be read (larger than %d bytes, the limit for %s)",
+                 path, START_FILE_MAX_BYTES, START_FILE_NAME);
+    return text;
+}
+
+/* The file's bytes (malloc'd, NUL-terminated), or NULL: *missing = 1 when there is none.
+ * POSIX: opened without blocking, then its type is read from the descriptor (a FIFO is
+ * refused, never read). Windows: its type is read first (a folder cannot be opened). */
 static char *file_bytes(const char *path, size_t *used, int *missing, char *why, size_t size)
 {
     struct stat info;
-    char *text;
+    FILE *stream = NULL;
 #ifdef _WIN32
-    FILE *stream;
-    *missing = 0;
-    if (stat(path, &info) != 0) { *missing = errno == ENOENT; if (*missing) return NULL; }
-    else if (!IS_REGULAR(info.st_mode)) {
+    int failed = stat(path, &info) != 0;
+    if (!failed && !IS_REGULAR(info.st_mode)) {
+        *missing = 0;
         snprintf(why, size, "%.300s: cannot be read (not a regular file)", path);
         return NULL;
     }
-    stream = fopen(path, "rb");
-    if (!stream) {
-        snprintf(why, size, "%.300s: cannot be read (%s)", path, strerror(errno));
-        return NULL;
-    }
-    text = read_all(stream, used);
-    fclose(stream);
+    failed = failed || !(stream = fopen(path, "rb"));
 #else
     int fd = open(path, O_RDONLY | O_NONBLOCK);
-    *missing = 0;
-    if (fd < 0) {
-        *missing = errno == ENOENT;
+    int failed = fd < 0;
+    if (!failed && (fstat(fd, &info) != 0 || !(stream = fdopen(fd, "rb")))) {
+        close(fd);
+        failed = 1;
+    }
+#endif
+    *missing = failed && errno == ENOENT;
+    if (failed) {
         if (!*missing) snprintf(why, size, "%.300s: cannot be read (%s)", path, strerror(errno));
         return NULL;
     }
-    if (fstat(fd, &info) != 0 || !IS_REGULAR(info.st_mode)) {
-        close(fd);
-        snprintf(why, size, "%.300s: cannot be read (not a regular file)", path);
-        return NULL;
-    }
-    if ((unsigned long long)info.st_size > START_FILE_MAX_BYTES) {
-        close(fd);
-        snprintf(why, size, "%.300s: cannot be read (larger than %d bytes, the limit for %s)",
-                 path, START_FILE_MAX_BYTES, START_FILE_NAME);
-        return NULL;
-    }
-    text = read_all(fd, used);
-    close(fd);
-#endif
-    if (!text) snprintf(why, size, "%.300s: cannot be read (out of memory)", path);
-    else if (*used > START_FILE_MAX_BYTES) {
-        free(text);
-        text = NULL;
-        snprintf(why, size, "%.300s: cannot be read (larger than %d bytes, the limit for %s)",
-                 path, START_FILE_MAX_BYTES, START_FILE_NAME);
-    }
-    return text;
+    return checked_bytes(stream, &info, path, used, why, size);
 }
 
 /* The first byte that is not strict UTF-8 (an encoded surrogate ED A0..BF counts), or n. */
