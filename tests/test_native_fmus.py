@@ -187,8 +187,9 @@ def test_bad_state_bytes_are_refused_with_a_message(native):
         blob = fmu.fmu.serializeFMUstate(fmu.fmu.getFMUstate())
         cases = {
             blob[:-3]: "truncated",
-            blob + b"\0": "bytes follow the state",
-            b"XX" + blob[2:]: "no SMAFMU2S header",
+            blob + b"\0": "extended",
+            b"XX" + blob[2:]: "does not start with SMAF",
+            blob[:20] + b"XX" + blob[22:]: "checksum does not match",
             other.fmu.serializeFMUstate(other.fmu.getFMUstate()): "model 'SmaPiController'",
         }
         for bad, words in cases.items():
@@ -298,12 +299,14 @@ def test_resource_locations_taken_and_refused_as_the_front_does(native, tmp_path
                                         ctypes.c_char_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
     library.fmi2FreeInstance.argtypes = [ctypes.c_void_p]
     folder = str(tmp_path / "SmaPiController" / "resources")
-    spaced = tmp_path / "with space" / "resources"
+    spaced = tmp_path / "with space" / "resources"  # the FMU's resources, in a spaced path
     spaced.mkdir(parents=True)
+    (spaced / "parameters.json").write_bytes((Path(folder) / "parameters.json").read_bytes())
     taken = [uri, f"file:{folder}", f"file://localhost{folder}", folder,
              "file://" + str(spaced).replace(" ", "%20")]
     refused = ["http://example.com/resources", "file://elsewhere" + folder, "file:resources",
-               f"file://{folder}/missing", "file://" + folder + "%zz", ""]
+               f"file://{folder}/missing", "file://" + folder + "%zz", "",
+               (tmp_path / "with space").as_uri()]  # exists, but holds no parameters.json
     for text in taken:
         component = library.fmi2Instantiate(b"u", 1, guid, text if isinstance(text, bytes) else text.encode(),
                                             None, 0, 0)

@@ -9,7 +9,9 @@
  * one enters it and is released then. Every instance is linked into one of BUCKETS chains
  * by its own `chain` field (no table to grow, so registering cannot fail); a chain is walked
  * under the lock and only through registered, allocated instances. Refusals go to stderr,
- * not to the host's logger: after fmi2FreeInstance the logger may be gone. */
+ * not to the host's logger: after fmi2FreeInstance the logger may be gone. When the library
+ * is unloaded the ring is released (a destructor on ELF, DllMain on Windows): no pointer
+ * into this library can be called after that, so what it guarded is gone with it. */
 #ifndef _WIN32
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -127,3 +129,36 @@ void layer_keep(Instance *in)
         free(dropped);
     }
 }
+
+/* Release the ring of freed instances (the library is being unloaded). Live instances are
+ * the host's to free and are left alone. */
+static void release_kept(void)
+{
+    size_t i;
+    LOCK();
+    for (i = 0; i < KEPT_FREED; ++i) {
+        Instance *dropped = kept[i];
+        Instance **link = dropped ? link_to(dropped) : NULL;
+        if (link) *link = dropped->chain;
+        kept[i] = NULL;
+        if (dropped) {
+            free(dropped->name);
+            free(dropped);
+        }
+    }
+    oldest = 0;
+    UNLOCK();
+}
+
+#ifdef _WIN32
+BOOL WINAPI DllMain(HINSTANCE module, DWORD reason, LPVOID reserved);
+BOOL WINAPI DllMain(HINSTANCE module, DWORD reason, LPVOID reserved)
+{
+    (void)module;
+    /* reserved != NULL: the process is ending, the system takes the memory back */
+    if (reason == DLL_PROCESS_DETACH && reserved == NULL) release_kept();
+    return TRUE;
+}
+#elif defined(__GNUC__)
+__attribute__((destructor)) static void unloaded(void) { release_kept(); }
+#endif

@@ -146,17 +146,21 @@ typedef struct {
     double *doubles;
     uint32_t count;
 } Parsed;
-/* The serialized state of `in` (malloc'd) and its size; NULL: out of memory. */
+/* The serialized state of `in` (malloc'd, framed) and its size; NULL: out of memory. */
 unsigned char *layer_serialize(const Instance *in, size_t *size);
-/* 1 with *p filled (free it with layer_parsed_free), or 0 with the reason in `why`. */
-int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, Parsed *p,
-                      char *why, size_t why_size);
+/* 1 with *p filled (free it with layer_parsed_free), or 0 with the reason in `why`.
+ * `framed`: the frame was checked already (bytes the instance wrote or deserialized). */
+int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, int framed,
+                      Parsed *p, char *why, size_t why_size);
 void layer_parsed_free(const SmaModel *model, Parsed *p);
 
 /* ---- resources (fmi2_resources.c) -------------------------------------------------------- */
 /* The folder of a file: URI (or a plain absolute path) in `folder` (malloc'd), or 0 with the
  * reason in `why`; *plain = 1 for a plain path. */
 int layer_resource_folder(const char *uri, char **folder, int *plain, char *why, size_t size);
+/* The checked text of the start-values file at `path` (fmi2_start_file.c; malloc'd), or NULL
+ * with the reason in `why`, or NULL with *missing = 1 when there is no such file. */
+char *layer_start_file(const char *path, int *missing, char *why, size_t size);
 /* Packed start values (resources/start_values.json), if the FMU has them. */
 int layer_packed_start_values(Instance *in, char *why, size_t size);
 

@@ -1,11 +1,12 @@
 /* Packed start values: resources/start_values.json, which `sma-fmu export` writes into every
- * FMU it packs (slave_support/start_values.py, systems/packed.py), read when the instance is
+ * FMU it packs (python_family/slave_support/start_values.py, systems/packed.py), read when the instance is
  * created, as the pythonfmu slaves read it (SlaveInterface): each parameter it names starts
  * with its value. Choice: the native FMU reads the same file as the pythonfmu one (with the
  * runtime's JSON reader, json_text.c), so packing needs nothing per family and the model
  * description's start attributes and the file cannot disagree for one family only.
- * A file that is not such a document, or a value that is not of the parameter's type, makes
- * fmi2Instantiate fail naming the file and the parameter, as in the pythonfmu FMUs. */
+ * A file that is not such a document (read by fmi2_start_file.c: a regular file, bounded,
+ * strict UTF-8), or a value that is not of the parameter's type, makes fmi2Instantiate fail
+ * naming the file and the parameter, as in the pythonfmu FMUs. */
 #include "fp_contract.h"
 #include <math.h>
 #include <stdio.h>
@@ -18,38 +19,6 @@
 #define START_VALUES_FILE "start_values.json"
 
 static const char *const KIND_NAMES[] = {"Real", "Integer", "Boolean", "String"};
-
-/* The file's text (malloc'd) or NULL: *missing = 1 when there is no such file. */
-static char *read_file(const char *path, int *missing, char *why, size_t size)
-{
-    FILE *stream = fopen(path, "rb");
-    char *text;
-    size_t used = 0, room = 4096;
-    *missing = 0;
-    if (!stream) {
-        *missing = 1;
-        return NULL;
-    }
-    text = (char *)malloc(room);
-    while (text) {
-        size_t n = fread(text + used, 1, room - used - 1, stream);
-        used += n;
-        if (n == 0) break;
-        if (room - used - 1 == 0) {
-            char *grown = room > JSON_TEXT_MAX_BYTES ? NULL : (char *)realloc(text, room * 2);
-            if (!grown) { free(text); text = NULL; break; }
-            text = grown;
-            room *= 2;
-        }
-    }
-    fclose(stream);
-    if (!text) {
-        snprintf(why, size, "%.300s: cannot be read (too large or out of memory)", path);
-        return NULL;
-    }
-    text[used] = '\0';
-    return text;
-}
 
 /* start_values.start_value: `value` as the start of `v`, into *out; else why. */
 static int start_value(const SmaVariable *v, const JsonValue *value, SmaValue *out, char *why,
@@ -93,7 +62,7 @@ int layer_packed_start_values(Instance *in, char *why, size_t size)
     const JsonValue *values;
     if (!in->resources) return 0;
     snprintf(path, sizeof path, "%s/%s", in->resources, START_VALUES_FILE);
-    text = read_file(path, &missing, why, size);
+    text = layer_start_file(path, &missing, why, size);
     if (!text) return missing ? 0 : 1;
     if (json_text_parse(text, &document, error, sizeof error)) {
         free(text);

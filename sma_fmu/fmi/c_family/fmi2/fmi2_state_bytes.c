@@ -1,6 +1,8 @@
 /* Saved FMU states as bytes (fmi2_states.c keeps and restores them): the layout below,
  * written by layer_serialize and read back, every entry checked, by layer_parse_state.
- * The bytes (native byte order, declared by the header):
+ * The body goes inside the frame of c_common/state_frame.c (header with length and CRC-32),
+ * which is checked first: a changed, truncated or extended state is refused whole.
+ * The body (native byte order, declared by the header):
  *   "SMAFMU2S" | u32 format version | u32 byte-order mark | str model name | str GUID |
  *   str the stepper's state format (e.g. PLANT_STATE_FORMAT) |
  *   u32 calling-sequence state | f64 start_time, stop_time, time, first_step |
@@ -18,6 +20,7 @@
 #include <string.h>
 
 #include "fmi2_layer.h"
+#include "state_frame.h"  /* the frame both families put around a state */
 
 #define MAGIC "SMAFMU2S"
 #define FORMAT_VERSION 1u
@@ -87,14 +90,15 @@ static void write_state(const Instance *in, Writer *w)
 
 unsigned char *layer_serialize(const Instance *in, size_t *size)
 {
-    Writer w = {NULL, 0};
+    Writer w = {NULL, STATE_FRAME_SIZE};  /* the body follows the frame's header */
     write_state(in, &w);
-    w.bytes = (unsigned char *)malloc(w.size ? w.size : 1);
+    w.bytes = (unsigned char *)malloc(w.size);
     if (!w.bytes) return NULL;
     *size = w.size;
-    w.size = 0;
+    w.size = STATE_FRAME_SIZE;
     write_state(in, &w);
     if (w.size != *size) { free(w.bytes); return NULL; }
+    state_frame_write(w.bytes, *size - STATE_FRAME_SIZE);
     return w.bytes;
 }
 
@@ -279,11 +283,15 @@ static int parse(const Instance *in, Reader *r, Parsed *p)
 }
 
 
-int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, Parsed *p,
-                      char *why, size_t why_size)
+int layer_parse_state(const Instance *in, const unsigned char *bytes, size_t size, int framed,
+                      Parsed *p, char *why, size_t why_size)
 {
     Reader r;
-    r.bytes = bytes; r.size = size; r.at = 0; r.why = why; r.why_size = why_size;
+    memset(p, 0, sizeof *p);
     why[0] = '\0';
+    if (!framed && !state_frame_check(bytes, size, why, why_size)) return 0;
+    if (size < STATE_FRAME_SIZE) return 0;  /* framed: never (the instance's own bytes) */
+    r.bytes = bytes + STATE_FRAME_SIZE; r.size = size - STATE_FRAME_SIZE; r.at = 0;
+    r.why = why; r.why_size = why_size;
     return parse(in, &r, p);
 }

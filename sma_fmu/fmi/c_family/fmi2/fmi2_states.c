@@ -56,13 +56,14 @@ fail:
     return NULL;
 }
 
-/* Restore the state in `bytes` into `in`: all or nothing; fmi2Error with the reason. */
+/* Restore the state in `bytes` into `in`: all or nothing; fmi2Error with the reason. The
+ * bytes are a state the instance keeps (written by it, or deserialized, frame checked). */
 static fmi2Status restore(Instance *in, const unsigned char *bytes, size_t size)
 {
     char why[700];
     Parsed p;
     void *stepper = NULL;
-    if (!layer_parse_state(in, bytes, size, &p, why, sizeof why)) goto refused;
+    if (!layer_parse_state(in, bytes, size, 1, &p, why, sizeof why)) goto refused;
     if (p.has_stepper && !(stepper = restored_stepper(in, &p, why, sizeof why))) goto refused;
     if ((p.state == STATE_STEP_COMPLETE || p.state == STATE_TERMINATED) &&
         !layer_outputs_finite(in, p.values)) {
@@ -220,7 +221,8 @@ FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte s
     if (*state && !find(in, *state))
         return layer_reject(in, fmi2Error, "fmi2DeSerializeFMUstate", "*FMUstate is neither NULL "
                             "nor a state of this instance");
-    if (!layer_parse_state(in, (const unsigned char *)serializedState, size, &p, why, sizeof why)) {
+    if (!layer_parse_state(in, (const unsigned char *)serializedState, size, 0, &p, why,
+                           sizeof why)) {
         layer_parsed_free(in->model, &p);
         layer_log(in, fmi2Error, "fmi2DeSerializeFMUstate: the bytes are refused: %s", why);
         return fmi2Error;

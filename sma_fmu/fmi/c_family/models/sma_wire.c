@@ -1,5 +1,6 @@
 /* The wire parameters of an instance (sma_wire.h). */
 #include "fp_contract.h"
+#include <math.h>
 #include <stdio.h>
 
 #include "sma_wire.h"
@@ -9,14 +10,20 @@ int sma_wire_parameters(const SmaModel *model, const SmaValue *values, const Sma
                         SmaMessage *message)
 {
     double merged[PARAM_COUNT];
+    unsigned char given[PARAM_COUNT];
     char source[256];
     size_t i;
-    for (i = 0; i < PARAM_COUNT; ++i) merged[i] = defaults[i];
-    for (i = 0; i < model->count; ++i) {
+    for (i = 0; i < PARAM_COUNT; ++i) {  /* a default NaN: an optional parameter not given */
+        merged[i] = defaults[i];
+        given[i] = !isnan(defaults[i]);
+    }
+    for (i = 0; i < model->count; ++i) {  /* a variable is always given, NaN too */
         const SmaVariable *v = &model->variables[i];
-        if (v->wire >= 0 && v->wire < PARAM_COUNT)
+        if (v->wire >= 0 && v->wire < PARAM_COUNT) {
             merged[v->wire] = v->kind == SMA_REAL ? values[i].real : (double)values[i].integer;
+            given[v->wire] = 1;
+        }
     }
     snprintf(source, sizeof source, "%s instance '%s'", run->model_name, run->instance_name);
-    return wire_parameters_from_values_source(out, merged, source, message);
+    return wire_parameters_from_given(out, merged, given, source, message);
 }

@@ -117,7 +117,7 @@ static int derived_failure(const WireParameters *p, const double *values, const 
 }
 
 /* The value in use of an optional parameter: `value`, or `fallback` when not given (NaN). */
-static double given(double value, double fallback)
+static double value_or(double value, double fallback)
 {
     return isnan(value) ? fallback : value;
 }
@@ -127,9 +127,9 @@ static int model_terms(const WireParameters *p, const double v[], ModelTerms *t,
                        SmaMessage *message)
 {
     double a2_h = v[PARAM_a2_h], a2_c = v[PARAM_a2_c];
-    t->nu_h = given(v[PARAM_nu_h], p->nu);
-    t->nu_c = given(v[PARAM_nu_c], p->nu);
-    t->w2 = given(v[PARAM_w2], 0.0);
+    t->nu_h = value_or(v[PARAM_nu_h], p->nu);
+    t->nu_c = value_or(v[PARAM_nu_c], p->nu);
+    t->w2 = value_or(v[PARAM_w2], 0.0);
     if (t->w2 > 0.0) {
         if (isnan(a2_h) || isnan(a2_c)) {
             return sma_message_set(message, "%s: parameter second_stage.%s is required when "
@@ -144,16 +144,16 @@ static int model_terms(const WireParameters *p, const double v[], ModelTerms *t,
     }
     t->a2_h = a2_h;
     t->a2_c = a2_c;
-    t->b2_h = given(v[PARAM_b2_h], p->b_h);
-    t->b2_c = given(v[PARAM_b2_c], p->b_c);
-    t->nu2_h = given(v[PARAM_nu2_h], t->nu_h);
-    t->nu2_c = given(v[PARAM_nu2_c], t->nu_c);
-    t->alpha_P = given(v[PARAM_alpha_P], 0.0);
-    t->alpha_MF = given(v[PARAM_alpha_MF], 0.0);
-    t->T_alpha = given(v[PARAM_T_alpha], DEFAULT_T_ALPHA);
-    t->span_ratio_0 = given(v[PARAM_span_ratio_0], 1.0);
-    t->span_ratio_sat = given(v[PARAM_span_ratio_sat], 1.0);
-    t->span_stress = given(v[PARAM_span_stress], DEFAULT_SPAN_STRESS);
+    t->b2_h = value_or(v[PARAM_b2_h], p->b_h);
+    t->b2_c = value_or(v[PARAM_b2_c], p->b_c);
+    t->nu2_h = value_or(v[PARAM_nu2_h], t->nu_h);
+    t->nu2_c = value_or(v[PARAM_nu2_c], t->nu_c);
+    t->alpha_P = value_or(v[PARAM_alpha_P], 0.0);
+    t->alpha_MF = value_or(v[PARAM_alpha_MF], 0.0);
+    t->T_alpha = value_or(v[PARAM_T_alpha], DEFAULT_T_ALPHA);
+    t->span_ratio_0 = value_or(v[PARAM_span_ratio_0], 1.0);
+    t->span_ratio_sat = value_or(v[PARAM_span_ratio_sat], 1.0);
+    t->span_stress = value_or(v[PARAM_span_stress], DEFAULT_SPAN_STRESS);
     t->two_stage = t->w2 > 0.0;
     t->strain = t->alpha_P != 0.0 || t->alpha_MF != 0.0 || t->span_ratio_0 != 1.0
                 || t->span_ratio_sat != 1.0;
@@ -161,21 +161,23 @@ static int model_terms(const WireParameters *p, const double v[], ModelTerms *t,
     return 0;
 }
 
-/* The parameter values as checked (defaults for optional ones not given), in spec order. */
-static int check_values(WireParameters *p, const double values[], double checked[],
-                        SmaMessage *message)
+/* The parameter values as checked (defaults for optional ones not given), in spec order.
+ * `given` NULL: an optional parameter's NaN means "not given"; else given[i] says it, and a
+ * NaN that was given is refused by name like any value that breaks its rule. */
+static int check_values(WireParameters *p, const double values[], const unsigned char *given,
+                        double checked[], SmaMessage *message)
 {
     int index;
     for (index = 0; index < PARAM_COUNT; index++) {
         const ParameterSpec *spec = &PARAMETER_SPECS[index];
         double value = values[index];
-        if (!spec->required && isnan(value)) {
+        if (!spec->required && (given != NULL ? !given[index] : isnan(value))) {
             if (index == PARAM_memory_depth) {
                 value = DEFAULT_DEPTH;
             } else if (index == PARAM_stress_max) {
                 value = DEFAULT_STRESS_MAX;
             } else {
-                checked[index] = value;   /* alpha and the terms: None */
+                checked[index] = NAN;     /* alpha and the terms: None (NaN below) */
                 continue;
             }
         }
@@ -192,6 +194,13 @@ static int check_values(WireParameters *p, const double values[], double checked
 int wire_parameters_from_values_source(WireParameters *out, const double values[],
                                        const char *source, SmaMessage *message)
 {
+    return wire_parameters_from_given(out, values, NULL, source, message);
+}
+
+int wire_parameters_from_given(WireParameters *out, const double values[],
+                               const unsigned char *given, const char *source,
+                               SmaMessage *message)
+{
     static const ParameterIndex MASS_X0[] = {PARAM_mass, PARAM_x0};
     static const ParameterIndex GEOMETRY[] = {PARAM_x0, PARAM_x_min, PARAM_diameter,
                                               PARAM_theta, PARAM_mass};
@@ -205,7 +214,7 @@ int wire_parameters_from_values_source(WireParameters *out, const double values[
 
     memset(&p, 0, sizeof p);
     snprintf(p.source, sizeof p.source, "%s", source != NULL ? source : "<parameters>");
-    if (check_values(&p, values, v, message)) {
+    if (check_values(&p, values, given, v, message)) {
         return 1;
     }
     p.x0 = v[PARAM_x0]; p.x_min = v[PARAM_x_min]; p.diameter = v[PARAM_diameter];
@@ -258,7 +267,7 @@ int wire_parameters_from_values_source(WireParameters *out, const double values[
     p.x_T = p.x_min - 0.5 * (p.l_M + p.l_F);
     p.x_f = p.l_F - 0.5 * (p.x_min + p.l_M);
     p.R_MF = 0.5 * (p.R_M + p.R_F);
-    p.phase_lag_alpha = isnan(p.alpha) ? p.tau_th : p.alpha;
+    p.phase_lag_alpha = isnan(p.alpha) ? p.tau_th : p.alpha;  /* checked: NaN only if not given */
     square = pow(p.diameter, 2.0);
     failure = isinf(square) ? SMA_POW_OVERFLOW : NULL;
     p.load_max = p.stress_max * 1e6 * SMA_PI * square / 4.0 / STANDARD_GRAVITY;

@@ -86,5 +86,12 @@ int wire_parameters_from_values(WireParameters *out, const double values[],
  * the text is copied (truncated to 255 bytes), never used as a format. */
 int wire_parameters_from_values_source(WireParameters *out, const double values[],
                                        const char *source, SmaMessage *message);
+/* The same with a "given" flag per parameter (PARAMETER_SPECS order): an optional parameter
+ * not given takes its default, and one given must hold its rule, so a NaN or an infinity that
+ * a host set is refused naming the parameter (an FMU's parameters are always given).
+ * `given` NULL: NaN means "not given", as above. */
+int wire_parameters_from_given(WireParameters *out, const double values[],
+                               const unsigned char *given, const char *source,
+                               SmaMessage *message);
 
 #endif

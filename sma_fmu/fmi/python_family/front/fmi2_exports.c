@@ -15,7 +15,7 @@
  *    very same step (t, h) discarded twice in a row reports fmi2Terminated, so masters that
  *    retry unchanged (fmpy, fmusim) stop instead of looping.
  *  - saved states are wrapped (FrontState, fmi2_states.c) so unknown or freed pointers give fmi2Error;
- *    serialized states carry a checked header (state_bytes.c).
+ *    serialized states carry a checked header (c_common/state_frame.c).
  *  - after fmi2Fatal (pythonfmu released its Python objects) every call is refused and
  *    fmi2FreeInstance leaks pythonfmu's instance instead of freeing it twice.
  *  - a pointer that is not a live instance (freed, or never one) is refused, not used

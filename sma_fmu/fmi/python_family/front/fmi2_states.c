@@ -3,7 +3,7 @@
  *
  * States handed to the host are FrontState wrappers kept in a list per instance, so a
  * pointer the instance never returned (or has freed) gives fmi2Error instead of reaching
- * pythonfmu as a Python object; serialized states carry a checked header (state_bytes.c).
+ * pythonfmu as a Python object; serialized states carry a checked header (c_common/state_frame.c).
  */
 #define _GNU_SOURCE
 #include <stdio.h>
@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "front.h"
+#include "state_frame.h"  /* the frame both families put around a state (c_common) */
 
 /* ---- saved states -------------------------------------------------------------------------- */
 FrontState* find_state(Instance* in, fmi2FMUstate state)
@@ -99,7 +100,7 @@ EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state
         return refuse(in, fmi2Error, "fmi2SerializedFMUstateSize", "unknown state or size is NULL");
     size_t payload = 0;
     fmi2Status status = finish(in, backend.SerializedFMUstateSize(in->backend, wrapper->saved, &payload));
-    if (status <= fmi2Warning) *size = payload + STATE_HEADER_SIZE;
+    if (status <= fmi2Warning) *size = payload + STATE_FRAME_SIZE;
     return status;
 }
 
@@ -113,14 +114,14 @@ EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi
     size_t payload = 0;
     fmi2Status status = finish(in, backend.SerializedFMUstateSize(in->backend, wrapper->saved, &payload));
     if (status > fmi2Warning) return status;
-    if (size != payload + STATE_HEADER_SIZE) { /* pythonfmu would copy `size` bytes unchecked */
+    if (size != payload + STATE_FRAME_SIZE) { /* pythonfmu would copy `size` bytes unchecked */
         host_logf(in, fmi2Error, "fmi2SerializeFMUstate: size is %zu, fmi2SerializedFMUstateSize "
-                  "said %zu", size, payload + STATE_HEADER_SIZE);
+                  "said %zu", size, payload + STATE_FRAME_SIZE);
         return fmi2Error;
     }
     status = finish(in, backend.SerializeFMUstate(in->backend, wrapper->saved,
-                                                  bytes + STATE_HEADER_SIZE, payload));
-    if (status <= fmi2Warning) write_state_header(bytes, payload);
+                                                  bytes + STATE_FRAME_SIZE, payload));
+    if (status <= fmi2Warning) state_frame_write((unsigned char*)bytes, payload);
     return status;
 }
 
@@ -133,12 +134,15 @@ EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serial
     if (*state && !find_state(in, *state))
         return refuse(in, fmi2Error, "fmi2DeSerializeFMUstate", "*FMUstate is neither NULL nor a "
                       "state of this instance");
-    if (!state_header_valid(serializedState, size))
-        return refuse(in, fmi2Error, "fmi2DeSerializeFMUstate", "these bytes are not a state "
-                      "serialized by this FMU (bad header, length or checksum)");
+    char why[300];
+    if (!state_frame_check((const unsigned char*)serializedState, size, why, sizeof why)) {
+        host_logf(in, fmi2Error, "fmi2DeSerializeFMUstate: these bytes are not a state "
+                  "serialized by this FMU: %s", why);
+        return fmi2Error;
+    }
     fmi2FMUstate saved = NULL;
     fmi2Status status = finish(in, backend.DeSerializeFMUstate(
-        in->backend, serializedState + STATE_HEADER_SIZE, size - STATE_HEADER_SIZE, &saved));
+        in->backend, serializedState + STATE_FRAME_SIZE, size - STATE_FRAME_SIZE, &saved));
     if (status > fmi2Warning) {
         if (saved && !in->dead) backend.FreeFMUstate(in->backend, &saved);
         return status;

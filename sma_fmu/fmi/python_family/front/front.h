@@ -268,9 +268,4 @@ char* resource_uri_for_pythonfmu(const char* uri, char* err, size_t errlen, char
                                  int* plain_path);
 int guid_matches(const char* resources, const char* guid, char* err, size_t errlen);
 
-/* ---- serialized states (state_bytes.c) --------------------------------------------------- */
-#define STATE_HEADER_SIZE 20
-void write_state_header(fmi2Byte* bytes, size_t payload_size);
-int state_header_valid(const fmi2Byte* bytes, size_t size);
-
 #endif
