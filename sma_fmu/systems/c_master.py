@@ -64,6 +64,15 @@ def unpacked_fmu(fmu, cache=None):
     return folder
 
 
+def _widen(pipe):
+    """A 1 MiB pipe (Linux): the host steps on while the rows of two frames wait here."""
+    try:
+        import fcntl
+        fcntl.fcntl(pipe.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), 1 << 20)
+    except (ImportError, OSError):  # another system, or a lower pipe-max-size: the default
+        pass
+
+
 def _read_frames(stream):
     """(tag, payload) frames from the host's stdout until it closes."""
     while True:
@@ -121,6 +130,7 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None):
     logs, failure, done = [], None, False
     with subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, env=environment) as host:
+        _widen(host.stdout)
         host.stdin.write(("\n".join(lines) + "\n").encode())
         host.stdin.close()
         for tag, payload in _read_frames(host.stdout):

@@ -3,11 +3,12 @@
 The host sends the recorded outputs at t_0 (after initialization) ... t_n (after each
 step); row k of the loop holds the states and signals at t_k and the blocks' outputs of
 step k, which the host reads after that step (sample k + 1), as :func:`~.hosts.loop_series`
-does for a whole series. :class:`RowAssembler` does it block by block, with the numbers
+does for a whole series. :class:`RowAssembler` does it frame by frame, with the numbers
 the fmpy master's :func:`~sma_fmu.cosim.loop.run_loop` computes in Python (t_k = k h, the
 stroke x_0 - x_k), and hands the rows on in its blocks of
 :data:`~sma_fmu.cosim.loop.ROWS_PER_CHUNK` (the streaming metrics add per block: the same
-blocks give the same sums, to the bit).
+blocks give the same sums, to the bit). The host's first frame has one sample more, so
+each frame makes one such block, handed on without a copy.
 """
 import math
 
@@ -95,6 +96,9 @@ class RowAssembler:
         self._emit(block)
 
     def _emit(self, block):
+        if self._filled == 0 and len(block) == ROWS_PER_CHUNK:  # a whole block: no copy
+            self._send(block)
+            return
         first = 0
         while first < len(block):
             take = min(ROWS_PER_CHUNK - self._filled, len(block) - first)
@@ -104,14 +108,15 @@ class RowAssembler:
             if self._filled == ROWS_PER_CHUNK:
                 self._send()
 
-    def _send(self):
-        rows = self._out[:self._filled]
-        if self.sink is None:
-            self._kept.append(rows.copy())
-        else:
-            self.sink(rows)
+    def _send(self, block=None):
+        """Hand on ``block`` (one of its own), else the gathered rows."""
+        if block is None:
+            block, self._filled = self._out[:self._filled], 0
             self._out = np.empty(ROWS_PER_CHUNK, dtype=TIMESERIES_DTYPE)  # the sink may keep it
-        self._filled = 0
+        if self.sink is None:
+            self._kept.append(block)
+        else:
+            self.sink(block)
 
     def finish(self):
         """The last sample as the final row (no step outputs), the rows not yet sent; returns

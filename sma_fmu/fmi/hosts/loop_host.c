@@ -25,7 +25,9 @@
  * Exit status 0, 1 when an FMI call fails (stderr names it), 2 on a bad system.
  * "binary ROWS" (the C master of `sma-fmu run --master c`): stdout is a stream of frames,
  * each a 4-byte tag and a 4-byte little-endian length of the payload that follows:
- *   ROWS  up to ROWS rows of the recorded columns, raw doubles (Booleans 0.0/1.0);
+ *   ROWS  rows of the recorded columns, raw doubles (Booleans 0.0/1.0): ROWS + 1 in the
+ *         first frame, ROWS in the others (the last one fewer), so that each frame
+ *         completes ROWS rows of the loop (row k holds the outputs after step k);
  *   LOG_  "STATUS NAME CATEGORY\tTEXT" of an FMU log message;
  *   FAIL  "NAME.CALL returned STATUS at t = T s" of a failed call (status > fmi2Warning),
  *         after the rows up to that step: the host then exits with status 1;
@@ -72,7 +74,7 @@ static Column column[MAX_ITEMS];
 static int starts, links, columns;
 static int binary;          /* "binary ROWS": frames on stdout (see the header) */
 static double *block, now;  /* the rows not yet written (binary), the time of the step [s] */
-static long block_rows, block_size;
+static long block_rows, block_size, frame_size;  /* frame_size: ROWS + 1, then ROWS */
 
 /* One frame: a 4-byte tag, the payload's length (4 bytes, little-endian), the payload. */
 static void frame(const char* tag, const void* payload, size_t size)
@@ -206,7 +208,10 @@ static void print_row(void)
                 check(f->GetReal(f->c, &column[k].vr, 1, &row[k]), f, "fmi2GetReal");
             }
         }
-        if (++block_rows == block_size) flush_rows();
+        if (++block_rows == frame_size) {
+            flush_rows();
+            frame_size = block_size;
+        }
         return;
     }
     fputs("row", stdout);
@@ -299,9 +304,10 @@ static void start_binary(long rows)
 #ifdef _WIN32
     _setmode(_fileno(stdout), _O_BINARY);
 #endif
-    block = malloc(sizeof(double) * (size_t)(rows * columns));
+    block = malloc(sizeof(double) * (size_t)((rows + 1) * columns));
     if (!block) bad("out of memory for", "the rows");
     block_size = rows;
+    frame_size = rows + 1;
     binary = 1;
 }
 
