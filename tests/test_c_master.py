@@ -10,6 +10,7 @@ import json
 import shutil
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from cli_failure import fails
@@ -131,3 +132,54 @@ def test_the_cli_names_the_failure_and_leaves_the_folder(native_dir, tmp_path, c
     fails(capsys, ["run", "heavy-pi", "--path", "library", "--master", "c", "--out", str(out)],
           "--master c", "--path library")
     assert [p.name for p in out.iterdir()] == ["keep.txt"]
+
+
+GRID = """
+[study]
+scenarios = ["load-step-pi+ff-adaptive", "heavy-pi"]
+seed = 3
+[overrides]
+"scenario.stop_time_s" = 2.0
+[axes]
+kind = "grid"
+[axes.values]
+"controller.Kp_W_per_ohm" = [0.3, -1.0]
+"""
+
+
+def test_a_sweep_task_over_native_fmus_runs_the_c_master(native_dir):
+    """Each run's metrics are those of the fmpy master over the same FMUs, to the bit."""
+    from sma_fmu.studies.overrides import template
+    from sma_fmu.studies.runs import metrics_record
+    from sma_fmu.studies.spec import StudyRunSpec
+    from sma_fmu.studies.tasks import run_task
+
+    base = template("load-step-pi+ff-adaptive")
+    overrides = [{"scenario.stop_time_s": 2.0, "controller.Kp_W_per_ohm": kp} for kp in (0.3, 1.0)]
+    rows = run_task([base], [StudyRunSpec(i, 0, o) for i, o in enumerate(overrides)], native_dir)
+    assert [(row["path"], row["status"]) for row in rows] == [("fmu", "ok")] * 2
+    for row, changes in zip(rows, overrides):
+        item = base.scenario(changes)
+        expected = metrics_record(scenario_metrics(run_fmus(item, native_dir).data, item))
+        assert {key: row[key] for key in expected} == expected
+    assert rows[0]["rmse_ohm"] != rows[1]["rmse_ohm"]
+
+
+def test_sweep_over_native_fmus_and_its_folder(native_dir, tmp_path, capsys):
+    from sma_fmu.cli import main
+
+    spec = tmp_path / "grid.toml"
+    spec.write_text(GRID, encoding="utf-8")
+    out = tmp_path / "out"
+    argv = ["sweep", str(spec), "--out", str(out), "--workers", "1", "--quiet"]
+    assert main([*argv, "--fmus", str(native_dir)]) == 0
+    table = pd.read_parquet(out / "results.parquet")
+    assert sorted(table["path"].dropna().unique()) == ["fmu"]
+    assert sorted(table["status"]) == ["failed", "failed", "ok", "ok"]   # Kp = -1 is refused
+    capsys.readouterr()
+    fails(capsys, argv, "holds runs of the fmu path, not batch")     # no mixing of paths
+    shutil.copytree(native_dir, tmp_path / "partial")
+    (tmp_path / "partial" / "SmaFeedforward.fmu").unlink()
+    fails(capsys, ["sweep", str(spec), "--out", str(tmp_path / "other"), "--fmus",
+                   str(tmp_path / "partial")], "SmaFeedforward.fmu not found")
+    assert not (tmp_path / "other").exists()
