@@ -92,7 +92,10 @@ class TimeseriesWriter:
         rows = np.concatenate(self._pending) if self._pending else np.empty(0, dtype=TIMESERIES_DTYPE)
         table = pa.table({label: rows[name] for (name, _), label in zip(COLUMNS, COLUMN_NAMES)})
         if self._parquet is None:
-            self._parquet = pq.ParquetWriter(str(self.path), table.schema, compression="zstd")
+            # no dictionary pages: float columns rarely repeat, and trying them took half the
+            # write time (30 s at 1 ms: 22 -> 10 ms, the file 2.5 -> 2.0 MB)
+            self._parquet = pq.ParquetWriter(str(self.path), table.schema, compression="zstd",
+                                             use_dictionary=False)
         if rows.size or self.rows == 0:
             self._parquet.write_table(table)
         self._pending, self._pending_rows = [], 0

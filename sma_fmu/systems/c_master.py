@@ -121,12 +121,14 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None):
     if windows is not None:
         folders = {name: wine_path(folder) for name, folder in folders.items()}
     executable = compile_host("loop_host", cache, windows=windows is not None)
-    lines = loop_host_lines(system, {k: str(v) for k, v in folders.items()}, scenario.steps)
+    columns = recorded_columns(system)
+    lines = loop_host_lines(system, {k: str(v) for k, v in folders.items()}, scenario.steps,
+                            columns=columns)
     lines[-1] += f" binary {ROWS_PER_CHUNK}"
     command = [str(executable)] if windows is None else [wine_executable(), str(executable)]
     environment = dict(os.environ if windows is None else windows)
     environment.pop("LD_PRELOAD", None)
-    rows = RowAssembler(scenario, recorded_columns(system), sink)
+    rows = RowAssembler(scenario, columns, sink)
     logs, failure, done = [], None, False
     with subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, env=environment) as host:

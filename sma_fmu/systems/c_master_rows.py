@@ -22,8 +22,10 @@ __all__ = ["recorded_columns", "check_variables", "RowAssembler"]
 
 
 def recorded_columns(system):
-    """The columns the host records for ``system``, in the order of its samples."""
-    return list(loop_outputs(system.scenario))
+    """The columns the host records for ``system``, in the order of its samples: grouped by
+    component (the host reads neighbouring columns of one component in one call)."""
+    outputs = loop_outputs(system.scenario)
+    return sorted(outputs, key=lambda column: (outputs[column][0], column == "saturated"))
 
 
 def _need(component, name, causality, types, why):

@@ -75,6 +75,10 @@ static int starts, links, columns;
 static int binary;          /* "binary ROWS": frames on stdout (see the header) */
 static double *block, now;  /* the rows not yet written (binary), the time of the step [s] */
 static long block_rows, block_size, frame_size;  /* frame_size: ROWS + 1, then ROWS */
+typedef struct { int component, boolean, first, count; } Read;  /* columns read in one call */
+static Read reads[MAX_ITEMS];
+static unsigned read_vr[MAX_ITEMS];
+static int n_reads;
 
 /* One frame: a 4-byte tag, the payload's length (4 bytes, little-endian), the payload. */
 static void frame(const char* tag, const void* payload, size_t size)
@@ -198,14 +202,17 @@ static void print_row(void)
 {
     if (binary) {
         double* row = block + block_rows * columns;
-        for (int k = 0; k < columns; ++k) {
-            const Fmu* f = &fmu[column[k].component];
-            if (column[k].boolean) {
-                int value;
-                check(f->GetBoolean(f->c, &column[k].vr, 1, &value), f, "fmi2GetBoolean");
-                row[k] = value ? 1.0 : 0.0;
+        for (int r = 0; r < n_reads; ++r) {
+            const Read* read = &reads[r];
+            const Fmu* f = &fmu[read->component];
+            if (read->boolean) {
+                int value[MAX_ITEMS];
+                check(f->GetBoolean(f->c, &read_vr[read->first], (size_t)read->count, value), f,
+                      "fmi2GetBoolean");
+                for (int k = 0; k < read->count; ++k) row[read->first + k] = value[k] ? 1.0 : 0.0;
             } else {
-                check(f->GetReal(f->c, &column[k].vr, 1, &row[k]), f, "fmi2GetReal");
+                check(f->GetReal(f->c, &read_vr[read->first], (size_t)read->count, &row[read->first]),
+                      f, "fmi2GetReal");
             }
         }
         if (++block_rows == frame_size) {
@@ -308,6 +315,14 @@ static void start_binary(long rows)
     if (!block) bad("out of memory for", "the rows");
     block_size = rows;
     frame_size = rows + 1;
+    for (int k = 0; k < columns; ++k) {  /* neighbouring columns of one component: one call */
+        read_vr[k] = column[k].vr;
+        Read* last = n_reads ? &reads[n_reads - 1] : NULL;
+        if (last && last->component == column[k].component && last->boolean == column[k].boolean)
+            ++last->count;
+        else
+            reads[n_reads++] = (Read){column[k].component, column[k].boolean, k, 1};
+    }
     binary = 1;
 }
 
