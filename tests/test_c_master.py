@@ -183,3 +183,17 @@ def test_sweep_over_native_fmus_and_its_folder(native_dir, tmp_path, capsys):
     fails(capsys, ["sweep", str(spec), "--out", str(tmp_path / "other"), "--fmus",
                    str(tmp_path / "partial")], "SmaFeedforward.fmu not found")
     assert not (tmp_path / "other").exists()
+
+
+def test_the_bench_section_compares_each_scenario_with_the_library(native_dir, tmp_path):
+    """One alternating run of one scenario: both walls, their ratio and the target's verdict
+    (the numbers themselves are the bench's to print, not asserted here)."""
+    from sma_fmu.bench.c_master import TARGET, c_master_lines, c_master_times
+
+    times = c_master_times(native_dir, 1, tmp_path, scenarios=("heavy-pi",), formats=("parquet",))
+    row = times["heavy-pi (parquet)"]
+    assert row["runs"] == 1 and row["library_s"] > 0 and row["c_s"] > 0
+    assert row["ratio"] == pytest.approx(row["c_s"] / row["library_s"], rel=0.01)
+    lines = c_master_lines(times)
+    assert "heavy-pi (parquet)" in lines[-1] and f"target <= {TARGET:g}" in lines[-1]
+    assert len(list(tmp_path.glob("heavy-pi-parquet-*/timeseries.parquet"))) == 2

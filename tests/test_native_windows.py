@@ -77,7 +77,7 @@ def test_the_linux64_loop_host_is_the_library_loop(linux_runs, name):
     assert {c.model for c in system.components} >= {"SmaActuator", "SmaFeedforward",
                                                     "SmaPiController", "SmaScenarioSignals"}
     data = loop_series(scenario, samples, scenario.steps)
-    assert deviation(data, run_library(scenario).data) <= 1e-9
+    assert deviation(data, run_library(scenario).data) == 0.0  # the C runtime is the library
     assert np.ptp(data["R"]) > 1.0 and np.ptp(data["load"]) > 0.1  # the loop really moved
 
 
