@@ -70,6 +70,14 @@ def test_the_c_master_is_the_fmpy_master_to_the_bit(native_dir, name):
     assert np.ptp(c.data["R"]) > 1.0 and np.ptp(c.data["P"][:-1]) > 0.1  # the loop moved
 
 
+def test_the_c_master_runs_the_pythonfmu_family_too(fmus):
+    """The default FMUs (pythonfmu, their C front loading libpython in the host): the same
+    rows as the fmpy master over them (no faster: the slaves are Python)."""
+    scenario = _scenario(PWM[0])
+    folder = fmus["SmaActuator"].parent
+    _same(run_c_master(scenario, folder).data, run_fmus(scenario, folder).data)
+
+
 def test_the_runner_records_the_same_files_and_metrics(native_dir, tmp_path):
     paths = resolve_scenarios(["heavy-pi+ff-adaptive", PWM[0]])
     for master in ("fmpy", "c"):
