@@ -15,6 +15,8 @@ the sink (and kept in the error), and the message names the FMU, the call and th
 """
 import hashlib
 import os
+import re
+import shutil
 import subprocess
 import tempfile
 import time
@@ -60,7 +62,7 @@ def unpacked_fmu(fmu, cache=None):
         try:
             os.replace(stage, folder)   # atomic: a parallel run never sees half a folder
         except OSError:                 # another run unpacked it first
-            subprocess.run(["rm", "-rf", str(stage)], check=False)
+            shutil.rmtree(stage, ignore_errors=True)
     return folder
 
 
@@ -90,17 +92,23 @@ def _log_entry(payload):
     return int(status), name, text
 
 
+_FAIL = re.compile(r"(?P<name>[^.]+)\.(?P<call>.+) returned (?P<status>-?\d+) at t = (?P<time>\S+) s")
+
+
 def _failure(scenario, text, logs, rows, windows):
     """The :class:`CMasterError` of a FAIL frame ``text``: "NAME.CALL returned S at t = T s"."""
-    words = text.split()
-    status = int(words[2]) if len(words) > 2 and words[2].isdigit() else 3
-    time_s = float(words[-2]) if len(words) > 2 else None
-    name = words[0].split(".")[0] if words else "?"
+    match = _FAIL.fullmatch(text.strip())
+    if match is None:  # not the host's form: say it as it came
+        name, call, status, time_s = "?", text, 3, None
+    else:
+        name, call = match["name"], match["call"]
+        status, time_s = int(match["status"]), float(match["time"])
     said = "; ".join(t for s, n, t in logs if n == name and s >= 2) or "no message"
     where = " (win64, wine)" if windows is not None else ""
-    message = (f"scenario {scenario.name}: C master{where}: {name}: {words[0].partition('.')[2]} "
-               f"failed ({_STATUS.get(status, status)}) at t = {time_s:g} s: {said}; "
-               f"the run stopped there ({rows} rows kept)")
+    when = "" if time_s is None else f" at t = {time_s:g} s"
+    message = (f"scenario {scenario.name}: C master{where}: {name}: {call} failed "
+               f"({_STATUS.get(status, status)}){when}: {said}; the run stopped there "
+               f"({rows} rows kept)")
     return CMasterError(message, status, time_s=time_s)
 
 
