@@ -141,18 +141,23 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None):
     with subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, env=environment) as host:
         _widen(host.stdout)
-        host.stdin.write(("\n".join(lines) + "\n").encode())
-        host.stdin.close()
+        try:
+            host.stdin.write(("\n".join(lines) + "\n").encode())
+            host.stdin.close()
+        except BrokenPipeError:  # the host refused the system early: its stderr says why
+            pass
         for tag, payload in _read_frames(host.stdout):
             if tag == b"ROWS":
                 rows.add(payload)
             elif tag == b"LOG_":
-                logs.append(_log_entry(payload))
+                entry = _log_entry(payload)
+                if entry[0] >= 2:  # what a failure quotes (warnings are not kept: a long
+                    logs.append(entry)  # run may log one per step)
             elif tag == b"FAIL":
                 failure = payload.decode("utf-8", "replace")
             elif tag == b"DONE":
                 done = True
-        error = host.stderr.read().decode("utf-8", "replace").strip()
+        said = host.stderr.read().decode("utf-8", "replace").strip()
         status = host.wait()
     if failure is not None:
         kept = rows.finish()   # the rows up to the failed step, the last without step outputs
@@ -162,6 +167,6 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None):
     if status != 0 or not done:
         where = " (win64, wine)" if windows is not None else ""
         raise CMasterError(f"scenario {scenario.name}: C master{where}: exit status {status}: "
-                           f"{error.splitlines()[-1] if error else 'no message'}", 3)
+                           f"{said.splitlines()[-1] if said else 'no message'}", 3)
     data = rows.finish()
     return LoopResult(scenario, data, "fmu", time.perf_counter() - started)
