@@ -123,11 +123,10 @@ class FigureSeries:
         """Offer recorded rows (consecutive, in order)."""
         if rows.size == 0:
             return
-        ordinals = self.count + np.arange(rows.size)
-        chosen = rows[ordinals % self.stride == 0]
+        chosen = rows[(-self.count) % self.stride::self.stride].copy()  # ordinals % stride == 0
         self.count += rows.size
         self._last = rows[-1:].copy()
-        self._blocks.append(chosen.copy())
+        self._blocks.append(chosen)
         self._kept += chosen.size
         if self._kept > 2 * self.limit:  # halve: keep every other kept row
             kept = np.concatenate(self._blocks)
