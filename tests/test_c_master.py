@@ -142,6 +142,15 @@ def test_the_cli_names_the_failure_and_leaves_the_folder(native_dir, tmp_path, c
     assert [p.name for p in out.iterdir()] == ["keep.txt"]
 
 
+
+def test_no_compiler_for_the_host_is_a_named_error(native_dir, tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("CC", "no-such-cc")
+    with pytest.raises(CMasterError, match=r"C master: C compiler 'no-such-cc' could not run"):
+        run_c_master(_scenario("heavy-pi"), native_dir, cache=tmp_path)
+    fails(capsys, ["run", "heavy-pi", "--fmus", str(native_dir), "--master", "c", "--out",
+                   str(tmp_path / "out")], "C master", "no-such-cc")
+    assert not (tmp_path / "out").exists()
+
 GRID = """
 [study]
 scenarios = ["load-step-pi+ff-adaptive", "heavy-pi"]

@@ -26,7 +26,7 @@ from pathlib import Path
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
 from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.driving.instance import FmuError
-from sma_fmu.fmi.hosts import compile_host
+from sma_fmu.fmi.hosts import CHostError, compile_host
 from sma_fmu.systems.c_master_rows import RowAssembler, check_variables, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
@@ -128,7 +128,10 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None):
     folders = {c.name: unpacked_fmu(c.fmu, cache) for c in system.components}
     if windows is not None:
         folders = {name: wine_path(folder) for name, folder in folders.items()}
-    executable = compile_host("loop_host", cache, windows=windows is not None)
+    try:
+        executable = compile_host("loop_host", cache, windows=windows is not None)
+    except CHostError as error:   # no compiler: one named error, not an internal one
+        raise CMasterError(f"scenario {scenario.name}: C master: {error}", 3) from None
     columns = recorded_columns(system)
     lines = loop_host_lines(system, {k: str(v) for k, v in folders.items()}, scenario.steps,
                             columns=columns)
