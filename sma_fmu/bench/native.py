@@ -9,7 +9,8 @@ Alternating runs (each ratio compares runs made next to each other), all at
   (ctypes: each call costs about a microsecond, which bounds the gain there).
 And the HIL case: the five native FMUs (signals, compensator, PI, PWM driver, plant) as a
 sequential loop in the plain C loop host (``loop_host.c``, no Python in the process),
-:data:`LOOP_STEPS` steps of 1 ms of the PWM set-point scenario, each step timed.
+:data:`LOOP_STEPS` steps of 1 ms of the PWM set-point scenario, each step timed. And the C
+master against the library per scenario, recording included (:mod:`.c_master`).
 """
 import dataclasses
 import statistics
@@ -104,6 +105,9 @@ def native_lines(native):
                  f"{native['loop_steps']} steps of 1 ms): per step p50 {loop['p50_us']:.3f} us, "
                  f"p99 {loop['p99_us']:.3f} us, p99.9 {loop['p99_9_us']:.3f} us, max {loop['max_us']:.1f} us: "
                  f"{_verdict(loop['p99_9_us'], NATIVE_TARGETS[name])} us")
+    if "c_master" in native:  # issue 41: the scenario's loop in the C master, recorded
+        from sma_fmu.bench.c_master import c_master_lines
+        lines += [""] + c_master_lines(native["c_master"])
     return lines
 
 
@@ -116,4 +120,8 @@ def native_section(python_paths, params, runs, folder):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NativeBuildWarning)  # win64 is not timed here
         native_paths = build_native_fmus(Path(folder) / "native-fmus")
-    return native_costs(python_paths, native_paths, params, runs, folder)
+    costs = native_costs(python_paths, native_paths, params, runs, folder)
+    from sma_fmu.bench.c_master import c_master_times
+    costs["c_master"] = c_master_times(Path(native_paths["SmaActuator"]).parent, runs,
+                                       Path(folder) / "c-master")
+    return costs

@@ -13,6 +13,13 @@ def _bench(args):
         from sma_fmu.bench.host_table import run_host_table
         run_host_table(args.out, args.scenario, args.stop_time, args.omsimulator)
         return 0
+    if args.only == "c-master":
+        from sma_fmu.bench.c_master import c_master_lines, run_c_master_bench
+        say = lambda text: print(text, flush=True)  # noqa: E731
+        results = run_c_master_bench(args.out, args.runs, args.fmus, progress=say)
+        print("\n".join(c_master_lines(results["c_master"], results["one_hour"])))
+        print(f"written: {args.out / 'benchmark.json'}")
+        return 0
     if args.only == "pwm":
         from sma_fmu.bench.pwm_table import pwm_table_rows
         pwm_table_rows()
@@ -28,10 +35,15 @@ def register(commands):
                        help="output folder")
     bench.add_argument("--runs", type=bounded_integer(1, MAX_RUNS), default=5,
                        help=f"repetitions per measurement, 1-{MAX_RUNS}")
-    bench.add_argument("--only", choices=("batch", "hosts", "pwm"),
+    bench.add_argument("--only", choices=("batch", "hosts", "pwm", "c-master"),
                        help="only this section (batch: the batch engine's throughput table; "
                             "hosts: every scenario in every host against the library loop, "
-                            "docs/systems.md's table; pwm: the PWM table of docs/model.md)")
+                            "docs/systems.md's table; pwm: the PWM table of docs/model.md; "
+                            "c-master: the C master against the library per scenario, and the "
+                            "peak memory of a one-hour run)")
+    bench.add_argument("--fmus", type=Path, metavar="DIR",
+                       help="with --only c-master: the native FMUs (sma-fmu build --native; "
+                            "default: built into the output folder)")
     bench.add_argument("--scenario", action="append", metavar="NAME",
                        help="with --only hosts: a scenario (repeatable; default: the paper's six "
                             "and the two PWM set-point ones)")

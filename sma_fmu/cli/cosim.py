@@ -9,7 +9,7 @@ __all__ = ["register"]
 def _run(args):
     from sma_fmu.systems.runner import timed_run
     timed_run(scenario_paths(args), args.out, args.path, args.fmus,
-              output_interval_s=args.output_interval, fmt=args.format)
+              output_interval_s=args.output_interval, fmt=args.format, master=args.master)
     return 0
 
 
@@ -23,6 +23,9 @@ def register(commands):
                      help="fmu: the FMUs under fmpy; library: the steppers directly; ssp: the "
                           "SSP package in libcosim (Jacobi); container: the one-FMU loop in libcosim")
     add_fmus_argument(run)
+    run.add_argument("--master", choices=("fmpy", "c"), default="fmpy",  # runner.FMU_MASTERS
+                     help="the FMU path's master: fmpy (default; Python) or c (the C master: "
+                          "the FMUs stepped in one C process, the same results to the bit)")
     run.add_argument("--output-interval", type=positive_number, metavar="S",
                      help="record every k-th step in the time series and figures: S seconds, a "
                           "whole number of steps (default: the scenario's output_interval_s, else "

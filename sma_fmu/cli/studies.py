@@ -15,7 +15,8 @@ __all__ = ["register"]
 def _sweep(args):
     from sma_fmu.studies.sweep import run_sweep
     out = args.out or Path("results") / f"sweep-{Path(args.spec).stem}"
-    summary = run_sweep(args.spec, out, args.scheduler, args.workers, progress=not args.quiet)
+    summary = run_sweep(args.spec, out, args.scheduler, args.workers, progress=not args.quiet,
+                        fmu_dir=args.fmus)
     status = summary["status"]
     print(f"{summary['runs']} runs: {status['ok']} ok, {status['failed']} failed, "
           f"{status['error']} task errors")
@@ -51,6 +52,9 @@ def register(commands):
     sweep.add_argument("--out", type=Path, metavar="DIR",
                        help="output folder (default: results/sweep-SPEC); rerun to resume")
     sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    sweep.add_argument("--fmus", type=Path, metavar="DIR",
+                       help="run every run through the C master over the FMUs in DIR (sma-fmu "
+                            "build --native: FMU-path studies at C speed); default: the batch engine")
     sweep.set_defaults(handler=_sweep)
 
     tune = commands.add_parser("tune", help="optimise Kp, Ki (and alpha, beta with "

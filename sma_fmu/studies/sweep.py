@@ -9,7 +9,10 @@ finished. Running the same spec into the same folder again resumes: runs already
 part (succeeded or failed) are not run again; runs of a task that itself failed (status
 "error", e.g. a worker died) are. ``OUT/study.json`` records the spec's fingerprint; a
 different spec into the same folder is refused. At the end, :mod:`~sma_fmu.studies.results`
-writes the table, the summary and the figures.
+writes the table, the summary and the figures. With ``fmu_dir`` (``--fmus DIR``) the runs
+go through the C master over those FMUs (:func:`~sma_fmu.studies.tasks.run_task`); the
+FMUs are checked against every base scenario before anything starts, and a folder holds
+the runs of one path only (``study.json`` says which).
 """
 import contextlib
 import io
@@ -68,20 +71,33 @@ def finished_runs(out):
     return dict(zip(table["run_id"].tolist(), table["status"].tolist()))
 
 
-def _check_folder(out, spec):
-    """Create ``out`` for ``spec``, or check that it holds a sweep of the same spec."""
+def _check_folder(out, spec, path="batch"):
+    """Create ``out`` for ``spec``, or check that it holds a sweep of the same spec and path."""
     out = Path(out)
     check_folder(out)
     marker = out / "study.json"
     fingerprint = spec.fingerprint()
     if marker.is_file():
-        recorded = json.loads(marker.read_text(encoding="utf-8")).get("fingerprint")
-        if recorded != fingerprint:
+        recorded = json.loads(marker.read_text(encoding="utf-8"))
+        if recorded.get("fingerprint") != fingerprint:
             raise StudyError(f"--out {out}: holds the results of another study spec "
                              f"(study.json); give another --out, or remove that folder")
+        if recorded.get("path", "batch") != path:
+            raise StudyError(f"--out {out}: holds runs of the {recorded.get('path', 'batch')} path, "
+                             f"not {path} (--fmus); give another --out, or remove that folder")
         return
     write_file(marker, json_text({"spec": str(spec.path), "fingerprint": fingerprint,
-                                  "runs": len(spec.runs())}))
+                                  "runs": len(spec.runs()), "path": path}))
+
+
+def _check_fmus(spec, fmu_dir):
+    """Every base scenario's loop in ``fmu_dir``: a missing FMU or one whose variables do
+    not match is refused before the sweep starts (the message names it)."""
+    from sma_fmu.systems.c_master_rows import check_variables
+    from sma_fmu.systems.closed_loop import closed_loop
+
+    for template in spec.templates:
+        check_variables(closed_loop(template.scenario({}), fmu_dir))
 
 
 def _write_part(out, rows):
@@ -99,14 +115,18 @@ def _error_rows(spec, runs, reason):
             for run in runs]
 
 
-def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True):
-    """Run the study spec at ``spec_path`` into folder ``out``; returns the summary dict."""
+def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True, fmu_dir=None):
+    """Run the study spec at ``spec_path`` into folder ``out``; returns the summary dict.
+    ``fmu_dir``: run through the C master over the FMUs there (else the batch engine)."""
     from dask.distributed import as_completed
     from tqdm import tqdm
 
     spec = load_spec(spec_path)
     runs = spec.runs()
-    _check_folder(out, spec)
+    if fmu_dir is not None:
+        fmu_dir = str(Path(fmu_dir).resolve())   # the workers' working folder may differ
+        _check_fmus(spec, fmu_dir)
+    _check_folder(out, spec, "batch" if fmu_dir is None else "fmu")
     done = finished_runs(out)
     todo = [run for run in runs if run.run_id not in done]
     if todo:
@@ -114,7 +134,7 @@ def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True):
             count = len(client.scheduler_info().get("workers", {})) or 1
             size = task_size(len(todo), count, spec.runs_per_task)
             chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
-            futures = {client.submit(run_task, spec.templates, chunk, pure=False): chunk
+            futures = {client.submit(run_task, spec.templates, chunk, fmu_dir, pure=False): chunk
                        for chunk in chunks}
             with tqdm(total=len(runs), initial=len(runs) - len(todo), unit="run",
                       disable=not progress, file=sys.stderr, desc="sweep") as bar:

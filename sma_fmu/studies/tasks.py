@@ -4,7 +4,9 @@ The runs go through :func:`~sma_fmu.studies.batch.run_batches`, one batch per st
 duration they share (metrics only, no time series kept; a run that fails there is run
 again on the scalar library path, so its row says ``path = library``). A run that cannot
 be built or fails is a row with ``status = "failed"`` and the reason in ``error``, never
-dropped.
+dropped. With ``fmu_dir`` (``sma-fmu sweep --fmus DIR``) each run goes through the C master
+over the FMUs there instead (:func:`~sma_fmu.systems.c_master.run_c_master`, metrics only,
+streamed; ``path = "fmu"``): FMU-path studies at C speed.
 """
 from sma_fmu.studies.batch import run_batches
 from sma_fmu.studies.overrides import StudyError
@@ -35,8 +37,31 @@ def _finish(row, scenario, metrics, path, error=None):
     return row
 
 
-def run_task(templates, runs):
-    """Rows (dicts) of ``runs`` (:class:`~sma_fmu.studies.spec.StudyRunSpec`), in order."""
+class _Outcome:
+    """What :func:`_c_master_runs` gives per run, as a batch outcome does."""
+
+    def __init__(self, metrics, error=None):
+        self.metrics, self.path, self.error = metrics, "fmu", error
+
+
+def _c_master_runs(scenarios, fmu_dir):
+    """An outcome per scenario, run in the C master over the FMUs in ``fmu_dir``."""
+    from sma_fmu.cosim.metrics import StreamingMetrics
+    from sma_fmu.systems.c_master import run_c_master
+
+    for scenario in scenarios:
+        metrics = StreamingMetrics(scenario)
+        try:
+            run_c_master(scenario, fmu_dir, metrics.update)
+        except (ValueError, RuntimeError) as error:  # a bad FMU or a failed call (FmuError)
+            yield _Outcome(None, str(error))
+            continue
+        yield _Outcome(metrics.result())
+
+
+def run_task(templates, runs, fmu_dir=None):
+    """Rows (dicts) of ``runs`` (:class:`~sma_fmu.studies.spec.StudyRunSpec`), in order;
+    through the C master over the FMUs in ``fmu_dir`` when given, else the batch engine."""
     rows, built = {}, []
     for run in runs:
         row = rows[run.run_id] = run_row(run, templates[run.base])
@@ -46,6 +71,8 @@ def run_task(templates, runs):
             row.update(status="failed", error=str(error))
             continue
         built.append((row, scenario))
-    for (row, scenario), outcome in zip(built, run_batches([s for _, s in built])):
+    scenarios = [s for _, s in built]
+    outcomes = run_batches(scenarios) if fmu_dir is None else _c_master_runs(scenarios, fmu_dir)
+    for (row, scenario), outcome in zip(built, outcomes):
         _finish(row, scenario, outcome.metrics, outcome.path, outcome.error)
     return [rows[run.run_id] for run in runs]

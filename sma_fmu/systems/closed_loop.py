@@ -18,6 +18,8 @@ the signals as JSON tables. Choices (the hysteresis mode, the inverse) are the I
 codes of :mod:`sma_fmu.fmi.python_family.slave_support.choices`.
 """
 from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 from sma_fmu.cosim.master import MissingFmuError, model_parameter_values, needed_fmus
 from sma_fmu.files.archives import require_safe_archive
@@ -88,6 +90,20 @@ class LoopSystem:
         return sorted(self.components, key=lambda component: STEP_ORDER.index(component.name))
 
 
+def _version(path):
+    """(path, size, modification time [ns]): a key that changes when the file does."""
+    stat = Path(path).stat()
+    return str(Path(path).resolve()), stat.st_size, stat.st_mtime_ns
+
+
+@lru_cache(maxsize=64)
+def _checked_variables(version):
+    """{name: ScalarVariable} of the FMU file ``version`` (:func:`_version`), its archive
+    checked as safe first; once per file version (a sweep or a bench builds many systems)."""
+    require_safe_archive(version[0])  # an export packs it for hosts that unpack it
+    return {v.name: v for v in read_description(version[0]).modelVariables}
+
+
 def _fmu_files(scenario, fmu_dir):
     paths = default_fmu_paths(fmu_dir)
     needed = ["SmaScenarioSignals", "SmaPiController", *needed_fmus(scenario)]
@@ -95,7 +111,6 @@ def _fmu_files(scenario, fmu_dir):
         if not paths[name].is_file():
             raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "
                                   f"sma-fmu build --out {fmu_dir}")
-        require_safe_archive(paths[name])  # an export packs it for hosts that unpack it
     return paths
 
 
@@ -105,7 +120,7 @@ def _component(name, model, paths, parameters=None, params=None):
     ``params``: the wire parameters whose values the FMU exposes as parameters (then
     updated with ``parameters``).
     """
-    variables = {v.name: v for v in read_description(paths[model]).modelVariables}
+    variables = dict(_checked_variables(_version(paths[model])))
     values = {} if params is None else model_parameter_values(paths[model], params,
                                                               variables.values())
     values.update(parameters or {})

@@ -22,8 +22,8 @@ from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.systems.container import loop_outputs
 from sma_fmu.systems.ssp import PARAMETER_SET
 
-__all__ = ["HostError", "STATE_COLUMNS", "STEP_COLUMNS", "loop_series", "run_ssp_libcosim",
-           "run_ssp_ecos", "run_container_fmpy", "run_container_libcosim", "load_tbb"]
+__all__ = ["HostError", "STATE_COLUMNS", "STEP_COLUMNS", "NO_COMPENSATOR", "loop_series",
+           "run_ssp_libcosim", "run_ssp_ecos", "run_container_fmpy", "run_container_libcosim", "load_tbb"]
 
 # columns whose value at t_k is the sample of row k (states and signals) ...
 STATE_COLUMNS = ("R_ref", "R", "T", "x", "xi_P", "xi_M", "xi_F", "load")
@@ -31,7 +31,7 @@ STATE_COLUMNS = ("R_ref", "R", "T", "x", "xi_P", "xi_M", "xi_F", "load")
 STEP_COLUMNS = ("P", "P_fb", "P_ff", "T_ref", "saturated")
 # the columns of a block the loop lacks (the "pi" controller's compensator), as the library
 # loop's rows hold them: u_ff = 0 W, T_ref = nan, not saturated
-_NO_COMPENSATOR = {"P_ff": 0.0, "T_ref": math.nan, "saturated": False}
+NO_COMPENSATOR = {"P_ff": 0.0, "T_ref": math.nan, "saturated": False}
 
 
 class HostError(RuntimeError):
@@ -55,7 +55,7 @@ def loop_series(scenario, samples, steps):
         if name in present:
             data[name][:-1] = np.asarray(samples[name])[1:]
         else:
-            data[name][:-1] = _NO_COMPENSATOR[name]
+            data[name][:-1] = NO_COMPENSATOR[name]
         data[name][-1] = False if name == "saturated" else math.nan
     data["stroke"] = data["x"][0] - data["x"]
     return data

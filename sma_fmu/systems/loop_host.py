@@ -45,10 +45,11 @@ def _value(kind, value):
     return str(int(value))
 
 
-def loop_host_lines(system, folders, steps, timing=False):
+def loop_host_lines(system, folders, steps, timing=False, columns=None):
     """The loop host's input for ``system`` (a :class:`~.closed_loop.LoopSystem`) whose FMUs
     are unpacked in ``folders`` ({component: folder text}); a list of lines. The recorded
-    columns are :func:`~.container.loop_outputs` of its scenario, in that order."""
+    columns are ``columns`` (default: :func:`~.container.loop_outputs` of its scenario), in
+    that order."""
     lines = []
     for component in system.components:
         lines.append(f"fmu {component.name} {folders[component.name]}")
@@ -61,7 +62,8 @@ def loop_host_lines(system, folders, steps, timing=False):
         lines.append(f"connect {c.source} {source.variables[c.output].valueReference} "
                      f"{c.target} {target.variables[c.input].valueReference}")
     lines.append("order " + " ".join(component.name for component in system.in_step_order()))
-    for name, variable in loop_outputs(system.scenario).values():
+    outputs = loop_outputs(system.scenario)
+    for name, variable in (outputs[column] for column in (columns or outputs)):
         v = system.component(name).variables[variable]
         lines.append(f"record {'boolean' if v.type == 'Boolean' else 'real'} {name} {v.valueReference}")
     step = repr(float(system.scenario.step_s))

@@ -20,9 +20,10 @@ from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.systems.c_master import run_c_master
 from sma_fmu.systems.runs import run_container, run_ssp
 
-__all__ = ["PATHS", "run_scenarios", "timed_run", "write_timeseries", "result_names",
+__all__ = ["PATHS", "FMU_MASTERS", "run_scenarios", "timed_run", "write_timeseries", "result_names",
            "comparison_labels"]
 
 # path -> run(scenario, fmu_dir, sink): the loops stream their rows into the sink; the
@@ -31,6 +32,9 @@ PATHS = {"fmu": lambda scenario, fmu_dir, sink: run_fmus(scenario, fmu_dir, sink
          "library": lambda scenario, fmu_dir, sink: run_library(scenario, sink=sink),
          "ssp": lambda scenario, fmu_dir, sink: run_ssp(scenario, fmu_dir),
          "container": lambda scenario, fmu_dir, sink: run_container(scenario, fmu_dir)}
+# the masters of the "fmu" path (``--master``): fmpy (Python) or the C master (loop_host.c)
+FMU_MASTERS = {"fmpy": PATHS["fmu"], "c": lambda scenario, fmu_dir, sink: run_c_master(
+    scenario, fmu_dir, sink)}
 
 
 def write_timeseries(data, path, fmt="csv"):
@@ -62,18 +66,24 @@ def comparison_labels(scenarios, names):
 
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print,
-                  output_interval_s=None, fmt="csv"):
+                  output_interval_s=None, fmt="csv", master="fmpy"):
     """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
     a failed run leaves ``out_dir`` as it was. ``output_interval_s`` [s]: record every
     k-th step in the time series and figures (None: the scenario's ``[scenario]
     output_interval_s``, else every step); the metrics count every step. ``fmt``: the time
-    series' format, "csv" or "parquet". Each run streams into its files
+    series' format, "csv" or "parquet". ``master``: the FMU path's master, a key of
+    :data:`FMU_MASTERS` (``"c"`` only with ``path="fmu"``). Each run streams into its files
     (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
     """
     if path not in PATHS:
         raise ValueError(f"path must be one of {', '.join(PATHS)}, got {path!r}")
+    if master not in FMU_MASTERS:
+        raise ValueError(f"--master must be one of {', '.join(FMU_MASTERS)}, got {master!r}")
+    if master != "fmpy" and path != "fmu":
+        raise ValueError(f"--master {master} runs the FMUs (--path fmu), not --path {path}")
+    run = FMU_MASTERS[master] if path == "fmu" else PATHS[path]
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
@@ -89,9 +99,11 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
                 progress(f"[{index}/{len(scenarios)}] {name} ({path}) ...")
             folder = stage / name
             folder.mkdir()
-            metrics, figure_rows, wall_time_s = _record_run(scenario, path, fmu_dir, folder,
+            metrics, figure_rows, wall_time_s = _record_run(scenario, run, fmu_dir, folder,
                                                              every[index - 1], fmt)
             metrics.update(path=path, wall_time_s=wall_time_s)
+            if path == "fmu":
+                metrics["master"] = master
             for warning in metrics["warnings"]:
                 progress(f"warning: {scenario.name}: {warning}")
             (folder / "metrics.json").write_text(json_text(metrics), encoding="utf-8")
@@ -110,13 +122,13 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     return rows
 
 
-def _record_run(scenario, path, fmu_dir, folder, every, fmt):
-    """Run one scenario into ``folder`` through a :class:`RunRecorder`; returns (metrics,
-    figure rows, wall time [s] of the run itself)."""
+def _record_run(scenario, run, fmu_dir, folder, every, fmt):
+    """Run one scenario with ``run`` (a value of :data:`PATHS`) into ``folder`` through a
+    :class:`RunRecorder`; returns (metrics, figure rows, wall time [s] of the run itself)."""
     bar = progress_bar(scenario.steps + 1, scenario.name)
     recorder = RunRecorder(scenario, folder, every, fmt, None if bar is None else bar.update)
     try:
-        result = PATHS[path](scenario, fmu_dir, recorder)
+        result = run(scenario, fmu_dir, recorder)
         wall_time_s = result.wall_time_s - recorder.seconds  # the run, not its recording
         if result.data is not None:  # a host that kept the whole series
             recorder.feed(result.data)
@@ -127,10 +139,11 @@ def _record_run(scenario, path, fmu_dir, folder, every, fmt):
     return metrics, figure_rows, wall_time_s
 
 
-def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv"):
+def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv",
+              master="fmpy"):
     """:func:`run_scenarios`, then print the summary table; returns the rows."""
     start = time.perf_counter()
-    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt)
+    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master)
     progress(summary_table(rows))
     progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)")
     return rows

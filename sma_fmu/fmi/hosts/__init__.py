@@ -3,7 +3,8 @@
 - ``fmi_host.c``: a plain ``dlopen`` FMI 2.0 co-simulation host driven by commands on
   stdin (the tests' fuzz suite, C-host checks and the benchmark's per-step timing);
 - ``loop_host.c``: a sequential (Gauss-Seidel) loop of FMUs in one process, as an
-  embedded master runs them;
+  embedded master runs them; in its binary mode the C master of ``sma-fmu run --master c``
+  (:mod:`sma_fmu.systems.c_master`);
 - ``host_platform.h``: what the dlopen hosts share (loading a binary, the platform shim);
 - ``cosim_host.c``: sma-fmu's C host on libcosim's C API (libcosimc, from the libcosimpy
   wheel): runs an FMU or an SSP package (``sma-fmu check``, the tests, the benchmark).

@@ -14,7 +14,8 @@
  *   order NAME ...                 the step order (Gauss-Seidel: each component takes the
  *                                  outputs of those before it in this step)
  *   record real|boolean NAME VR    a recorded output (one column)
- *   run STEP_S STEPS [timing]      initialize, then STEPS steps of STEP_S at t_k = k STEP_S
+ *   run STEP_S STEPS [timing|binary ROWS]   initialize, then STEPS steps of STEP_S at
+ *                                  t_k = k STEP_S
  * Initialization: in the order of the fmu lines, each component gets its start values and
  * the current outputs of its sources, then leaves Initialization Mode.
  * Output: "row V..." (%.17g; Booleans 0/1) after initialization and after every step; with
@@ -22,11 +23,24 @@
  * wall time of each step (all components set, stepped and read). Every FMU log message is a
  * line "log STATUS NAME CATEGORY TEXT" (TEXT hex, formatted as printf like fmusim does).
  * Exit status 0, 1 when an FMI call fails (stderr names it), 2 on a bad system.
+ * "binary ROWS" (the C master of `sma-fmu run --master c`): stdout is a stream of frames,
+ * each a 4-byte tag and a 4-byte little-endian length of the payload that follows:
+ *   ROWS  rows of the recorded columns, raw doubles (Booleans 0.0/1.0): ROWS + 1 in the
+ *         first frame, ROWS in the others (the last one fewer), so that each frame
+ *         completes ROWS rows of the loop (row k holds the outputs after step k);
+ *   LOG_  "STATUS NAME CATEGORY\tTEXT" of an FMU log message;
+ *   FAIL  "NAME.CALL returned STATUS at t = T s" of a failed call (status > fmi2Warning),
+ *         after the rows up to that step: the host then exits with status 1;
+ *   DONE  the run ended (after the last rows).
  */
 #define _GNU_SOURCE
 #include <stdarg.h>
 
 #include "host_platform.h"  /* loading a binary, the platform shim */
+#ifdef _WIN32
+#include <fcntl.h>
+#include <io.h>
+#endif
 
 #define MAX_COMPONENTS 8
 #define MAX_ITEMS 256
@@ -58,6 +72,29 @@ static Start start[MAX_ITEMS];
 static Link edge[MAX_ITEMS];
 static Column column[MAX_ITEMS];
 static int starts, links, columns;
+static int binary;          /* "binary ROWS": frames on stdout (see the header) */
+static double *block, now;  /* the rows not yet written (binary), the time of the step [s] */
+static long block_rows, block_size, frame_size;  /* frame_size: ROWS + 1, then ROWS */
+typedef struct { int component, boolean, first, count; } Read;  /* columns read in one call */
+static Read reads[MAX_ITEMS];
+static unsigned read_vr[MAX_ITEMS];
+static int n_reads;
+
+/* One frame: a 4-byte tag, the payload's length (4 bytes, little-endian), the payload. */
+static void frame(const char* tag, const void* payload, size_t size)
+{
+    unsigned char head[8];
+    memcpy(head, tag, 4);
+    for (int i = 0; i < 4; ++i) head[4 + i] = (unsigned char)((size >> (8 * i)) & 0xff);
+    fwrite(head, 1, sizeof head, stdout);
+    if (size) fwrite(payload, 1, size, stdout);
+}
+
+static void flush_rows(void)
+{
+    if (block_rows) frame("ROWS", block, sizeof(double) * (size_t)(block_rows * columns));
+    block_rows = 0;
+}
 
 static void logger(void* env, const char* name, int status, const char* category, const char* message, ...)
 {
@@ -67,6 +104,13 @@ static void logger(void* env, const char* name, int status, const char* category
     va_start(args, message);
     vsnprintf(text, sizeof text, message, args); /* the message is a printf format (FMI 2.0) */
     va_end(args);
+    if (binary) {
+        char entry[8192 + 600];
+        int size = snprintf(entry, sizeof entry, "%d %s %s\t%s", status, name && *name ? name : "-",
+                            category && *category ? category : "-", text);
+        frame("LOG_", entry, size < 0 ? 0 : size < (int)sizeof entry ? (size_t)size : sizeof entry - 1);
+        return;
+    }
     printf("log %d %s %s ", status, name && *name ? name : "-", category && *category ? category : "-");
     for (const char* p = text; *p; ++p) printf("%02x", (unsigned char)*p);
     if (!*text) putchar('_');
@@ -128,6 +172,14 @@ static void resource_uri(const char* dir, char* uri, size_t size)
 static void check(int status, const Fmu* f, const char* call)
 {
     if (status > 1) {
+        if (binary) {  /* the rows up to this step, then what failed and when */
+            char text[512];
+            int size = snprintf(text, sizeof text, "%s.%s returned %d at t = %.9g s", f->name, call,
+                                status, now);
+            flush_rows();
+            frame("FAIL", text, size < 0 ? 0 : size < (int)sizeof text ? (size_t)size : sizeof text - 1);
+            fflush(stdout);
+        }
         fprintf(stderr, "loop_host: %s.%s returned %d\n", f->name, call, status);
         exit(1);
     }
@@ -145,8 +197,30 @@ static void feed(int i)
     }
 }
 
+/* The recorded columns now: a row of the block (written when it is full), or a line. */
 static void print_row(void)
 {
+    if (binary) {
+        double* row = block + block_rows * columns;
+        for (int r = 0; r < n_reads; ++r) {
+            const Read* read = &reads[r];
+            const Fmu* f = &fmu[read->component];
+            if (read->boolean) {
+                int value[MAX_ITEMS];
+                check(f->GetBoolean(f->c, &read_vr[read->first], (size_t)read->count, value), f,
+                      "fmi2GetBoolean");
+                for (int k = 0; k < read->count; ++k) row[read->first + k] = value[k] ? 1.0 : 0.0;
+            } else {
+                check(f->GetReal(f->c, &read_vr[read->first], (size_t)read->count, &row[read->first]),
+                      f, "fmi2GetReal");
+            }
+        }
+        if (++block_rows == frame_size) {
+            flush_rows();
+            frame_size = block_size;
+        }
+        return;
+    }
     fputs("row", stdout);
     for (int k = 0; k < columns; ++k) {
         const Fmu* f = &fmu[column[k].component];
@@ -205,6 +279,7 @@ static void run(double h, long steps, int timing)
     const double begin = host_now();
     for (long k = 0; k < steps; ++k) {
         const double t = (double)k * h, before = timing ? host_now() : 0.0;
+        now = t;
         for (int j = 0; j < ordered; ++j) {
             Fmu* f = &fmu[order[j]];
             feed(order[j]);
@@ -213,7 +288,12 @@ static void run(double h, long steps, int timing)
         if (timing) cost[k] = host_now() - before;
         else print_row();
     }
+    now = (double)steps * h;
     const double total = host_now() - begin;
+    if (binary) {
+        flush_rows();
+        frame("DONE", NULL, 0);
+    }
     if (timing) {
         qsort(cost, (size_t)steps, sizeof(double), by_value);
         printf("timing %.4f %.4f %.4f %.4f %.6f\n", 1e6 * cost[steps / 2],
@@ -222,6 +302,28 @@ static void run(double h, long steps, int timing)
         print_row();
         free(cost);
     }
+}
+
+/* Binary output (the C master): stdout untranslated, a block of `rows` rows. */
+static void start_binary(long rows)
+{
+    if (rows < 1 || columns < 1) bad("bad binary block size or no recorded column", "run");
+#ifdef _WIN32
+    _setmode(_fileno(stdout), _O_BINARY);
+#endif
+    block = malloc(sizeof(double) * (size_t)((rows + 1) * columns));
+    if (!block) bad("out of memory for", "the rows");
+    block_size = rows;
+    frame_size = rows + 1;
+    for (int k = 0; k < columns; ++k) {  /* neighbouring columns of one component: one call */
+        read_vr[k] = column[k].vr;
+        Read* last = n_reads ? &reads[n_reads - 1] : NULL;
+        if (last && last->component == column[k].component && last->boolean == column[k].boolean)
+            ++last->count;
+        else
+            reads[n_reads++] = (Read){column[k].component, column[k].boolean, k, 1};
+    }
+    binary = 1;
 }
 
 int main(void)
@@ -256,10 +358,12 @@ int main(void)
         } else if (!strcmp(word[0], "record") && n == 4 && columns < MAX_ITEMS) {
             column[columns++] = (Column){!strcmp(word[1], "boolean"), find(word[2]),
                                          (unsigned)strtoul(word[3], NULL, 10)};
-        } else if (!strcmp(word[0], "run") && (n == 3 || (n == 4 && !strcmp(word[3], "timing")))) {
+        } else if (!strcmp(word[0], "run") && (n == 3 || (n == 4 && !strcmp(word[3], "timing"))
+                                                || (n == 5 && !strcmp(word[3], "binary")))) {
             const double h = strtod(word[1], NULL);
             const long steps = atol(word[2]);
             if (!(h > 0.0) || steps < 1 || ordered != components) bad("bad run line or step order", word[1]);
+            if (n == 5) start_binary(atol(word[4]));
             initialize((double)steps * h, &callbacks);
             run(h, steps, n == 4);
             for (int i = 0; i < components; ++i) {

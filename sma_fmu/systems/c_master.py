@@ -1,0 +1,175 @@
+"""The C master (``sma-fmu run --master c``): a scenario's closed loop stepped in C.
+
+The loop host (``sma_fmu/fmi/hosts/loop_host.c``, mode "binary") loads the FMUs' binaries
+through FMI and steps them Gauss-Seidel in :data:`~.closed_loop.STEP_ORDER`, the order of
+the fmpy master (:func:`~sma_fmu.cosim.master.run_fmus`): compensator, PI, driver, plant,
+then the signals (SmaScenarioSignals, on the grid t_k = k h). It writes the recorded
+outputs after initialization and after every step as raw doubles, in frames of
+:data:`~sma_fmu.cosim.loop.ROWS_PER_CHUNK` samples, on a pipe; here they become the loop's
+rows (:mod:`.c_master_rows`) and go to the sink in the fmpy master's blocks, so the
+recorder, the metrics and the figures are those of the fmpy master, to the bit.
+
+A missing FMU, a model whose variables do not match, or a failed call gets a named error
+(:class:`CMasterError`): a failed step ends the run there, the rows up to it are given to
+the sink (and kept in the error), and the message names the FMU, the call and the time.
+"""
+import hashlib
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import time
+import zipfile
+from pathlib import Path
+
+from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
+from sma_fmu.files.archives import require_safe_archive
+from sma_fmu.fmi.driving.instance import FmuError
+from sma_fmu.fmi.hosts import CHostError, compile_host
+from sma_fmu.systems.c_master_rows import RowAssembler, check_variables, recorded_columns
+from sma_fmu.systems.closed_loop import closed_loop
+from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
+
+__all__ = ["MASTERS", "CMasterError", "unpacked_fmu", "run_c_master"]
+
+MASTERS = ("fmpy", "c")   # `sma-fmu run --master`: the fmpy master, or this one
+_STATUS = {2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal"}
+
+
+class CMasterError(FmuError):
+    """A run of the C master failed; ``rows`` holds the rows up to the failed step (a
+    structured array, or None when the sink took them) and ``time_s`` the step's time [s]."""
+
+    def __init__(self, message, status, rows=None, time_s=None):
+        super().__init__(message, status)
+        self.rows, self.time_s = rows, time_s
+
+
+def unpacked_fmu(fmu, cache=None):
+    """The folder ``fmu`` is unpacked in, once per file version: under ``cache`` (default:
+    the temporary folder), keyed by its path, size and modification time [ns]."""
+    fmu = Path(fmu).resolve()
+    stat = fmu.stat()
+    key = hashlib.sha256(f"{fmu}\0{stat.st_size}\0{stat.st_mtime_ns}".encode()).hexdigest()[:16]
+    folder = Path(cache or tempfile.gettempdir()) / "sma-fmu-unpacked" / f"{fmu.stem}-{key}"
+    if not (folder / "modelDescription.xml").is_file():
+        require_safe_archive(fmu)
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(dir=folder.parent, prefix=".stage-"))
+        with zipfile.ZipFile(fmu) as archive:
+            archive.extractall(stage)
+        try:
+            os.replace(stage, folder)   # atomic: a parallel run never sees half a folder
+        except OSError:                 # another run unpacked it first
+            shutil.rmtree(stage, ignore_errors=True)
+    return folder
+
+
+def _widen(pipe):
+    """A 1 MiB pipe (Linux): the host steps on while the rows of two frames wait here."""
+    try:
+        import fcntl
+        fcntl.fcntl(pipe.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), 1 << 20)
+    except (ImportError, OSError):  # another system, or a lower pipe-max-size: the default
+        pass
+
+
+def _read_frames(stream):
+    """(tag, payload) frames from the host's stdout until it closes."""
+    while True:
+        head = stream.read(8)
+        if len(head) < 8:
+            return
+        size = int.from_bytes(head[4:], "little")
+        yield head[:4], stream.read(size) if size else b""
+
+
+def _log_entry(payload):
+    """(status, component, text) of a LOG_ frame."""
+    head, _, text = payload.decode("utf-8", "replace").partition("\t")
+    status, name, _category = (head.split(" ") + ["", ""])[:3]
+    return int(status), name, text
+
+
+_FAIL = re.compile(r"(?P<name>[^.]+)\.(?P<call>.+) returned (?P<status>-?\d+) at t = (?P<time>\S+) s")
+
+
+def _failure(scenario, text, logs, rows, windows):
+    """The :class:`CMasterError` of a FAIL frame ``text``: "NAME.CALL returned S at t = T s"."""
+    match = _FAIL.fullmatch(text.strip())
+    if match is None:  # not the host's form: say it as it came
+        name, call, status, time_s = "?", text, 3, None
+    else:
+        name, call = match["name"], match["call"]
+        status, time_s = int(match["status"]), float(match["time"])
+    said = "; ".join(t for s, n, t in logs if n == name and s >= 2) or "no message"
+    where = " (win64, wine)" if windows is not None else ""
+    when = "" if time_s is None else f" at t = {time_s:g} s"
+    message = (f"scenario {scenario.name}: C master{where}: {name}: {call} failed "
+               f"({_STATUS.get(status, status)}){when}: {said}; the run stopped there "
+               f"({rows} rows kept)")
+    return CMasterError(message, status, time_s=time_s)
+
+
+def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None):
+    """Run ``scenario`` through the FMUs in ``fmu_dir`` in the C master; a :class:`LoopResult`
+    (``path`` "fmu"), its ``data`` None when ``sink`` took the rows (see
+    :func:`~sma_fmu.cosim.loop.run_loop`). ``windows``: None for the linux64 build, else the
+    environment of a wine64 prefix (the win64 host with the FMUs' win64 binaries).
+
+    Raises :class:`~sma_fmu.cosim.master.MissingFmuError` for a missing FMU, ``ValueError``
+    naming the FMU and the variable when its variables do not match, and
+    :class:`CMasterError` when a call fails (the rows up to that step kept).
+    """
+    started = time.perf_counter()
+    system = closed_loop(scenario, fmu_dir)
+    check_variables(system)
+    folders = {c.name: unpacked_fmu(c.fmu, cache) for c in system.components}
+    if windows is not None:
+        folders = {name: wine_path(folder) for name, folder in folders.items()}
+    try:
+        executable = compile_host("loop_host", cache, windows=windows is not None)
+    except CHostError as error:   # no compiler: one named error, not an internal one
+        raise CMasterError(f"scenario {scenario.name}: C master: {error}", 3) from None
+    columns = recorded_columns(system)
+    lines = loop_host_lines(system, {k: str(v) for k, v in folders.items()}, scenario.steps,
+                            columns=columns)
+    lines[-1] += f" binary {ROWS_PER_CHUNK}"
+    command = [str(executable)] if windows is None else [wine_executable(), str(executable)]
+    environment = dict(os.environ if windows is None else windows)
+    environment.pop("LD_PRELOAD", None)
+    rows = RowAssembler(scenario, columns, sink)
+    logs, failure, done = [], None, False
+    with subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, env=environment) as host:
+        _widen(host.stdout)
+        try:
+            host.stdin.write(("\n".join(lines) + "\n").encode())
+            host.stdin.close()
+        except BrokenPipeError:  # the host refused the system early: its stderr says why
+            pass
+        for tag, payload in _read_frames(host.stdout):
+            if tag == b"ROWS":
+                rows.add(payload)
+            elif tag == b"LOG_":
+                entry = _log_entry(payload)
+                if entry[0] >= 2:  # what a failure quotes (warnings are not kept: a long
+                    logs.append(entry)  # run may log one per step)
+            elif tag == b"FAIL":
+                failure = payload.decode("utf-8", "replace")
+            elif tag == b"DONE":
+                done = True
+        said = host.stderr.read().decode("utf-8", "replace").strip()
+        status = host.wait()
+    if failure is not None:
+        kept = rows.finish()   # the rows up to the failed step, the last without step outputs
+        error = _failure(scenario, failure, logs, rows.count, windows)
+        error.rows = kept
+        raise error
+    if status != 0 or not done:
+        where = " (win64, wine)" if windows is not None else ""
+        raise CMasterError(f"scenario {scenario.name}: C master{where}: exit status {status}: "
+                           f"{said.splitlines()[-1] if said else 'no message'}", 3)
+    data = rows.finish()
+    return LoopResult(scenario, data, "fmu", time.perf_counter() - started)

@@ -1,0 +1,134 @@
+"""The C master's samples as the loop's rows, and the check that a system's FMUs fit the loop.
+
+The host sends the recorded outputs at t_0 (after initialization) ... t_n (after each
+step); row k of the loop holds the states and signals at t_k and the blocks' outputs of
+step k, which the host reads after that step (sample k + 1), as :func:`~.hosts.loop_series`
+does for a whole series. :class:`RowAssembler` does it frame by frame, with the numbers
+the fmpy master's :func:`~sma_fmu.cosim.loop.run_loop` computes in Python (t_k = k h, the
+stroke x_0 - x_k), and hands the rows on in its blocks of
+:data:`~sma_fmu.cosim.loop.ROWS_PER_CHUNK` (the streaming metrics add per block: the same
+blocks give the same sums, to the bit). The host's first frame has one sample more, so
+each frame makes one such block, handed on without a copy.
+"""
+import math
+
+import numpy as np
+
+from sma_fmu.cosim.loop import ROWS_PER_CHUNK, TIMESERIES_DTYPE
+from sma_fmu.systems.container import loop_outputs
+from sma_fmu.systems.hosts import NO_COMPENSATOR, STATE_COLUMNS, STEP_COLUMNS
+
+__all__ = ["recorded_columns", "check_variables", "RowAssembler"]
+
+
+def recorded_columns(system):
+    """The columns the host records for ``system``, in the order of its samples: grouped by
+    component (the host reads neighbouring columns of one component in one call)."""
+    outputs = loop_outputs(system.scenario)
+    return sorted(outputs, key=lambda column: (outputs[column][0], column == "saturated"))
+
+
+def _need(component, name, causality, types, why):
+    variable = component.variables.get(name)
+    if variable is None or variable.causality != causality or variable.type not in types:
+        found = ("none" if variable is None
+                 else f"a {variable.causality} {variable.type}")
+        raise ValueError(f"{component.fmu}: the model's variables do not match the loop: "
+                         f"{component.name} needs {causality} {name!r} ({'/'.join(types)}; {why}), "
+                         f"the FMU has {found}")
+
+
+def check_variables(system):
+    """``ValueError`` naming the FMU and the variable when a component of ``system`` lacks an
+    input, output or parameter the loop uses (or has it with another causality or type)."""
+    for c in system.connections:
+        _need(system.component(c.source), c.output, "output", ("Real",), f"feeds {c.target}.{c.input}")
+        _need(system.component(c.target), c.input, "input", ("Real",), f"fed by {c.source}.{c.output}")
+    for column, (name, variable) in loop_outputs(system.scenario).items():
+        types = ("Boolean",) if column == "saturated" else ("Real",)
+        _need(system.component(name), variable, "output", types, f"the {column} column")
+    for component in system.components:
+        for name in component.parameters:
+            if name not in component.variables:
+                raise ValueError(f"{component.fmu}: the model's variables do not match the loop: "
+                                 f"no variable {name!r} for the scenario's value")
+
+
+class RowAssembler:
+    """Samples (raw doubles, ``columns`` per sample) in, the loop's rows out, to ``sink``
+    (a callable taking structured arrays) or kept (``sink`` None)."""
+
+    def __init__(self, scenario, columns, sink=None):
+        self.step_s, self.sink = scenario.step_s, sink
+        self.index = {name: i for i, name in enumerate(columns)}
+        self.width = len(columns)
+        self.count = 0                  # rows made so far
+        self._carry = self._start_x = None
+        self._out = np.empty(ROWS_PER_CHUNK, dtype=TIMESERIES_DTYPE)
+        self._filled, self._kept = 0, []
+
+    def add(self, payload):
+        """Take one frame of samples (bytes)."""
+        samples = np.frombuffer(payload, dtype=np.float64).reshape(-1, self.width)
+        if self._carry is not None:
+            samples = np.concatenate([self._carry, samples])
+        if self._start_x is None:
+            self._start_x = samples[0, self.index["x"]]
+        self._carry = samples[-1:].copy()
+        if len(samples) > 1:
+            self._rows(samples[:-1], samples[1:])
+
+    def _rows(self, now, after):
+        """Rows from the samples ``now`` and the samples after their step (None: no step)."""
+        block = np.empty(len(now), dtype=TIMESERIES_DTYPE)
+        block["t"] = np.arange(self.count, self.count + len(now), dtype=np.float64) * self.step_s
+        for name in STATE_COLUMNS:
+            block[name] = now[:, self.index[name]]
+        block["stroke"] = self._start_x - block["x"]
+        for name in STEP_COLUMNS:
+            if after is None:
+                block[name] = False if name == "saturated" else math.nan
+            elif name not in self.index:
+                block[name] = NO_COMPENSATOR[name]
+            elif name == "saturated":
+                block[name] = after[:, self.index[name]] != 0.0
+            else:
+                block[name] = after[:, self.index[name]]
+        self.count += len(now)
+        self._emit(block)
+
+    def _emit(self, block):
+        if self._filled == 0 and len(block) == ROWS_PER_CHUNK:  # a whole block: no copy
+            self._send(block)
+            return
+        first = 0
+        while first < len(block):
+            take = min(ROWS_PER_CHUNK - self._filled, len(block) - first)
+            self._out[self._filled:self._filled + take] = block[first:first + take]
+            self._filled += take
+            first += take
+            if self._filled == ROWS_PER_CHUNK:
+                self._send()
+
+    def _send(self, block=None):
+        """Hand on ``block`` (one of its own), else the gathered rows."""
+        if block is None:
+            block, self._filled = self._out[:self._filled], 0
+            self._out = np.empty(ROWS_PER_CHUNK, dtype=TIMESERIES_DTYPE)  # the sink may keep it
+        if self.sink is None:
+            self._kept.append(block)
+        else:
+            self.sink(block)
+
+    def finish(self):
+        """The last sample as the final row (no step outputs), the rows not yet sent; returns
+        every row (a structured array) when there is no sink, else None."""
+        if self._carry is not None:
+            self._rows(self._carry, None)
+            self._carry = None
+        if self._filled:
+            self._send()
+        if self.sink is not None:
+            return None
+        return (np.concatenate(self._kept) if self._kept
+                else np.empty(0, dtype=TIMESERIES_DTYPE))
