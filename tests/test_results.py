@@ -121,3 +121,34 @@ def test_outputs_get_the_usual_permissions(tmp_path):
         os.umask(mask)
     assert stat.S_IMODE((tmp_path / "out").stat().st_mode) == 0o755
     assert stat.S_IMODE((tmp_path / "b.csv").stat().st_mode) == 0o644
+
+
+def test_csv_blocks_are_written_as_numpy_savetxt_writes_them(tmp_path):
+    """The CSV writer formats a whole block at once: the text is np.savetxt's, row by row,
+    for ordinary, tiny, huge, negative and non-finite values and booleans."""
+    import io
+
+    import numpy as np
+
+    from sma_fmu.cosim.loop import COLUMN_NAMES, COLUMNS, TIMESERIES_DTYPE
+    from sma_fmu.cosim.recording import CSV_FORMAT, TimeseriesWriter
+
+    rng = np.random.default_rng(7)
+    rows = np.zeros(500, dtype=TIMESERIES_DTYPE)
+    for name, _ in COLUMNS:
+        if rows[name].dtype == bool:
+            rows[name] = rng.random(500) < 0.5
+        else:
+            rows[name] = rng.normal(0.0, 1.0, 500) * 10.0 ** rng.integers(-300, 300, 500)
+    first = [name for name, _ in COLUMNS if rows[name].dtype != bool][0]
+    rows[first][:3] = [math.nan, math.inf, -math.inf]
+    path = tmp_path / "timeseries.csv"
+    writer = TimeseriesWriter(path, "csv")
+    writer.write(rows[:123])
+    writer.write(rows[123:])
+    writer.close()
+    expected = io.StringIO()
+    expected.write(",".join(COLUMN_NAMES) + "\n")
+    np.savetxt(expected, np.column_stack([rows[name].astype(float) for name, _ in COLUMNS]),
+               delimiter=",", fmt=CSV_FORMAT)
+    assert path.read_text(encoding="utf-8") == expected.getvalue()
