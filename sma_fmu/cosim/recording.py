@@ -65,7 +65,7 @@ class TimeseriesWriter:
         timeseries_name(fmt)
         self.path, self.fmt, self.rows = Path(path), fmt, 0
         self._stream = self._parquet = None
-        self._pending, self._pending_rows = [], 0   # Parquet rows not yet written
+        self._pending, self._pending_rows = None, 0   # Parquet rows not yet written (a row group)
         if fmt == "csv":
             self._stream = open(self.path, "w", encoding="utf-8", newline="\n")
             self._stream.write(",".join(COLUMN_NAMES) + "\n")
@@ -81,10 +81,16 @@ class TimeseriesWriter:
             line = ",".join([CSV_FORMAT] * table.shape[1]) + "\n"
             self._stream.write((line * table.shape[0]) % tuple(table.ravel().tolist()))
         else:  # gathered into row groups of PARQUET_ROW_GROUP rows: they compress far better
-            self._pending.append(rows.copy())
-            self._pending_rows += rows.size
-            if self._pending_rows >= PARQUET_ROW_GROUP:
-                self._flush()
+            at = 0
+            while at < rows.size:  # copied once, into the row group's own buffer
+                if self._pending is None:
+                    self._pending = np.empty(PARQUET_ROW_GROUP, dtype=rows.dtype)
+                count = min(rows.size - at, PARQUET_ROW_GROUP - self._pending_rows)
+                self._pending[self._pending_rows:self._pending_rows + count] = rows[at:at + count]
+                self._pending_rows += count
+                at += count
+                if self._pending_rows == PARQUET_ROW_GROUP:
+                    self._flush()
         self.rows += rows.size
 
     def _flush(self):
@@ -92,7 +98,8 @@ class TimeseriesWriter:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        rows = _joined(self._pending)
+        rows = (self._pending[:self._pending_rows] if self._pending is not None
+                else np.empty(0, dtype=TIMESERIES_DTYPE))
         table = pa.Table.from_arrays([_arrow_column(rows[name]) for name, _ in COLUMNS],
                                      names=list(COLUMN_NAMES))
         if self._parquet is None:
@@ -102,14 +109,14 @@ class TimeseriesWriter:
                                              use_dictionary=False)
         if rows.size or self.rows == 0:
             self._parquet.write_table(table)
-        self._pending, self._pending_rows = [], 0
+        self._pending_rows = 0   # the buffer is reused (the Arrow columns are copies of it)
 
     def close(self):
         """Finish the file (an empty run still gets its header or schema)."""
         if self._stream is not None:
             self._stream.close()
             return
-        if self._pending or self._parquet is None:
+        if self._pending_rows or self._parquet is None:
             self._flush()
         self._parquet.close()
         self._parquet = None
