@@ -117,6 +117,9 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
 def test_each_fmu_is_read_once_for_the_ssp_and_the_container(fmu_dir, tmp_path, monkeypatch):
     import fmpy
 
+    from sma_fmu.systems import closed_loop as loop_module
+
+    loop_module._checked_variables.cache_clear()   # earlier tests read these files already
     reads, read = [], fmpy.read_model_description
     monkeypatch.setattr(fmpy, "read_model_description",
                         lambda filename, *args, **kwargs: reads.append(Path(filename).name)
