@@ -91,10 +91,11 @@ def model_sources(model_name, generated=(), front="fmi2"):
     implementers = _implementers(files)
     wanted = [f"{model_name}.c"] + sorted(n for n in files if n.startswith(front) or
                                           n.startswith("layer") or n == "sma_model.c")
+    other = {"fmi2": "fmi3", "fmi3": "fmi2"}[front]  # the other front is never compiled in
     found, queue = set(), list(wanted)
     while queue:
         name = queue.pop()
-        if name in found:
+        if name in found or name.startswith(other):
             continue
         found.add(name)
         if name in generated:

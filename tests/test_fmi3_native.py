@@ -1,0 +1,263 @@
+"""The C family as FMI 3.0 co-simulation FMUs (issue 39): `sma-fmu build --native --fmi 3`.
+
+Built from the same C models and core as FMI 2.0, under the FMI 3.0 front. fmpy validates
+them; driven side by side with their FMI 2.0 twins through fmpy (FMU3Slave, FMU2Slave) on
+random input walks, every output is equal (difference 0.0); saved states replay alike and a
+corrupted one is refused; bad input gets the FMI 2.0 status and a message naming the same
+variable, and the fmi3 function; calls outside their state and arrays of the wrong size get
+fmi3Error.
+"""
+import random
+import zipfile
+import xml.etree.ElementTree as ET
+
+import pytest
+
+from fmi3_twins import Instance3
+from native_twins import Instance
+from test_native_equivalence import _plant_inputs, _reference_inputs
+from sma_fmu.cli import main
+from sma_fmu.runtime.reachable_band import reachable_band
+
+pytestmark = pytest.mark.needs("gcc")
+
+NAMES = ["SmaActuator", "SmaFeedforward", "SmaPiController", "SmaPwmDriver", "SmaScenarioSignals"]
+
+
+@pytest.fixture(scope="module")
+def fmi3_fmus(tmp_path_factory):
+    from sma_fmu.fmi.packaging.build import build_fmus
+    return build_fmus(tmp_path_factory.mktemp("fmi3"), native=True, fmi_version=3)
+
+
+class Versions:
+    """One C-family model as FMI 2.0 (``v2``) and FMI 3.0 (``v3``)."""
+
+    def __init__(self, native_fmus, fmi3_fmus, model, tag):
+        self.v2 = Instance(native_fmus[model], f"{tag}-v2")
+        self.v3 = Instance3(fmi3_fmus[model], f"{tag}-v3")
+
+    def both(self, method, *args):
+        results = [getattr(side, method)(*args) for side in (self.v2, self.v3)]
+        statuses = [r[0] if isinstance(r, tuple) else r for r in results]
+        assert statuses[0] == statuses[1], (method, args, self.v2.log[-1:], self.v3.log[-1:])
+        return results
+
+    def compare(self):
+        """Every output equal (0.0 difference); returns the FMI 3.0 outputs."""
+        v2, v3 = self.v2.values(), self.v3.values()
+        assert v2 == v3
+        return v3
+
+    def walk(self, inputs, time=0.0, step=1e-3):
+        seen = []
+        for values in inputs:
+            for name, value in values.items():
+                self.both("set", name, value)
+            assert self.both("step", time, step)[0] <= 1, self.v3.log[-2:]
+            time += step
+            seen.append(self.compare())
+        return seen, time
+
+    def close(self):
+        self.v2.close()
+        self.v3.close()
+
+
+def test_fmpy_validates_them_and_they_are_fmi3(fmi3_fmus):
+    from fmpy.validation import validate_fmu
+    for name in NAMES:
+        path = fmi3_fmus[name]
+        assert validate_fmu(str(path)) == [], name
+        with zipfile.ZipFile(path) as archive:
+            files = set(archive.namelist())
+            root = ET.fromstring(archive.read("modelDescription.xml"))
+            build = ET.fromstring(archive.read("sources/buildDescription.xml"))
+        assert root.get("fmiVersion") == "3.0" and root.get("instantiationToken")
+        assert {f"binaries/x86_64-linux/{name}.so", f"binaries/x86_64-windows/{name}.dll",
+                "resources/parameters.json"} <= files
+        listed = {f.get("name") for f in build.iter("SourceFile")}
+        assert listed and all(f"sources/{n}" in files for n in listed)
+        assert not any(n.startswith("fmi2") for n in listed)
+        time = [v for v in root.find("ModelVariables") if v.get("name") == "time"]
+        assert time[0].get("causality") == "independent" and time[0].get("unit") == "s"
+        kinds = {v.get("name"): v.tag for v in root.find("ModelVariables")}
+        for choice in ("hysteresis_mode", "inverse"):
+            assert kinds.get(choice, "Enumeration") == "Enumeration"
+    assert sum(k == "Enumeration" for k in kinds.values()) == 0  # SmaScenarioSignals: none
+
+
+def test_binaries_export_only_fmi3_functions(fmi3_fmus, tmp_path):
+    import shutil
+    import subprocess
+    if not shutil.which("nm"):
+        pytest.skip("no nm")
+    with zipfile.ZipFile(fmi3_fmus["SmaActuator"]) as archive:
+        archive.extract("binaries/x86_64-linux/SmaActuator.so", tmp_path)
+    out = subprocess.run(["nm", "-D", "--defined-only", str(tmp_path / "binaries/x86_64-linux/SmaActuator.so")],
+                         capture_output=True, text=True, check=True).stdout
+    exported = [line.split()[-1] for line in out.splitlines() if " T " in line]
+    assert "fmi3DoStep" in exported and "fmi3GetFloat64" in exported
+    assert all(name.startswith("fmi3") for name in exported), exported
+    assert len(exported) == 75  # every function fmi3Functions.h declares, no fmi2 one
+
+
+@pytest.mark.parametrize("mode", [1, 2])
+def test_plant_walks_equal_fmi2(native_fmus, fmi3_fmus, mode):
+    rng = random.Random(39 + mode)
+    twins = Versions(native_fmus, fmi3_fmus, "SmaActuator", f"plant3-{mode}")
+    try:
+        start = {"hysteresis_mode": mode, "memory_depth": 3, "load": 0.2}
+        assert twins.both("start", start) == [0, 0]
+        twins.compare()
+        inputs = _plant_inputs(rng, 6000)
+        _, time = twins.walk(inputs[:4000])
+        # saved states, taken in both versions: set and deserialized, they replay alike
+        saved = (twins.v2.fmu.getFMUstate(), twins.v3.fmu.getFMUState())
+        blobs = (twins.v2.fmu.serializeFMUstate(saved[0]), twins.v3.fmu.serializeFMUState(saved[1]))
+        first, _ = twins.walk(inputs[4000:5000], time)
+        twins.v2.fmu.setFMUstate(saved[0])
+        twins.v3.fmu.setFMUState(saved[1])
+        assert twins.walk(inputs[4000:5000], time)[0] == first
+        twins.v2.fmu.setFMUstate(twins.v2.fmu.deSerializeFMUstate(blobs[0]))
+        twins.v3.fmu.setFMUState(twins.v3.fmu.deserializeFMUState(blobs[1]))
+        _, time = twins.walk(inputs[4000:5000], time)
+        twins.walk(inputs[5000:], time)
+    finally:
+        twins.close()
+
+
+def test_saved_states_replay_and_a_corrupted_one_is_refused(fmi3_fmus):
+    rng = random.Random(3)
+    inputs = _plant_inputs(rng, 1500)
+    one = Instance3(fmi3_fmus["SmaActuator"], "states3")
+    try:
+        assert one.start({"memory_depth": 3, "load": 0.2}) == 0
+        time = 0.0
+        for values in inputs[:500]:
+            for name, value in values.items():
+                one.set(name, value)
+            assert one.step(time, 1e-3) == 0
+            time += 1e-3
+        state = one.fmu.getFMUState()
+        blob = one.fmu.serializeFMUState(state)
+
+        def run():
+            seen, t = [], time
+            for values in inputs[500:]:
+                for name, value in values.items():
+                    one.set(name, value)
+                assert one.step(t, 1e-3) == 0
+                t += 1e-3
+                seen.append(one.values())
+            return seen
+
+        first = run()
+        one.fmu.setFMUState(state)
+        assert run() == first
+        one.fmu.setFMUState(one.fmu.deserializeFMUState(blob))
+        assert run() == first
+        bad = bytearray(blob)
+        bad[len(bad) // 2] ^= 0xFF
+        status, _ = one.call("deserializeFMUState", bytes(bad))
+        assert status == 3
+        assert one.log[-1][0] == 3 and "fmi3DeserializeFMUState: the bytes are refused" in one.log[-1][1]
+        one.fmu.setFMUState(state)  # the refusal changed nothing: the state still replays
+        assert run() == first
+        one.fmu.freeFMUState(state)
+    finally:
+        one.close()
+
+
+@pytest.mark.parametrize("inverse", [1, 2])
+def test_compensator_walks_equal_fmi2(native_fmus, fmi3_fmus, params, inverse):
+    rng = random.Random(11 * inverse)
+    band = reachable_band(0.1, params)
+    twins = Versions(native_fmus, fmi3_fmus, "SmaFeedforward", f"ff3-{inverse}")
+    try:
+        start = {"inverse": inverse, "memory_depth": 3, "R_ref": band.cold, "load": 0.1}
+        assert twins.both("start", start) == [0, 0]
+        twins.compare()
+        twins.walk(_reference_inputs(rng, 5000, band))
+    finally:
+        twins.close()
+
+
+@pytest.mark.parametrize("model,inputs", [
+    ("SmaPiController", lambda rng: {"R": rng.uniform(35, 50), "R_ref": rng.uniform(35, 50),
+                                     "P_ff": rng.uniform(0, 2)}),
+    ("SmaPwmDriver", lambda rng: {"P_demand": rng.uniform(-0.5, 3.0)}),
+    ("SmaScenarioSignals", lambda rng: {}),
+])
+def test_other_walks_equal_fmi2(native_fmus, fmi3_fmus, model, inputs):
+    rng = random.Random(len(model))
+    twins = Versions(native_fmus, fmi3_fmus, model, f"{model}-3")
+    try:
+        assert twins.both("start") == [0, 0]
+        twins.compare()
+        walk = []
+        for k in range(4000):
+            walk.append(inputs(rng) if k % rng.randint(1, 50) == 0 else {})
+        twins.walk(walk)
+    finally:
+        twins.close()
+
+
+def test_bad_input_and_refused_calls(native_fmus, fmi3_fmus):
+    twins = Versions(native_fmus, fmi3_fmus, "SmaActuator", "bad3")
+    try:
+        # a call outside its state: fmi3Error naming the fmi3 function
+        assert twins.v3.step(0.0, 1e-3) == 3
+        assert "fmi3DoStep: illegal call in state 'instantiated'" in twins.v3.log[-1][1]
+        assert twins.both("start", {"load": 0.2}) == [0, 0]
+        # bad input: the FMI 2.0 status, the same variable named
+        time = 0.0
+        for name, value in (("P_in", float("nan")), ("load", -0.5), ("P_in", 1e307)):
+            twins.both("set", name, value)
+            assert twins.both("step", time, 1e-3) == [2, 2]
+            texts = [side.log[-1][1].replace(side.name, "#") for side in (twins.v2, twins.v3)]
+            assert texts[0] == texts[1] and (name in texts[1] or "temperature" in texts[1])
+            twins.both("set", name, 0.2)
+            assert twins.both("step", time, 1e-3) == [0, 0]
+            time += 1e-3
+        # the very same step discarded twice: terminateSimulation
+        twins.both("set", "P_in", float("nan"))
+        assert twins.v3.do_step(time, 1e-3) == (2, False, False, False, time)
+        assert twins.v3.do_step(time, 1e-3) == (2, False, True, False, time)
+        twins.both("set", "P_in", 0.5)
+        # an array of the wrong size, a type that is not the variable's: fmi3Error
+        vr = twins.v3.variables["R"].valueReference
+        assert twins.v3.call("getFloat64", [vr], nValues=2)[0] == 3
+        assert "fmi3GetFloat64: nValues = 2" in twins.v3.log[-1][1]
+        mode = twins.v3.variables["hysteresis_mode"].valueReference
+        assert twins.v3.call("getInt32", [mode])[0] == 3
+        assert "Enumeration variable hysteresis_mode, not an Int32" in twins.v3.log[-1][1]
+        assert twins.v3.call("getInt64", [mode]) == (0, [1])
+        assert twins.v3.call("getFloat32", [vr])[0] == 3
+        assert twins.v3.call("setFloat64", [twins.v3.variables["time"].valueReference], [1.0])[0] == 3
+        assert twins.v3.call("getFloat64", [twins.v3.variables["time"].valueReference]) == (0, [time])
+        # a fixed parameter after initialization: the FMI 2.0 refusal, in FMI 3.0's words
+        assert twins.both("set", "T_start", 20.0) == [3, 3]
+        assert "before fmi3ExitInitializationMode" in twins.v3.log[-1][1]
+        assert all("fmi2" not in text for _, text in twins.v3.log)
+    finally:
+        twins.close()
+
+
+def test_event_mode_is_refused_without_a_crash(fmi3_fmus):
+    with pytest.raises(Exception, match="Failed to instantiate"):
+        Instance3(fmi3_fmus["SmaPwmDriver"], "events3", event_mode=True)
+
+
+def test_fmpy_simulates_each(fmi3_fmus):
+    from fmpy import simulate_fmu
+    for name in NAMES:
+        result = simulate_fmu(str(fmi3_fmus[name]), stop_time=0.2, output_interval=1e-3)
+        assert len(result) >= 200 and result["time"][-1] == pytest.approx(0.2)
+
+
+def test_fmi3_needs_the_c_family(capsys, tmp_path):
+    assert main(["build", "--fmi", "3", "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["sma-fmu: error: FMI 3.0 FMUs are built by the C family only (--native): "
+                   "pythonfmu is FMI 2.0 only"]
