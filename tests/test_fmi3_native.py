@@ -261,3 +261,21 @@ def test_fmi3_needs_the_c_family(capsys, tmp_path):
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["sma-fmu: error: FMI 3.0 FMUs are built by the C family only (--native): "
                    "pythonfmu is FMI 2.0 only"]
+
+
+def test_fmpy_compiles_one_from_its_build_description_alone(fmi3_fmus, tmp_path):
+    """build_platform_binary (CMake over sources/buildDescription.xml): the same results."""
+    import shutil
+    from fmpy import simulate_fmu
+    from fmpy.build import build_platform_binary
+    folder = tmp_path / "unzipped"
+    with zipfile.ZipFile(fmi3_fmus["SmaActuator"]) as archive:
+        archive.extractall(folder)
+    shutil.rmtree(folder / "binaries")
+    build_platform_binary(folder.absolute())
+    assert (folder / "binaries" / "x86_64-linux" / "SmaActuator.so").is_file()
+    inputs = {"P_in": 1.2, "load": 0.15}
+    compiled = simulate_fmu(str(folder), stop_time=2.0, step_size=1e-3, start_values=inputs)
+    shipped = simulate_fmu(str(fmi3_fmus["SmaActuator"]), stop_time=2.0, step_size=1e-3,
+                           start_values=inputs)
+    assert compiled.tolist() == shipped.tolist() and compiled["T"][-1] > compiled["T"][0]
