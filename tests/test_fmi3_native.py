@@ -87,6 +87,21 @@ def test_fmpy_validates_them_and_they_are_fmi3(fmi3_fmus):
     assert sum(k == "Enumeration" for k in kinds.values()) == 0  # SmaScenarioSignals: none
 
 
+def test_the_plant_has_terminals_valid_by_the_schema(fmi3_fmus):
+    import os
+    import fmpy
+    from lxml import etree
+    schema = etree.XMLSchema(file=os.path.join(os.path.dirname(fmpy.__file__), "schema", "fmi3",
+                                               "fmi3TerminalsAndIcons.xsd"))
+    with zipfile.ZipFile(fmi3_fmus["SmaActuator"]) as archive:
+        root = etree.fromstring(archive.read("terminalsAndIcons/terminalsAndIcons.xml"))
+    assert schema.validate(root), schema.error_log
+    members = {t.get("name"): [m.get("variableName") for m in t] for t in root.iter("Terminal")}
+    assert members == {"electrical": ["P_in", "R"], "thermal": ["T"], "mechanical": ["load", "x"]}
+    with zipfile.ZipFile(fmi3_fmus["SmaPwmDriver"]) as archive:
+        assert not any(n.startswith("terminalsAndIcons/") for n in archive.namelist())
+
+
 def test_binaries_export_only_fmi3_functions(fmi3_fmus, tmp_path):
     import shutil
     import subprocess

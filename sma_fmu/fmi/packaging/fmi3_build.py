@@ -9,7 +9,8 @@ front (``c_family/fmi3/``). Each FMU holds:
   FMI 2.0) and ``fmi3_model.h``, and ``buildDescription.xml`` listing what a tool compiles;
 - ``binaries/x86_64-linux/<Model>.so`` and ``binaries/x86_64-windows/<Model>.dll`` (mingw-w64;
   left out with a warning without it), built as the FMI 2.0 ones are;
-- ``resources/parameters.json`` and ``extra/`` (the reference result), as in FMI 2.0.
+- ``resources/parameters.json`` and ``extra/`` (the reference result), as in FMI 2.0;
+- the plant's ``terminalsAndIcons/terminalsAndIcons.xml`` (:mod:`.fmi3_terminals`).
 """
 import shutil
 import tempfile
@@ -23,6 +24,7 @@ from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarn
 from sma_fmu.fmi.packaging.c_family_description import native_description, variables_header
 from sma_fmu.fmi.packaging.fmi3_description import (build_description, fmi3_description,
                                                     fmi3_model_header)
+from sma_fmu.fmi.packaging.fmi3_terminals import terminals_and_icons
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
@@ -67,6 +69,9 @@ def _build_one(model_name, python_fmu, folder, work):
     fmu = folder / f"{model_name}.fmu"
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.writestr("modelDescription.xml", description)
+        terminals = terminals_and_icons(description)
+        if terminals:
+            archive.writestr("terminalsAndIcons/terminalsAndIcons.xml", terminals)
         for name in names:
             archive.write(sources / name, f"sources/{name}")
         archive.writestr("sources/buildDescription.xml",
