@@ -259,6 +259,25 @@ def test_bad_input_and_refused_calls(native_fmus, fmi3_fmus):
         twins.close()
 
 
+def test_a_bad_resource_path_is_refused_in_fmi3_words(fmi3_fmus, tmp_path):
+    from fmpy.fmi3 import (fmi3InstanceEnvironment, fmi3IntermediateUpdateCallback,
+                           fmi3LogMessageCallback, fmi3ValueReference)
+    one = Instance3(fmi3_fmus["SmaPwmDriver"], "resources3")
+    try:
+        callback = fmi3LogMessageCallback(one._logger)
+        token = one.fmu.guid.encode()
+        for where, words in ((b"relative/path/", "is not a file: URI"),
+                             (str(tmp_path).encode() + b"/", "holds no parameters.json")):
+            made = one.fmu.fmi3InstantiateCoSimulation(
+                b"other", token, where, False, False, False, False, (fmi3ValueReference * 0)(), 0,
+                fmi3InstanceEnvironment(), callback, fmi3IntermediateUpdateCallback())
+            assert not made
+            assert one.log[-1][0] == 3 and words in one.log[-1][1]
+            assert "resourcePath" in one.log[-1][1] and "fmuResourceLocation" not in one.log[-1][1]
+    finally:
+        one.close()
+
+
 def test_event_mode_is_refused_without_a_crash(fmi3_fmus):
     with pytest.raises(Exception, match="Failed to instantiate"):
         Instance3(fmi3_fmus["SmaPwmDriver"], "events3", event_mode=True)

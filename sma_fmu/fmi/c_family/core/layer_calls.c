@@ -129,6 +129,17 @@ Instance *layer_new(const char *prefix, const char *instance_name, LayerEmit emi
     return in;
 }
 
+/* FMI 3.0 calls fmuResourceLocation resourcePath: the shared URI reader's messages in its words. */
+static void fmi3_words(char *text)
+{
+    static const char OLD[] = "fmuResourceLocation", NEW[] = "resourcePath";
+    char *at;
+    while ((at = strstr(text, OLD)) != NULL) {  /* NEW is shorter: the text only shrinks */
+        memmove(at + sizeof NEW - 1, at + sizeof OLD - 1, strlen(at + sizeof OLD - 1) + 1);
+        memcpy(at, NEW, sizeof NEW - 1);
+    }
+}
+
 int layer_instantiate(Instance *in, const char *function, const char *token,
                       const char *token_name, const char *resource_location)
 {
@@ -147,6 +158,7 @@ int layer_instantiate(Instance *in, const char *function, const char *token,
     in->guid = copy_text(token);
     if (!in->guid) goto fail;
     if (!layer_resource_folder(resource_location, &in->resources, &plain, why, sizeof why)) {
+        if (!fmi2) fmi3_words(why);
         layer_plain(in, SMA_ERROR, "%s: %s", function, why);
         goto fail;
     }
