@@ -278,9 +278,85 @@ def test_a_bad_resource_path_is_refused_in_fmi3_words(fmi3_fmus, tmp_path):
         one.close()
 
 
-def test_event_mode_is_refused_without_a_crash(fmi3_fmus):
-    with pytest.raises(Exception, match="Failed to instantiate"):
-        Instance3(fmi3_fmus["SmaPwmDriver"], "events3", event_mode=True)
+def test_event_mode_without_events_changes_nothing(fmi3_fmus):
+    """The plant in event mode: Event Mode after initialization, no discrete update, no
+    event asked for; stepping as without event mode."""
+    rng = random.Random(5)
+    inputs = _plant_inputs(rng, 300)
+    runs = []
+    for events in (False, True):
+        one = Instance3(fmi3_fmus["SmaActuator"], f"ev{events}", event_mode=events, early_return=events)
+        try:
+            assert one.start({"load": 0.2}) == 0
+            if events:
+                assert one.call("doStep", 0.0, 1e-3)[0] == 3 and "Event Mode" in one.log[-1][1]
+                update = one.fmu.updateDiscreteStates()
+                assert update[0] is False and update[4] is False  # nothing, no next event
+                assert one.call("enterStepMode")[0] == 0
+            seen, time = [], 0.0
+            for values in inputs:
+                for name, value in values.items():
+                    one.set(name, value)
+                status, event, terminate, early, last = one.do_step(time, 1e-3)
+                assert (status, event, terminate, early) == (0, False, False, False)
+                time = last
+                seen.append(one.values())
+            runs.append(seen)
+        finally:
+            one.close()
+    assert runs[0] == runs[1]
+
+
+def _period_means(samples, frequency, periods):
+    """Mean power [W] of each period from (start, end, P_in) samples held over each step."""
+    means = []
+    for j in range(periods):
+        a, b = j / frequency, (j + 1) / frequency
+        means.append(sum(p * max(0.0, min(e, b) - max(s, a)) for s, e, p in samples) * frequency)
+    return means
+
+
+def test_the_pwm_driver_returns_early_at_its_edges(native_fmus, fmi3_fmus):
+    """130 Hz (a period is no whole number of 1 ms steps), duty 0.3 of 2 W. With event mode
+    and early return, a step stops at each edge, P_in is 2 W or 0 W (to rounding), and the
+    mean power per period, from the outputs held over each step as a master sees them, is
+    the exact duty-cycle value 0.6 W to 1e-9; the fixed-step FMI 2.0 run's per-period means are off by
+    up to a step's share. Both errors are printed (pytest -s)."""
+    frequency, periods, setup = 130.0, 12, {"frequency_Hz": 130.0, "peak_W": 2.0}
+    runs = {}
+    for version in ("v2", "v3"):
+        one = (Instance(native_fmus["SmaPwmDriver"], "edges2") if version == "v2" else
+               Instance3(fmi3_fmus["SmaPwmDriver"], "edges3", event_mode=True, early_return=True))
+        try:
+            assert one.start(dict(setup, P_demand=0.6)) == 0
+            if version == "v3":
+                assert one.call("enterStepMode")[0] == 0
+            samples, time, events = [], 0.0, 0
+            while time < periods / frequency - 1e-12:
+                if version == "v3":
+                    status, event, terminate, early, last = one.do_step(time, 1e-3)
+                    assert status == 0 and not terminate and (early <= event)
+                    if event:
+                        events += 1
+                        assert one.call("enterEventMode")[0] == 0
+                        assert one.fmu.updateDiscreteStates()[0] is False
+                        assert one.call("enterStepMode")[0] == 0
+                else:
+                    assert one.step(time, 1e-3) == 0
+                    last = time + 1e-3
+                samples.append((time, last, one.get("P_in")[1]))
+                time = last
+            runs[version] = samples
+        finally:
+            one.close()
+    assert events >= 2 * periods - 1
+    # rounding of the edge times leaves slivers of 1e-15 W around the edges
+    assert all(min(abs(p), abs(p - 2.0)) < 1e-12 for _, _, p in runs["v3"])
+    errors = {v: max(abs(m - 0.6) for m in _period_means(s, frequency, periods))
+              for v, s in runs.items()}
+    print(f"PWM 130 Hz, duty 0.3 of 2 W: largest error of the mean power per period: "
+          f"FMI 2.0 fixed 1 ms steps {errors['v2']:.3g} W, FMI 3.0 event mode {errors['v3']:.3g} W")
+    assert errors["v3"] < 1e-9 and errors["v2"] > 1000 * errors["v3"]
 
 
 def test_fmpy_simulates_each(fmi3_fmus):

@@ -4,7 +4,8 @@ Nothing about the interface is written twice: the FMI 3.0 description is the nat
 one (:mod:`.c_family_description`) in FMI 3.0's terms:
 
 - ``instantiationToken`` for the ``guid``; ``CoSimulation`` with saved and serialized
-  states, no event mode and no early return (yet);
+  states and event mode; the models with events of their own (:data:`EVENT_MODELS`: the PWM
+  driver's edges) may return early from a step, at the event;
 - the independent variable ``time`` [s], one value reference past the model's variables (the
   C core keeps the FMI 2.0 numbering);
 - Real -> Float64 (its unit kept), Integer -> Int32, Boolean, String (start as ``<Start>``),
@@ -20,11 +21,14 @@ import xml.etree.ElementTree as ET
 
 from sma_fmu.fmi.python_family.slave_support.choices import CHOICES
 
-__all__ = ["fmi3_description", "build_description", "fmi3_model_header", "time_reference"]
+__all__ = ["EVENT_MODELS", "fmi3_description", "build_description", "fmi3_model_header",
+           "time_reference"]
+
+EVENT_MODELS = {"SmaPwmDriver"}  # their C adapter has next_event (models/<Model>.c)
 
 _CO_SIMULATION = {"canHandleVariableCommunicationStepSize": "true",
                   "canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
-                  "hasEventMode": "false", "providesIntermediateUpdate": "false",
+                  "hasEventMode": "true", "providesIntermediateUpdate": "false",
                   "canReturnEarlyAfterIntermediateUpdate": "false"}
 _TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
 _KEPT = ("name", "valueReference", "description", "causality", "variability", "initial")
@@ -60,7 +64,9 @@ def fmi3_description(fmi2_description):
             root.set(key, old.get(key))
     root.set("instantiationToken", old.get("guid"))
     identifier = old.find("CoSimulation").get("modelIdentifier")
-    ET.SubElement(root, "CoSimulation", modelIdentifier=identifier, **_CO_SIMULATION)
+    co_simulation = ET.SubElement(root, "CoSimulation", modelIdentifier=identifier, **_CO_SIMULATION)
+    if old.get("modelName") in EVENT_MODELS:
+        co_simulation.set("mightReturnEarlyFromDoStep", "true")
     if old.find("UnitDefinitions") is not None:
         units = ET.SubElement(root, "UnitDefinitions")
         units.extend(old.find("UnitDefinitions"))

@@ -72,6 +72,9 @@ typedef struct Instance {
     int stepped, terminated, have_discard;  /* GetXXXStatus bookkeeping (as the front) */
     double discard_time, discard_step;
     SavedState *states;              /* states handed out and not freed */
+    /* FMI 3.0 only (its front sets and reads them; not in saved states): */
+    int event_mode_used, early_return;  /* fmi3InstantiateCoSimulation's flags */
+    int event_mode;                  /* in Event Mode (the core's state is then stepComplete) */
 } Instance;
 
 /* ---- calls (layer_calls.c) --------------------------------------------------------------- */

@@ -73,6 +73,9 @@ typedef struct {
     size_t (*state_size)(const void *stepper);
     void (*state_write)(const void *stepper, double *out);
     int (*state_read)(void *stepper, const double *in, size_t count, SmaMessage *message);
+    /* FMI 3.0 event mode: the time [s] of the model's next discontinuity after `time` [s]
+     * with the present inputs; NULL: the model has no events of its own. */
+    double (*next_event)(const void *stepper, const SmaValue *values, double time);
 } SmaModel;
 
 /* Each adapter defines this one object (models/<Model>.c). */

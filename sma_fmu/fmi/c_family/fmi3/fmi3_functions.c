@@ -5,8 +5,11 @@
  * refusals and messages). FMI 3.0's differences:
  *  - fmi3InstantiateCoSimulation takes the instantiation token and a resource path (a
  *    file: URI is accepted with a warning); Model Exchange and Scheduled Execution give
- *    NULL; eventModeUsed is refused (no event mode yet), earlyReturnAllowed is ignored
- *    (these FMUs never return early);
+ *    NULL;
+ *  - Event Mode (eventModeUsed): entered after initialization and by fmi3EnterEventMode,
+ *    left by fmi3EnterStepMode; there fmi3UpdateDiscreteStates reports no discrete change
+ *    and the next event time of a model that has events (the PWM driver's edges), inputs
+ *    may be set and outputs read, and fmi3DoStep is refused (fmi3_step.c);
  *  - fmi3EnterInitializationMode carries fmi2SetupExperiment's start and stop times;
  *  - the messages go to the logger as text (FMI 3.0 passes no format). */
 #include "fp_contract.h"
@@ -75,21 +78,17 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
     const char *function = "fmi3InstantiateCoSimulation";
     Instance *in = layer_new("fmi3", instanceName, emit, (void (*)(void))logMessage,
                              instanceEnvironment, loggingOn);
-    (void)visible; (void)earlyReturnAllowed; (void)requiredIntermediateVariables;
+    (void)visible; (void)requiredIntermediateVariables;
     (void)intermediateUpdate;
     if (!in) return NULL;
-    if (eventModeUsed) {
-        layer_reject(in, SMA_ERROR, function, "eventModeUsed is true, but this FMU declares no "
-                     "event mode (hasEventMode is false)");
-        layer_discard(in);
-        return NULL;
-    }
     if (nRequiredIntermediateVariables > 0) {
         layer_reject(in, SMA_ERROR, function, "requiredIntermediateVariables: this FMU provides "
                      "no intermediate update (providesIntermediateUpdate is false)");
         layer_discard(in);
         return NULL;
     }
+    in->event_mode_used = eventModeUsed ? 1 : 0;
+    in->early_return = earlyReturnAllowed ? 1 : 0;
     return layer_instantiate(in, function, instantiationToken, "instantiationToken", resourcePath)
                ? in : NULL;
 }
@@ -118,15 +117,22 @@ FMI3_Export fmi3Status fmi3EnterInitializationMode(fmi3Instance instance,
 
 FMI3_Export fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
 {
+    SmaStatus status;
     ENTER;
-    DONE(layer_exit_initialization(in, "fmi3ExitInitializationMode", STATE_STEP_COMPLETE));
+    status = layer_exit_initialization(in, "fmi3ExitInitializationMode", STATE_STEP_COMPLETE);
+    if (status <= SMA_WARNING) in->event_mode = in->event_mode_used;
+    DONE(status);
 }
 
 FMI3_Export fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
     ENTER;
-    DONE(layer_reject(in, SMA_ERROR, "fmi3EnterEventMode", "illegal call: this FMU declares no "
-                      "event mode (hasEventMode is false)"));
+    if (!in->event_mode_used)
+        DONE(layer_reject(in, SMA_ERROR, "fmi3EnterEventMode", "illegal call: the instance was "
+                          "made with eventModeUsed = false"));
+    if (!layer_allowed(in, "fmi3EnterEventMode", IN(STATE_STEP_COMPLETE))) return fmi3Error;
+    in->event_mode = 1;
+    return fmi3OK;
 }
 
 FMI3_Export fmi3Status fmi3Terminate(fmi3Instance instance)
@@ -141,6 +147,7 @@ FMI3_Export fmi3Status fmi3Reset(fmi3Instance instance)
 {
     char why[1200];
     ENTER;
+    in->event_mode = 0;
     if (!layer_initial_state(in, why, sizeof why)) {
         layer_log(in, SMA_ERROR, "fmi3Reset: %s", why);
         return fmi3Error;

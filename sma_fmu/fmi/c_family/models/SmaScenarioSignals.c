@@ -57,4 +57,4 @@ static int state_read(void *stepper, const double *in, size_t count, SmaMessage 
 
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, "sma-fmu signals state", LOG_CATEGORIES, VARIABLES, VAR_COUNT,
-    0, sizeof(SignalSource), start, step, release, NULL, state_size, state_write, state_read};
+    0, sizeof(SignalSource), start, step, release, NULL, state_size, state_write, state_read, NULL};
