@@ -359,6 +359,34 @@ def test_the_pwm_driver_returns_early_at_its_edges(native_fmus, fmi3_fmus):
     assert errors["v3"] < 1e-9 and errors["v2"] > 1000 * errors["v3"]
 
 
+def test_the_signals_return_early_at_their_steps(fmi3_fmus):
+    """Load switching at 5.7 ms and 21.3 ms, the reference stepping at 12.5 ms: with early
+    return, steps of 1 ms end at each of these times, where the output has switched."""
+    import json
+    one = Instance3(fmi3_fmus["SmaScenarioSignals"], "signals3", event_mode=True,
+                    early_return=True)
+    try:
+        reference = {"kind": "step", "initial_ohm": 45.0, "final_ohm": 40.0, "time_s": 0.0125}
+        load = {"times_s": [0.0, 0.0057, 0.0213], "values_kg": [0.1, 0.2, 0.05]}
+        assert one.start({"reference": json.dumps(reference), "load_profile": json.dumps(load)}) == 0
+        assert one.fmu.updateDiscreteStates()[4:] == (True, 0.0057)
+        assert one.call("enterStepMode")[0] == 0
+        time, ends = 0.0, {}
+        while time < 0.03 - 1e-12:
+            status, event, terminate, early, last = one.do_step(time, 1e-3)
+            assert status == 0 and not terminate
+            if event:
+                ends[round(last, 12)] = one.values()
+                assert one.call("enterEventMode")[0] == 0
+                assert one.call("enterStepMode")[0] == 0
+            time = last
+        assert set(ends) == {0.0057, 0.0125, 0.0213}
+        assert ends[0.0057] == {"R_ref": 45.0, "load": 0.2}
+        assert ends[0.0125]["R_ref"] == 40.0 and ends[0.0213]["load"] == 0.05
+    finally:
+        one.close()
+
+
 def test_fmpy_simulates_each(fmi3_fmus):
     from fmpy import simulate_fmu
     for name in NAMES:
@@ -366,7 +394,7 @@ def test_fmpy_simulates_each(fmi3_fmus):
         assert len(plain) >= 200 and plain["time"][-1] == pytest.approx(0.2)
         events = simulate_fmu(str(fmi3_fmus[name]), stop_time=0.2, output_interval=1e-3,
                               use_event_mode=True, early_return_allowed=True)
-        if name != "SmaPwmDriver":  # no events of their own: the same run
+        if name != "SmaPwmDriver":  # no events before 0.2 s: the same run
             assert events.tolist() == plain.tolist()
 
 

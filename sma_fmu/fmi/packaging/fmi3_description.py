@@ -5,7 +5,8 @@ one (:mod:`.c_family_description`) in FMI 3.0's terms:
 
 - ``instantiationToken`` for the ``guid``; ``CoSimulation`` with saved and serialized
   states and event mode; the models with events of their own (:data:`EVENT_MODELS`: the PWM
-  driver's edges) may return early from a step, at the event;
+  driver's edges, the signals' load and set-point steps) may return early from a step, at
+  the event;
 - the independent variable ``time`` [s], one value reference past the model's variables (the
   C core keeps the FMI 2.0 numbering);
 - Real -> Float64 (its unit kept), Integer -> Int32, Boolean, String (start as ``<Start>``),
@@ -24,7 +25,7 @@ from sma_fmu.fmi.python_family.slave_support.choices import CHOICES
 __all__ = ["EVENT_MODELS", "fmi3_description", "build_description", "fmi3_model_header",
            "time_reference"]
 
-EVENT_MODELS = {"SmaPwmDriver"}  # their C adapter has next_event (models/<Model>.c)
+EVENT_MODELS = {"SmaPwmDriver", "SmaScenarioSignals"}  # their C adapter has next_event (models/<Model>.c)
 
 _CO_SIMULATION = {"canHandleVariableCommunicationStepSize": "true",
                   "canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
