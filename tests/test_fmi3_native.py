@@ -421,3 +421,14 @@ def test_fmpy_compiles_one_from_its_build_description_alone(fmi3_fmus, tmp_path)
     shipped = simulate_fmu(str(fmi3_fmus["SmaActuator"]), stop_time=2.0, step_size=1e-3,
                            start_values=inputs)
     assert compiled.tolist() == shipped.tolist() and compiled["T"][-1] > compiled["T"][0]
+
+
+@pytest.mark.parametrize("kind", [["ssp", "paper"], ["container", "setpoints-pwm-pi+ff-adaptive"],
+                                  ["cross-check"]])
+def test_export_refuses_fmi3_fmus_by_name(fmi3_fmus, capsys, tmp_path, kind):
+    folder = fmi3_fmus["SmaActuator"].parent
+    out = tmp_path / ("out.fmu" if kind[0] == "container" else "out")
+    assert main(["export", *kind, "--fmus", str(folder), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"sma-fmu: error: export {kind[0]}: ")
+    assert "is an FMI 3.0 FMU" in err[0] and not out.exists()
