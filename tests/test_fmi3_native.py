@@ -476,3 +476,14 @@ def test_corrupted_states_are_refused_alike_in_both_versions(native_fmus, fmi3_f
     finally:
         twins.close()
         other.close()
+
+
+def test_sma_fmu_check_passes_each(fmi3_fmus, capsys):
+    """fmpy validation, FMI checker, state round trip (FMU3Slave), reference result,
+    platforms from the FMI 3.0 annotation; libcosim's run is n/a (it runs no FMI 3.0)."""
+    assert main(["check", *(str(fmi3_fmus[name]) for name in NAMES)]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert not [line for line in lines if line.startswith("FAIL")]
+    for check in ("state round trip: FMI 3.0, serialized", "platform x86_64-linux: ",
+                  "platform x86_64-windows: ", "C host (libcosim): libcosim runs no FMI 3.0"):
+        assert sum(check in line for line in lines) == len(NAMES), check

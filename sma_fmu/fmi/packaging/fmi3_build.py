@@ -4,7 +4,8 @@ The same C models and core as the FMI 2.0 build (:mod:`.c_family_build`), under 
 front (``c_family/fmi3/``). Each FMU holds:
 
 - ``modelDescription.xml`` (FMI 3.0, :mod:`.fmi3_description`): the native FMI 2.0
-  description in FMI 3.0's terms (instantiation token, ``time``, Enumerations);
+  description in FMI 3.0's terms (instantiation token, ``time``, Enumerations), with the
+  platforms annotation ``sma-fmu check`` reads;
 - ``sources/``: the C files, flat, the generated ``<Model>_variables.h`` (the same table as
   FMI 2.0) and ``fmi3_model.h``, and ``buildDescription.xml`` listing what a tool compiles;
 - ``binaries/x86_64-linux/<Model>.so`` and ``binaries/x86_64-windows/<Model>.dll`` (mingw-w64;
@@ -22,8 +23,8 @@ from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarning, _c_files,
                                                   _exact_starts, compile_binary, model_sources)
 from sma_fmu.fmi.packaging.c_family_description import native_description, variables_header
-from sma_fmu.fmi.packaging.fmi3_description import (build_description, fmi3_description,
-                                                    fmi3_model_header)
+from sma_fmu.fmi.packaging.fmi3_description import (annotate_platforms, build_description,
+                                                    fmi3_description, fmi3_model_header)
 from sma_fmu.fmi.packaging.fmi3_terminals import terminals_and_icons
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
@@ -67,8 +68,9 @@ def _build_one(model_name, python_fmu, folder, work):
         if NATIVE_MARKER not in output.read_bytes():
             raise RuntimeError(f"{platform}: the native marker is missing (layer_calls.c)")
     fmu = folder / f"{model_name}.fmu"
+    annotated = annotate_platforms(description, {b.split("/")[1]: b for b in binaries})
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
-        archive.writestr("modelDescription.xml", description)
+        archive.writestr("modelDescription.xml", annotated)
         terminals = terminals_and_icons(description)
         if terminals:
             archive.writestr("terminalsAndIcons/terminalsAndIcons.xml", terminals)

@@ -22,8 +22,8 @@ import xml.etree.ElementTree as ET
 
 from sma_fmu.fmi.python_family.slave_support.choices import CHOICES
 
-__all__ = ["EVENT_MODELS", "fmi3_description", "build_description", "fmi3_model_header",
-           "time_reference"]
+__all__ = ["EVENT_MODELS", "fmi3_description", "annotate_platforms", "build_description",
+           "fmi3_model_header", "time_reference"]
 
 EVENT_MODELS = {"SmaPwmDriver", "SmaScenarioSignals"}  # their C adapter has next_event (models/<Model>.c)
 
@@ -101,6 +101,19 @@ def fmi3_description(fmi2_description):
         found = old.find("ModelStructure").find(group)
         for unknown in found if found is not None else ():
             ET.SubElement(structure, tag, valueReference=references[int(unknown.get("index")) - 1])
+    ET.indent(root, "\t")
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
+
+
+def annotate_platforms(fmi3_description_bytes, binaries):
+    """The description with ``<Annotation type="sma-fmu">`` naming the native ``binaries``
+    ({platform tuple: path in the FMU}), which ``sma-fmu check`` reads (platforms.py)."""
+    root = ET.fromstring(fmi3_description_bytes)
+    note = ET.SubElement(ET.SubElement(root, "Annotations"), "Annotation", type="sma-fmu")
+    platforms = ET.SubElement(note, "Platforms")
+    for name, binary in binaries.items():
+        ET.SubElement(platforms, "Platform", name=name, binary=binary, front="false",
+                      python="none (native C)", native="true")
     ET.indent(root, "\t")
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
 
