@@ -19,7 +19,7 @@ from graph_cycles import find_cycle
 
 FMI = Path(fmi.__file__).parent
 FRONT = FMI / "python_family" / "front"
-C_FAMILY = [FMI / "c_family" / folder for folder in ("runtime", "fmi2", "models")] + [FMI / "c_common"]
+C_FAMILY = [FMI / "c_family" / folder for folder in ("runtime", "core", "fmi2", "fmi3", "models")] + [FMI / "c_common"]
 _DEFINITION = re.compile(r"^(?!static\b)[A-Za-z_][^\n;(=]*?\b([A-Za-z_]\w*)\s*\([^;{]*\)\s*\{", re.M)
 
 

@@ -1,4 +1,4 @@
-"""The native (C) FMUs refuse pointers that are not live instances (fmi2_instances.c).
+"""The native (C) FMUs refuse pointers that are not live instances (core/layer_instances.c).
 
 A host calling with a freed instance, freeing one twice, or passing memory that never was an
 instance gets fmi2Error (fmi2FreeInstance: nothing) and one stderr line, and no other instance

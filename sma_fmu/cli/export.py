@@ -1,15 +1,45 @@
 """Export commands: the closed loop for system-level tools (SSP package, container FMU), and
 the FMI Cross-Check tree of the built FMUs."""
+import re
+import zipfile
 from pathlib import Path
 
 from .arguments import add_fmus_argument, add_scenario_arguments, scenario_paths
 
-__all__ = ["register"]
+__all__ = ["Fmi3ExportError", "register"]
+
+# Why no export takes FMI 3.0 FMUs: its hosts do not run them (docs/fmus.md, FMI versions).
+_NO_FMI3 = {
+    "ssp": "the SSP hosts it is for do not run FMI 3.0 co-simulation (libcosimpy 0.0.6 and "
+           "OMSimulator v3.0.0 crash on it)",
+    "container": "the container (fmu-manipulation-toolbox) is an FMI 2.0 FMU that holds FMI "
+                 "2.0 FMUs",
+    "cross-check": "the tree it writes is the FMI 2.0 one (fmus/2.0/cs/...)",
+}
+
+
+class Fmi3ExportError(ValueError):
+    """An export was asked of FMI 3.0 FMUs, which its hosts would crash on."""
+
+
+def _refuse_fmi3(folder, kind):
+    """Raise :class:`Fmi3ExportError` if ``folder`` holds an FMI 3.0 FMU."""
+    for path in sorted(Path(folder).glob("*.fmu")):
+        try:
+            with zipfile.ZipFile(path) as archive:
+                head = archive.read("modelDescription.xml")[:4000].decode("utf-8", "replace")
+        except (OSError, KeyError, zipfile.BadZipFile):
+            continue  # not an FMU: the export itself names the problem
+        if re.search(r'fmiVersion\s*=\s*"3', head):
+            raise Fmi3ExportError(
+                f"export {kind}: {path} is an FMI 3.0 FMU, and {_NO_FMI3[kind]}; export the "
+                f"FMI 2.0 FMUs instead (sma-fmu build [--native])")
 
 
 def _ssp(args):
     from sma_fmu.systems.ssp import export_ssp
 
+    _refuse_fmi3(args.fmus, "ssp")
     for path in export_ssp(scenario_paths(args), args.out, args.fmus):
         print(path)
     return 0
@@ -19,6 +49,7 @@ def _container(args):
     from sma_fmu.cosim.scenario import resolve_scenarios
     from sma_fmu.systems.container import export_container
 
+    _refuse_fmi3(args.fmus, "container")
     paths = resolve_scenarios([args.scenario])
     if len(paths) != 1:
         raise ValueError(f"SCENARIO {args.scenario!r}: names {len(paths)} scenarios; a container "
@@ -30,6 +61,7 @@ def _container(args):
 def _cross_check(args):
     from sma_fmu.fmi.packaging.cross_check import export_cross_check
 
+    _refuse_fmi3(args.fmus, "cross-check")
     for folder in export_cross_check(args.fmus, args.out):  # prints the FMUs it leaves out
         print(folder)
     return 0

@@ -12,7 +12,8 @@ __all__ = ["register"]
 def _build(args):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        paths = fmu_build.build_fmus(args.out, args.model, native=args.native)
+        paths = fmu_build.build_fmus(args.out, args.model, native=args.native,
+                                     fmi_version=args.fmi)
     for warning in caught:
         print(f"sma-fmu: warning: {warning.message}", file=sys.stderr)
     for name, path in paths.items():
@@ -41,6 +42,9 @@ def register(commands):
     build.add_argument("--native", action="store_true",
                        help="build the C family: source-code FMUs with linux64/win64 binaries, "
                             "no Python needed (default: pythonfmu)")
+    build.add_argument("--fmi", type=int, choices=(2, 3), default=2, metavar="{2,3}",
+                       help="FMI version (default: 2); 3 needs --native: FMI 3.0 co-simulation "
+                            "FMUs (x86_64-linux/x86_64-windows binaries, buildDescription.xml)")
     build.set_defaults(handler=_build)
 
     validate = commands.add_parser("validate", help="validate FMUs with fmpy (exit 1 on problems)")

@@ -3,9 +3,11 @@
 Per FMU (a container is an FMU; the FMUs inside an SSP are checked one by one):
 - ``fmpy validation``: fmpy's check of modelDescription.xml (schema and rules);
 - ``FMI checker``: fmu-manipulation-toolbox's checkers (FMI XSD and the standard's rules);
-- ``C host (libcosim)``: a short run in sma-fmu's C host (:mod:`.c_host`), all outputs finite;
+- ``C host (libcosim)``: a short run in sma-fmu's C host (:mod:`.c_host`), all outputs finite
+  ("n/a" for an FMI 3.0 FMU: libcosim runs none);
 - ``state round trip``: save the state, step, restore, step again: the same outputs, bit
-  for bit (serialized and read back when the FMU can); "n/a" when it does not declare it.
+  for bit (serialized and read back when the FMU can); "n/a" when it does not declare it;
+  an FMI 3.0 FMU through fmpy's FMU3Slave.
 - ``default experiment``: the FMU's default experiment run again in fmpy gives the
   reference result it carries (:mod:`sma_fmu.fmi.packaging.reference_results`, the fmi-ls-ref layout);
   "n/a" without one, or for an FMU an export packed with a scenario's values.
@@ -111,6 +113,8 @@ def _state_round_trip(path, description):
     cs = description.coSimulation
     if cs is None or not cs.canGetAndSetFMUstate:
         return "n/a", "the FMU does not declare canGetAndSetFMUstate"
+    if description.fmiVersion.startswith("3"):
+        return _state_round_trip3(path, description)
     step = _fmu_step(description)
     outputs = tuple(v.name for v in description.modelVariables
                     if v.type == "Real" and v.causality == "output")
@@ -136,6 +140,56 @@ def _state_round_trip(path, description):
             else ("FAIL", f"{STATE_STEPS} steps after restoring the state differ from the first run"))
 
 
+def _state_round_trip3(path, description):
+    """The same round trip for an FMI 3.0 FMU, through fmpy's FMU3Slave (Float64 outputs)."""
+    import shutil
+
+    from fmpy import extract
+    from fmpy.fmi3 import FMU3Slave
+
+    cs, step = description.coSimulation, _fmu_step(description)
+    outputs = [v.valueReference for v in description.modelVariables
+               if v.type == "Float64" and v.causality == "output"]
+    folder = extract(str(path))
+    fmu = FMU3Slave(guid=description.instantiationToken, unzipDirectory=folder,
+                    modelIdentifier=cs.modelIdentifier, instanceName="state_check")
+    try:
+        fmu.instantiate(logMessage=lambda *message: None)
+        fmu.enterInitializationMode(startTime=0.0)
+        fmu.exitInitializationMode()
+
+        def run(first):
+            values = []
+            for k in range(first, first + STATE_STEPS):
+                fmu.doStep(k * step, step)
+                values.append(repr(fmu.getFloat64(outputs)))
+            return values
+
+        run(0)
+        state = fmu.getFMUState()
+        if cs.canSerializeFMUstate:
+            saved, state = state, fmu.deserializeFMUState(fmu.serializeFMUState(state))
+            fmu.freeFMUState(saved)
+        before = run(STATE_STEPS)
+        fmu.setFMUState(state)
+        after = run(STATE_STEPS)
+        fmu.freeFMUState(state)
+        fmu.terminate()
+    finally:
+        fmu.freeInstance()
+        shutil.rmtree(folder, ignore_errors=True)
+    how = "FMI 3.0, serialized, " if cs.canSerializeFMUstate else "FMI 3.0, "
+    return (("ok", f"{how}{STATE_STEPS} steps repeated bit for bit") if before == after
+            else ("FAIL", f"{STATE_STEPS} steps after restoring the state differ from the first run"))
+
+
+def _c_host_run(path, description):
+    """The C host's short run; n/a for FMI 3.0 (libcosim runs FMI 1.0 and 2.0 only)."""
+    if description.fmiVersion.startswith("3"):
+        return "n/a", "libcosim runs no FMI 3.0 FMU"
+    return _short_run("fmu", path, _fmu_step(description))
+
+
 def _fmu_checks(path, label, c_host=True):
     from fmpy import read_model_description
 
@@ -145,8 +199,7 @@ def _fmu_checks(path, label, c_host=True):
     results = [_run(label, "fmpy validation", lambda: _fmpy_validation(path)),
                _run(label, "FMI checker", lambda: _toolbox_checker(path))]
     if c_host:
-        results.append(_run(label, "C host (libcosim)",
-                            lambda: _short_run("fmu", path, _fmu_step(description()))))
+        results.append(_run(label, "C host (libcosim)", lambda: _c_host_run(path, description())))
     results.append(_run(label, "state round trip", lambda: _state_round_trip(path, description())))
     results.append(_run(label, "default experiment", lambda: reference_check(path, START_VALUES_ENTRY)))
     return results

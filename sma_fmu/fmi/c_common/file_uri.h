@@ -1,5 +1,5 @@
 /* fmuResourceLocation -> a local folder path, for both families of FMUs (the C family's
- * fmi2/fmi2_resources.c and the Python family's front/resource_uri.c compile this file).
+ * c_family/core/layer_resources.c and the Python family's front/resource_uri.c compile this file).
  * Each family then checks the folder its own way. */
 #ifndef SMA_FILE_URI_H
 #define SMA_FILE_URI_H

@@ -4,7 +4,7 @@
  * (native byte order). CRC-32 is zlib's (polynomial 0xEDB88320): it detects every change of
  * up to 32 consecutive bits, so any one changed byte, and a truncated or extended body (the
  * length field), is refused before a single byte of the body is read. The C family frames
- * its binary state (fmi2/fmi2_state_bytes.c), the Python family's front pythonfmu's
+ * its binary state (c_family/core/layer_state_bytes.c), the Python family's front pythonfmu's
  * (front/fmi2_states.c). */
 #ifndef SMA_STATE_FRAME_H
 #define SMA_STATE_FRAME_H

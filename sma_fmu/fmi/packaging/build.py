@@ -1,25 +1,37 @@
 """``sma-fmu build``: either family's FMUs, and fmpy's validation of any FMU.
 
 - the Python family (pythonfmu, behind the C front): :mod:`.pythonfmu_build`;
-- the C family (``--native``: no Python inside): :mod:`.c_family_build`.
+- the C family (``--native``: no Python inside): :mod:`.c_family_build` (FMI 2.0) and
+  :mod:`.fmi3_build` (``--fmi 3``: FMI 3.0 co-simulation; the pythonfmu family is FMI 2.0
+  only).
 """
 from pathlib import Path
 
 from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
+from sma_fmu.fmi.packaging.fmi3_build import build_fmi3_fmus
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, FMU_SCRIPTS
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
 
 __all__ = ["build_fmus", "build_fmu", "validate_fmus"]
 
 
-def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False):
+def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False,
+               fmi_version=2):
     """Build FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``; return {name: path}.
 
     They are built in a temporary folder beside ``out_dir`` and moved there at the end, so
     a failed build leaves ``out_dir`` as it was. ``native``: the C family instead
     (:mod:`sma_fmu.fmi.packaging.c_family_build`: same interface, no Python inside).
+    ``fmi_version`` 3: the C family as FMI 3.0 co-simulation FMUs (needs ``native``).
     """
+    if fmi_version not in (2, 3):
+        raise ValueError(f"FMI version {fmi_version!r}: 2 or 3")
+    if fmi_version == 3 and not native:
+        raise ValueError("FMI 3.0 FMUs are built by the C family only (--native): pythonfmu is "
+                         "FMI 2.0 only")
+    if fmi_version == 3:
+        return build_fmi3_fmus(out_dir, parameter_file, names)
     if native:
         return build_native_fmus(out_dir, parameter_file, names)
     return build_pythonfmu_fmus(out_dir, parameter_file, names)

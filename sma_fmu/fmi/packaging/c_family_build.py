@@ -58,7 +58,10 @@ class NativeBuildWarning(FrontWarning):
 def _c_files():
     """{file name: path} of the C family's shipped files (flat names are unique)."""
     files = {}
-    for folder in (C_FAMILY / "fmi2", C_FAMILY / "runtime", C_FAMILY / "models", C_COMMON):
+    for folder in (C_FAMILY / "fmi2", C_FAMILY / "fmi3", C_FAMILY / "core", C_FAMILY / "runtime",
+                   C_FAMILY / "models", C_COMMON):
+        if not folder.is_dir():
+            continue
         for path in sorted(folder.iterdir()):
             if path.suffix in (".c", ".h"):
                 if path.name in files:
@@ -80,17 +83,19 @@ def _implementers(files):
     return found
 
 
-def model_sources(model_name, generated=()):
-    """The file names sources/ needs for ``model_name``: its adapter, the layer, and every
-    header they include, transitively, with the .c files implementing it; ``generated``
-    names files written later."""
+def model_sources(model_name, generated=(), front="fmi2"):
+    """The file names sources/ needs for ``model_name``: its adapter, the FMI ``front``
+    (``fmi2`` or ``fmi3``), the core, and every header they include, transitively, with the
+    .c files implementing it; ``generated`` names files written later."""
     files = _c_files()
     implementers = _implementers(files)
-    wanted = [f"{model_name}.c"] + sorted(n for n in files if n.startswith("fmi2") or n == "sma_model.c")
+    wanted = [f"{model_name}.c"] + sorted(n for n in files if n.startswith(front) or
+                                          n.startswith("layer") or n == "sma_model.c")
+    other = {"fmi2": "fmi3", "fmi3": "fmi2"}[front]  # the other front is never compiled in
     found, queue = set(), list(wanted)
     while queue:
         name = queue.pop()
-        if name in found:
+        if name in found or name.startswith(other):
             continue
         found.add(name)
         if name in generated:

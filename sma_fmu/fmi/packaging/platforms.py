@@ -23,8 +23,11 @@ __all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", 
 
 FRONT_MARKER = b"sma-fmu native front"  # a string every front binary carries (fmi2_exports.c);
 # its old words are kept so FMUs built before the word "native" came to mean the C family still count
-NATIVE_MARKER = b"sma-fmu native C FMU"  # ... every C-family binary (c_family/fmi2/fmi2_functions.c)
+NATIVE_MARKER = b"sma-fmu native C FMU"  # ... every C-family binary (c_family/core/layer_calls.c)
 PLATFORMS = {"linux64": ".so", "win64": ".dll"}
+# FMI 3.0's platform tuples (the C family's FMI 3.0 FMUs) and their binaries' suffixes
+FMI3_PLATFORMS = {"x86_64-linux": ".so", "aarch64-linux": ".so", "x86_64-windows": ".dll",
+                  "x86_64-darwin": ".dylib", "aarch64-darwin": ".dylib"}
 HOW_PYTHON_IS_FOUND = {
     "linux64": "the process's own Python, else $SMA_FMU_LIBPYTHON, else the build's libpython, "
                "else the newest libpython3.X.so.1.0 (3.10 or newer) on the library search path "
@@ -131,9 +134,13 @@ def _declared(model_description):
     import xml.etree.ElementTree as ET
 
     root = ET.fromstring(model_description)
-    return {node.get("name"): dict(node.attrib)
-            for tool in root.iterfind("VendorAnnotations/Tool") if tool.get("name") == _TOOL
-            for node in tool.iterfind("Platforms/Platform")}
+    found = {node.get("name"): dict(node.attrib)
+             for tool in root.iterfind("VendorAnnotations/Tool") if tool.get("name") == _TOOL
+             for node in tool.iterfind("Platforms/Platform")}
+    found.update({node.get("name"): dict(node.attrib)  # FMI 3.0: <Annotation type="sma-fmu">
+                  for note in root.iterfind("Annotations/Annotation") if note.get("type") == _TOOL
+                  for node in note.iterfind("Platforms/Platform")})
+    return found
 
 
 def platform_report(fmu_path):
@@ -171,7 +178,7 @@ def _built_by_sma_fmu(archive, names):
 
 
 def _platform_line(archive, names, identifier, name, said):
-    binary = f"binaries/{name}/{identifier}{PLATFORMS.get(name, '')}"
+    binary = f"binaries/{name}/{identifier}{PLATFORMS.get(name) or FMI3_PLATFORMS.get(name, '')}"
     if binary not in names:
         return "FAIL", name, f"lists the platform but has no {binary}"
     data = archive.read(binary)

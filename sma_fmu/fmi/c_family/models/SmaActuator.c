@@ -71,4 +71,4 @@ static int state_read(void *stepper, const double *in, size_t count, SmaMessage 
 
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, PLANT_STATE_FORMAT, LOG_CATEGORIES, VARIABLES, VAR_COUNT,
-    1, sizeof(PlantStepper), start, step, release, warning, state_size, state_write, state_read};
+    1, sizeof(PlantStepper), start, step, release, warning, state_size, state_write, state_read, NULL};

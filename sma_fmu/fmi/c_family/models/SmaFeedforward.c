@@ -79,4 +79,4 @@ static int state_read(void *stepper, const double *in, size_t count, SmaMessage 
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, FEEDFORWARD_STATE_FORMAT, LOG_CATEGORIES, VARIABLES, VAR_COUNT,
     1, sizeof(FeedforwardStepper), start, step, release, warning, state_size, state_write,
-    state_read};
+    state_read, NULL};

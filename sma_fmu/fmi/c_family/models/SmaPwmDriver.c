@@ -8,6 +8,8 @@
  * exactly. After initialization P_in is 0 W. Invalid parameters refuse
  * fmi2ExitInitializationMode; a non-finite P_demand discards the step. */
 #include "fp_contract.h"
+#include <math.h>
+
 #include "pwm.h"
 #include "scenario_signals.h"
 #include "SmaPwmDriver_variables.h"
@@ -52,6 +54,21 @@ static int state_read(void *stepper, const double *in, size_t count, SmaMessage 
     return pwm_driver_state_read((PwmDriver *)stepper, in, count, message);
 }
 
+/* The next edge of the wave after `time` [s]: the end of the on-time of the period in
+ * progress (its held duty, or the duty the present demand gives a period starting now),
+ * else the next period's start. Events within PERIOD_TOLERANCE periods count as now. */
+static double next_event(const void *stepper, const SmaValue *values, double time)
+{
+    const PwmDriver *driver = (const PwmDriver *)stepper;
+    double k = floor(time / driver->period + PERIOD_TOLERANCE), duty, off;
+    int held = driver->has_held && driver->held_index.minus_one == 0 && driver->held_index.base == k;
+    duty = held ? driver->held_duty : pwm_driver_duty_of(driver, values[VAR_P_demand].real);
+    off = (k + duty) * driver->period;
+    if (duty > 0.0 && duty < 1.0 && off > time + PERIOD_TOLERANCE * driver->period) return off;
+    return (k + 1.0) * driver->period;
+}
+
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, "sma-fmu PWM state", LOG_CATEGORIES, VARIABLES, VAR_COUNT,
-    0, sizeof(PwmDriver), start, step, NULL, NULL, state_size, state_write, state_read};
+    0, sizeof(PwmDriver), start, step, NULL, NULL, state_size, state_write, state_read,
+    next_event};

@@ -7,7 +7,8 @@
  * FMU packed by `sma-fmu export` the exported scenario's (resources/start_values.json).
  * A source: after initialization the outputs are the signals at the start time; after
  * doStep(t, h) at t + h, on the step's grid. Invalid tables refuse
- * fmi2ExitInitializationMode naming the parameter and the key. */
+ * ExitInitializationMode naming the parameter and the key. In FMI 3.0 event mode its events
+ * are the load's switching times and the reference's step. */
 #include "fp_contract.h"
 #include "scenario_signals.h"
 #include "SmaScenarioSignals_variables.h"
@@ -55,6 +56,27 @@ static int state_read(void *stepper, const double *in, size_t count, SmaMessage 
     return signal_source_state_read((SignalSource *)stepper, in, count, message);
 }
 
+/* The next discontinuity after `time` [s]: a load switching time or the reference's step
+ * (ramps, waves and tables are continuous); a time within LOAD_TOLERANCE_S counts as now. */
+static double next_event(const void *stepper, const SmaValue *values, double time)
+{
+    const SignalSource *source = (const SignalSource *)stepper;
+    double next = time - 1.0;
+    size_t i;
+    (void)values;
+    for (i = 0; i < source->load.count; ++i)
+        if (source->load.times[i] > time + LOAD_TOLERANCE_S) {
+            next = source->load.times[i];
+            break;
+        }
+    if (source->reference.kind == REFERENCE_STEP &&
+        source->reference.time_s > time + LOAD_TOLERANCE_S &&
+        (next < time || source->reference.time_s < next))
+        next = source->reference.time_s;
+    return next;
+}
+
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, "sma-fmu signals state", LOG_CATEGORIES, VARIABLES, VAR_COUNT,
-    0, sizeof(SignalSource), start, step, release, NULL, state_size, state_write, state_read};
+    0, sizeof(SignalSource), start, step, release, NULL, state_size, state_write, state_read,
+    next_event};

@@ -12,7 +12,7 @@ as well as one that binds them all; the bindings stay, and hold the same values.
 Values are JSON numbers, booleans and strings, one per parameter name, of the variable's
 FMI type (a Real may be written as an integer).
 
-Both families read it alike (the C family: c_family/fmi2/fmi2_start_values.c, same checks,
+Both families read it alike (the C family: c_family/core/layer_start_values.c, same checks,
 same order, same messages, all naming the file): it must be a regular file (a FIFO, a
 folder or a device is refused at once, never read), of at most :data:`MAX_BYTES`, without a
 NUL byte, strict UTF-8 (no encoded surrogates), nested at most :data:`MAX_DEPTH` deep, with

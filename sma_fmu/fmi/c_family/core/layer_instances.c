@@ -20,7 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "fmi2_layer.h"
+#include "layer.h"
 
 #ifdef _WIN32
 #define WIN32_LEAN_AND_MEAN
@@ -72,10 +72,10 @@ static void refused(const char *function, const void *pointer, const char *name)
 {
     if (name)
         fprintf(stderr, "sma-fmu native: %s: refused: instance '%s' was freed by "
-                "fmi2FreeInstance\n", function, name);
+                "%.4sFreeInstance\n", function, name, function);
     else
         fprintf(stderr, "sma-fmu native: %s: refused: %p is no instance of this FMU (not made "
-                "by fmi2Instantiate, or freed over %u instances ago)\n", function, pointer,
+                "by %.4sInstantiate, or freed over %u instances ago)\n", function, pointer, function,
                 KEPT_FREED);
     fflush(stderr);
 }

@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "log_category.h"
-#include "fmi2_layer.h"
+#include "layer.h"
 
 static int category_enabled(const Instance *in, const char *category)
 {
@@ -31,15 +31,15 @@ static int category_enabled(const Instance *in, const char *category)
     return 0;
 }
 
-static int wanted(const Instance *in, fmi2Status status)
+static int wanted(const Instance *in, SmaStatus status)
 {
     const char *category = log_status_category((int)status);
-    if (status >= fmi2Warning && in->log_problems) return 1;
+    if (status >= SMA_WARNING && in->log_problems) return 1;
     return in->log_all || category_enabled(in, "logAll") || category_enabled(in, category);
 }
 
 /* Formats and passes on one message; `prefixed`: "<model> '<instance>': " first. */
-static void emit(Instance *in, fmi2Status status, int prefixed, const char *format,
+static void emit(Instance *in, SmaStatus status, int prefixed, const char *format,
                  va_list arguments)
 {
     char text[2048];
@@ -51,10 +51,10 @@ static void emit(Instance *in, fmi2Status status, int prefixed, const char *form
         if (used < 0 || (size_t)used >= sizeof text) used = 0;
     }
     vsnprintf(text + used, sizeof text - (size_t)used, format, arguments);
-    in->logger(in->environment, in->name, status, log_status_category((int)status), "%s", text);
+    in->emit(in, status, log_status_category((int)status), text);
 }
 
-void layer_log(Instance *in, fmi2Status status, const char *format, ...)
+void layer_log(Instance *in, SmaStatus status, const char *format, ...)
 {
     va_list arguments;
     va_start(arguments, format);
@@ -62,7 +62,7 @@ void layer_log(Instance *in, fmi2Status status, const char *format, ...)
     va_end(arguments);
 }
 
-void layer_plain(Instance *in, fmi2Status status, const char *format, ...)
+void layer_plain(Instance *in, SmaStatus status, const char *format, ...)
 {
     va_list arguments;
     va_start(arguments, format);
@@ -70,13 +70,13 @@ void layer_plain(Instance *in, fmi2Status status, const char *format, ...)
     va_end(arguments);
 }
 
-fmi2Status layer_reject(Instance *in, fmi2Status status, const char *function, const char *why)
+SmaStatus layer_reject(Instance *in, SmaStatus status, const char *function, const char *why)
 {
     layer_plain(in, status, "%s: %s", function, why);
     return status;
 }
 
-fmi2Status layer_refuse(Instance *in, fmi2Status status, const char *function, const char *why)
+SmaStatus layer_refuse(Instance *in, SmaStatus status, const char *function, const char *why)
 {
     layer_log(in, status, "%s: %s", function, why);
     return status;
@@ -109,7 +109,7 @@ static void disable(Instance *in, const char *category)
     }
 }
 
-int layer_set_debug_logging(Instance *in, int on, size_t n, const fmi2String categories[])
+int layer_set_debug_logging(Instance *in, int on, size_t n, const char *const categories[])
 {
     size_t i;
     if (n == 0) {

@@ -4,7 +4,7 @@
  * with its value. Choice: the native FMU reads the same file as the pythonfmu one (with the
  * runtime's JSON reader, json_text.c), so packing needs nothing per family and the model
  * description's start attributes and the file cannot disagree for one family only.
- * A file that is not such a document (read by fmi2_start_file.c: a regular file, bounded,
+ * A file that is not such a document (read by layer_start_file.c: a regular file, bounded,
  * strict UTF-8), or a value that is not of the parameter's type, makes fmi2Instantiate fail
  * naming the file and the parameter, as in the pythonfmu FMUs. */
 #include "fp_contract.h"
@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi2_layer.h"
+#include "layer.h"
 #include "json_text.h"
 
 #define START_VALUES_FILE "start_values.json"

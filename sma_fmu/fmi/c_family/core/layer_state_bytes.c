@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi2_layer.h"
+#include "layer.h"
 #include "state_frame.h"  /* the frame both families put around a state */
 
 #define MAGIC "SMAFMU2S"

@@ -1,4 +1,5 @@
-/* fmi2Get/fmi2Set by value reference, with the pythonfmu FMUs' rules and messages.
+/* Getting and setting variables by value reference (for both FMI fronts), with the
+ * pythonfmu FMUs' rules and messages.
  *
  * Which variable may be set in which state is lifecycle.py's table; the refusals are
  * SlaveInterface.setting_refusal / describe_reference's texts, followed by "; nothing was
@@ -10,9 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi2_layer.h"
+#include "layer.h"
 
 static const char *const KIND_NAMES[] = {"Real", "Integer", "Boolean", "String"};
+static const char *const FMI3_KIND_NAMES[] = {"Float64", "Int32", "Boolean", "String"};
 static const char *const CAUSALITY_NAMES[] = {"parameter", "input", "output"};
 
 const SmaVariable *layer_variable(const SmaModel *model, unsigned int vr, size_t *index)
@@ -140,7 +142,7 @@ int layer_refresh_outputs(Instance *in, const char *function)
     }
     if (in->initial_error[0]) {
         snprintf(why, sizeof why, "the outputs are undefined: %s", in->initial_error);
-        layer_refuse(in, fmi2Error, function, why);
+        layer_refuse(in, SMA_ERROR, function, why);
         return 0;
     }
     return 1;
@@ -153,15 +155,17 @@ static void describe_reference(const Instance *in, SmaKind kind, unsigned int vr
     const SmaVariable *v = layer_variable(in->model, vr, NULL);
     if (!v)
         snprintf(text, size, "value reference %u is not a variable of %s", vr, in->model->name);
-    else
+    else {
+        const char *const *names = in->prefix[3] == '3' ? FMI3_KIND_NAMES : KIND_NAMES;
         snprintf(text, size, "value reference %u is %s variable %s, not a %s", vr,
-                 KIND_NAMES[v->kind], v->name, KIND_NAMES[kind]);
+                 names[v->kind], v->name, names[kind]);
+    }
 }
 
 /* lifecycle.setting_refusal: NULL if a variable of this causality and variability may be
  * set in `state`, else why not. */
-static const char *setting_refusal(const SmaVariable *v, LayerState state, char *text,
-                                   size_t size)
+static const char *setting_refusal(const SmaVariable *v, LayerState state, const char *prefix,
+                                   char *text, size_t size)
 {
     int settable;
     if (v->causality == SMA_INPUT)
@@ -179,9 +183,11 @@ static const char *setting_refusal(const SmaVariable *v, LayerState state, char 
         return text;
     }
     if (settable) return NULL;
-    if (v->causality == SMA_PARAMETER && v->variability == SMA_FIXED)
-        return "it is a fixed parameter; fixed parameters can be set only before "
-               "fmi2ExitInitializationMode";
+    if (v->causality == SMA_PARAMETER && v->variability == SMA_FIXED) {
+        snprintf(text, size, "it is a fixed parameter; fixed parameters can be set only before "
+                 "%sExitInitializationMode", prefix);
+        return text;
+    }
     snprintf(text, size, "the instance is in state '%s'", STATE_NAMES[state]);
     return text;
 }
@@ -189,16 +195,16 @@ static const char *setting_refusal(const SmaVariable *v, LayerState state, char 
 /* repr of the i-th value of a `kind` array, as the guard's message shows it. */
 static void value_repr(SmaKind kind, const void *value, size_t i, char *text, size_t size)
 {
-    if (kind == SMA_REAL) layer_repr(((const fmi2Real *)value)[i], text);
-    else if (kind == SMA_INTEGER) snprintf(text, size, "%d", ((const fmi2Integer *)value)[i]);
-    else if (kind == SMA_BOOLEAN) snprintf(text, size, "%s", ((const fmi2Boolean *)value)[i] ? "True" : "False");
-    else snprintf(text, size, "'%.200s'", ((const fmi2String *)value)[i]);
+    if (kind == SMA_REAL) layer_repr(((const double *)value)[i], text);
+    else if (kind == SMA_INTEGER) snprintf(text, size, "%d", ((const int *)value)[i]);
+    else if (kind == SMA_BOOLEAN) snprintf(text, size, "%s", ((const int *)value)[i] ? "True" : "False");
+    else snprintf(text, size, "'%.200s'", ((const char *const *)value)[i]);
 }
 
 /* The common set, inputs by their own index (pythonfmu's numbering) in a state that allows
  * setting them, done without building any text; 0: not that case (nothing set), layer_set's
  * full path decides. */
-static int quick_set(Instance *in, SmaKind kind, const fmi2ValueReference vr[], size_t nvr,
+static int quick_set(Instance *in, SmaKind kind, const unsigned int vr[], size_t nvr,
                      const void *value)
 {
     const SmaModel *model = in->model;
@@ -211,24 +217,24 @@ static int quick_set(Instance *in, SmaKind kind, const fmi2ValueReference vr[], 
             return 0;
     }
     for (i = 0; i < nvr; ++i) {
-        if (kind == SMA_REAL) in->values[vr[i]].real = ((const fmi2Real *)value)[i];
-        else if (kind == SMA_INTEGER) in->values[vr[i]].integer = ((const fmi2Integer *)value)[i];
-        else in->values[vr[i]].integer = ((const fmi2Boolean *)value)[i] ? 1 : 0;
+        if (kind == SMA_REAL) in->values[vr[i]].real = ((const double *)value)[i];
+        else if (kind == SMA_INTEGER) in->values[vr[i]].integer = ((const int *)value)[i];
+        else in->values[vr[i]].integer = ((const int *)value)[i] ? 1 : 0;
     }
     if (in->state == STATE_INITIALIZATION) in->outputs_current = 0;
     return 1;
 }
 
-fmi2Status layer_set(Instance *in, const char *function, SmaKind kind,
-                     const fmi2ValueReference vr[], size_t nvr, const void *value)
+SmaStatus layer_set(Instance *in, const char *function, SmaKind kind,
+                     const unsigned int vr[], size_t nvr, const void *value)
 {
     size_t i, index = 0;
     char why[400], shown[220], text[700];
-    if (quick_set(in, kind, vr, nvr, value)) return fmi2OK;
+    if (quick_set(in, kind, vr, nvr, value)) return SMA_OK;
     if (in->state != STATE_INSTANTIATED && in->state != STATE_INITIALIZATION &&
         in->state != STATE_STEP_COMPLETE) {
         snprintf(text, sizeof text, "illegal call in state '%s'", STATE_NAMES[in->state]);
-        return layer_refuse(in, fmi2Error, function, text);
+        return layer_refuse(in, SMA_ERROR, function, text);
     }
     for (i = 0; i < nvr; ++i) {  /* all checked before anything is set */
         const SmaVariable *v = layer_variable(in->model, vr[i], NULL);
@@ -238,7 +244,7 @@ fmi2Status layer_set(Instance *in, const char *function, SmaKind kind,
             problem = why;
         } else {
             char refusal[200];
-            const char *reason = setting_refusal(v, in->state, refusal, sizeof refusal);
+            const char *reason = setting_refusal(v, in->state, in->prefix, refusal, sizeof refusal);
             if (reason) {
                 snprintf(why, sizeof why, "%s (value reference %u) cannot be set: %s", v->name,
                          vr[i], reason);
@@ -248,37 +254,37 @@ fmi2Status layer_set(Instance *in, const char *function, SmaKind kind,
         if (problem) {
             value_repr(kind, value, i, shown, sizeof shown);
             snprintf(text, sizeof text, "%s; nothing was set (value %s)", problem, shown);
-            return layer_refuse(in, fmi2Error, function, text);
+            return layer_refuse(in, SMA_ERROR, function, text);
         }
     }
     for (i = 0; i < nvr; ++i) {
         layer_variable(in->model, vr[i], &index);
-        if (kind == SMA_REAL) in->values[index].real = ((const fmi2Real *)value)[i];
-        else if (kind == SMA_INTEGER) in->values[index].integer = ((const fmi2Integer *)value)[i];
-        else if (kind == SMA_BOOLEAN) in->values[index].integer = ((const fmi2Boolean *)value)[i] ? 1 : 0;
+        if (kind == SMA_REAL) in->values[index].real = ((const double *)value)[i];
+        else if (kind == SMA_INTEGER) in->values[index].integer = ((const int *)value)[i];
+        else if (kind == SMA_BOOLEAN) in->values[index].integer = ((const int *)value)[i] ? 1 : 0;
         else {
-            const char *source = ((const fmi2String *)value)[i];
+            const char *source = ((const char *const *)value)[i];
             char *copy = (char *)malloc(strlen(source) + 1);
-            if (!copy) return layer_refuse(in, fmi2Error, function, "out of memory");
+            if (!copy) return layer_refuse(in, SMA_ERROR, function, "out of memory");
             strcpy(copy, source);
             free(in->values[index].text);
             in->values[index].text = copy;
         }
     }
     if (in->state == STATE_INITIALIZATION) in->outputs_current = 0;
-    return fmi2OK;
+    return SMA_OK;
 }
 
 static void put_missing(SmaKind kind, void *value, size_t i)
 {
-    if (kind == SMA_REAL) ((fmi2Real *)value)[i] = 0.0;
-    else if (kind == SMA_STRING) ((fmi2String *)value)[i] = "";
-    else ((fmi2Integer *)value)[i] = 0;
+    if (kind == SMA_REAL) ((double *)value)[i] = 0.0;
+    else if (kind == SMA_STRING) ((const char **)value)[i] = "";
+    else ((int *)value)[i] = 0;
 }
 
 /* The common get after initialization, every reference its own index (pythonfmu's
  * numbering) and of `kind`; 0: not that case, layer_get's full path writes every value. */
-static int quick_get(const Instance *in, SmaKind kind, const fmi2ValueReference vr[], size_t nvr,
+static int quick_get(const Instance *in, SmaKind kind, const unsigned int vr[], size_t nvr,
                      void *value)
 {
     const SmaModel *model = in->model;
@@ -288,27 +294,27 @@ static int quick_get(const Instance *in, SmaKind kind, const fmi2ValueReference 
         unsigned int r = vr[i];
         if (!(r < model->count && model->variables[r].vr == r && model->variables[r].kind == kind))
             return 0;
-        if (kind == SMA_REAL) ((fmi2Real *)value)[i] = in->values[r].real;
-        else if (kind == SMA_STRING) ((fmi2String *)value)[i] = in->values[r].text;
-        else ((fmi2Integer *)value)[i] = in->values[r].integer;
+        if (kind == SMA_REAL) ((double *)value)[i] = in->values[r].real;
+        else if (kind == SMA_STRING) ((const char **)value)[i] = in->values[r].text;
+        else ((int *)value)[i] = in->values[r].integer;
     }
     return 1;
 }
 
-fmi2Status layer_get(Instance *in, const char *function, SmaKind kind,
-                     const fmi2ValueReference vr[], size_t nvr, void *value)
+SmaStatus layer_get(Instance *in, const char *function, SmaKind kind,
+                     const unsigned int vr[], size_t nvr, void *value)
 {
     size_t i, index, used = 0;
     char text[1500];
-    if (quick_get(in, kind, vr, nvr, value)) return fmi2OK;
+    if (quick_get(in, kind, vr, nvr, value)) return SMA_OK;
     if (in->state == STATE_INSTANTIATED ||
         (in->state == STATE_INITIALIZATION && !layer_refresh_outputs(in, function))) {
         for (i = 0; i < nvr; ++i) put_missing(kind, value, i);
         if (in->state == STATE_INSTANTIATED) {
             snprintf(text, sizeof text, "illegal call in state '%s'", STATE_NAMES[in->state]);
-            return layer_refuse(in, fmi2Error, function, text);
+            return layer_refuse(in, SMA_ERROR, function, text);
         }
-        return fmi2Error;
+        return SMA_ERROR;
     }
     text[0] = '\0';
     for (i = 0; i < nvr; ++i) {
@@ -320,10 +326,10 @@ fmi2Status layer_get(Instance *in, const char *function, SmaKind kind,
             if (used < sizeof text)
                 used += (size_t)snprintf(text + used, sizeof text - used, "%s%s",
                                          used ? ", " : "", why);
-        } else if (kind == SMA_REAL) ((fmi2Real *)value)[i] = in->values[index].real;
-        else if (kind == SMA_STRING) ((fmi2String *)value)[i] = in->values[index].text;
-        else ((fmi2Integer *)value)[i] = in->values[index].integer;
+        } else if (kind == SMA_REAL) ((double *)value)[i] = in->values[index].real;
+        else if (kind == SMA_STRING) ((const char **)value)[i] = in->values[index].text;
+        else ((int *)value)[i] = in->values[index].integer;
     }
-    if (text[0]) return layer_refuse(in, fmi2Error, function, text);
-    return fmi2OK;
+    if (text[0]) return layer_refuse(in, SMA_ERROR, function, text);
+    return SMA_OK;
 }

@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 
 #include "file_uri.h"
-#include "fmi2_layer.h"
+#include "layer.h"
 
 #ifdef _WIN32
 #define IS_FOLDER(mode) (((mode) & _S_IFMT) == _S_IFDIR)

@@ -14,7 +14,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "fmi2_layer.h"
+#include "layer.h"
 #include "json_string.h"
 #include "json_text.h"
 

@@ -1,11 +1,12 @@
-/* The contract between the FMI layer (fmi2/) and a model adapter (models/<Model>.c).
+/* The contract between the core (core/, under the fronts fmi2/ and fmi3/) and a model
+ * adapter (models/<Model>.c).
  *
  * Like the Reference-FMUs' model.h, nothing here is FMI: an adapter declares its variables
  * (a generated table, <Model>_variables.h) and a few functions over its runtime stepper;
- * the layer (FMI 2.0 today, an FMI 3.0 one could follow) owns the values, the calling
- * sequence, the checks, the log and the saved states. The adapters are as thin as the
- * pythonfmu slaves (fmi/python_family/slaves/) and keep their semantics: a failing start refuses
- * fmi2ExitInitializationMode, a failing step discards it (slave_support/guards.py). */
+ * the core owns the values, the calling sequence, the checks, the log and the saved
+ * states, and the fronts translate them to an FMI version. The adapters are as thin as the
+ * pythonfmu slaves (fmi/python_family/slaves/) and keep their semantics: a failing start
+ * refuses ExitInitializationMode, a failing step discards it (slave_support/guards.py). */
 #ifndef SMA_MODEL_H
 #define SMA_MODEL_H
 
@@ -72,6 +73,9 @@ typedef struct {
     size_t (*state_size)(const void *stepper);
     void (*state_write)(const void *stepper, double *out);
     int (*state_read)(void *stepper, const double *in, size_t count, SmaMessage *message);
+    /* FMI 3.0 event mode: the time [s] of the model's next discontinuity after `time` [s]
+     * with the present inputs; NULL: the model has no events of its own. */
+    double (*next_event)(const void *stepper, const SmaValue *values, double time);
 } SmaModel;
 
 /* Each adapter defines this one object (models/<Model>.c). */

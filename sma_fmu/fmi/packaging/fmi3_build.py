@@ -1,0 +1,107 @@
+"""``sma-fmu build --native --fmi 3``: the five C-family FMUs as FMI 3.0 co-simulation FMUs.
+
+The same C models and core as the FMI 2.0 build (:mod:`.c_family_build`), under the FMI 3.0
+front (``c_family/fmi3/``). Each FMU holds:
+
+- ``modelDescription.xml`` (FMI 3.0, :mod:`.fmi3_description`): the native FMI 2.0
+  description in FMI 3.0's terms (instantiation token, ``time``, Enumerations), with the
+  platforms annotation ``sma-fmu check`` reads;
+- ``sources/``: the C files, flat, the generated ``<Model>_variables.h`` (the same table as
+  FMI 2.0) and ``fmi3_model.h``, and ``buildDescription.xml`` listing what a tool compiles;
+- ``binaries/x86_64-linux/<Model>.so`` and ``binaries/x86_64-windows/<Model>.dll`` (mingw-w64;
+  left out with a warning without it), built as the FMI 2.0 ones are;
+- ``resources/parameters.json`` and ``extra/`` (the reference result), as in FMI 2.0;
+- the plant's ``terminalsAndIcons/terminalsAndIcons.xml`` (:mod:`.fmi3_terminals`).
+"""
+import shutil
+import tempfile
+import warnings
+import zipfile
+from pathlib import Path
+
+from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarning, _c_files,
+                                                  _exact_starts, compile_binary, model_sources)
+from sma_fmu.fmi.packaging.c_family_description import native_description, variables_header
+from sma_fmu.fmi.packaging.fmi3_description import (annotate_platforms, build_description,
+                                                    fmi3_description, fmi3_model_header)
+from sma_fmu.fmi.packaging.fmi3_terminals import terminals_and_icons
+from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.front_build import FrontWarning
+from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
+
+__all__ = ["PLATFORMS", "build_fmi3_fmus"]
+
+# FMI 3.0 platform tuple -> (the compile target of c_family_build, the binary's suffix)
+PLATFORMS = {"x86_64-linux": ("linux64", ".so"), "x86_64-windows": ("win64", ".dll")}
+_GENERATED = "fmi3_model.h"
+
+
+def _build_one(model_name, python_fmu, folder, work):
+    """Write ``folder/<model_name>.fmu`` from the pythonfmu FMU; returns [problem texts]."""
+    unpacked = work / model_name
+    with zipfile.ZipFile(python_fmu) as archive:
+        archive.extractall(unpacked)
+    starts, defaults = _exact_starts(model_name, unpacked / "resources")
+    header_name = f"{model_name}_variables.h"
+    names = model_sources(model_name, generated=(header_name, _GENERATED), front="fmi3")
+    fmi2_description, _ = native_description((unpacked / "modelDescription.xml").read_bytes(),
+                                             starts, [])
+    description = fmi3_description(fmi2_description)
+    sources = work / f"{model_name}.sources"
+    sources.mkdir()
+    files = _c_files()
+    for name in names:
+        if name not in (header_name, _GENERATED):
+            shutil.copyfile(files[name], sources / name)
+    (sources / header_name).write_text(variables_header(fmi2_description, starts, defaults),
+                                       encoding="utf-8")
+    (sources / _GENERATED).write_text(fmi3_model_header(description), encoding="utf-8")
+    binaries, problems = {}, []
+    for platform, (target, suffix) in PLATFORMS.items():
+        output = work / f"{model_name}{suffix}"
+        problem = compile_binary(target, sources, output)
+        if problem:
+            problems.append(f"{model_name}: built without {platform}: {problem}")
+            continue
+        binaries[f"binaries/{platform}/{model_name}{suffix}"] = output.read_bytes()
+        if NATIVE_MARKER not in output.read_bytes():
+            raise RuntimeError(f"{platform}: the native marker is missing (layer_calls.c)")
+    fmu = folder / f"{model_name}.fmu"
+    annotated = annotate_platforms(description, {b.split("/")[1]: b for b in binaries})
+    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("modelDescription.xml", annotated)
+        terminals = terminals_and_icons(description)
+        if terminals:
+            archive.writestr("terminalsAndIcons/terminalsAndIcons.xml", terminals)
+        for name in names:
+            archive.write(sources / name, f"sources/{name}")
+        archive.writestr("sources/buildDescription.xml",
+                         build_description(model_name, [n for n in names if n.endswith(".c")]))
+        for binary, data in binaries.items():
+            archive.writestr(binary, data)
+        archive.write(unpacked / "resources" / "parameters.json", "resources/parameters.json")
+        for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
+            if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
+                archive.write(extra, extra.relative_to(unpacked).as_posix())
+    return problems
+
+
+def build_fmi3_fmus(out_dir, parameter_file=None, names=None):
+    """Build the FMI 3.0 C-family FMUs (default: all five) into ``out_dir``; {name: path}.
+
+    Built beside ``out_dir`` and moved there at the end: a failed build leaves it as it was.
+    """
+    names = list(FMU_SCRIPTS) if names is None else list(names)
+    with tempfile.TemporaryDirectory(prefix="sma_fmu_fmi3_") as work:
+        work = Path(work)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FrontWarning)  # the twins' fronts: not shipped
+            python_fmus = build_pythonfmu_fmus(work / "python", parameter_file, names)
+        problems = []
+        with staged_folder(out_dir) as folder:
+            for name in names:
+                problems += _build_one(name, python_fmus[name], folder, work)
+    for message in sorted(set(p.split(": ", 1)[1] for p in problems)):
+        warnings.warn(NativeBuildWarning(f"FMI 3.0 FMUs {message}."), stacklevel=2)
+    return {name: Path(out_dir) / f"{name}.fmu" for name in names}

@@ -1,0 +1,91 @@
+"""One FMI 3.0 instance driven through fmpy's FMU3Slave, every call returning its FMI status,
+with the same interface as native_twins.Instance (FMI 2.0), so the two versions of a C-family
+FMU can be driven side by side. Each instance has its own logger (FMI 3.0 passes no instance
+name to it); Enumerations are read and set as Int64.
+"""
+import shutil
+
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64
+from ctypes import byref
+
+__all__ = ["Instance3"]
+
+_ACCESSOR = {"Enumeration": "Int64"}
+
+
+class Instance3:
+    """An instantiated FMI 3.0 FMU (``path``) named ``name``; ``self.log``: its messages."""
+
+    def __init__(self, path, name, event_mode=False, early_return=False):
+        description = read_model_description(str(path))
+        self.variables = {v.name: v for v in description.modelVariables}
+        self.outputs = [v.name for v in description.modelVariables if v.causality == "output"]
+        self.folder = extract(str(path))
+        self.name = name
+        self.log = []
+        self.fmu = FMU3Slave(guid=description.instantiationToken, unzipDirectory=self.folder,
+                             modelIdentifier=description.coSimulation.modelIdentifier,
+                             instanceName=name)
+        self.fmu.instantiate(loggingOn=False, eventModeUsed=event_mode,
+                             earlyReturnAllowed=early_return, logMessage=self._logger)
+
+    def _logger(self, environment, status, category, message):
+        self.log.append((status, message.decode("utf-8", "replace")))
+
+    def call(self, method, *args, **kwargs):
+        """(status, result) of an FMU3Slave method."""
+        try:
+            return 0, getattr(self.fmu, method)(*args, **kwargs)
+        except FMICallException as error:
+            return error.status, None
+
+    def start(self, values=None, start_time=0.0):
+        """Initialization Mode with ``values`` set; the status of its exit."""
+        self.fmu.enterInitializationMode(startTime=start_time)
+        for name, value in (values or {}).items():
+            assert self.set(name, value) == 0, (name, value, self.log[-1:])
+        return self.call("exitInitializationMode")[0]
+
+    def _type(self, name):
+        kind = self.variables[name].type
+        return _ACCESSOR.get(kind, kind)
+
+    def set(self, name, value):
+        return self.call("set" + self._type(name), [self.variables[name].valueReference], [value])[0]
+
+    def get(self, name):
+        status, values = self.call("get" + self._type(name), [self.variables[name].valueReference])
+        return status, None if values is None else values[0]
+
+    def values(self, names=None):
+        """{name: value} of the outputs (or ``names``); every get must succeed."""
+        found = {}
+        for name in names or self.outputs:
+            status, value = self.get(name)
+            assert status <= 1, (self.name, name, self.log[-2:])
+            found[name] = value
+        return found
+
+    def do_step(self, time, step):
+        """(status, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime)."""
+        flags = [fmi3Boolean(), fmi3Boolean(), fmi3Boolean()]
+        last = fmi3Float64()
+        try:
+            status = self.fmu.fmi3DoStep(self.fmu.component, time, step, fmi3Boolean(True),
+                                         *(byref(f) for f in flags), byref(last))
+        except FMICallException as error:
+            status = error.status
+        return (status, *(bool(f.value) for f in flags), last.value)
+
+    def step(self, time, step):
+        return self.do_step(time, step)[0]
+
+    def close(self):
+        try:
+            self.fmu.terminate()
+        except FMICallException:
+            pass
+        self.fmu.freeInstance()
+        shutil.rmtree(self.folder, ignore_errors=True)
