@@ -40,6 +40,7 @@ DEGRADED = ("pythonfmu's binary without the C front: C hosts need libpython in L
             "Python version; each instance keeps its copy of the binary in memory")
 _ELF_MACHINES = {62: "x86-64", 183: "aarch64", 3: "x86", 40: "arm"}
 _PE_MACHINES = {0x8664: "x86-64", 0xAA64: "aarch64", 0x14C: "x86"}
+_MACHO_MACHINES = {0x01000007: "x86-64", 0x0100000C: "aarch64"}
 _MACHINES = {"x86_64": "x86-64", "amd64": "x86-64", "aarch64": "aarch64", "arm64": "aarch64",
              "i386": "x86", "i686": "x86", "x86": "x86"}
 _TOOL = "sma-fmu"
@@ -62,7 +63,9 @@ class PlatformEntry:
 
 
 def binary_architecture(data):
-    """"x86-64", "aarch64", ... of an ELF or PE binary's bytes; None if neither."""
+    """"x86-64", "aarch64", ... of an ELF, PE or 64-bit Mach-O binary's bytes; None if none."""
+    if data[:4] == b"\xcf\xfa\xed\xfe" and len(data) >= 8:
+        return _MACHO_MACHINES.get(struct.unpack_from("<I", data, 4)[0], "unknown")
     if data[:4] == b"\x7fELF" and len(data) >= 20:
         return _ELF_MACHINES.get(struct.unpack_from("<H", data, 18)[0], "unknown")
     if data[:2] == b"MZ" and len(data) >= 64:

@@ -1,0 +1,119 @@
+"""The platforms the C family is built for, and the compilers that build them.
+
+One table, :data:`TARGETS`, keyed by the FMI 3.0 platform tuple (``x86_64-linux``...), gives
+each target its FMI 2.0 folder name where FMI 2.0 defines one (``linux64``, ``win64``,
+``darwin64``, ``win32``; FMI 2.0 has no name for aarch64), the binary's suffix, the
+toolchains that build it, best first, and how the tests run it on this project's CI
+machine (x86-64 Linux): ``native``, ``wine``, ``qemu`` or ``None`` (only built).
+
+Toolchains: the system gcc for x86_64-linux (the binary whose speed ``sma-fmu bench``
+measures), mingw-w64 for the Windows targets, and ``zig cc`` (PyPI ``ziglang``, run as
+``python -m ziglang cc``: clang with every target's libc) for all of them, the only one for
+aarch64-linux and macOS. :func:`compile_shared` compiles a folder of C files with
+:data:`FLAGS` (``-Werror``; ``-ffp-contract=off``: no fused multiply-add) for one target.
+"""
+import importlib.util
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+
+__all__ = ["FLAGS", "Target", "TARGETS", "target", "fmi2_targets", "zig_command", "toolchain",
+           "compile_shared", "RUNS_HERE"]
+
+FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off", "-O2",
+         "-shared"]
+RUNS_HERE = {"native": "run natively (x86-64 Linux)", "wine": "run under wine64",
+             "qemu": "run under qemu-aarch64 (qemu-user)", None: "only built, never run"}
+
+
+@dataclass(frozen=True)
+class Target:
+    """One platform of the C family."""
+
+    tuple: str                 # FMI 3.0 platform tuple
+    fmi2: str | None           # FMI 2.0 binaries/ folder, None where FMI 2.0 names none
+    zig: str                   # zig cc -target
+    suffix: str
+    flags: tuple = ()
+    libraries: tuple = ()
+    gcc: str | None = None     # "host" (the system compiler), "mingw64", or None
+    runs: str | None = None    # how the tests run it here: a key of RUNS_HERE
+
+    def folder(self, fmi_version=2):
+        """The binaries/ folder name under FMI ``fmi_version`` (None: no name there)."""
+        return self.fmi2 if fmi_version == 2 else self.tuple
+
+
+_ELF = ("-fPIC", "-fvisibility=hidden")
+_WINDOWS = ("-D__USE_MINGW_ANSI_STDIO=1", "-s")
+TARGETS = {t.tuple: t for t in (
+    Target("x86_64-linux", "linux64", "x86_64-linux-gnu.2.17", ".so", _ELF + ("-Wl,--no-undefined",),
+           ("-lm",), gcc="host", runs="native"),
+    Target("x86_64-windows", "win64", "x86_64-windows-gnu", ".dll", _WINDOWS, gcc="mingw64",
+           runs="wine"),
+    Target("x86_64-darwin", "darwin64", "x86_64-macos", ".dylib", ("-fPIC", "-fvisibility=hidden")),
+    Target("aarch64-linux", None, "aarch64-linux-gnu.2.17", ".so", _ELF + ("-Wl,--no-undefined",),
+           ("-lm",), runs="qemu"),
+    Target("aarch64-darwin", None, "aarch64-macos", ".dylib", ("-fPIC", "-fvisibility=hidden")),
+)}
+
+
+def target(name):
+    """The :class:`Target` of an FMI 3.0 tuple or an FMI 2.0 folder name."""
+    for entry in TARGETS.values():
+        if name in (entry.tuple, entry.fmi2):
+            return entry
+    raise KeyError(f"no C-family target {name!r}; known: "
+                   f"{', '.join(n for t in TARGETS.values() for n in (t.tuple, t.fmi2) if n)}")
+
+
+def fmi2_targets():
+    """The targets FMI 2.0 has a folder name for, in table order."""
+    return [t for t in TARGETS.values() if t.fmi2]
+
+
+def zig_command():
+    """``[python, -m, ziglang, cc]`` when the ``ziglang`` package is installed, else None."""
+    if importlib.util.find_spec("ziglang") is None:
+        return None
+    return [sys.executable, "-m", "ziglang", "cc"]
+
+
+def toolchain(entry, prefer_zig=False):
+    """(compiler command, its extra flags) for ``entry``, or (None, reason) when none is here."""
+    if not prefer_zig and entry.gcc == "host" and sys.platform.startswith("linux") \
+            and sys.maxsize > 2 ** 32 and shutil.which(c_compiler()[0]):
+        return c_compiler(), []
+    if not prefer_zig and entry.gcc == "mingw64" and shutil.which(windows_compiler()[0]):
+        return windows_compiler(), ["-static-libgcc"]
+    zig = zig_command()
+    if zig is None:
+        return None, (f"no compiler for {entry.tuple} (pip install ziglang"
+                      f"{', or install gcc' if entry.gcc == 'host' else ''}"
+                      f"{', or mingw-w64' if entry.gcc == 'mingw64' else ''})")
+    return [*zig, "-target", entry.zig], []
+
+
+def compile_shared(entry, sources_folder, output, prefer_zig=False):
+    """Compile the .c files of ``sources_folder`` into the shared library ``output`` for
+    ``entry``; returns None, or the reason no compiler for it is here. A compiler that
+    fails raises RuntimeError with its message: the sources are at fault, not the machine."""
+    compiler, extra = toolchain(entry, prefer_zig)
+    if compiler is None:
+        return extra
+    command = [*compiler, *FLAGS, *entry.flags, *extra, "-I", str(sources_folder),
+               "-o", str(output), *sorted(str(p) for p in Path(sources_folder).glob("*.c")),
+               *entry.libraries]
+    try:
+        result = subprocess.run(command, capture_output=True, text=True, timeout=900)
+    except (OSError, subprocess.SubprocessError) as error:
+        return f"C compiler {' '.join(compiler)!r} could not run ({error})"
+    if result.returncode != 0 or not Path(output).is_file():
+        message = result.stderr.strip() or "no message"
+        raise RuntimeError(f"C compiler {' '.join(compiler)!r} failed for {entry.tuple} (a bug "
+                           f"of the C family, not of the machine): {message[-3000:]}")
+    return None
