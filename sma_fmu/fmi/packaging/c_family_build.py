@@ -35,6 +35,7 @@ from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.platforms import NATIVE_MARKER, PlatformEntry, annotate
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
+from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
 __all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_sources",
            "build_native_fmus", "compile_binary"]
@@ -46,7 +47,8 @@ FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract
 _TARGETS = {"linux64": {"flags": ["-fPIC", "-fvisibility=hidden", "-Wl,--no-undefined"],
                         "libraries": ["-lm"],
                         "suffix": ".so"},
-            "win64": {"flags": ["-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1", "-s"],
+            "win64": {"flags": ["-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1", "-s",
+                                "-Wl,--no-insert-timestamp", "-Wl,--disable-auto-image-base"],
                       "libraries": [], "suffix": ".dll"}}
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
@@ -182,6 +184,7 @@ def _build_one(model_name, python_fmu, folder, work):
         for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
             if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
                 archive.write(extra, extra.relative_to(unpacked).as_posix())
+    fix_timestamps(fmu)  # reproducible.py: the same inputs, the same bytes
     return problems
 
 

@@ -4,7 +4,8 @@ A native FMU must drop in for its pythonfmu twin (an SSP or a container made wit
 family runs with the other), so nothing about its interface is written twice: the model
 description is the one ``sma-fmu build`` writes, with only what makes it native changed:
 
-- ``guid`` (another build) and ``generationTool``;
+- ``guid`` (:func:`~.reproducible.structural_guid`: the same for every parameter file),
+  ``generationTool``, no ``generationDateAndTime``;
 - the ``CoSimulation`` element: ``needsExecutionTool="false"``, saved and serialized states,
   and ``<SourceFiles>``;
 - the ``start`` of every Real as the exact value the Python slave starts with (``repr``:
@@ -19,10 +20,10 @@ the FMU does not expose. An adapter that names a variable the FMU does not have 
 compile.
 """
 import math
-import uuid
 import xml.etree.ElementTree as ET
 
 from sma_fmu import __version__
+from sma_fmu.fmi.packaging.reproducible import structural_guid
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 
 __all__ = ["LOG_CATEGORIES", "native_description", "variables_header", "c_string"]
@@ -51,8 +52,9 @@ def native_description(python_description, starts, source_files):
     (bytes); ``starts`` {name: exact start value}; ``source_files`` the names in sources/.
     Returns (bytes, guid)."""
     root = ET.fromstring(python_description)
-    guid = str(uuid.uuid4())
+    guid = structural_guid(root, __version__)  # one per structure: reproducible builds
     root.set("guid", guid)
+    root.attrib.pop("generationDateAndTime", None)
     root.set("generationTool", f"sma-fmu {__version__} (build --native: C99, no Python)")
     co_simulation = root.find("CoSimulation")
     identifier = co_simulation.get("modelIdentifier")

@@ -49,7 +49,8 @@ class Target:
 
 
 _ELF = ("-fPIC", "-fvisibility=hidden")
-_WINDOWS = ("-D__USE_MINGW_ANSI_STDIO=1", "-s")
+_WINDOWS = ("-D__USE_MINGW_ANSI_STDIO=1", "-s", "-Wl,--no-insert-timestamp",  # no PE date,
+            "-Wl,--disable-auto-image-base")  # nor a base from the output path
 TARGETS = {t.tuple: t for t in (
     Target("x86_64-linux", "linux64", "x86_64-linux-gnu.2.17", ".so", _ELF + ("-Wl,--no-undefined",),
            ("-lm",), gcc="host", runs="native"),

@@ -40,7 +40,8 @@ _BACKEND = "_pythonfmu"
 _COMMON = ["-std=c11", "-O2", "-shared", "-Wall"]
 _LINUX = {"flags": [*_COMMON, "-fPIC", "-fvisibility=hidden", "-Wl,--no-undefined"],
           "libraries": ["-ldl", "-lpthread"], "output": "front.so"}
-_WINDOWS = {"flags": [*_COMMON, "-s", "-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1"],
+_WINDOWS = {"flags": [*_COMMON, "-s", "-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1",
+                       "-Wl,--no-insert-timestamp", "-Wl,--disable-auto-image-base"],
             "libraries": ["-ladvapi32"], "output": "front.dll"}
 _compiled = {}  # (compiler, sources digest, defines) -> FrontBuild
 
