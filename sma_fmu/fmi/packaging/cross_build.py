@@ -22,7 +22,7 @@ from pathlib import Path
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
 
 __all__ = ["FLAGS", "Target", "TARGETS", "target", "fmi2_targets", "zig_command", "toolchain",
-           "compile_shared", "RUNS_HERE"]
+           "compile_shared", "compile_host_for", "RUNS_HERE"]
 
 FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off", "-O2",
          "-shared"]
@@ -117,4 +117,29 @@ def compile_shared(entry, sources_folder, output, prefer_zig=False):
         message = result.stderr.strip() or "no message"
         raise RuntimeError(f"C compiler {' '.join(compiler)!r} failed for {entry.tuple} (a bug "
                            f"of the C family, not of the machine): {message[-3000:]}")
+    return None
+
+
+def compile_host_for(entry, name, output):
+    """Cross-build the dlopen C host ``name`` (fmi_host or loop_host, sma_fmu/fmi/hosts/) for
+    the Linux target ``entry`` with zig into ``output``; it loads ``binaries/<tuple>/``.
+    Returns None or the reason it could not (no zig)."""
+    from importlib import resources
+
+    zig = zig_command()
+    if zig is None:
+        return "no zig cc (pip install ziglang)"
+    if not entry.tuple.endswith("-linux"):
+        raise ValueError(f"C hosts are cross-built for Linux targets only, not {entry.tuple}")
+    hosts = resources.files("sma_fmu.fmi.hosts")
+    output = Path(output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    for source in (f"{name}.c", "host_platform.h"):
+        (output.parent / source).write_bytes(hosts.joinpath(source).read_bytes())
+    command = [*zig, "-target", entry.zig, "-std=c11", "-O2", "-Wall", "-Wextra", "-Werror",
+               f'-DPLATFORM="{entry.tuple}"', "-o", str(output), str(output.parent / f"{name}.c"),
+               "-ldl"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=900)
+    if result.returncode != 0:
+        raise RuntimeError(f"zig cc could not build {name} for {entry.tuple}: {result.stderr[-3000:]}")
     return None
