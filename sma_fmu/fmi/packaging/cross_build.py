@@ -12,10 +12,15 @@ measures), mingw-w64 for the Windows targets, and ``zig cc`` (PyPI ``ziglang``, 
 aarch64-linux and macOS. :func:`compile_shared` compiles a folder of C files with
 :data:`FLAGS` (``-Werror``; ``-ffp-contract=off``: no fused multiply-add) for one target.
 """
+import hashlib
 import importlib.util
+import os
+import platform
+import shlex
 import shutil
 import subprocess
 import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,8 +54,9 @@ class Target:
 
 
 _ELF = ("-fPIC", "-fvisibility=hidden")
-_WINDOWS = ("-D__USE_MINGW_ANSI_STDIO=1", "-s", "-Wl,--no-insert-timestamp",  # no PE date,
-            "-Wl,--disable-auto-image-base")  # nor a base from the output path
+_WINDOWS = ("-D__USE_MINGW_ANSI_STDIO=1", "-s")
+_MINGW = ["-static-libgcc", "-Wl,--no-insert-timestamp",  # no PE date,
+          "-Wl,--disable-auto-image-base"]                 # nor an image base from the path
 TARGETS = {t.tuple: t for t in (
     Target("x86_64-linux", "linux64", "x86_64-linux-gnu.2.17", ".so", _ELF + ("-Wl,--no-undefined",),
            ("-lm",), gcc="host", runs="native"),
@@ -78,45 +84,75 @@ def fmi2_targets():
 
 
 def zig_command():
-    """``[python, -m, ziglang, cc]`` when the ``ziglang`` package is installed, else None."""
+    """zig cc as a command list: ``$SMA_FMU_ZIG_CC`` split like a shell would (``none``: no
+    zig), else ``python -m ziglang cc`` when PyPI's ``ziglang`` is installed, else None."""
+    given = os.environ.get("SMA_FMU_ZIG_CC", "").strip()
+    if given:
+        return None if given.lower() == "none" else shlex.split(given)
     if importlib.util.find_spec("ziglang") is None:
         return None
     return [sys.executable, "-m", "ziglang", "cc"]
 
 
+def _x86_64_linux():
+    return sys.platform.startswith("linux") and platform.machine().lower() in ("x86_64", "amd64")
+
+
 def toolchain(entry, prefer_zig=False):
     """(compiler command, its extra flags) for ``entry``, or (None, reason) when none is here."""
-    if not prefer_zig and entry.gcc == "host" and sys.platform.startswith("linux") \
-            and sys.maxsize > 2 ** 32 and shutil.which(c_compiler()[0]):
+    if not prefer_zig and entry.gcc == "host" and _x86_64_linux() and shutil.which(c_compiler()[0]):
         return c_compiler(), []
     if not prefer_zig and entry.gcc == "mingw64" and shutil.which(windows_compiler()[0]):
-        return windows_compiler(), ["-static-libgcc"]
+        return windows_compiler(), _MINGW
     zig = zig_command()
     if zig is None:
-        return None, (f"no compiler for {entry.tuple} (pip install ziglang"
-                      f"{', or install gcc' if entry.gcc == 'host' else ''}"
-                      f"{', or mingw-w64' if entry.gcc == 'mingw64' else ''})")
-    return [*zig, "-target", entry.zig], []
+        other = {"host": "gcc on x86-64 Linux, ", "mingw64": "mingw-w64, "}.get(entry.gcc, "")
+        return None, f"no compiler for {entry.tuple} ({other}or zig: pip install ziglang)"
+    return [*zig, "-target", entry.zig], ["-s"]
+
+
+def _cache_file(command, sources_folder, output):
+    """Where the output of ``command`` over ``sources_folder``'s files is kept (a compiler's
+    output is a function of its command and its inputs, as for ccache)."""
+    digest = hashlib.sha256("\0".join(command).encode())
+    for path in sorted(Path(sources_folder).iterdir()):
+        digest.update(path.name.encode() + b"\0" + path.read_bytes())
+    return Path(tempfile.gettempdir()) / "sma-fmu-c-family" / digest.hexdigest()[:24] / Path(output).name
 
 
 def compile_shared(entry, sources_folder, output, prefer_zig=False):
     """Compile the .c files of ``sources_folder`` into the shared library ``output`` for
     ``entry``; returns None, or the reason no compiler for it is here. A compiler that
-    fails raises RuntimeError with its message: the sources are at fault, not the machine."""
+    fails raises RuntimeError with its message: the sources are at fault, not the machine.
+
+    It runs on a copy of the sources, on relative names, writing the output's own name (a
+    DLL's export table and a dylib's install name hold it): no build path gets into the
+    binary. The result is kept in a cache under the temporary folder, keyed by the command
+    and the sources (as ccache does)."""
     compiler, extra = toolchain(entry, prefer_zig)
     if compiler is None:
         return extra
-    command = [*compiler, *FLAGS, *entry.flags, *extra, "-I", str(sources_folder),
-               "-o", str(output), *sorted(str(p) for p in Path(sources_folder).glob("*.c")),
-               *entry.libraries]
-    try:
-        result = subprocess.run(command, capture_output=True, text=True, timeout=900)
-    except (OSError, subprocess.SubprocessError) as error:
-        return f"C compiler {' '.join(compiler)!r} could not run ({error})"
-    if result.returncode != 0 or not Path(output).is_file():
-        message = result.stderr.strip() or "no message"
-        raise RuntimeError(f"C compiler {' '.join(compiler)!r} failed for {entry.tuple} (a bug "
-                           f"of the C family, not of the machine): {message[-3000:]}")
+    name = Path(output).name
+    command = [*compiler, *FLAGS, *entry.flags, *extra, "-I", ".", "-o", name,
+               *sorted(p.name for p in Path(sources_folder).glob("*.c")), *entry.libraries]
+    cached = _cache_file(command, sources_folder, output)
+    if not cached.is_file():
+        cached.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=cached.parent) as stage:
+            for path in Path(sources_folder).iterdir():
+                if path.suffix in (".c", ".h"):
+                    shutil.copyfile(path, Path(stage) / path.name)
+            try:
+                result = subprocess.run(command, capture_output=True, text=True, timeout=900,
+                                        cwd=stage)
+            except (OSError, subprocess.SubprocessError) as error:
+                return f"C compiler {' '.join(compiler)!r} could not run ({error})"
+            if result.returncode != 0 or not (Path(stage) / name).is_file():
+                message = result.stderr.strip() or "no message"
+                raise RuntimeError(f"C compiler {' '.join(compiler)!r} failed for {entry.tuple} "
+                                   f"(a bug of the C family, not of the machine): {message[-3000:]}")
+            os.replace(Path(stage) / name, cached)  # atomic: a parallel build sees all or nothing
+    shutil.copyfile(cached, output)
     return None
 
 

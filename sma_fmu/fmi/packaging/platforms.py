@@ -24,7 +24,7 @@ __all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", 
 FRONT_MARKER = b"sma-fmu native front"  # a string every front binary carries (fmi2_exports.c);
 # its old words are kept so FMUs built before the word "native" came to mean the C family still count
 NATIVE_MARKER = b"sma-fmu native C FMU"  # ... every C-family binary (c_family/fmi2/fmi2_functions.c)
-PLATFORMS = {"linux64": ".so", "win64": ".dll"}
+PLATFORMS = {"linux64": ".so", "win64": ".dll", "darwin64": ".dylib"}
 HOW_PYTHON_IS_FOUND = {
     "linux64": "the process's own Python, else $SMA_FMU_LIBPYTHON, else the build's libpython, "
                "else the newest libpython3.X.so.1.0 (3.10 or newer) on the library search path "
@@ -60,6 +60,7 @@ class PlatformEntry:
     python: str = ""
     degraded: str = ""
     native: bool = False  # a C-family binary (sma-fmu build --native): no Python at all
+    runs: str = ""        # how the tests run it (cross_build.RUNS_HERE): natively, wine, qemu, only built
 
 
 def binary_architecture(data):
@@ -118,6 +119,8 @@ def annotate(model_description, entries):
             attributes += f" degraded={quoteattr(entry.degraded)}"
         if entry.native:
             attributes += ' native="true"'
+        if entry.runs:
+            attributes += f" tested={quoteattr(entry.runs)}"
         lines.append(f"\t\t\t\t<Platform {attributes}/>")
     lines += ["\t\t\t</Platforms>", "\t\t</Tool>"]
     block = "\n".join(lines) + "\n"
@@ -183,7 +186,8 @@ def _platform_line(archive, names, identifier, name, said):
     if said is not None and said.get("native") == "true":
         if NATIVE_MARKER not in data:
             return "FAIL", name, f"modelDescription.xml says native, but {what} is no sma-fmu C-family binary"
-        return "ok", name, f"{what}: native C (sma-fmu build --native), no Python"
+        tested = f"; {said['tested']}" if said.get("tested") else ""
+        return "ok", name, f"{what}: native C (sma-fmu build --native), no Python{tested}"
     if said is None:
         return "FAIL", name, f"{what}, {'the front' if front else 'without this front'}, is not " \
                              "declared in modelDescription.xml"
