@@ -302,7 +302,8 @@ def test_resource_locations_taken_and_refused_as_the_front_does(native, tmp_path
     folder = str(tmp_path / "SmaPiController" / "resources")
     spaced = tmp_path / "with space" / "resources"  # the FMU's resources, in a spaced path
     spaced.mkdir(parents=True)
-    (spaced / "parameters.json").write_bytes((Path(folder) / "parameters.json").read_bytes())
+    for name in ("parameters.json", "model_starts.json"):
+        (spaced / name).write_bytes((Path(folder) / name).read_bytes())
     taken = [uri, f"file:{folder}", f"file://localhost{folder}", folder,
              "file://" + str(spaced).replace(" ", "%20")]
     refused = ["http://example.com/resources", "file://elsewhere" + folder, "file:resources",

@@ -61,3 +61,24 @@ def test_two_builds_give_the_same_bytes(fmus, native_fmus, tmp_path, native, mon
         assert b"generationDateAndTime" not in description
         if native:
             assert structural_guid(description, __version__).encode() in description
+
+
+@pytest.mark.needs("gcc")
+def test_another_parameter_file_gives_the_same_c_family_binaries(native_fmus, tmp_path):
+    """The binaries hold no parameter file's values: those travel in resources/."""
+    from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
+    from sma_fmu.files.package_data import shipped_file
+    text = shipped_file("models", "reference_wire.toml").read_text(encoding="utf-8")
+    other = tmp_path / "other.toml"
+    other.write_text(text.replace("R_P = { value = 33.0,", "R_P = { value = 34.5,"), encoding="utf-8")
+    assert other.read_text(encoding="utf-8") != text
+    built = build_native_fmus(tmp_path / "other", other, names=["SmaActuator"])["SmaActuator"]
+    with zipfile.ZipFile(native_fmus["SmaActuator"]) as first, zipfile.ZipFile(built) as second:
+        binaries = [n for n in first.namelist() if n.startswith("binaries/")]
+        assert len(binaries) >= 2 and binaries == [n for n in second.namelist() if n.startswith("binaries/")]
+        for name in binaries:
+            assert first.read(name) == second.read(name), name
+        assert first.read("resources/model_starts.json") != second.read("resources/model_starts.json")
+        assert b'"R_P"' in first.read("resources/parameters.json")
+    from fmpy import read_model_description
+    assert read_model_description(str(built)).guid == read_model_description(str(native_fmus["SmaActuator"])).guid

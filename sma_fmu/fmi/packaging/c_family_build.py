@@ -14,8 +14,10 @@ Each native FMU holds:
   (``-Werror``; ``-ffp-contract=off``: no fused multiply-add, so results stay equal to the
   Python runtime's on every machine), export only the fmi2 functions and link no libpython;
 - ``resources/parameters.json``: the wire parameter file of the build, for the record
-  (``sma-fmu check``): the binary has its values compiled in and reads only
-  ``resources/start_values.json``, which ``sma-fmu export`` packs;
+  (``sma-fmu check``), and ``resources/model_starts.json``: the start of every variable and
+  the wire parameter file's values, which the binary reads (it holds none of them: one
+  binary serves every parameter file), then ``resources/start_values.json``, which
+  ``sma-fmu export`` packs;
 - ``extra/``: the pythonfmu twin's, if it has one (its reference result: the same numbers).
 """
 import re
@@ -29,7 +31,7 @@ from pathlib import Path
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.fmi.packaging.cross_build import FLAGS, RUNS_HERE, compile_shared, fmi2_targets, target
-from sma_fmu.fmi.packaging.c_family_description import native_description, variables_header
+from sma_fmu.fmi.packaging.c_family_description import model_starts, native_description, variables_header
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.platforms import NATIVE_MARKER, PlatformEntry, annotate
@@ -132,8 +134,7 @@ def _build_one(model_name, python_fmu, folder, work):
     for name in names:
         if name != header_name:
             shutil.copyfile(files[name], sources / name)
-    (sources / header_name).write_text(variables_header(description, starts, defaults),
-                                       encoding="utf-8")
+    (sources / header_name).write_text(variables_header(description), encoding="utf-8")
     binaries, problems, entries = {}, [], []
     for entry in fmi2_targets():
         output = work / entry.fmi2 / f"{model_name}{entry.suffix}"
@@ -157,6 +158,7 @@ def _build_one(model_name, python_fmu, folder, work):
         for binary, data in binaries.items():
             archive.writestr(binary, data)
         archive.write(unpacked / "resources" / "parameters.json", "resources/parameters.json")
+        archive.writestr("resources/model_starts.json", model_starts(description, starts, defaults))
         for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
             if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
                 archive.write(extra, extra.relative_to(unpacked).as_posix())

@@ -60,6 +60,7 @@ typedef struct Instance {
     int stepped, terminated, have_discard;  /* fmi2GetXXXStatus bookkeeping (as the front) */
     double discard_time, discard_step;
     SavedState *states;              /* states handed out and not freed */
+    double *wire_defaults;           /* run.wire_defaults (malloc'd; fmi2_start_values.c) */
 } Instance;
 
 /* ---- calls (fmi2_functions.c) -------------------------------------------------------------- */
@@ -163,5 +164,8 @@ int layer_resource_folder(const char *uri, char **folder, int *plain, char *why,
 char *layer_start_file(const char *path, int *missing, char *why, size_t size);
 /* Packed start values (resources/start_values.json), if the FMU has them. */
 int layer_packed_start_values(Instance *in, char *why, size_t size);
+/* The build's start values of every variable and its wire parameter file
+ * (resources/model_starts.json, which every C-family FMU holds). */
+int layer_build_starts(Instance *in, char *why, size_t size);
 
 #endif
