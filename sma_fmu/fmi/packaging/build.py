@@ -13,15 +13,17 @@ from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
 __all__ = ["build_fmus", "build_fmu", "validate_fmus"]
 
 
-def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False):
+def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False,
+               compile=False):
     """Build FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``; return {name: path}.
 
     They are built in a temporary folder beside ``out_dir`` and moved there at the end, so
     a failed build leaves ``out_dir`` as it was. ``native``: the C family instead
-    (:mod:`sma_fmu.fmi.packaging.c_family_build`: same interface, no Python inside).
+    (:mod:`sma_fmu.fmi.packaging.c_family_build`: same interface, no Python inside), whose
+    binaries are the wheel's prebuilt ones unless ``compile`` (or none fits).
     """
     if native:
-        return build_native_fmus(out_dir, parameter_file, names)
+        return build_native_fmus(out_dir, parameter_file, names, compile)
     return build_pythonfmu_fmus(out_dir, parameter_file, names)
 
 def build_fmu(model_name, out_dir=DEFAULT_FMU_DIR, parameter_file=None):

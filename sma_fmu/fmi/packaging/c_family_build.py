@@ -35,6 +35,7 @@ from sma_fmu.fmi.packaging.c_family_description import model_starts, native_desc
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.platforms import NATIVE_MARKER, PlatformEntry, annotate
+from sma_fmu.fmi.packaging.prebuilt import find_prebuilt, sources_digest
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
 from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
@@ -117,7 +118,7 @@ def _exact_starts(model_name, resources_folder):
     return starts, defaults
 
 
-def _build_one(model_name, python_fmu, folder, work):
+def _build_one(model_name, python_fmu, folder, work, compile=False):
     """Write ``folder/<model_name>.fmu`` from the pythonfmu FMU; returns [warning texts]."""
     unpacked = work / model_name
     with zipfile.ZipFile(python_fmu) as archive:
@@ -136,15 +137,19 @@ def _build_one(model_name, python_fmu, folder, work):
             shutil.copyfile(files[name], sources / name)
     (sources / header_name).write_text(variables_header(description), encoding="utf-8")
     binaries, problems, entries = {}, [], []
+    digest = sources_digest({path.name: path.read_bytes() for path in sources.iterdir()})
     for entry in fmi2_targets():
-        output = work / entry.fmi2 / f"{model_name}{entry.suffix}"
-        output.parent.mkdir(exist_ok=True)
-        problem = compile_binary(entry.fmi2, sources, output)
-        if problem:
-            problems.append(f"{model_name}: built without {entry.fmi2}: {problem}")
-            continue
         binary = f"binaries/{entry.fmi2}/{model_name}{entry.suffix}"
-        binaries[binary] = output.read_bytes()
+        data = None if compile else find_prebuilt(model_name, entry.fmi2, digest)
+        if data is None:
+            output = work / entry.fmi2 / f"{model_name}{entry.suffix}"
+            output.parent.mkdir(exist_ok=True)
+            problem = compile_binary(entry.fmi2, sources, output)
+            if problem:
+                problems.append(f"{model_name}: built without {entry.fmi2}: {problem}")
+                continue
+            data = output.read_bytes()
+        binaries[binary] = data
         if NATIVE_MARKER not in binaries[binary]:
             raise RuntimeError(f"{binary}: the native marker is missing (fmi2_functions.c)")
         entries.append(PlatformEntry(entry.fmi2, binary, front=False, python="none (native C)",
@@ -166,8 +171,11 @@ def _build_one(model_name, python_fmu, folder, work):
     return problems
 
 
-def build_native_fmus(out_dir, parameter_file=None, names=None):
+def build_native_fmus(out_dir, parameter_file=None, names=None, compile=False):
     """Build the native FMUs (default: all five) into ``out_dir``; return {name: path}.
+
+    Each platform's binary is the prebuilt one of the wheel when it was compiled from the
+    same sources (:mod:`.prebuilt`), else, or with ``compile``, compiled here.
 
     Built beside ``out_dir`` and moved there at the end: a failed build leaves it as it was.
     """
@@ -181,7 +189,7 @@ def build_native_fmus(out_dir, parameter_file=None, names=None):
         problems = []
         with staged_folder(out_dir) as folder:
             for name in names:
-                problems += _build_one(name, python_fmus[name], folder, work)
+                problems += _build_one(name, python_fmus[name], folder, work, compile)
     for message in sorted(set(p.split(": ", 1)[1] for p in problems)):
         hint = " Their sources/ compile there: fmpy.build.build_platform_binary"
         if message.startswith("built without win64"):
