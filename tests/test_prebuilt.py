@@ -70,3 +70,21 @@ def test_compile_ignores_them(folder, tmp_path, monkeypatch):
     _no_compiler(monkeypatch, folder)
     fmus, problems = _build(tmp_path / "fmus", names=["SmaPwmDriver"], compile=True)
     assert len(problems) == 3 and _binaries(fmus["SmaPwmDriver"]) == {}
+
+
+def test_without_a_compiler_the_prebuilt_hosts_are_taken(tmp_path, monkeypatch):
+    """sma-fmu check's C host (and the others) come prebuilt where no compiler is, but only
+    when built from the same source; with a compiler they are compiled as before."""
+    from sma_fmu.fmi import hosts
+    folder = hosts.write_prebuilt_hosts(tmp_path / "hosts")
+    assert sorted(p.name for p in folder.iterdir()) == sorted([*hosts.HOST_PROGRAMS, "manifest.json"])
+    monkeypatch.setattr(hosts, "PREBUILT_HOSTS", folder)
+    assert hosts.compile_host("fmi_host", tmp_path / "cache") != folder / "fmi_host"  # compiled
+    monkeypatch.setenv("CC", "no-such-cc")
+    for name in hosts.HOST_PROGRAMS:
+        assert hosts.compile_host(name, tmp_path / "cache") == folder / name
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["fmi_host"] = "0" * 64
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(hosts.CHostError, match="no-such-cc"):
+        hosts.compile_host("fmi_host", tmp_path / "cache2")

@@ -1,5 +1,7 @@
 """Filling the prebuilt folder of :mod:`.prebuilt` (``.ci/run``, before the wheel is built):
-``python -m sma_fmu.fmi.packaging.prebuilt_writer [--out DIR]``."""
+``python -m sma_fmu.fmi.packaging.prebuilt_writer [--out DIR]``; without ``--out`` it also
+writes the prebuilt C hosts (:func:`sma_fmu.fmi.hosts.write_prebuilt_hosts`: what
+``sma-fmu check`` runs where no C compiler is)."""
 import argparse
 import json
 import shutil
@@ -9,6 +11,7 @@ import warnings
 import zipfile
 from pathlib import Path
 
+from sma_fmu.fmi.hosts import CHostError, write_prebuilt_hosts
 from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
 from sma_fmu.fmi.packaging.cross_build import fmi2_targets
 from sma_fmu.fmi.packaging.prebuilt import MANIFEST, PREBUILT, sources_digest
@@ -57,7 +60,9 @@ def main(argv=None):
     args = parser.parse_args(argv)
     try:
         built = write_prebuilt(args.out)
-    except RuntimeError as error:
+        if args.out == PREBUILT:
+            print(f"C hosts: {write_prebuilt_hosts()}")
+    except (RuntimeError, CHostError) as error:
         print(f"prebuilt: {error}", file=sys.stderr)
         return 1
     for model, platforms in built.items():
