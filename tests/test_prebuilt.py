@@ -20,7 +20,8 @@ PLATFORMS = ("linux64", "win64", "darwin64")
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     folder = tmp_path_factory.mktemp("prebuilt") / "binaries"
-    assert write_prebuilt(folder) == {name: sorted(PLATFORMS) for name in FMU_SCRIPTS}
+    assert write_prebuilt(folder) == {**{name: sorted(PLATFORMS) for name in FMU_SCRIPTS},
+                                      "front": ["linux64", "win64"]}
     return folder
 
 
@@ -88,3 +89,21 @@ def test_without_a_compiler_the_prebuilt_hosts_are_taken(tmp_path, monkeypatch):
     (folder / "manifest.json").write_text(json.dumps(manifest))
     with pytest.raises(hosts.CHostError, match="no-such-cc"):
         hosts.compile_host("fmi_host", tmp_path / "cache2")
+
+
+def test_without_a_compiler_the_python_family_gets_the_prebuilt_fronts(folder, tmp_path, monkeypatch):
+    """sma-fmu build (the Python family) with no compiler: the front on linux64 and win64, no
+    degraded warning; the model description says the front is the prebuilt one."""
+    from sma_fmu.fmi.packaging.front_build import FrontWarning
+    from sma_fmu.fmi.packaging.platforms import platform_report
+    from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
+    _no_compiler(monkeypatch, folder)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fmus = build_pythonfmu_fmus(tmp_path / "fmus", names=["SmaPwmDriver"])
+    assert [w for w in caught if isinstance(w.message, FrontWarning)] == []
+    report = platform_report(fmus["SmaPwmDriver"])
+    assert [(status, name) for status, name, _ in report] == [("ok", "linux64"), ("ok", "win64")]
+    assert all("prebuilt front" in detail for _, _, detail in report)
+    with zipfile.ZipFile(fmus["SmaPwmDriver"]) as archive:
+        assert archive.read("binaries/linux64/SmaPwmDriver.so") == (folder / "front" / "linux64" / "front.so").read_bytes()

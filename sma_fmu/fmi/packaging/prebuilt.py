@@ -9,7 +9,9 @@ sources they were compiled from, and the file of each FMI 2.0 platform.
 
 :func:`find_prebuilt` gives a binary only when its sources' digest equals that of the
 sources being packed, so a changed C file, another version (the GUID) or a stale folder is
-never used: the build compiles instead. ``python -m sma_fmu.fmi.packaging.prebuilt_writer``
+never used: the build compiles instead. The Python family's C front is kept there too
+(``front/linux64/front.so``, ``front/win64/front.dll``), taken only where no compiler
+builds it; the prebuilt linux64 front records no build libpython. ``python -m sma_fmu.fmi.packaging.prebuilt_writer``
 fills the folder; ``.ci/run`` runs it before building the wheel, with gcc, mingw-w64 and
 zig present, and fails if any platform is missing.
 """
@@ -17,7 +19,7 @@ import hashlib
 import json
 from pathlib import Path
 
-__all__ = ["PREBUILT", "MANIFEST", "sources_digest", "find_prebuilt"]
+__all__ = ["PREBUILT", "MANIFEST", "FRONTS", "sources_digest", "find_prebuilt", "find_prebuilt_front"]
 
 PREBUILT = Path(__file__).parent / "prebuilt_binaries"
 MANIFEST = "manifest.json"
@@ -48,3 +50,12 @@ def find_prebuilt(model, platform, digest, folder=None):
         return None
     path = Path(folder) / model / platform / name
     return path.read_bytes() if path.is_file() else None
+
+
+FRONTS = {"linux64": "front.so", "win64": "front.dll"}  # the Python family's, under front/
+
+
+def find_prebuilt_front(platform, digest, folder=None):
+    """The bytes of the Python family's prebuilt front for ``platform`` (linux64 or win64),
+    compiled from front sources of ``digest`` and recording no build libpython; or None."""
+    return find_prebuilt("front", platform, digest, folder)

@@ -14,9 +14,26 @@ from pathlib import Path
 from sma_fmu.fmi.hosts import CHostError, write_prebuilt_hosts
 from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
 from sma_fmu.fmi.packaging.cross_build import fmi2_targets
-from sma_fmu.fmi.packaging.prebuilt import MANIFEST, PREBUILT, sources_digest
+from sma_fmu.fmi.packaging.prebuilt import FRONTS, MANIFEST, PREBUILT, sources_digest
 
 __all__ = ["write_prebuilt", "main"]
+
+
+def _write_fronts(folder):
+    """The Python family's fronts, compiled recording no build libpython: their manifest entry."""
+    from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+    from sma_fmu.fmi.packaging.front_build import _LINUX, _WINDOWS, _compile_cached, _sources
+
+    binaries = {}
+    for platform, (compiler, target) in {"linux64": (c_compiler(), _LINUX),
+                                         "win64": (windows_compiler(), _WINDOWS)}.items():
+        build = _compile_cached(compiler, target, [])
+        if build.library is None:
+            raise RuntimeError(f"prebuilt front for {platform}: {build.problem}")
+        (folder / "front" / platform).mkdir(parents=True)
+        (folder / "front" / platform / FRONTS[platform]).write_bytes(build.library)
+        binaries[platform] = FRONTS[platform]
+    return {"sources": sources_digest(_sources()), "binaries": binaries}
 
 
 def write_prebuilt(folder=PREBUILT):
@@ -47,6 +64,7 @@ def write_prebuilt(folder=PREBUILT):
                     (folder / model / entry.fmi2 / name).write_bytes(data)
                     binaries[entry.fmi2] = name
             manifest[model] = {"sources": sources_digest(sources), "binaries": binaries}
+    manifest["front"] = _write_fronts(folder)
     (folder / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n",
                                    encoding="utf-8")
     return {model: sorted(entry["binaries"]) for model, entry in manifest.items()}
