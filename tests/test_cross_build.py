@@ -32,7 +32,7 @@ def test_no_c_file_uses_a_libc_macro_name():
 
 def test_the_table_names_fmi2_and_fmi3_platforms():
     assert target("linux64") is TARGETS["x86_64-linux"]
-    assert [t.fmi2 for t in TARGETS.values() if t.fmi2] == ["linux64", "win64", "darwin64"]
+    assert [t.fmi2 for t in TARGETS.values() if t.fmi2] == ["linux64", "win64", "darwin64", "win32"]
     assert set(TARGETS) >= {"x86_64-linux", "aarch64-linux", "x86_64-windows", "x86_64-darwin",
                             "aarch64-darwin"}
     with pytest.raises(KeyError, match="darwin64"):
@@ -48,11 +48,11 @@ def actuator_sources(native_fmus, tmp_path_factory):
 
 
 _FORMATS = {".so": b"\x7fELF", ".dll": b"MZ", ".dylib": b"\xcf\xfa\xed\xfe"}
-_ARCHITECTURES = {"x86_64": "x86-64", "aarch64": "aarch64"}
+_ARCHITECTURES = {"x86_64": "x86-64", "aarch64": "aarch64", "x86": "x86"}
 
 
 @pytest.mark.needs("gcc", "zig")
-@pytest.mark.parametrize("name", ["x86_64-darwin", "aarch64-darwin", "aarch64-linux"])
+@pytest.mark.parametrize("name", ["x86_64-darwin", "aarch64-darwin", "aarch64-linux", "x86-windows"])
 def test_sources_compile_with_werror_under_zig(actuator_sources, tmp_path, name):
     need("zig")
     entry = TARGETS[name]

@@ -39,7 +39,7 @@ def register(commands):
     build.add_argument("--model", metavar="FILE",
                        help="parameter file the FMUs carry (default: the shipped reference_wire.toml)")
     build.add_argument("--native", action="store_true",
-                       help="build the C family: source-code FMUs with linux64/win64/darwin64 binaries, "
+                       help="build the C family: source-code FMUs with linux64/win64/darwin64/win32 binaries, "
                             "no Python needed (default: pythonfmu)")
     build.add_argument("--compile", action="store_true",
                        help="--native: compile every binary here, even where the installed "

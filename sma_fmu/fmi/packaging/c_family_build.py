@@ -8,9 +8,9 @@ Each native FMU holds:
   the generated ``<Model>_variables.h``: what a tool compiles (fmpy's
   ``build_platform_binary`` does, with sources/ as its include folder);
 - a binary for each FMI 2.0 platform of :mod:`.cross_build`'s table:
-  ``binaries/linux64/<Model>.so`` (gcc), ``binaries/win64/<Model>.dll`` (mingw-w64) and
-  ``binaries/darwin64/<Model>.dylib`` (zig cc), each falling back to zig cc; a platform with
-  no compiler here is left out with a warning. All are built with :data:`FLAGS`
+  ``binaries/linux64/<Model>.so`` (gcc), ``binaries/win64/<Model>.dll`` (mingw-w64),
+  ``binaries/darwin64/<Model>.dylib`` and ``binaries/win32/<Model>.dll`` (zig cc); zig cc is
+  the fallback of the others; a platform with no compiler here is left out with a warning. All are built with :data:`FLAGS`
   (``-Werror``; ``-ffp-contract=off``: no fused multiply-add, so results stay equal to the
   Python runtime's on every machine), export only the fmi2 functions and link no libpython;
 - ``resources/parameters.json``: the wire parameter file of the build, for the record

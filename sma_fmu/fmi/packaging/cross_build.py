@@ -63,6 +63,7 @@ TARGETS = {t.tuple: t for t in (
     Target("x86_64-windows", "win64", "x86_64-windows-gnu", ".dll", _WINDOWS, gcc="mingw64",
            runs="wine"),
     Target("x86_64-darwin", "darwin64", "x86_64-macos", ".dylib", ("-fPIC", "-fvisibility=hidden")),
+    Target("x86-windows", "win32", "x86-windows-gnu", ".dll", _WINDOWS),
     Target("aarch64-linux", None, "aarch64-linux-gnu.2.17", ".so", _ELF + ("-Wl,--no-undefined",),
            ("-lm",), runs="qemu"),
     Target("aarch64-darwin", None, "aarch64-macos", ".dylib", ("-fPIC", "-fvisibility=hidden")),

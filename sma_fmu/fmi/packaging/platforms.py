@@ -24,7 +24,7 @@ __all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", 
 FRONT_MARKER = b"sma-fmu native front"  # a string every front binary carries (fmi2_exports.c);
 # its old words are kept so FMUs built before the word "native" came to mean the C family still count
 NATIVE_MARKER = b"sma-fmu native C FMU"  # ... every C-family binary (c_family/fmi2/fmi2_functions.c)
-PLATFORMS = {"linux64": ".so", "win64": ".dll", "darwin64": ".dylib"}
+PLATFORMS = {"linux64": ".so", "win64": ".dll", "darwin64": ".dylib", "win32": ".dll"}
 HOW_PYTHON_IS_FOUND = {
     "linux64": "the process's own Python, else $SMA_FMU_LIBPYTHON, else the build's libpython, "
                "else the newest libpython3.X.so.1.0 (3.10 or newer) on the library search path "
