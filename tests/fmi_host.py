@@ -60,12 +60,14 @@ class FmiHost:
         The unpacked FMU.
     env : dict, optional
         Environment (default: this process's, without LD_PRELOAD).
+    runner : sequence of str, optional
+        What runs the host (an emulator: ``qemu-aarch64 -L SYSROOT``).
     """
 
-    def __init__(self, exe, folder, env=None):
+    def __init__(self, exe, folder, env=None, runner=()):
         if env is None:
             env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
-        self.process = subprocess.Popen([str(exe), str(folder)], stdin=subprocess.PIPE,
+        self.process = subprocess.Popen([*runner, str(exe), str(folder)], stdin=subprocess.PIPE,
                                         stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                         text=True, env=env)
 

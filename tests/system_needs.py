@@ -15,6 +15,7 @@ separated by spaces or commas) makes needs count as missing that a PATH cannot h
 lives in /usr/lib/wine, libpython in /usr/lib, root is who runs): the simulated fresh
 machine of ``tests/test_system_needs.py`` uses it.
 """
+import importlib.util
 import os
 import re
 import shutil
@@ -24,11 +25,12 @@ import pytest
 
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
 
-__all__ = ["NEEDS", "WITHOUT_VARIABLE", "need", "needs", "missing", "wine_command", "by_hand_executable",
+__all__ = ["AARCH64_SYSROOT", "NEEDS", "WITHOUT_VARIABLE", "need", "needs", "missing", "wine_command", "by_hand_executable",
            "system_libpythons"]
 
 WITHOUT_VARIABLE = "SMA_FMU_TESTS_WITHOUT"
 DEBIAN_LIBPYTHON = Path("/usr/lib/x86_64-linux-gnu/libpython3.11.so.1.0")
+AARCH64_SYSROOT = "/usr/aarch64-linux-gnu"   # Debian libc6-arm64-cross: qemu-aarch64 -L
 STANDARD_FOLDERS = ("/usr/local/lib", "/usr/local/lib64", "/usr/lib/x86_64-linux-gnu",
                     "/lib/x86_64-linux-gnu", "/usr/lib64", "/lib64", "/usr/lib", "/lib")
 
@@ -75,6 +77,11 @@ NEEDS = {
                          "apt-get install libpython3.11 (or your release's libpython3.X)"),
     "python3": (Path("/usr/bin/python3").is_file, "Debian's python3 (/usr/bin/python3)",
                 "apt-get install python3"),
+    "zig": (lambda: importlib.util.find_spec("ziglang") is not None,
+            "zig cc (PyPI ziglang: the cross-compiler of the C family's targets)", "pip install ziglang"),
+    "qemu-user": (lambda: shutil.which("qemu-aarch64") is not None and Path(AARCH64_SYSROOT).is_dir(),
+                  f"qemu-aarch64 and the aarch64 C library ({AARCH64_SYSROOT})",
+                  "apt-get install qemu-user libc6-arm64-cross"),
     "root": (lambda: os.geteuid() == 0, "root (unshare --mount, chroot)",
              "run the tests as root, e.g. sudo -E python -m pytest -q"),
 }

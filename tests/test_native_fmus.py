@@ -208,10 +208,11 @@ def test_bad_state_bytes_are_refused_with_a_message(native):
         other.close()
 
 
-def test_build_without_mingw_warns_and_leaves_win64_out(tmp_path, monkeypatch):
+def test_build_without_mingw_and_zig_warns_and_leaves_win64_out(tmp_path, monkeypatch):
     from sma_fmu.fmi.packaging.c_family_build import NativeBuildWarning, build_native_fmus
     from sma_fmu.fmi.packaging.platforms import platform_report
     monkeypatch.setenv("SMA_FMU_WIN64_CC", "no-such-mingw-gcc")
+    monkeypatch.setenv("SMA_FMU_ZIG_CC", "none")  # nor zig cc, which builds win64 and darwin64 too
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         paths = build_native_fmus(tmp_path / "fmus", names=["SmaPwmDriver"])
@@ -301,7 +302,8 @@ def test_resource_locations_taken_and_refused_as_the_front_does(native, tmp_path
     folder = str(tmp_path / "SmaPiController" / "resources")
     spaced = tmp_path / "with space" / "resources"  # the FMU's resources, in a spaced path
     spaced.mkdir(parents=True)
-    (spaced / "parameters.json").write_bytes((Path(folder) / "parameters.json").read_bytes())
+    for name in ("parameters.json", "model_starts.json"):
+        (spaced / name).write_bytes((Path(folder) / name).read_bytes())
     taken = [uri, f"file:{folder}", f"file://localhost{folder}", folder,
              "file://" + str(spaced).replace(" ", "%20")]
     refused = ["http://example.com/resources", "file://elsewhere" + folder, "file:resources",

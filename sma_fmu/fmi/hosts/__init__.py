@@ -25,11 +25,15 @@ import tempfile
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["CHostError", "HOST_PROGRAMS", "SHARED_HEADER", "c_compiler", "windows_compiler", "compile_host"]
+__all__ = ["CHostError", "HOST_PROGRAMS", "SHARED_HEADER", "PREBUILT_HOSTS", "c_compiler",
+           "windows_compiler", "compile_host", "prebuilt_host", "write_prebuilt_hosts"]
 
 HOST_PROGRAMS = ("fmi_host", "cosim_host", "loop_host")
 SHARED_HEADER = "host_platform.h"   # loading a binary, the platform shim (fmi_host, loop_host)
 _FLAGS = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"]
+PREBUILT_HOSTS = Path(__file__).parent / "prebuilt"  # the wheel's (write_prebuilt_hosts)
+# from site-packages/sma_fmu/fmi/hosts/prebuilt/ to site-packages/libcosimpy/libcosimc/
+_RELATIVE_LIBCOSIMC = "$ORIGIN/../../../../libcosimpy/libcosimc"
 
 
 class CHostError(RuntimeError):
@@ -85,6 +89,10 @@ def compile_host(name, cache=None, windows=False):
     source = resources.files(__name__).joinpath(f"{name}.c").read_bytes()
     shared = resources.files(__name__).joinpath(SHARED_HEADER).read_bytes()
     compiler = windows_compiler() if windows else c_compiler()
+    if not windows and shutil.which(compiler[0]) is None:
+        prebuilt = prebuilt_host(name)
+        if prebuilt is not None:  # no compiler here: the wheel's host of the same source
+            return prebuilt
     link = _link_flags(name, windows)
     key = hashlib.sha256(source + shared + "\0".join([*compiler, *_FLAGS, *link]).encode()).hexdigest()[:12]
     folder = Path(cache or tempfile.gettempdir()) / f"sma-fmu-{name}-{key}"
@@ -110,3 +118,52 @@ def compile_host(name, cache=None, windows=False):
                              f"{result.stderr.strip()}")
         os.replace(built, executable)  # atomic: a parallel build never sees half a file
     return executable
+
+
+def _source_digest(name):
+    files = resources.files(__name__)
+    data = files.joinpath(f"{name}.c").read_bytes() + b"\0" + files.joinpath(SHARED_HEADER).read_bytes()
+    return hashlib.sha256(data).hexdigest()
+
+
+def prebuilt_host(name, folder=None):
+    """The wheel's prebuilt ``name`` (Linux x86-64) if it was built from this source, else None."""
+    import json
+
+    folder = Path(PREBUILT_HOSTS if folder is None else folder)
+    try:
+        manifest = json.loads((folder / "manifest.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    path = folder / name
+    if manifest.get(name) != _source_digest(name) or not os.access(path, os.X_OK):
+        return None
+    return path
+
+
+def write_prebuilt_hosts(folder=None):
+    """Compile the three hosts for the wheel into ``folder`` (default :data:`PREBUILT_HOSTS`),
+    cosim_host finding libcosimc relative to itself in site-packages; returns the folder."""
+    import json
+
+    folder = Path(PREBUILT_HOSTS if folder is None else folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    manifest = {}
+    for name in HOST_PROGRAMS:
+        built = compile_host(name, folder / ".cache")
+        if name == "cosim_host":  # again, with an rpath that holds where the wheel installs it
+            library = _libcosimc_folder()
+            command = [*c_compiler(), *_FLAGS, "-o", str(folder / name),
+                       str(resources.files(__name__).joinpath(f"{name}.c")), f"-L{library}",
+                       "-lcosimc", f"-Wl,-rpath,{_RELATIVE_LIBCOSIMC}"]
+            result = subprocess.run(command, capture_output=True, text=True, timeout=300)
+            if result.returncode != 0:
+                raise CHostError(f"could not build the prebuilt cosim_host: {result.stderr.strip()}")
+        else:
+            shutil.copyfile(built, folder / name)
+        (folder / name).chmod(0o755)
+        manifest[name] = _source_digest(name)
+    shutil.rmtree(folder / ".cache", ignore_errors=True)
+    (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n",
+                                          encoding="utf-8")
+    return folder

@@ -20,7 +20,9 @@
 #define SUFFIX ".dll"
 #else
 #include <dlfcn.h>
+#ifndef PLATFORM  /* a cross-built host names its folder: -DPLATFORM='"aarch64-linux"' */
 #define PLATFORM "linux64"
+#endif
 #define SUFFIX ".so"
 #endif
 

@@ -17,12 +17,13 @@ __all__ = ["build_fmus", "build_fmu", "validate_fmus"]
 
 
 def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False,
-               fmi_version=2):
+               fmi_version=2, compile=False):
     """Build FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``; return {name: path}.
 
     They are built in a temporary folder beside ``out_dir`` and moved there at the end, so
     a failed build leaves ``out_dir`` as it was. ``native``: the C family instead
-    (:mod:`sma_fmu.fmi.packaging.c_family_build`: same interface, no Python inside).
+    (:mod:`sma_fmu.fmi.packaging.c_family_build`: same interface, no Python inside), whose
+    binaries are the wheel's prebuilt ones unless ``compile`` (or none fits).
     ``fmi_version`` 3: the C family as FMI 3.0 co-simulation FMUs (needs ``native``).
     """
     if fmi_version not in (2, 3):
@@ -33,7 +34,7 @@ def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=
     if fmi_version == 3:
         return build_fmi3_fmus(out_dir, parameter_file, names)
     if native:
-        return build_native_fmus(out_dir, parameter_file, names)
+        return build_native_fmus(out_dir, parameter_file, names, compile)
     return build_pythonfmu_fmus(out_dir, parameter_file, names)
 
 def build_fmu(model_name, out_dir=DEFAULT_FMU_DIR, parameter_file=None):

@@ -7,20 +7,21 @@ Each native FMU holds:
   ``models/<Model>.c``, the runtime modules it includes, transitively, the FMI headers) and
   the generated ``<Model>_variables.h``: what a tool compiles (fmpy's
   ``build_platform_binary`` does, with sources/ as its include folder);
-- ``binaries/linux64/<Model>.so`` (gcc) and ``binaries/win64/<Model>.dll`` (mingw-w64;
-  without it the build warns and leaves win64 out, as the pythonfmu build does), both built
-  with :data:`FLAGS` (``-Werror``; ``-ffp-contract=off``: no fused multiply-add, so results
-  stay equal to the Python runtime's on every machine), exporting only the fmi2 functions,
-  linking no libpython;
+- a binary for each FMI 2.0 platform of :mod:`.cross_build`'s table:
+  ``binaries/linux64/<Model>.so`` (gcc), ``binaries/win64/<Model>.dll`` (mingw-w64),
+  ``binaries/darwin64/<Model>.dylib`` and ``binaries/win32/<Model>.dll`` (zig cc); zig cc is
+  the fallback of the others; a platform with no compiler here is left out with a warning. All are built with :data:`FLAGS`
+  (``-Werror``; ``-ffp-contract=off``: no fused multiply-add, so results stay equal to the
+  Python runtime's on every machine), export only the fmi2 functions and link no libpython;
 - ``resources/parameters.json``: the wire parameter file of the build, for the record
-  (``sma-fmu check``): the binary has its values compiled in and reads only
-  ``resources/start_values.json``, which ``sma-fmu export`` packs;
+  (``sma-fmu check``), and ``resources/model_starts.json``: the start of every variable and
+  the wire parameter file's values, which the binary reads (it holds none of them: one
+  binary serves every parameter file), then ``resources/start_values.json``, which
+  ``sma-fmu export`` packs;
 - ``extra/``: the pythonfmu twin's, if it has one (its reference result: the same numbers).
 """
 import re
 import shutil
-import subprocess
-import sys
 import tempfile
 import warnings
 import zipfile
@@ -29,25 +30,20 @@ from pathlib import Path
 
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
-from sma_fmu.fmi.hosts import c_compiler, windows_compiler
-from sma_fmu.fmi.packaging.c_family_description import native_description, variables_header
+from sma_fmu.fmi.packaging.cross_build import FLAGS, RUNS_HERE, compile_shared, fmi2_targets, target
+from sma_fmu.fmi.packaging.c_family_description import model_starts, native_description, variables_header
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.platforms import NATIVE_MARKER, PlatformEntry, annotate
+from sma_fmu.fmi.packaging.prebuilt import find_prebuilt, sources_digest
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
+from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
 __all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_sources",
            "build_native_fmus", "compile_binary"]
 
 C_FAMILY = Path(__file__).parents[1] / "c_family"
 C_COMMON = Path(__file__).parents[1] / "c_common"   # C code both families compile
-FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off", "-O2",
-         "-shared"]
-_TARGETS = {"linux64": {"flags": ["-fPIC", "-fvisibility=hidden", "-Wl,--no-undefined"],
-                        "libraries": ["-lm"],
-                        "suffix": ".so"},
-            "win64": {"flags": ["-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1", "-s"],
-                      "libraries": [], "suffix": ".dll"}}
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -109,25 +105,9 @@ def model_sources(model_name, generated=(), front="fmi2"):
 
 
 def compile_binary(platform, sources_folder, output):
-    """Compile the .c files of ``sources_folder`` into ``output`` for ``platform``; returns
-    None or the reason it could not (no compiler, or its last error line)."""
-    target = _TARGETS[platform]
-    compiler = c_compiler() if platform == "linux64" else windows_compiler()
-    if platform == "linux64" and not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
-        return f"the linux64 binary is built on 64-bit Linux only (this is {sys.platform})"
-    if shutil.which(compiler[0]) is None:
-        return f"no {'mingw-w64 cross ' if platform == 'win64' else ''}C compiler ({compiler[0]} not found)"
-    command = [*compiler, *FLAGS, *target["flags"], "-I", str(sources_folder), "-o", str(output),
-               *sorted(str(p) for p in Path(sources_folder).glob("*.c")), *target["libraries"]]
-    try:
-        result = subprocess.run(command, capture_output=True, text=True, timeout=600)
-    except (OSError, subprocess.SubprocessError) as error:
-        return f"C compiler {' '.join(compiler)!r} could not run ({error})"
-    if result.returncode != 0 or not Path(output).is_file():
-        message = result.stderr.strip() or "no message"
-        raise RuntimeError(f"C compiler {' '.join(compiler)!r} failed (a bug of the C family, "
-                           f"not of the machine): {message[-3000:]}")
-    return None
+    """Compile the .c files of ``sources_folder`` into ``output`` for ``platform`` (an FMI 2.0
+    folder name or FMI 3.0 tuple, :mod:`.cross_build`); returns None or why it could not."""
+    return compile_shared(target(platform), sources_folder, output)
 
 
 def _exact_starts(model_name, resources_folder):
@@ -143,7 +123,7 @@ def _exact_starts(model_name, resources_folder):
     return starts, defaults
 
 
-def _build_one(model_name, python_fmu, folder, work):
+def _build_one(model_name, python_fmu, folder, work, compile=False):
     """Write ``folder/<model_name>.fmu`` from the pythonfmu FMU; returns [warning texts]."""
     unpacked = work / model_name
     with zipfile.ZipFile(python_fmu) as archive:
@@ -160,21 +140,25 @@ def _build_one(model_name, python_fmu, folder, work):
     for name in names:
         if name != header_name:
             shutil.copyfile(files[name], sources / name)
-    (sources / header_name).write_text(variables_header(description, starts, defaults),
-                                       encoding="utf-8")
+    (sources / header_name).write_text(variables_header(description), encoding="utf-8")
     binaries, problems, entries = {}, [], []
-    for platform, target in _TARGETS.items():
-        output = work / f"{model_name}{target['suffix']}"
-        problem = compile_binary(platform, sources, output)
-        if problem:
-            problems.append(f"{model_name}: built without {platform}: {problem}")
-            continue
-        binary = f"binaries/{platform}/{model_name}{target['suffix']}"
-        binaries[binary] = output.read_bytes()
+    digest = sources_digest({path.name: path.read_bytes() for path in sources.iterdir()})
+    for entry in fmi2_targets():
+        binary = f"binaries/{entry.fmi2}/{model_name}{entry.suffix}"
+        data = None if compile else find_prebuilt(model_name, entry.fmi2, digest)
+        if data is None:
+            output = work / entry.fmi2 / f"{model_name}{entry.suffix}"
+            output.parent.mkdir(exist_ok=True)
+            problem = compile_binary(entry.fmi2, sources, output)
+            if problem:
+                problems.append(f"{model_name}: built without {entry.fmi2}: {problem}")
+                continue
+            data = output.read_bytes()
+        binaries[binary] = data
         if NATIVE_MARKER not in binaries[binary]:
             raise RuntimeError(f"{binary}: the native marker is missing (fmi2_functions.c)")
-        entries.append(PlatformEntry(platform, binary, front=False, python="none (native C)",
-                                     native=True))
+        entries.append(PlatformEntry(entry.fmi2, binary, front=False, python="none (native C)",
+                                     native=True, runs=RUNS_HERE[entry.runs]))
     text = annotate(description.decode("utf-8"), entries)
     fmu = folder / f"{model_name}.fmu"
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
@@ -184,14 +168,19 @@ def _build_one(model_name, python_fmu, folder, work):
         for binary, data in binaries.items():
             archive.writestr(binary, data)
         archive.write(unpacked / "resources" / "parameters.json", "resources/parameters.json")
+        archive.writestr("resources/model_starts.json", model_starts(description, starts, defaults))
         for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
             if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
                 archive.write(extra, extra.relative_to(unpacked).as_posix())
+    fix_timestamps(fmu)  # reproducible.py: the same inputs, the same bytes
     return problems
 
 
-def build_native_fmus(out_dir, parameter_file=None, names=None):
+def build_native_fmus(out_dir, parameter_file=None, names=None, compile=False):
     """Build the native FMUs (default: all five) into ``out_dir``; return {name: path}.
+
+    Each platform's binary is the prebuilt one of the wheel when it was compiled from the
+    same sources (:mod:`.prebuilt`), else, or with ``compile``, compiled here.
 
     Built beside ``out_dir`` and moved there at the end: a failed build leaves it as it was.
     """
@@ -205,10 +194,10 @@ def build_native_fmus(out_dir, parameter_file=None, names=None):
         problems = []
         with staged_folder(out_dir) as folder:
             for name in names:
-                problems += _build_one(name, python_fmus[name], folder, work)
+                problems += _build_one(name, python_fmus[name], folder, work, compile)
     for message in sorted(set(p.split(": ", 1)[1] for p in problems)):
-        hint = (" Install mingw-w64 (Debian: apt-get install gcc-mingw-w64-x86-64) or set "
-                "SMA_FMU_WIN64_CC" if message.startswith("built without win64") else
-                " Their sources/ compile there: fmpy.build.build_platform_binary")
+        hint = " Their sources/ compile there: fmpy.build.build_platform_binary"
+        if message.startswith("built without win64"):
+            hint = " Install mingw-w64 (Debian: apt-get install gcc-mingw-w64-x86-64) or set SMA_FMU_WIN64_CC," + hint
         warnings.warn(NativeBuildWarning(f"native FMUs {message}.{hint}"), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}

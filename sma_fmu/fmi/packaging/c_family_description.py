@@ -4,7 +4,8 @@ A native FMU must drop in for its pythonfmu twin (an SSP or a container made wit
 family runs with the other), so nothing about its interface is written twice: the model
 description is the one ``sma-fmu build`` writes, with only what makes it native changed:
 
-- ``guid`` (another build) and ``generationTool``;
+- ``guid`` (:func:`~.reproducible.structural_guid`: the same for every parameter file),
+  ``generationTool``, no ``generationDateAndTime``;
 - the ``CoSimulation`` element: ``needsExecutionTool="false"``, saved and serialized states,
   and ``<SourceFiles>``;
 - the ``start`` of every Real as the exact value the Python slave starts with (``repr``:
@@ -12,20 +13,22 @@ description is the one ``sma-fmu build`` writes, with only what makes it native 
 - the platforms annotation (:mod:`sma_fmu.fmi.packaging.platforms`): native binaries, no Python.
 
 The C header ``<Model>_variables.h`` (:func:`variables_header`) holds the same variables
-(value reference, name, type, causality, variability, exact start) as an enum ``VAR_<name>``
-and a table the layer uses, plus ``WIRE_DEFAULTS``: the wire parameter file the FMU was
-built with, in PARAMETER_SPECS order (NaN where Python's value is None), for the parameters
-the FMU does not expose. An adapter that names a variable the FMU does not have does not
-compile.
+(value reference, name, type, causality, variability) as an enum ``VAR_<name>`` and a table
+the layer uses: the structure only, so one binary serves every parameter file. The start
+values travel in ``resources/model_starts.json`` (:func:`model_starts`): the exact start of
+every variable, and the wire parameter file the FMU was built with, in PARAMETER_SPECS order
+(null where Python's value is None), for the parameters the FMU does not expose. An adapter
+that names a variable the FMU does not have does not compile.
 """
+import json
 import math
-import uuid
 import xml.etree.ElementTree as ET
 
 from sma_fmu import __version__
+from sma_fmu.fmi.packaging.reproducible import structural_guid
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 
-__all__ = ["LOG_CATEGORIES", "native_description", "variables_header", "c_string"]
+__all__ = ["LOG_CATEGORIES", "native_description", "variables_header", "model_starts", "c_string"]
 
 LOG_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal",
                   "logAll")
@@ -51,8 +54,9 @@ def native_description(python_description, starts, source_files):
     (bytes); ``starts`` {name: exact start value}; ``source_files`` the names in sources/.
     Returns (bytes, guid)."""
     root = ET.fromstring(python_description)
-    guid = str(uuid.uuid4())
+    guid = structural_guid(root, __version__)  # one per structure: reproducible builds
     root.set("guid", guid)
+    root.attrib.pop("generationDateAndTime", None)
     root.set("generationTool", f"sma-fmu {__version__} (build --native: C99, no Python)")
     co_simulation = root.find("CoSimulation")
     identifier = co_simulation.get("modelIdentifier")
@@ -106,15 +110,14 @@ def _number(value):
     return repr(value)
 
 
-def variables_header(description, starts, wire_defaults):
-    """Text of ``<Model>_variables.h`` for the native model ``description`` (bytes).
-
-    ``starts``: {name: exact start}; ``wire_defaults``: the WireParameters of the build's
-    parameter file (or None for models without wire parameters)."""
+def variables_header(description):
+    """Text of ``<Model>_variables.h`` for the native model ``description`` (bytes): the
+    structure only (no start value: those are in :func:`model_starts`), so the binary is
+    the same for every parameter file."""
     root = ET.fromstring(description)
     model, guid = root.get("modelName"), root.get("guid")
     spec_index = {spec.name: i for i, spec in enumerate(PARAMETER_SPECS)}
-    rows, names, strings = [], [], []
+    rows, names = [], []
     for variable, typed in _variables(root):
         name = variable.get("name")
         causality = variable.get("causality")
@@ -122,29 +125,42 @@ def variables_header(description, starts, wire_defaults):
         if causality not in ("parameter", "input", "output") or \
                 variability not in ("fixed", "tunable", "discrete", "continuous"):
             raise ValueError(f"{model}: variable {name} is a {variability} {causality}")
-        start, text = starts.get(name), "NULL"
-        if typed.tag == "String":
-            strings.append(f"static const char START_{name}[] = {c_string(start)};")
-            start, text = 0.0, f"START_{name}"
-        number = _number(0.0 if start is None else float(start))
         wire = spec_index.get(name, -1) if causality == "parameter" else -1
         rows.append(f"    {{{variable.get('valueReference')}u, \"{name}\", {_KINDS[typed.tag]}, "
-                    f"SMA_{causality.upper()}, SMA_{variability.upper()}, {number}, {text}, {wire}}},")
+                    f"SMA_{causality.upper()}, SMA_{variability.upper()}, 0.0, NULL, {wire}}},")
         names.append(f"VAR_{name}")
     lines = [f"/* {model}: its variables, generated by `sma-fmu build --native` from the",
              " * pythonfmu FMU's model description (sma_fmu/fmi/packaging/c_family_description.py).",
-             " * Do not edit. */",
+             " * Their start values are read from resources/model_starts.json. Do not edit. */",
              f"#ifndef {model.upper()}_VARIABLES_H", f"#define {model.upper()}_VARIABLES_H", "",
-             "#include <math.h>", "", '#include "sma_model.h"', "",
+             '#include "sma_model.h"', "",
              f'#define MODEL_NAME "{model}"', f'#define MODEL_GUID "{guid}"',
              "#define LOG_CATEGORIES {" + ", ".join(f'"{c}"' for c in LOG_CATEGORIES) + ", NULL}",
-             "", "enum { " + ", ".join(names) + ", VAR_COUNT };", "", *strings, "",
-             "static const SmaVariable VARIABLES[VAR_COUNT] = {", *rows, "};"]
-    if wire_defaults is not None:
-        values = [_number(getattr(wire_defaults, spec.name)) for spec in PARAMETER_SPECS]
-        lines += ["", f"/* the wire parameter file of the build: {wire_defaults.source} */",
-                  f"static const double WIRE_DEFAULTS[{len(values)}] = {{",
-                  *(f"    {value},  /* {spec.name} */" for value, spec in zip(values, PARAMETER_SPECS)),
-                  "};"]
-    lines += ["", "#endif", ""]
+             "", "enum { " + ", ".join(names) + ", VAR_COUNT };", "",
+             "static const SmaVariable VARIABLES[VAR_COUNT] = {", *rows, "};", "", "#endif", ""]
     return "\n".join(lines)
+
+
+def model_starts(description, starts, wire_defaults):
+    """Text of ``resources/model_starts.json``: the exact start of every variable of the
+    native model ``description`` (bytes), and ``wire_defaults`` (the WireParameters of the
+    build's parameter file, or None) in PARAMETER_SPECS order, null where Python's is None."""
+    root = ET.fromstring(description)
+    values = {}
+    for variable, typed in _variables(root):
+        name = variable.get("name")
+        start = starts.get(name)
+        if typed.tag == "String":
+            values[name] = "" if start is None else str(start)
+        elif typed.tag == "Boolean":
+            values[name] = bool(start)
+        elif typed.tag == "Integer":
+            values[name] = int(start or 0)
+        else:
+            values[name] = float(_number(0.0 if start is None else start))
+    wire = [] if wire_defaults is None else \
+        [None if getattr(wire_defaults, spec.name) is None else float(_number(getattr(wire_defaults, spec.name)))
+         for spec in PARAMETER_SPECS]
+    document = {"format": "sma-fmu C-family start values 1", "model": root.get("modelName"),
+                "values": values, "wire_defaults": wire}
+    return json.dumps(document, indent=1, allow_nan=False) + "\n"

@@ -22,18 +22,22 @@ from pathlib import Path
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarning, _c_files,
                                                   _exact_starts, compile_binary, model_sources)
-from sma_fmu.fmi.packaging.c_family_description import native_description, variables_header
+from sma_fmu.fmi.packaging.c_family_description import (model_starts, native_description,
+                                                        variables_header)
+from sma_fmu.fmi.packaging.cross_build import TARGETS
 from sma_fmu.fmi.packaging.fmi3_description import (annotate_platforms, build_description,
                                                     fmi3_description, fmi3_model_header)
 from sma_fmu.fmi.packaging.fmi3_terminals import terminals_and_icons
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
+from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
 __all__ = ["PLATFORMS", "build_fmi3_fmus"]
 
-# FMI 3.0 platform tuple -> (the compile target of c_family_build, the binary's suffix)
-PLATFORMS = {"x86_64-linux": ("linux64", ".so"), "x86_64-windows": ("win64", ".dll")}
+# FMI 3.0 platform tuple -> (its compile target, the binary's suffix): every target of
+# cross_build's table (gcc, mingw-w64, zig cc; one without its toolchain is left out, warned)
+PLATFORMS = {name: (name, entry.suffix) for name, entry in TARGETS.items()}
 _GENERATED = "fmi3_model.h"
 
 
@@ -54,12 +58,12 @@ def _build_one(model_name, python_fmu, folder, work):
     for name in names:
         if name not in (header_name, _GENERATED):
             shutil.copyfile(files[name], sources / name)
-    (sources / header_name).write_text(variables_header(fmi2_description, starts, defaults),
-                                       encoding="utf-8")
+    (sources / header_name).write_text(variables_header(fmi2_description), encoding="utf-8")
     (sources / _GENERATED).write_text(fmi3_model_header(description), encoding="utf-8")
     binaries, problems = {}, []
     for platform, (target, suffix) in PLATFORMS.items():
-        output = work / f"{model_name}{suffix}"
+        output = work / platform / f"{model_name}{suffix}"
+        output.parent.mkdir(exist_ok=True)
         problem = compile_binary(target, sources, output)
         if problem:
             problems.append(f"{model_name}: built without {platform}: {problem}")
@@ -81,9 +85,14 @@ def _build_one(model_name, python_fmu, folder, work):
         for binary, data in binaries.items():
             archive.writestr(binary, data)
         archive.write(unpacked / "resources" / "parameters.json", "resources/parameters.json")
+        # the start of every variable and the build's wire parameters: one binary serves
+        # every parameter file (issue 40), as in the FMI 2.0 build
+        archive.writestr("resources/model_starts.json",
+                         model_starts(fmi2_description, starts, defaults))
         for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
             if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
                 archive.write(extra, extra.relative_to(unpacked).as_posix())
+    fix_timestamps(fmu)  # reproducible.py: the same inputs, the same bytes
     return problems
 
 

@@ -20,6 +20,7 @@ the model beyond the core's table (the value reference of ``time``, the Enumerat
 """
 import xml.etree.ElementTree as ET
 
+from sma_fmu.fmi.packaging.cross_build import RUNS_HERE, TARGETS
 from sma_fmu.fmi.python_family.slave_support.choices import CHOICES
 
 __all__ = ["EVENT_MODELS", "fmi3_description", "annotate_platforms", "build_description",
@@ -113,7 +114,8 @@ def annotate_platforms(fmi3_description_bytes, binaries):
     platforms = ET.SubElement(note, "Platforms")
     for name, binary in binaries.items():
         ET.SubElement(platforms, "Platform", name=name, binary=binary, front="false",
-                      python="none (native C)", native="true")
+                      python="none (native C)", native="true",
+                      tested=RUNS_HERE[TARGETS[name].runs])  # as the FMI 2.0 annotation says
     ET.indent(root, "\t")
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
 

@@ -30,6 +30,7 @@ from importlib import resources
 from pathlib import Path
 
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+from sma_fmu.fmi.packaging.prebuilt import find_prebuilt_front, sources_digest
 from sma_fmu.fmi.packaging.platforms import (DEGRADED, HOW_PYTHON_IS_FOUND, PLATFORMS, PlatformEntry,
                                    annotate, check_build_machine)
 
@@ -40,7 +41,8 @@ _BACKEND = "_pythonfmu"
 _COMMON = ["-std=c11", "-O2", "-shared", "-Wall"]
 _LINUX = {"flags": [*_COMMON, "-fPIC", "-fvisibility=hidden", "-Wl,--no-undefined"],
           "libraries": ["-ldl", "-lpthread"], "output": "front.so"}
-_WINDOWS = {"flags": [*_COMMON, "-s", "-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1"],
+_WINDOWS = {"flags": [*_COMMON, "-s", "-static-libgcc", "-D__USE_MINGW_ANSI_STDIO=1",
+                       "-Wl,--no-insert-timestamp", "-Wl,--disable-auto-image-base"],
             "libraries": ["-ladvapi32"], "output": "front.dll"}
 _compiled = {}  # (compiler, sources digest, defines) -> FrontBuild
 
@@ -62,6 +64,7 @@ class Fronts:
 
     def __init__(self, builds, libpython=("", "")):
         self.builds, self.libpython = dict(builds), libpython
+        self.prebuilt = set()  # platforms whose front is the wheel's prebuilt one
 
     def warnings(self):
         """One message per platform that gets no front: what the FMUs lose there."""
@@ -151,13 +154,23 @@ def compile_fronts():
     """Check the build machine (:func:`~sma_fmu.fmi.packaging.platforms.check_build_machine`, which
     raises on one pythonfmu has no binary for), then compile the front of each platform."""
     check_build_machine()
-    return Fronts({"linux64": compile_front(), "win64": compile_windows_front()}, libpython_path())
+    fronts = Fronts({"linux64": compile_front(), "win64": compile_windows_front()}, libpython_path())
+    digest = sources_digest(_sources())
+    for platform, build in fronts.builds.items():
+        if build.library is None:  # no compiler for it here: the wheel's, of the same sources
+            library = find_prebuilt_front(platform, digest)
+            if library is not None:
+                fronts.builds[platform] = FrontBuild(library=library)
+                fronts.prebuilt.add(platform)
+    return fronts
 
 
-def _entry(platform, binary, front, libpython):
+def _entry(platform, binary, front, libpython, prebuilt=False):
     python = HOW_PYTHON_IS_FOUND.get(platform, "")
     if platform == "linux64" and libpython[0]:
         python += f" (the build's: {libpython[0]})"
+    if prebuilt:
+        python += " (the installed package's prebuilt front: no build libpython recorded)"
     return PlatformEntry(platform, binary, front, python, "" if front else DEGRADED)
 
 
@@ -178,7 +191,9 @@ def install_fronts(fmu_path, model_identifier, fronts):
             build = fronts.builds.get(platform)
             if build is not None and build.library is None and platform == "win64":
                 continue  # left out: no front for it
-            entries.append(_entry(platform, binary, bool(build and build.library), fronts.libpython))
+            entries.append(_entry(platform, binary, bool(build and build.library),
+                                  ("", "") if platform in fronts.prebuilt else fronts.libpython,
+                                  platform in fronts.prebuilt))
         kept = {entry.binary: entry for entry in entries}
         keep_win64 = any(entry.platform == "win64" for entry in entries)
         for item in source.infolist():

@@ -24,10 +24,10 @@ __all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", 
 FRONT_MARKER = b"sma-fmu native front"  # a string every front binary carries (fmi2_exports.c);
 # its old words are kept so FMUs built before the word "native" came to mean the C family still count
 NATIVE_MARKER = b"sma-fmu native C FMU"  # ... every C-family binary (c_family/core/layer_calls.c)
-PLATFORMS = {"linux64": ".so", "win64": ".dll"}
+PLATFORMS = {"linux64": ".so", "win64": ".dll", "darwin64": ".dylib", "win32": ".dll"}
 # FMI 3.0's platform tuples (the C family's FMI 3.0 FMUs) and their binaries' suffixes
 FMI3_PLATFORMS = {"x86_64-linux": ".so", "aarch64-linux": ".so", "x86_64-windows": ".dll",
-                  "x86_64-darwin": ".dylib", "aarch64-darwin": ".dylib"}
+                  "x86-windows": ".dll", "x86_64-darwin": ".dylib", "aarch64-darwin": ".dylib"}
 HOW_PYTHON_IS_FOUND = {
     "linux64": "the process's own Python, else $SMA_FMU_LIBPYTHON, else the build's libpython, "
                "else the newest libpython3.X.so.1.0 (3.10 or newer) on the library search path "
@@ -43,6 +43,7 @@ DEGRADED = ("pythonfmu's binary without the C front: C hosts need libpython in L
             "Python version; each instance keeps its copy of the binary in memory")
 _ELF_MACHINES = {62: "x86-64", 183: "aarch64", 3: "x86", 40: "arm"}
 _PE_MACHINES = {0x8664: "x86-64", 0xAA64: "aarch64", 0x14C: "x86"}
+_MACHO_MACHINES = {0x01000007: "x86-64", 0x0100000C: "aarch64"}
 _MACHINES = {"x86_64": "x86-64", "amd64": "x86-64", "aarch64": "aarch64", "arm64": "aarch64",
              "i386": "x86", "i686": "x86", "x86": "x86"}
 _TOOL = "sma-fmu"
@@ -62,10 +63,13 @@ class PlatformEntry:
     python: str = ""
     degraded: str = ""
     native: bool = False  # a C-family binary (sma-fmu build --native): no Python at all
+    runs: str = ""        # how the tests run it (cross_build.RUNS_HERE): natively, wine, qemu, only built
 
 
 def binary_architecture(data):
-    """"x86-64", "aarch64", ... of an ELF or PE binary's bytes; None if neither."""
+    """"x86-64", "aarch64", ... of an ELF, PE or 64-bit Mach-O binary's bytes; None if none."""
+    if data[:4] == b"\xcf\xfa\xed\xfe" and len(data) >= 8:
+        return _MACHO_MACHINES.get(struct.unpack_from("<I", data, 4)[0], "unknown")
     if data[:4] == b"\x7fELF" and len(data) >= 20:
         return _ELF_MACHINES.get(struct.unpack_from("<H", data, 18)[0], "unknown")
     if data[:2] == b"MZ" and len(data) >= 64:
@@ -118,6 +122,8 @@ def annotate(model_description, entries):
             attributes += f" degraded={quoteattr(entry.degraded)}"
         if entry.native:
             attributes += ' native="true"'
+        if entry.runs:
+            attributes += f" tested={quoteattr(entry.runs)}"
         lines.append(f"\t\t\t\t<Platform {attributes}/>")
     lines += ["\t\t\t</Platforms>", "\t\t</Tool>"]
     block = "\n".join(lines) + "\n"
@@ -187,7 +193,8 @@ def _platform_line(archive, names, identifier, name, said):
     if said is not None and said.get("native") == "true":
         if NATIVE_MARKER not in data:
             return "FAIL", name, f"modelDescription.xml says native, but {what} is no sma-fmu C-family binary"
-        return "ok", name, f"{what}: native C (sma-fmu build --native), no Python"
+        tested = f"; {said['tested']}" if said.get("tested") else ""
+        return "ok", name, f"{what}: native C (sma-fmu build --native), no Python{tested}"
     if said is None:
         return "FAIL", name, f"{what}, {'the front' if front else 'without this front'}, is not " \
                              "declared in modelDescription.xml"

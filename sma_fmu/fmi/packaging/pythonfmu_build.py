@@ -37,6 +37,7 @@ from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, DEFAULT_SIGNALS_SCE
 from sma_fmu.fmi.packaging.front_build import (FrontWarning, compile_fronts, install_fronts,
                                                stage_slave_module)
 from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.fmi.packaging.reproducible import content_guid, fix_timestamps
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.files.toml_files import read_toml
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
@@ -155,8 +156,10 @@ def build_pythonfmu_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=Non
     with staged_folder(out_dir) as folder:
         for name in names:
             path = _build_into(name, folder, parameter_set, stamp)
+            fix_timestamps(path, content_guid(path))  # reproducible.py: no random GUID, no date
             install_fronts(path, name, fronts)
             add_documentation_and_reference(path)  # documentation/, extra/ fmi-ls-ref (extras.py)
+            fix_timestamps(path)
     for message in fronts.warnings():
         warnings.warn(FrontWarning(message), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}

@@ -72,6 +72,7 @@ typedef struct Instance {
     int stepped, terminated, have_discard;  /* GetXXXStatus bookkeeping (as the front) */
     double discard_time, discard_step;
     SavedState *states;              /* states handed out and not freed */
+    double *wire_defaults;           /* run.wire_defaults (malloc'd; layer_start_values.c) */
     /* FMI 3.0 only (its front sets and reads them; not in saved states): */
     int event_mode_used, early_return;  /* fmi3InstantiateCoSimulation's flags */
     int event_mode;                  /* in Event Mode (the core's state is then stepComplete) */
@@ -197,5 +198,8 @@ void layer_parsed_free(const SmaModel *model, Parsed *p);
 int layer_resource_folder(const char *uri, char **folder, int *plain, char *why, size_t size);
 char *layer_start_file(const char *path, int *missing, char *why, size_t size);
 int layer_packed_start_values(Instance *in, char *why, size_t size);
+/* The build's start values of every variable and its wire parameter file
+ * (resources/model_starts.json, which every C-family FMU holds). */
+int layer_build_starts(Instance *in, char *why, size_t size);
 
 #endif

@@ -60,6 +60,10 @@ static void release_contents(Instance *in)
     free(in->categories);
     free(in->resources);
     free(in->guid);
+    free(in->wire_defaults);
+    in->wire_defaults = NULL;
+    in->run.wire_defaults = NULL;
+    in->run.wire_count = 0;
     in->values = NULL;
     in->real_outputs = NULL;
     in->categories = in->resources = in->guid = NULL;
@@ -89,7 +93,7 @@ int layer_initial_state(Instance *in, char *why, size_t size)
         snprintf(why, size, "out of memory");
         return 0;
     }
-    return !layer_packed_start_values(in, why, size);
+    return !layer_build_starts(in, why, size) && !layer_packed_start_values(in, why, size);
 }
 
 static char *copy_text(const char *text)

@@ -17,12 +17,13 @@
 #include "json_text.h"
 
 #define START_VALUES_FILE "start_values.json"
+#define BUILD_STARTS_FILE "model_starts.json"
 
 static const char *const KIND_NAMES[] = {"Real", "Integer", "Boolean", "String"};
 
-/* start_values.start_value: `value` as the start of `v`, into *out; else why. */
-static int start_value(const SmaVariable *v, const JsonValue *value, SmaValue *out, char *why,
-                       size_t size)
+/* start_values.start_value: `value` as the start of `v`, into *out; else why (naming `file`). */
+static int start_value(const char *file, const SmaVariable *v, const JsonValue *value,
+                       SmaValue *out, char *why, size_t size)
 {
     char shown[200];
     int ok = 0;
@@ -47,7 +48,7 @@ static int start_value(const SmaVariable *v, const JsonValue *value, SmaValue *o
     }
     if (ok) return 0;
     json_value_repr(value, shown, sizeof shown);
-    snprintf(why, size, "%s: %s = %s is not a valid %s start value", START_VALUES_FILE, v->name,
+    snprintf(why, size, "%s: %s = %s is not a valid %s start value", file, v->name,
              shown, KIND_NAMES[v->kind]);
     return 1;
 }
@@ -81,11 +82,88 @@ int layer_packed_start_values(Instance *in, char *why, size_t size)
         for (index = 0; index < in->model->count; ++index) {
             const SmaVariable *v = &in->model->variables[index];
             if (v->causality == SMA_PARAMETER && json_string_is(key, v->name)) {
-                failed = start_value(v, &values->items[i], &in->values[index], why, size);
+                failed = start_value(START_VALUES_FILE, v, &values->items[i], &in->values[index],
+                                     why, size);
                 break;
             }
         }
     }
+    json_value_free(&document);
+    return failed;
+}
+
+/* The build's starts: {"values": {every variable: its start}, "wire_defaults": [numbers or
+ * null, PARAMETER_SPECS order]}, written by `sma-fmu build --native` beside parameters.json
+ * (packaging/c_family_build.py). Choice: the binary holds none of a parameter file's values,
+ * so one binary serves every parameter file and can be built once (reproducible.py); the
+ * model description's start attributes are written from the same numbers. */
+static int build_wire_defaults(Instance *in, const JsonValue *wire, const char *path, char *why,
+                               size_t size)
+{
+    size_t i;
+    if (!wire || wire->kind != JSON_ARRAY) {
+        snprintf(why, size, "%.300s: must hold an array 'wire_defaults'", path);
+        return 1;
+    }
+    free(in->wire_defaults);
+    in->wire_defaults = (double *)malloc((wire->count ? wire->count : 1) * sizeof(double));
+    in->run.wire_defaults = in->wire_defaults;
+    in->run.wire_count = 0;
+    if (!in->wire_defaults) { snprintf(why, size, "out of memory"); return 1; }
+    for (i = 0; i < wire->count; ++i) {
+        const JsonValue *item = &wire->items[i];
+        if (item->kind != JSON_NULL && !(item->kind == JSON_NUMBER && isfinite(item->number))) {
+            snprintf(why, size, "%.300s: wire_defaults[%lu] is neither a finite number nor null",
+                     path, (unsigned long)i);
+            return 1;
+        }
+        in->wire_defaults[i] = item->kind == JSON_NULL ? NAN : item->number;
+    }
+    in->run.wire_count = wire->count;
+    return 0;
+}
+
+int layer_build_starts(Instance *in, char *why, size_t size)
+{
+    char path[4200], error[400];
+    int missing, failed = 0;
+    size_t i, index;
+    char *text;
+    JsonValue document;
+    const JsonValue *values;
+    if (!in->resources) return 0;
+    snprintf(path, sizeof path, "%s/%s", in->resources, BUILD_STARTS_FILE);
+    text = layer_start_file(path, &missing, why, size);
+    if (!text) {
+        if (missing) snprintf(why, size, "%.300s: missing (the FMU's start values)", path);
+        return 1;
+    }
+    if (json_text_parse(text, &document, error, sizeof error)) {
+        free(text);
+        snprintf(why, size, "%.300s: cannot be read (%s)", path, error);
+        return 1;
+    }
+    free(text);
+    values = document.kind == JSON_OBJECT ? json_object_get(&document, "values") : NULL;
+    if (!values || values->kind != JSON_OBJECT) {
+        json_value_free(&document);
+        snprintf(why, size, "%.300s: must be a JSON object with an object 'values'", path);
+        return 1;
+    }
+    for (index = 0; index < in->model->count && !failed; ++index) {
+        const SmaVariable *v = &in->model->variables[index];
+        for (i = 0; i < values->count; ++i)
+            if (json_string_is(&values->keys[i], v->name)) break;
+        if (i == values->count) {
+            snprintf(why, size, "%.300s: no start value of %s", path, v->name);
+            failed = 1;
+        } else {
+            failed = start_value(BUILD_STARTS_FILE, v, &values->items[i], &in->values[index], why,
+                                 size);
+        }
+    }
+    if (!failed)
+        failed = build_wire_defaults(in, json_object_get(&document, "wire_defaults"), path, why, size);
     json_value_free(&document);
     return failed;
 }

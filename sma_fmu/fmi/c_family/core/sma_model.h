@@ -44,6 +44,8 @@ typedef struct {
     const char *instance_name;
     double start_time;          /* fmi2SetupExperiment's startTime [s] (0 until set) */
     double first_step;          /* h0 [s], the first step's size; <= 0 until the first step */
+    const double *wire_defaults;  /* the build's wire parameter file (resources/model_starts.json), */
+    size_t wire_count;            /* in PARAMETER_SPECS order, NaN where not given */
 } SmaRun;
 
 /* A step within GRID_TOLERANCE steps of h0 is taken as h0 (SlaveInterface.nominal_step):

@@ -28,7 +28,7 @@ static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *messa
     PlantStepper *plant = (PlantStepper *)stepper;
     WireParameters params;
     const char *mode;
-    if (sma_wire_parameters(&SMA_MODEL, values, run, WIRE_DEFAULTS, &params, message) ||
+    if (sma_wire_parameters(&SMA_MODEL, values, run, &params, message) ||
         choice_name("hysteresis_mode", values[VAR_hysteresis_mode].integer, &mode, message) ||
         plant_stepper_init(plant, &params, &values[VAR_T_start].real, mode,
                            values[VAR_load].real, message))

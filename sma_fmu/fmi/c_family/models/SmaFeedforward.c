@@ -26,7 +26,7 @@ static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *messa
     WireParameters params;
     FeedforwardOutputs outputs;
     const char *inverse;
-    if (sma_wire_parameters(&SMA_MODEL, values, run, WIRE_DEFAULTS, &params, message) ||
+    if (sma_wire_parameters(&SMA_MODEL, values, run, &params, message) ||
         choice_name("inverse", values[VAR_inverse].integer, &inverse, message) ||
         feedforward_stepper_init(self, &params, params.phase_lag_alpha, params.beta,
                                  params.model_load, values[VAR_adapt_to_load].integer, inverse,

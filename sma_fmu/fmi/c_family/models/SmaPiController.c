@@ -16,7 +16,7 @@ static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *messa
     WireParameters params;
     PIController *controller = (PIController *)stepper;
     double power, feedback;
-    if (sma_wire_parameters(&SMA_MODEL, values, run, WIRE_DEFAULTS, &params, message) ||
+    if (sma_wire_parameters(&SMA_MODEL, values, run, &params, message) ||
         pi_controller_init(controller, params.Kp, params.Ki, message) ||
         pi_controller_preview(controller, values[VAR_R].real, values[VAR_R_ref].real,
                               values[VAR_P_ff].real, &power, &feedback, message))

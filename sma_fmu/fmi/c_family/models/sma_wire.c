@@ -6,16 +6,18 @@
 #include "sma_wire.h"
 
 int sma_wire_parameters(const SmaModel *model, const SmaValue *values, const SmaRun *run,
-                        const double defaults[PARAM_COUNT], WireParameters *out,
-                        SmaMessage *message)
+                        WireParameters *out, SmaMessage *message)
 {
     double merged[PARAM_COUNT];
     unsigned char given[PARAM_COUNT];
     char source[256];
     size_t i;
+    if (run->wire_defaults == NULL || run->wire_count != PARAM_COUNT)
+        return sma_message_set(message, "model_starts.json: %lu wire parameters, not %d",
+                               (unsigned long)run->wire_count, (int)PARAM_COUNT);
     for (i = 0; i < PARAM_COUNT; ++i) {  /* a default NaN: an optional parameter not given */
-        merged[i] = defaults[i];
-        given[i] = !isnan(defaults[i]);
+        merged[i] = run->wire_defaults[i];
+        given[i] = !isnan(merged[i]);
     }
     for (i = 0; i < model->count; ++i) {  /* a variable is always given, NaN too */
         const SmaVariable *v = &model->variables[i];

@@ -1,6 +1,6 @@
-/* The wire parameters of an instance: the parameter file the FMU was built with (compiled
- * in: WIRE_DEFAULTS of <Model>_variables.h) with the present values of the parameters the
- * FMU exposes (SlaveInterface.wire_parameters). */
+/* The wire parameters of an instance: the parameter file the FMU was built with (read from
+ * resources/model_starts.json into run->wire_defaults) with the present values of the
+ * parameters the FMU exposes (SlaveInterface.wire_parameters). */
 #ifndef SMA_WIRE_H
 #define SMA_WIRE_H
 
@@ -10,7 +10,6 @@
 /* Validated WireParameters, or nonzero with the ParameterError text, whose source is
  * "<model> instance '<instance>'" as in the pythonfmu FMUs. */
 int sma_wire_parameters(const SmaModel *model, const SmaValue *values, const SmaRun *run,
-                        const double defaults[PARAM_COUNT], WireParameters *out,
-                        SmaMessage *message);
+                        WireParameters *out, SmaMessage *message);
 
 #endif

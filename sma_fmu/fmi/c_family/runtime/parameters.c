@@ -206,7 +206,7 @@ int wire_parameters_from_given(WireParameters *out, const double values[],
                                               PARAM_theta, PARAM_mass};
     static const ParameterIndex SURFACE[] = {PARAM_h_c, PARAM_A_s};
     static const ParameterIndex HEAT[] = {PARAM_mass, PARAM_c_p, PARAM_h_c, PARAM_A_s};
-    static const ParameterIndex DOMAIN[] = {PARAM_nu, PARAM_eps_T};
+    static const ParameterIndex DOMAIN_ENERGY[] = {PARAM_nu, PARAM_eps_T};
     static const ParameterIndex STRESS[] = {PARAM_stress_max, PARAM_diameter};
     WireParameters p;
     double v[PARAM_COUNT], numbers[4], square;
@@ -258,7 +258,7 @@ int wire_parameters_from_given(WireParameters *out, const double values[],
         return 1;
     }
     numbers[0] = p.nu * p.eps_T / BOLTZMANN;
-    if (derived_failure(&p, v, "domain energy over k_B, nu eps_T/k_B", "K", DOMAIN, 2, numbers,
+    if (derived_failure(&p, v, "domain energy over k_B, nu eps_T/k_B", "K", DOMAIN_ENERGY, 2, numbers,
                         1, NULL, message)) {
         return 1;
     }
