@@ -10,7 +10,7 @@ from pathlib import Path
 from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
 from sma_fmu.fmi.packaging.fmi3_build import build_fmi3_fmus
-from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, FMU_SCRIPTS
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
 
 __all__ = ["build_fmus", "build_fmu", "validate_fmus"]

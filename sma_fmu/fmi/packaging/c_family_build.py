@@ -40,7 +40,7 @@ from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
 from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
 __all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_sources",
-           "build_native_fmus", "compile_binary"]
+           "build_from_twins", "build_native_fmus", "compile_binary"]
 
 C_FAMILY = Path(__file__).parents[1] / "c_family"
 C_COMMON = Path(__file__).parents[1] / "c_common"   # C code both families compile
@@ -176,15 +176,12 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
     return problems
 
 
-def build_native_fmus(out_dir, parameter_file=None, names=None, compile=False):
-    """Build the native FMUs (default: all five) into ``out_dir``; return {name: path}.
-
-    Each platform's binary is the prebuilt one of the wheel when it was compiled from the
-    same sources (:mod:`.prebuilt`), else, or with ``compile``, compiled here.
-
-    Built beside ``out_dir`` and moved there at the end: a failed build leaves it as it was.
-    """
-
+def build_from_twins(out_dir, parameter_file, names, build_one):
+    """Build each C-family FMU of ``names`` (default: all five) from its pythonfmu twin (the
+    variables, units and exact starts: one interface for both families) into ``out_dir``;
+    ``build_one(name, twin path, staging folder, work folder)`` writes one FMU and returns its
+    problem texts. Built beside ``out_dir`` and moved there at the end (a failed build leaves
+    it as it was); returns (names, the distinct problems without their model names)."""
     names = list(FMU_SCRIPTS) if names is None else list(names)
     with tempfile.TemporaryDirectory(prefix="sma_fmu_native_") as work:
         work = Path(work)
@@ -194,8 +191,23 @@ def build_native_fmus(out_dir, parameter_file=None, names=None, compile=False):
         problems = []
         with staged_folder(out_dir) as folder:
             for name in names:
-                problems += _build_one(name, python_fmus[name], folder, work, compile)
-    for message in sorted(set(p.split(": ", 1)[1] for p in problems)):
+                problems += build_one(name, python_fmus[name], folder, work)
+    return names, sorted(set(problem.split(": ", 1)[1] for problem in problems))
+
+
+def build_native_fmus(out_dir, parameter_file=None, names=None, compile=False):
+    """Build the native FMUs (default: all five) into ``out_dir``; return {name: path}.
+
+    Each platform's binary is the prebuilt one of the wheel when it was compiled from the
+    same sources (:mod:`.prebuilt`), else, or with ``compile``, compiled here.
+
+    Built beside ``out_dir`` and moved there at the end: a failed build leaves it as it was.
+    """
+
+    names, problems = build_from_twins(
+        out_dir, parameter_file, names,
+        lambda name, twin, folder, work: _build_one(name, twin, folder, work, compile))
+    for message in problems:
         hint = " Their sources/ compile there: fmpy.build.build_platform_binary"
         if message.startswith("built without win64"):
             hint = " Install mingw-w64 (Debian: apt-get install gcc-mingw-w64-x86-64) or set SMA_FMU_WIN64_CC," + hint

@@ -14,23 +14,19 @@ front (``c_family/fmi3/``). Each FMU holds:
 - the plant's ``terminalsAndIcons/terminalsAndIcons.xml`` (:mod:`.fmi3_terminals`).
 """
 import shutil
-import tempfile
 import warnings
 import zipfile
 from pathlib import Path
 
-from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarning, _c_files,
-                                                  _exact_starts, compile_binary, model_sources)
+                                                  _exact_starts, build_from_twins, compile_binary,
+                                                  model_sources)
 from sma_fmu.fmi.packaging.c_family_description import (model_starts, native_description,
                                                         variables_header)
 from sma_fmu.fmi.packaging.cross_build import TARGETS
 from sma_fmu.fmi.packaging.fmi3_description import (annotate_platforms, build_description,
                                                     fmi3_description, fmi3_model_header)
 from sma_fmu.fmi.packaging.fmi3_terminals import terminals_and_icons
-from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
-from sma_fmu.fmi.packaging.front_build import FrontWarning
-from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
 from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
 __all__ = ["PLATFORMS", "build_fmi3_fmus"]
@@ -101,16 +97,7 @@ def build_fmi3_fmus(out_dir, parameter_file=None, names=None):
 
     Built beside ``out_dir`` and moved there at the end: a failed build leaves it as it was.
     """
-    names = list(FMU_SCRIPTS) if names is None else list(names)
-    with tempfile.TemporaryDirectory(prefix="sma_fmu_fmi3_") as work:
-        work = Path(work)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", FrontWarning)  # the twins' fronts: not shipped
-            python_fmus = build_pythonfmu_fmus(work / "python", parameter_file, names)
-        problems = []
-        with staged_folder(out_dir) as folder:
-            for name in names:
-                problems += _build_one(name, python_fmus[name], folder, work)
-    for message in sorted(set(p.split(": ", 1)[1] for p in problems)):
+    names, problems = build_from_twins(out_dir, parameter_file, names, _build_one)
+    for message in problems:
         warnings.warn(NativeBuildWarning(f"FMI 3.0 FMUs {message}."), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}

@@ -53,30 +53,44 @@ static int start_value(const char *file, const SmaVariable *v, const JsonValue *
     return 1;
 }
 
+/* Read resources/<file> as a JSON object holding an object "values": 1 with *document parsed
+ * and *values in it (free the document), 0 when the file is missing, -1 with `why` set. */
+static int read_values_document(const Instance *in, const char *file, char *path,
+                                size_t path_size, JsonValue *document, const JsonValue **values,
+                                char *why, size_t size)
+{
+    char error[400];
+    int missing;
+    char *text;
+    snprintf(path, path_size, "%s/%s", in->resources, file);
+    text = layer_start_file(path, &missing, why, size);
+    if (!text) return missing ? 0 : -1;
+    if (json_text_parse(text, document, error, sizeof error)) {
+        free(text);
+        snprintf(why, size, "%.300s: cannot be read (%s)", path, error);
+        return -1;
+    }
+    free(text);
+    *values = document->kind == JSON_OBJECT ? json_object_get(document, "values") : NULL;
+    if (!*values || (*values)->kind != JSON_OBJECT) {
+        json_value_free(document);
+        snprintf(why, size, "%.300s: must be a JSON object with an object 'values'", path);
+        return -1;
+    }
+    return 1;
+}
+
 int layer_packed_start_values(Instance *in, char *why, size_t size)
 {
-    char path[4200], error[400];
-    int missing, failed = 0;
+    char path[4200];
+    int failed = 0, found;
     size_t i, index;
-    char *text;
     JsonValue document;
     const JsonValue *values;
     if (!in->resources) return 0;
-    snprintf(path, sizeof path, "%s/%s", in->resources, START_VALUES_FILE);
-    text = layer_start_file(path, &missing, why, size);
-    if (!text) return missing ? 0 : 1;
-    if (json_text_parse(text, &document, error, sizeof error)) {
-        free(text);
-        snprintf(why, size, "%.300s: cannot be read (%s)", path, error);
-        return 1;
-    }
-    free(text);
-    values = document.kind == JSON_OBJECT ? json_object_get(&document, "values") : NULL;
-    if (!values || values->kind != JSON_OBJECT) {
-        json_value_free(&document);
-        snprintf(why, size, "%.300s: must be a JSON object with an object 'values'", path);
-        return 1;
-    }
+    found = read_values_document(in, START_VALUES_FILE, path, sizeof path, &document, &values,
+                                 why, size);
+    if (found <= 0) return found < 0;   /* no packed values: nothing to do */
     for (i = 0; i < values->count && !failed; ++i) {
         const JsonValue *key = &values->keys[i];
         for (index = 0; index < in->model->count; ++index) {
@@ -125,31 +139,16 @@ static int build_wire_defaults(Instance *in, const JsonValue *wire, const char *
 
 int layer_build_starts(Instance *in, char *why, size_t size)
 {
-    char path[4200], error[400];
-    int missing, failed = 0;
+    char path[4200];
+    int failed = 0, found;
     size_t i, index;
-    char *text;
     JsonValue document;
     const JsonValue *values;
     if (!in->resources) return 0;
-    snprintf(path, sizeof path, "%s/%s", in->resources, BUILD_STARTS_FILE);
-    text = layer_start_file(path, &missing, why, size);
-    if (!text) {
-        if (missing) snprintf(why, size, "%.300s: missing (the FMU's start values)", path);
-        return 1;
-    }
-    if (json_text_parse(text, &document, error, sizeof error)) {
-        free(text);
-        snprintf(why, size, "%.300s: cannot be read (%s)", path, error);
-        return 1;
-    }
-    free(text);
-    values = document.kind == JSON_OBJECT ? json_object_get(&document, "values") : NULL;
-    if (!values || values->kind != JSON_OBJECT) {
-        json_value_free(&document);
-        snprintf(why, size, "%.300s: must be a JSON object with an object 'values'", path);
-        return 1;
-    }
+    found = read_values_document(in, BUILD_STARTS_FILE, path, sizeof path, &document, &values,
+                                 why, size);
+    if (found == 0) snprintf(why, size, "%.300s: missing (the FMU's start values)", path);
+    if (found <= 0) return 1;
     for (index = 0; index < in->model->count && !failed; ++index) {
         const SmaVariable *v = &in->model->variables[index];
         for (i = 0; i < values->count; ++i)
