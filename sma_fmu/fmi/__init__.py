@@ -2,7 +2,8 @@
 
 Lowest room first; each imports only from rooms before it (``tests/test_layout.py``):
 
-- ``c_common/``: C code both families compile (the resource-location URI, log categories);
+- ``c_common/``: C code both families compile (the resource-location URI, log categories,
+  the saved-state frame);
 - ``python_family/``: the pythonfmu FMUs' code: ``slaves/`` (one slave script per FMU),
   ``slave_support/`` (the FMI glue every such FMU ships) and ``front/`` (the C front, the
   FMU's binary in front of pythonfmu's);
