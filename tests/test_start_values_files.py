@@ -96,7 +96,13 @@ def test_both_families_accept_and_refuse_the_same_documents_alike(fmus, native_f
         assert "start_values.json" in message, message
         logged = "\n".join(python[1])  # pythonfmu logs the slave's ValueError, then the front
         assert "Traceback" not in logged and "RecursionError" not in logged
-        assert message.split("start_values.json", 1)[1] in logged, (python, native)
+        if case == "syntax error" and sys.version_info >= (3, 13):
+            # Python 3.13's json words a trailing comma its own way ("Illegal trailing comma
+            # before end of object", a column earlier); the C reader words it as 3.11 and 3.12
+            # do: both refuse the file, naming it, with the decoder's line and column
+            assert "start_values.json: cannot be read (" in logged and "line 1 column" in logged
+        else:
+            assert message.split("start_values.json", 1)[1] in logged, (python, native)
 
 
 LIMITS = {"nesting 65 deep": "nesting deeper than 64 levels", "257 members": "more than 256 members",
