@@ -46,6 +46,15 @@ def native_fmus(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def fmi3_fmus(tmp_path_factory):
+    """The native FMUs as FMI 3.0, built once per session (sma-fmu build --native --fmi 3):
+    {name: path}."""
+    need("gcc")
+    from sma_fmu.fmi.packaging.build import build_fmus
+    return build_fmus(tmp_path_factory.mktemp("fmi3"), native=True, fmi_version=3)
+
+
+@pytest.fixture(scope="session")
 def unpacked(fmus, tmp_path_factory):
     """Both FMUs unpacked once per session: {name: folder}."""
     from fmi_host import unpack

@@ -24,12 +24,6 @@ pytestmark = pytest.mark.needs("gcc")
 NAMES = ["SmaActuator", "SmaFeedforward", "SmaPiController", "SmaPwmDriver", "SmaScenarioSignals"]
 
 
-@pytest.fixture(scope="module")
-def fmi3_fmus(tmp_path_factory):
-    from sma_fmu.fmi.packaging.build import build_fmus
-    return build_fmus(tmp_path_factory.mktemp("fmi3"), native=True, fmi_version=3)
-
-
 class Versions:
     """One C-family model as FMI 2.0 (``v2``) and FMI 3.0 (``v3``)."""
 

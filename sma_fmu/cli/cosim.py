@@ -9,7 +9,8 @@ __all__ = ["register"]
 def _run(args):
     from sma_fmu.systems.runner import timed_run
     timed_run(scenario_paths(args), args.out, args.path, args.fmus,
-              output_interval_s=args.output_interval, fmt=args.format, master=args.master)
+              output_interval_s=args.output_interval, fmt=args.format, master=args.master,
+              events=args.events)
     return 0
 
 
@@ -26,6 +27,10 @@ def register(commands):
     run.add_argument("--master", choices=("fmpy", "c"), default="fmpy",  # runner.FMU_MASTERS
                      help="the FMU path's master: fmpy (default; Python) or c (the C master: "
                           "the FMUs stepped in one C process, the same results to the bit)")
+    run.add_argument("--events", action="store_true",
+                     help="FMI 3.0 FMUs only, fmpy master: instantiate with event mode and early "
+                          "return; the plant steps from edge to edge of the PWM wave, the rows "
+                          "stay on the fixed step grid")
     run.add_argument("--output-interval", type=positive_number, metavar="S",
                      help="record every k-th step in the time series and figures: S seconds, a "
                           "whole number of steps (default: the scenario's output_interval_s, else "

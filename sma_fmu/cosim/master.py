@@ -20,14 +20,16 @@ from ctypes import POINTER, Structure, byref, c_double, c_int, c_size_t, c_uint,
 from functools import partial
 from pathlib import Path
 
+from sma_fmu.cosim.event_drive import EventDrivenPlant, PassThroughDriver, traced_driver
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
 from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.fmi.python_family.slave_support.choices import choice_code
-from sma_fmu.fmi.driving.instance import FmuError, FmuInstance
+from sma_fmu.fmi.driving.instance import FmuError
+from sma_fmu.fmi.driving.instance3 import fmi_major, open_instance
 
 __all__ = ["FmuPlant", "FmuCompensator", "FmuDriver", "LeanStep", "needed_fmus", "run_fmus",
-           "MissingFmuError", "model_parameter_values"]
+           "MissingFmuError", "model_parameter_values", "fmi_versions"]
 
 
 class MissingFmuError(FileNotFoundError):
@@ -77,18 +79,20 @@ class LeanStep:
         component = c_void_p(fmu.component)
         library = fmu.library
         self._names = (inputs, outputs, flags)
+        real, boolean = fmu.PORT_TYPES  # (FMI 2.0: Real, Boolean; FMI 3.0: Float64, Boolean)
 
-        def bound(function, names, ctype):
+        def bound(kind, getter, names):
+            _, set_name, get_name, ctype = fmu.ACCESSORS[kind]
             references = (c_uint * len(names))(*(fmu.variables[name].valueReference for name in names))
             values = (ctype * len(names))()
-            raw = library[function]  # a function object of its own: no argtypes, int result
+            raw = library[get_name if getter else set_name]  # a function object of its own: no argtypes
             raw.restype = c_int
-            return partial(raw, component, references, c_size_t(len(names)), values), values
+            return fmu.bind(raw, references, values), values
 
-        self._set, self.inputs = bound("fmi2SetReal", inputs, c_double)
-        self._get, self.outputs = bound("fmi2GetReal", outputs, c_double)
-        self._get_flags, self.flags = bound("fmi2GetBoolean", flags, c_int) if flags else (None, None)
-        self._do_step = partial(fmu._do_step_c, component)
+        self._set, self.inputs = bound(real, False, inputs)
+        self._get, self.outputs = bound(real, True, outputs)
+        self._get_flags, self.flags = bound(boolean, True, flags) if flags else (None, None)
+        self._do_step = fmu.step_call()
         self.combined = None
         if combined is not False:
             self.combined = self._combined_call(library, component)
@@ -114,7 +118,8 @@ class LeanStep:
         """The :class:`~sma_fmu.fmi.driving.instance.FmuError` of a call above fmi2Warning: ``stage``
         0 set, 1 doStep, 2 get."""
         inputs, outputs, flags = self._names
-        what = (f"set {', '.join(inputs)}", "fmi2DoStep", f"get {', '.join(outputs + flags)}")[min(stage, 2)]
+        what = (f"set {', '.join(inputs)}", f"{self.fmu.PREFIX}DoStep",
+                f"get {', '.join(outputs + flags)}")[min(stage, 2)]
         return self.fmu.failure(what, status)
 
     def _closure(self):
@@ -155,12 +160,12 @@ class LeanStep:
 class FmuPlant:
     """The SmaActuator FMU as a loop plant."""
 
-    def __init__(self, scenario, fmu_path, instance_name="plant", combined=None):
+    def __init__(self, scenario, fmu_path, instance_name="plant", combined=None, events=False):
         start = model_parameter_values(fmu_path, scenario.params)
         start.update(T_start=scenario.T_start,
                      hysteresis_mode=choice_code("hysteresis_mode", scenario.hysteresis_mode),
                      load=scenario.load.value(0.0))
-        self.fmu = FmuInstance(fmu_path, instance_name, start)
+        self.fmu = open_instance(fmu_path, instance_name, start, events=events)
         self._outputs = self.fmu.port(PLANT_OUTPUTS)
         lean = LeanStep(self.fmu, ("P_in", "load"), PLANT_OUTPUTS, combined=combined)
         inputs, values, lean_step = lean.inputs, lean.outputs, lean.step
@@ -185,14 +190,14 @@ class FmuPlant:
 class FmuCompensator:
     """The SmaFeedforward FMU as the loop's compensator."""
 
-    def __init__(self, scenario, fmu_path, instance_name="feedforward", combined=None):
+    def __init__(self, scenario, fmu_path, instance_name="feedforward", combined=None, events=False):
         c = scenario.controller
         start = model_parameter_values(fmu_path, scenario.compensator_params)
         start.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
                      adapt_to_load=c.adapt_to_load, inverse=choice_code("inverse", c.inverse),
                      R_ref=scenario.reference.value(0.0),
                      load=scenario.load.value(0.0))
-        self.fmu = FmuInstance(fmu_path, instance_name, start)
+        self.fmu = open_instance(fmu_path, instance_name, start, events=events)
         lean = LeanStep(self.fmu, ("R_ref", "load"), ("P_ff", "T_ref"), ("saturated",),
                         combined=combined)
         inputs, outputs, saturated, lean_step = lean.inputs, lean.outputs, lean.flags, lean.step
@@ -213,10 +218,11 @@ class FmuCompensator:
 class FmuDriver:
     """The SmaPwmDriver FMU as the loop's driver (the hook of :func:`~sma_fmu.cosim.loop.run_loop`)."""
 
-    def __init__(self, scenario, fmu_path, instance_name="driver", combined=None):
+    def __init__(self, scenario, fmu_path, instance_name="driver", combined=None, events=False):
         drive = scenario.drive
-        self.fmu = FmuInstance(fmu_path, instance_name,
-                               {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W})
+        self.fmu = open_instance(fmu_path, instance_name,
+                                 {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W},
+                                 events=events)
         self._initial = self.fmu.port(("P_in",))
         lean = LeanStep(self.fmu, ("P_demand",), ("P_in",), combined=combined)
         inputs, outputs, lean_step = lean.inputs, lean.outputs, lean.step
@@ -244,27 +250,53 @@ def needed_fmus(scenario):
             + (["SmaPwmDriver"] if scenario.drive.pwm else []))
 
 
-def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None):
-    """Run ``scenario`` through the FMUs in ``fmu_dir``; returns a :class:`LoopResult`.
-
-    ``sink``: see :func:`~sma_fmu.cosim.loop.run_loop` (then the result's ``data`` is None).
-    ``combined``: see :class:`LeanStep` (False: the separate FMI calls).
-    """
+def fmi_versions(scenario, fmu_dir):
+    """{FMU name: FMI major version ("2" or "3")} of the FMUs ``scenario`` needs in ``fmu_dir``;
+    :class:`MissingFmuError` names one not built."""
     paths = default_fmu_paths(fmu_dir)
     for name in needed_fmus(scenario):
         if not paths[name].is_file():
             raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "
                                   f"sma-fmu build --out {Path(fmu_dir)}")
+    return {name: fmi_major(paths[name]) for name in needed_fmus(scenario)}
+
+
+def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events=False,
+             power_trace=None):
+    """Run ``scenario`` through the FMUs in ``fmu_dir``; returns a :class:`LoopResult`.
+
+    Each FMU is driven through the adapter of its own FMI version (2.0 or 3.0; a folder may
+    mix them). ``sink``: see :func:`~sma_fmu.cosim.loop.run_loop` (then the result's
+    ``data`` is None). ``combined``: see :class:`LeanStep` (False: the separate FMI calls).
+    ``events``: FMI 3.0 event mode and early return (:mod:`sma_fmu.cosim.event_drive`);
+    every FMU the scenario needs must be FMI 3.0 (``ValueError`` names one that is not).
+    ``power_trace``: a list that gets (start [s], end [s], P_demand [W], P_in [W]) of every
+    step the plant makes behind the PWM driver (scenarios with ``[drive] kind = "pwm"``).
+    """
+    versions = fmi_versions(scenario, fmu_dir)
+    paths = default_fmu_paths(fmu_dir)
+    if events:
+        older = [name for name, version in versions.items() if version != "3"]
+        if older:
+            raise ValueError(f"--events: {paths[older[0]]} is an FMI {versions[older[0]]}.0 FMU; "
+                             f"event mode and early return need FMI 3.0 FMUs (sma-fmu build "
+                             f"--native --fmi 3)")
     start = time.perf_counter()
     parts = {}
     try:
-        parts["plant"] = FmuPlant(scenario, paths["SmaActuator"], combined=combined)
+        parts["plant"] = FmuPlant(scenario, paths["SmaActuator"], combined=combined, events=events)
         if scenario.controller.feedforward:
-            parts["compensator"] = FmuCompensator(scenario, paths["SmaFeedforward"], combined=combined)
+            parts["compensator"] = FmuCompensator(scenario, paths["SmaFeedforward"],
+                                                  combined=combined, events=events)
         if scenario.drive.pwm:
-            parts["driver"] = FmuDriver(scenario, paths["SmaPwmDriver"], combined=combined)
-        data = run_loop(scenario, parts["plant"], parts.get("compensator"),
-                        driver=parts.get("driver"), sink=sink)
+            parts["driver"] = FmuDriver(scenario, paths["SmaPwmDriver"], combined=combined,
+                                        events=events)
+        plant, driver = parts["plant"], parts.get("driver")
+        if events and driver is not None:
+            plant, driver = EventDrivenPlant(driver, plant, power_trace), PassThroughDriver()
+        elif driver is not None and power_trace is not None:
+            driver = traced_driver(driver, power_trace)
+        data = run_loop(scenario, plant, parts.get("compensator"), driver=driver, sink=sink)
     except FmuError as error:
         raise FmuError(f"scenario {scenario.name}: {error}", error.status) from None
     finally:

@@ -66,7 +66,7 @@ def comparison_labels(scenarios, names):
 
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print,
-                  output_interval_s=None, fmt="csv", master="fmpy"):
+                  output_interval_s=None, fmt="csv", master="fmpy", events=False):
     """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
@@ -74,7 +74,9 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     k-th step in the time series and figures (None: the scenario's ``[scenario]
     output_interval_s``, else every step); the metrics count every step. ``fmt``: the time
     series' format, "csv" or "parquet". ``master``: the FMU path's master, a key of
-    :data:`FMU_MASTERS` (``"c"`` only with ``path="fmu"``). Each run streams into its files
+    :data:`FMU_MASTERS` (``"c"`` only with ``path="fmu"``). ``events``: the fmpy master
+    runs FMI 3.0 FMUs with event mode and early return (:mod:`sma_fmu.cosim.event_drive`;
+    only with ``path="fmu"``, ``master="fmpy"``). Each run streams into its files
     (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
     """
     if path not in PATHS:
@@ -83,7 +85,13 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         raise ValueError(f"--master must be one of {', '.join(FMU_MASTERS)}, got {master!r}")
     if master != "fmpy" and path != "fmu":
         raise ValueError(f"--master {master} runs the FMUs (--path fmu), not --path {path}")
+    if events and (path != "fmu" or master != "fmpy"):
+        raise ValueError(f"--events runs the FMUs through the fmpy master (--path fmu --master "
+                         f"fmpy), not --path {path} --master {master}")
     run = FMU_MASTERS[master] if path == "fmu" else PATHS[path]
+    if events:
+        def run(scenario, fmu_dir, sink):
+            return run_fmus(scenario, fmu_dir, sink, events=True)
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
@@ -104,6 +112,8 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
             metrics.update(path=path, wall_time_s=wall_time_s)
             if path == "fmu":
                 metrics["master"] = master
+            if events:
+                metrics["events"] = True
             for warning in metrics["warnings"]:
                 progress(f"warning: {scenario.name}: {warning}")
             (folder / "metrics.json").write_text(json_text(metrics), encoding="utf-8")
@@ -140,10 +150,11 @@ def _record_run(scenario, run, fmu_dir, folder, every, fmt):
 
 
 def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv",
-              master="fmpy"):
+              master="fmpy", events=False):
     """:func:`run_scenarios`, then print the summary table; returns the rows."""
     start = time.perf_counter()
-    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master)
+    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master,
+                         events)
     progress(summary_table(rows))
     progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)")
     return rows
