@@ -14,12 +14,12 @@ Step Mode; :meth:`Fmu3Instance.step_events` reports what doStep said (an event t
 early return and where the step ended). :func:`open_instance` picks the adapter by the FMU's
 ``fmiVersion``.
 """
-from ctypes import POINTER, byref, c_bool, c_double, c_int32, c_int64, c_size_t, c_void_p
+from ctypes import addressof, c_bool, c_double, c_int32, c_int64, c_size_t, c_void_p
 from functools import partial
 
 from fmpy.fmi3 import FMU3Slave
 
-from sma_fmu.fmi.driving import unpacked
+from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.fmi.driving.instance import FmuInstance, _raw
 
 __all__ = ["Fmu3Instance", "open_instance", "fmi_major"]
@@ -27,12 +27,8 @@ __all__ = ["Fmu3Instance", "open_instance", "fmi_major"]
 
 def fmi_major(path):
     """The FMI major version of the FMU file ``path``: "2" or "3" (its model description's
-    ``fmiVersion``; the file is unpacked once per process, :mod:`.unpacked`)."""
-    held = unpacked.acquire(str(path))
-    try:
-        return held.description.fmiVersion.split(".")[0]
-    finally:
-        unpacked.release(held)
+    ``fmiVersion``; :class:`~sma_fmu.fmi.driving.description.FmuFileError` for no usable FMU)."""
+    return read_description(path).fmiVersion.split(".")[0]
 
 
 def open_instance(path, instance_name, start_values=None, start_time=0.0, events=False):
@@ -70,7 +66,8 @@ class Fmu3Instance(FmuInstance):
         self.events = bool(events)
         # doStep's outputs: eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime
         self.flags = (c_bool(), c_bool(), c_bool(), c_double())
-        self._flag_refs = tuple(byref(flag) for flag in self.flags)
+        # their addresses as void* arguments: ctypes passes these faster than byref() objects
+        self._flag_refs = tuple(c_void_p(addressof(flag)) for flag in self.flags)
         super().__init__(path, instance_name, start_values, start_time)
 
     def _slave(self, description):
@@ -79,9 +76,7 @@ class Fmu3Instance(FmuInstance):
                          instanceName=self.instance_name)
 
     def _raw_do_step(self, library):
-        flag = POINTER(c_bool)
-        return _raw(library, "fmi3DoStep", [c_void_p, c_double, c_double, c_bool, flag, flag, flag,
-                                            POINTER(c_double)])
+        return _raw(library, "fmi3DoStep", [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4)
 
     def _log3(self, environment, status, category, message):
         self._record(status, message)
@@ -109,13 +104,14 @@ class Fmu3Instance(FmuInstance):
         returns the status. With event mode, an event asked for is handled at once (the
         instance is back in Step Mode); an early return raises :class:`FmuError` (a block that
         may return early is stepped with :meth:`step_events`)."""
-        raw, component, refs = self._do_step_c, c_void_p(self.component), self._flag_refs
+        raw, component = self._do_step_c, c_void_p(self.component)
+        a, b, c, d = self._flag_refs
         if not self.events:
-            return lambda time, step_size, no_set: raw(component, time, step_size, no_set, *refs)
+            return lambda time, step_size, no_set: raw(component, time, step_size, no_set, a, b, c, d)
         event, early = self.flags[0], self.flags[2]
 
         def call(time, step_size, no_set):
-            status = raw(component, time, step_size, no_set, *refs)
+            status = raw(component, time, step_size, no_set, a, b, c, d)
             if status <= 1 and early.value:
                 raise self.failure("fmi3DoStep", 3, f"returned early at t = {self.flags[3].value!r} "
                                    f"s, which this block's master does not handle")
