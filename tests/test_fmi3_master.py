@@ -52,6 +52,38 @@ def test_each_fmu_gets_the_adapter_of_its_version(fmi2_dir, fmi3_dir):
         open_instance(fmi2_dir / "SmaActuator.fmu", "v2", events=True)
 
 
+def test_saved_states_replay_through_the_fmi3_adapter(fmi3_dir):
+    with open_instance(fmi3_dir / "SmaActuator.fmu", "states", {"load": 0.1}) as fmu:
+        def run(first):
+            values = []
+            for k in range(first, first + 50):
+                fmu.set_real(("P_in",), (0.3 + 0.2 * (k % 7),))
+                fmu.step(k * 1e-3, 1e-3)
+                values.append(fmu.get_real(("R", "T")))
+            return values
+        run(0)
+        saved = fmu.get_state()
+        state = fmu.deserialize_state(fmu.serialize_state(saved))
+        fmu.free_state(saved)
+        first = run(50)
+        fmu.set_state(state)
+        fmu.free_state(state)
+        assert run(50) == first and first[0] != first[-1]
+
+
+def test_a_block_that_returns_early_unasked_is_an_error(fmi3_dir):
+    """The master's fixed-grid step (LeanStep) of a block in event mode: an early return
+    it does not handle is an FmuError naming fmi3DoStep, not a silently short step."""
+    from sma_fmu.cosim.master import LeanStep
+    with open_instance(fmi3_dir / "SmaPwmDriver.fmu", "early", {"frequency_Hz": 130.0},
+                       events=True) as fmu:
+        lean = LeanStep(fmu, ("P_demand",), ("P_in",))
+        lean.inputs[0] = 0.3 * fmu.get_real(("peak_W",))[0]
+        with pytest.raises(FmuError, match=r"early: fmi3DoStep failed \(error\): returned early"):
+            for k in range(10):
+                lean.step(k * 1e-3, 1e-3)
+
+
 @pytest.mark.parametrize("name", PAPER_SET + PWM)
 def test_fmi3_fmus_give_the_fmi2_rows_and_metrics_to_the_bit(fmi2_dir, fmi3_dir, name):
     scenario = _scenario(name)

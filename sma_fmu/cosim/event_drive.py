@@ -39,7 +39,8 @@ class PassThroughDriver:
 class EventDrivenPlant:
     """The SmaPwmDriver FMU (``driver``, an :class:`~sma_fmu.cosim.master.FmuDriver` with event
     mode) and the plant (an :class:`~sma_fmu.cosim.master.FmuPlant`) stepped together from edge
-    to edge; a loop plant whose ``step`` takes the demand [W] instead of the power."""
+    to edge; a loop plant whose ``step`` takes the demand [W] instead of the power. The
+    master closes the two itself."""
 
     def __init__(self, driver, plant, power_trace=None):
         self.driver, self.plant = driver, plant
@@ -75,11 +76,6 @@ class EventDrivenPlant:
             start = last
         outputs[6] = energy / step_size
         return outputs
-
-    def close(self):
-        """Free both instances."""
-        self.driver.close()
-        self.plant.close()
 
 
 def traced_driver(driver, power_trace):
