@@ -28,7 +28,8 @@ from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
 
-__all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "identifier", "STEP_ORDER"]
+__all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "identifier", "STEP_ORDER",
+           "COMPONENT_MODELS", "loop_connections"]
 
 # Gauss-Seidel order of a sequential host: the sampled blocks in data-flow order (the PWM
 # driver's output is the wave's mean over the step it was given), then the blocks whose
@@ -36,6 +37,9 @@ __all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "identifier",
 # at t + h), so every block of step k sees R_k, R_ref(t_k), f(t_k) and the u_ff,k, u_k
 # and driver power just computed, as in the library loop
 STEP_ORDER = ("compensator", "pi", "driver", "plant", "signals")
+# component name in the system -> its FMU's model name
+COMPONENT_MODELS = {"signals": "SmaScenarioSignals", "compensator": "SmaFeedforward",
+                    "pi": "SmaPiController", "driver": "SmaPwmDriver", "plant": "SmaActuator"}
 
 
 def identifier(name):
@@ -127,6 +131,22 @@ def _component(name, model, paths, parameters=None, params=None):
     return Component(name, model, paths[model], values, variables)
 
 
+def loop_connections(feedforward, pwm):
+    """The loop's :class:`Connection` list: with the compensator (``feedforward``) and the PWM
+    driver (``pwm``) or without them (the PI's P_ff then keeps its start; the PI feeds the
+    plant directly)."""
+    power = ([Connection("pi", "P", "driver", "P_demand"), Connection("driver", "P_in", "plant", "P_in")]
+             if pwm else [Connection("pi", "P", "plant", "P_in")])
+    connections = [Connection("signals", "R_ref", "pi", "R_ref"), *power,
+                   Connection("signals", "load", "plant", "load"),
+                   Connection("plant", "R", "pi", "R")]
+    if feedforward:
+        connections[1:1] = [Connection("signals", "R_ref", "compensator", "R_ref"),
+                            Connection("signals", "load", "compensator", "load"),
+                            Connection("compensator", "P_ff", "pi", "P_ff")]
+    return connections
+
+
 def closed_loop(scenario, fmu_dir):
     """The :class:`LoopSystem` of ``scenario`` with the FMUs built in ``fmu_dir``."""
     paths = _fmu_files(scenario, fmu_dir)
@@ -135,19 +155,12 @@ def closed_loop(scenario, fmu_dir):
         "reference": table_text(scenario.reference.as_table()),
         "load_profile": table_text(scenario.load.as_table())})]
     drive = scenario.drive
-    power = ([Connection("pi", "P", "driver", "P_demand"), Connection("driver", "P_in", "plant", "P_in")]
-             if drive.pwm else [Connection("pi", "P", "plant", "P_in")])
-    connections = [Connection("signals", "R_ref", "pi", "R_ref"), *power,
-                   Connection("signals", "load", "plant", "load"),
-                   Connection("plant", "R", "pi", "R")]
+    connections = loop_connections(c.feedforward, drive.pwm)
     if c.feedforward:
         components.append(_component("compensator", "SmaFeedforward", paths, {
             "alpha": c.alpha, "beta": c.beta, "model_load": c.model_load,
             "adapt_to_load": c.adapt_to_load, "inverse": choice_code("inverse", c.inverse)},
             scenario.compensator_params))
-        connections[1:1] = [Connection("signals", "R_ref", "compensator", "R_ref"),
-                            Connection("signals", "load", "compensator", "load"),
-                            Connection("compensator", "P_ff", "pi", "P_ff")]
     components.append(_component("pi", "SmaPiController", paths, {"Kp": c.Kp, "Ki": c.Ki}))
     if drive.pwm:
         components.append(_component("driver", "SmaPwmDriver", paths, {
