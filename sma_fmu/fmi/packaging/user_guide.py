@@ -7,13 +7,15 @@ as ``<span class="limit" data-name="name" data-value="repr">value unit</span>`` 
 sees the value with its unit and a test can read the exact number back.
 
 :func:`loop_section` says how to connect the FMU in the closed loop: the connections of
-:func:`sma_fmu.systems.closed_loop.loop_connections` that touch the model, and its place in
-the Gauss-Seidel order :data:`~sma_fmu.systems.closed_loop.STEP_ORDER`.
+:func:`.loop_wiring.loop_connections` that touch the model, and its place in
+the Gauss-Seidel order :data:`~.loop_wiring.STEP_ORDER`.
 """
 import html
 import math
 from importlib import resources
 from string import Template
+
+from sma_fmu.fmi.packaging.loop_wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
 
 __all__ = ["PAGES", "limits", "page_template", "model_section", "loop_section"]
 
@@ -69,8 +71,6 @@ def model_section(model_name, params):
 
 def _connection_rows(model_name):
     """(from, to, note) of the loop connections that touch ``model_name``."""
-    from sma_fmu.systems.closed_loop import COMPONENT_MODELS, loop_connections
-
     role = next(name for name, model in COMPONENT_MODELS.items() if model == model_name)
     full = loop_connections(feedforward=True, pwm=True)
     direct = [c for c in loop_connections(feedforward=True, pwm=False) if c not in full]
@@ -84,8 +84,6 @@ def _connection_rows(model_name):
 
 def loop_section(model_name, step):
     """The HTML of how ``model_name`` sits in the closed loop, sampled every ``step`` [s]."""
-    from sma_fmu.systems.closed_loop import COMPONENT_MODELS, STEP_ORDER
-
     if model_name not in COMPONENT_MODELS.values():
         return ""
     role, rows = _connection_rows(model_name)
