@@ -4,6 +4,7 @@ carry their own fmi-ls-ref reference result, which ``sma-fmu check`` verifies (e
 fmi3_build.py, reference_results.py)."""
 import html
 import re
+import xml.etree.ElementTree as ET
 import zipfile
 from html.parser import HTMLParser
 
@@ -21,6 +22,7 @@ pytestmark = pytest.mark.needs("gcc")
 
 NAMES = ["SmaActuator", "SmaFeedforward", "SmaPiController", "SmaPwmDriver", "SmaScenarioSignals"]
 FAMILIES = ["pythonfmu-fmi2", "c-fmi2", "c-fmi3"]
+LS = "{http://fmi-standard.org/fmi-ls-manifest}"
 VOID = {"meta", "img", "br", "hr", "input", "link", "col", "wbr"}
 
 # per model: units its equations section must state, and the validity numbers it must quote
@@ -103,7 +105,9 @@ def test_each_index_html_is_well_formed_and_offline(family):
         assert "<script" not in text and "<link" not in text, (label, model)
         assert not [s for s in checker.sources if "//" in s], (label, model, checker.sources)
         figures = [s[4:] for s in checker.sources if s.startswith("img:")]
-        assert figures, (label, model)
+        assert figures[0] == "result.png", (label, model)
+        # the plant also shows its hysteresis, R over T, from the same reference result
+        assert ("hysteresis.png" in figures) == (model == "SmaActuator"), (label, model, figures)
         for figure in figures:   # the figure it shows is in the archive, a PNG
             assert _read(fmus[model], f"documentation/{figure}")[:8] == b"\x89PNG\r\n\x1a\n", figure
 
@@ -167,6 +171,9 @@ def test_fmi3_fmus_carry_their_own_reference_equal_to_the_fmi2_twins(fmi3_fmus, 
         assert set(files) | {"documentation/index.html", "documentation/result.png"} <= names, model
         for name in files:
             assert _read(fmi3_fmus[model], name) == _read(fmus[model], name), (model, name)
+        root = ET.fromstring(_read(fmi3_fmus[model], MANIFEST))   # FMI 3.0's layered-standard manifest
+        assert root.get(f"{LS}fmi-ls-name") == LS_REF_FOLDER.split("/")[1], model
+        assert root.get(f"{LS}fmi-ls-version") and root.get(f"{LS}fmi-ls-description"), model
         status, detail = reference_check(fmi3_fmus[model])
         assert status == "ok" and "10000 steps of 0.001 s" in detail, (model, detail)
 
@@ -201,7 +208,10 @@ def test_c_family_fmi2_documentation_is_added_after_the_twins_reference(native_f
     for model in NAMES:
         with zipfile.ZipFile(native_fmus[model]) as archive:
             names = archive.namelist()
-        assert names[-2:] == ["documentation/result.png", "documentation/index.html"], model
+        documentation = ["documentation/result.png"] + \
+            (["documentation/hysteresis.png"] if model == "SmaActuator" else []) + ["documentation/index.html"]
+        assert names[-len(documentation):] == documentation, model
+        assert not [n for n in names[:-len(documentation)] if n.startswith("documentation/")], model
         for name in [n for n in names if n.startswith("extra/")]:
             assert _read(native_fmus[model], name) == _read(fmus[model], name), (model, name)
         text = _read(native_fmus[model], "documentation/index.html").decode("utf-8")

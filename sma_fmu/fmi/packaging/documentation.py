@@ -8,7 +8,8 @@ every variable with its causality, type, unit, start value and description, the 
 parameters (``resources/parameters.json``), its platforms
 (:func:`~sma_fmu.fmi.packaging.platforms.platform_report`, else its ``binaries/`` folders), the
 calling sequence of its FMI version, and a figure of its default experiment (``result.png``,
-matplotlib) with the files of the reference result (:mod:`.reference_results`).
+matplotlib) with the files of the reference result (:mod:`.reference_results`); for the
+plant also ``hysteresis.png``, its resistance over its temperature in that experiment.
 """
 import html
 import json
@@ -17,10 +18,12 @@ import zipfile
 from sma_fmu.files.png_output import png_bytes
 from sma_fmu.fmi.packaging.user_guide import loop_section, model_section
 
-__all__ = ["FIGURE", "INDEX", "calling_sequence", "figure_png", "index_html"]
+__all__ = ["FIGURE", "HYSTERESIS", "INDEX", "calling_sequence", "figure_png", "hysteresis_png",
+           "index_html"]
 
 INDEX = "documentation/index.html"
 FIGURE = "documentation/result.png"
+HYSTERESIS = "documentation/hysteresis.png"   # R over T, for a result with both
 
 _CALLING_SEQUENCE = {
     "2": ("fmi2Instantiate(instanceName, fmi2CoSimulation, GUID, resourceURI, ...)",
@@ -73,6 +76,30 @@ def figure_png(result, inputs, units, title):
         axis.legend(loc="upper right", fontsize="small")
         axis.grid(True, alpha=0.3)
     axes[-1].set_xlabel("time [s]")
+    figure.suptitle(title)
+    return png_bytes(figure)
+
+
+def hysteresis_png(result, units, title):
+    """PNG bytes: R over T of ``result`` (a structured array), heating and cooling rows apart
+    (its ``heating`` column, 1 or 0); None for a result without R and T."""
+    names = result.dtype.names
+    if "R" not in names or "T" not in names:
+        return None
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(6.0, 4.5), dpi=80, layout="constrained")
+    axis = figure.subplots()
+    heating = result["heating"] > 0.5 if "heating" in names else result["T"] == result["T"]
+    for rows, label, style in ((heating, "heating", "C3."), (~heating, "cooling", "C0.")):
+        if rows.any():
+            axis.plot(result["T"][rows], result["R"][rows], style, markersize=2, label=label)
+    axis.set_xlabel(f"T [{units.get('T') or '1'}]")
+    axis.set_ylabel(f"R [{units.get('R') or '1'}]")
+    axis.legend(loc="upper right", fontsize="small")
+    axis.grid(True, alpha=0.3)
     figure.suptitle(title)
     return png_bytes(figure)
 
@@ -203,5 +230,8 @@ def index_html(fmu_path, description, experiment, files):
           "runs the experiment again and compares. With fmpy:</p>",
         f"<pre>{e(run)}</pre>",
         f"<img src=\"result.png\" alt=\"{e(name)}: the default experiment\">",
+        (f"<p>Its resistance over its temperature in that experiment: the heating and the "
+         f"cooling branch of the hysteresis.</p>\n<img src=\"{e(files['hysteresis'].split('/')[-1])}\" "
+         f"alt=\"{e(name)}: R over T\">" if files.get("hysteresis") else ""),
         "</body>", "</html>", ""]
     return "\n".join(parts)

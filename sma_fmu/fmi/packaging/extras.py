@@ -8,7 +8,8 @@ FMI 3.0 FMU itself): it works on any FMI 2.0 or 3.0 co-simulation archive. It
 2. runs that experiment in fmpy with the model's stimuli (:mod:`.reference_results`);
 3. writes into the archive the fmi-ls-ref files (manifest, ``<Model>_in.csv``,
    ``<Model>_out.csv`` under ``extra/org.fmi-standard.fmi-ls-ref/``) and
-   ``documentation/index.html`` with ``documentation/result.png`` (:mod:`.documentation`).
+   ``documentation/index.html`` with ``documentation/result.png`` (and, for the plant,
+   ``documentation/hysteresis.png``: R over T) (:mod:`.documentation`).
 
 :func:`add_documentation` does step 3's documentation only, from the reference result the
 archive already carries: the FMI 2.0 C family's FMUs, whose ``extra/`` is their pythonfmu
@@ -23,7 +24,8 @@ import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
-from sma_fmu.fmi.packaging.documentation import FIGURE, INDEX, figure_png, index_html
+from sma_fmu.fmi.packaging.documentation import (FIGURE, HYSTERESIS, INDEX, figure_png, hysteresis_png,
+                                                 index_html)
 from sma_fmu.fmi.packaging.reference_results import (LS_REF_FOLDER, MANIFEST, Experiment, csv_bytes,
                                                      experiment_of, manifest_bytes, read_csv_bytes,
                                                      read_manifest, simulate_experiment, stimuli)
@@ -99,10 +101,15 @@ def _document(fmu_path, description, experiment, result, inputs, files):
     """Write documentation/index.html and its figure of ``result`` into the FMU; ``files``
     updated with their names."""
     units = {v.name: v.unit for v in description.modelVariables}
-    figure = figure_png(result, inputs, units, f"{description.modelName}: default experiment")
-    _rewrite(fmu_path, {FIGURE: figure})     # index.html reads the platforms from the archive
+    name = description.modelName
+    figures = {FIGURE: figure_png(result, inputs, units, f"{name}: default experiment")}
+    files = dict(files, figure=FIGURE)
+    hysteresis = hysteresis_png(result, units, f"{name}: R over T in the default experiment")
+    if hysteresis is not None:
+        figures[HYSTERESIS], files["hysteresis"] = hysteresis, HYSTERESIS
+    _rewrite(fmu_path, figures)     # index.html reads the platforms from the archive
     _rewrite(fmu_path, {INDEX: index_html(fmu_path, description, experiment, files).encode("utf-8")})
-    return dict(files, index=INDEX, figure=FIGURE)
+    return dict(files, index=INDEX)
 
 
 def add_documentation(fmu_path):
