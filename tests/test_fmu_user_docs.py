@@ -160,6 +160,14 @@ def test_the_calling_sequence_is_the_fmus_version(family):
         sequence = _section(_read(fmus[model], "documentation/index.html").decode("utf-8"),
                             "Calling sequence")
         assert f"{own}DoStep" in sequence and f"{other}DoStep" not in sequence, (label, model)
+        # FMI 3.0's event mode: the models with events of their own say so, the others that
+        # they have none; FMI 2.0 has no event mode in co-simulation
+        if own == "fmi3":
+            has_events = model in ("SmaPwmDriver", "SmaScenarioSignals")
+            assert ("has events of its own" in sequence) == has_events, model
+            assert ("has no events of its own" in sequence) == (not has_events), model
+        else:
+            assert "Event mode" not in sequence, (label, model)
 
 
 def test_fmi3_fmus_carry_their_own_reference_equal_to_the_fmi2_twins(fmi3_fmus, fmus):

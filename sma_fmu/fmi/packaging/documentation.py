@@ -168,6 +168,21 @@ def _model_part(name, description, params):
     return f"<h2>What the model is</h2>\n<p>{html.escape(description.description or '')}</p>"
 
 
+def _event_note(description):
+    """FMI 3.0: what event mode does in this FMU ("" for FMI 2.0 or without event mode)."""
+    cs = description.coSimulation
+    if not description.fmiVersion.startswith("3") or cs is None or not getattr(cs, "hasEventMode", False):
+        return ""
+    if getattr(cs, "mightReturnEarlyFromDoStep", False):
+        return ("<p>Event mode: this FMU has events of its own, its discontinuities (the PWM "
+                "driver's switching edges; the scenario's load switching times and reference "
+                "steps). With eventModeUsed a step that ends at one sets eventHandlingNeeded, and "
+                "with earlyReturnAllowed a step stops at the first one inside it "
+                "(earlyReturn, lastSuccessfulTime). Without them it steps as the FMI 2.0 FMU does.</p>")
+    return ("<p>Event mode: this FMU accepts eventModeUsed but has no events of its own; its "
+            "steps are the same with or without it.</p>")
+
+
 def index_html(fmu_path, description, experiment, files):
     """The text of documentation/index.html of the FMU ``fmu_path`` (FMI 2.0 or 3.0).
 
@@ -217,6 +232,7 @@ def index_html(fmu_path, description, experiment, files):
         "<h2>Platforms</h2>", _table(("platform", "status", "binary and notes"), platforms),
         "<h2>Calling sequence</h2>",
         "<ol>" + "".join(f"<li><code>{e(step)}</code></li>" for step in calling_sequence(version)) + "</ol>",
+        _event_note(description),
         f"<p>Invalid inputs make {fmi}DoStep return {fmi}Discard with a log message and change "
         "nothing; the instance goes on with valid ones. Log categories: logStatusWarning, "
         "logStatusDiscard, logStatusError (see the model description).</p>",
