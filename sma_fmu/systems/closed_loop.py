@@ -1,15 +1,11 @@
 """One scenario's closed loop as a system of FMUs: components, parameter values, connections.
 
 The SSP package (:mod:`.ssp`) and the container FMU (:mod:`.container`) are both written
-from this one description, so they wire and parameterise the loop alike::
-
-    signals.R_ref --> compensator.R_ref, pi.R_ref        signals.load --> compensator.load, plant.load
-    compensator.P_ff --> pi.P_ff     pi.P --> plant.P_in     plant.R --> pi.R
-
-The "pi" controller has no compensator (the PI's P_ff input then keeps its start, 0 W).
-A scenario with ``[drive] kind = "pwm"`` has a PWM driver between the PI and the plant::
-
-    pi.P --> driver.P_demand     driver.P_in --> plant.P_in
+from this one description, so they wire and parameterise the loop alike. The wiring
+(connections, Gauss-Seidel :data:`STEP_ORDER`) is :mod:`sma_fmu.fmi.packaging.loop_wiring`'s,
+which the FMUs' documentation shows too. The "pi" controller has no compensator (the PI's
+P_ff input then keeps its start, 0 W); a scenario with ``[drive] kind = "pwm"`` has a PWM
+driver between the PI and the plant.
 
 Each component's parameter values are the scenario's: every wire parameter its FMU
 exposes (from the scenario's parameter file), the controller's gains and filter, the
@@ -24,18 +20,13 @@ from pathlib import Path
 from sma_fmu.cosim.master import MissingFmuError, model_parameter_values, needed_fmus
 from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.packaging.fmu_names import default_fmu_paths
+from sma_fmu.fmi.packaging.loop_wiring import STEP_ORDER, Connection, loop_connections
 from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
 
 __all__ = ["Component", "Connection", "LoopSystem", "closed_loop", "identifier", "STEP_ORDER"]
 
-# Gauss-Seidel order of a sequential host: the sampled blocks in data-flow order (the PWM
-# driver's output is the wave's mean over the step it was given), then the blocks whose
-# outputs hold at the end of their step (plant: the state at t + h; signals: their values
-# at t + h), so every block of step k sees R_k, R_ref(t_k), f(t_k) and the u_ff,k, u_k
-# and driver power just computed, as in the library loop
-STEP_ORDER = ("compensator", "pi", "driver", "plant", "signals")
 
 
 def identifier(name):
@@ -58,16 +49,6 @@ class Component:
     fmu: object
     parameters: dict
     variables: dict
-
-
-@dataclass(frozen=True)
-class Connection:
-    """``source``.``output`` feeds ``target``.``input`` (component and variable names)."""
-
-    source: str
-    output: str
-    target: str
-    input: str
 
 
 @dataclass(frozen=True)
@@ -135,19 +116,12 @@ def closed_loop(scenario, fmu_dir):
         "reference": table_text(scenario.reference.as_table()),
         "load_profile": table_text(scenario.load.as_table())})]
     drive = scenario.drive
-    power = ([Connection("pi", "P", "driver", "P_demand"), Connection("driver", "P_in", "plant", "P_in")]
-             if drive.pwm else [Connection("pi", "P", "plant", "P_in")])
-    connections = [Connection("signals", "R_ref", "pi", "R_ref"), *power,
-                   Connection("signals", "load", "plant", "load"),
-                   Connection("plant", "R", "pi", "R")]
+    connections = loop_connections(c.feedforward, drive.pwm)
     if c.feedforward:
         components.append(_component("compensator", "SmaFeedforward", paths, {
             "alpha": c.alpha, "beta": c.beta, "model_load": c.model_load,
             "adapt_to_load": c.adapt_to_load, "inverse": choice_code("inverse", c.inverse)},
             scenario.compensator_params))
-        connections[1:1] = [Connection("signals", "R_ref", "compensator", "R_ref"),
-                            Connection("signals", "load", "compensator", "load"),
-                            Connection("compensator", "P_ff", "pi", "P_ff")]
     components.append(_component("pi", "SmaPiController", paths, {"Kp": c.Kp, "Ki": c.Ki}))
     if drive.pwm:
         components.append(_component("driver", "SmaPwmDriver", paths, {

@@ -19,6 +19,8 @@ Each native FMU holds:
   binary serves every parameter file), then ``resources/start_values.json``, which
   ``sma-fmu export`` packs;
 - ``extra/``: the pythonfmu twin's, if it has one (its reference result: the same numbers).
+- ``documentation/``: index.html and result.png (:func:`.extras.add_documentation`) for
+  this FMU, its figure from that reference result.
 """
 import re
 import shutil
@@ -32,11 +34,13 @@ from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.fmi.packaging.cross_build import FLAGS, RUNS_HERE, compile_shared, fmi2_targets, target
 from sma_fmu.fmi.packaging.c_family_description import model_starts, native_description, variables_header
+from sma_fmu.fmi.packaging.extras import add_documentation
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.platforms import NATIVE_MARKER, PlatformEntry, annotate
 from sma_fmu.fmi.packaging.prebuilt import find_prebuilt, sources_digest
 from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
+from sma_fmu.fmi.packaging.reference_results import MANIFEST
 from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
 __all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_sources",
@@ -172,6 +176,8 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
         for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
             if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
                 archive.write(extra, extra.relative_to(unpacked).as_posix())
+    if (unpacked / MANIFEST).is_file():
+        add_documentation(fmu)  # documentation/ of this FMU, from the twin's reference (extras.py)
     fix_timestamps(fmu)  # reproducible.py: the same inputs, the same bytes
     return problems
 

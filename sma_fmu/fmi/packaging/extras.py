@@ -1,14 +1,19 @@
 """Post-process a built FMU archive: its documentation and its reference result.
 
 :func:`add_documentation_and_reference` is called once per FMU by ``sma-fmu build`` (the
-pythonfmu FMUs, :mod:`.build`) and by the native C family on its FMUs: it works on any FMI
-2.0 co-simulation archive. It
+pythonfmu FMUs, :mod:`.build`) and by the FMI 3.0 C family (:mod:`.fmi3_build`, which runs the
+FMI 3.0 FMU itself): it works on any FMI 2.0 or 3.0 co-simulation archive. It
 
 1. gives the FMU a DefaultExperiment if it has none (:data:`DEFAULT_EXPERIMENT`);
 2. runs that experiment in fmpy with the model's stimuli (:mod:`.reference_results`);
 3. writes into the archive the fmi-ls-ref files (manifest, ``<Model>_in.csv``,
    ``<Model>_out.csv`` under ``extra/org.fmi-standard.fmi-ls-ref/``) and
-   ``documentation/index.html`` with ``documentation/result.png`` (:mod:`.documentation`).
+   ``documentation/index.html`` with ``documentation/result.png`` (and, for the plant,
+   ``documentation/hysteresis.png``: R over T) (:mod:`.documentation`).
+
+:func:`add_documentation` does step 3's documentation only, from the reference result the
+archive already carries: the FMI 2.0 C family's FMUs, whose ``extra/`` is their pythonfmu
+twin's (the same numbers), so nothing but ``documentation/`` is added to them.
 
 Entries it writes replace entries of the same name (running it twice gives the same
 archive but for the figure's and the XML's bytes); the others are copied unchanged.
@@ -19,11 +24,13 @@ import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
-from sma_fmu.fmi.packaging.documentation import FIGURE, INDEX, figure_png, index_html
+from sma_fmu.fmi.packaging.documentation import (FIGURE, HYSTERESIS, INDEX, figure_png, hysteresis_png,
+                                                 index_html)
 from sma_fmu.fmi.packaging.reference_results import (LS_REF_FOLDER, MANIFEST, Experiment, csv_bytes,
-                                       experiment_of, manifest_bytes, simulate_experiment, stimuli)
+                                                     experiment_of, manifest_bytes, read_csv_bytes,
+                                                     read_manifest, simulate_experiment, stimuli)
 
-__all__ = ["DEFAULT_EXPERIMENT", "add_documentation_and_reference"]
+__all__ = ["DEFAULT_EXPERIMENT", "add_documentation_and_reference", "add_documentation"]
 
 DEFAULT_EXPERIMENT = Experiment(0.0, 10.0, 1e-3)   # start, stop, step [s] for an FMU without one
 _MODEL_DESCRIPTION = "modelDescription.xml"
@@ -86,9 +93,37 @@ def add_documentation_and_reference(fmu_path):
     if inputs is not None:
         files["stimuli"] = f"{LS_REF_FOLDER}/{name}_in.csv"
         entries[files["stimuli"]] = csv_bytes(inputs)
+    _rewrite(fmu_path, entries)
+    return _document(fmu_path, description, experiment, result, inputs, files)
+
+
+def _document(fmu_path, description, experiment, result, inputs, files):
+    """Write documentation/index.html and its figure of ``result`` into the FMU; ``files``
+    updated with their names."""
     units = {v.name: v.unit for v in description.modelVariables}
-    entries[FIGURE] = figure_png(result, inputs, units, f"{name}: default experiment")
-    _rewrite(fmu_path, entries)     # index.html reads the platforms from the archive
+    name = description.modelName
+    figures = {FIGURE: figure_png(result, inputs, units, f"{name}: default experiment")}
+    files = dict(files, figure=FIGURE)
+    hysteresis = hysteresis_png(result, units, f"{name}: R over T in the default experiment")
+    if hysteresis is not None:
+        figures[HYSTERESIS], files["hysteresis"] = hysteresis, HYSTERESIS
+    _rewrite(fmu_path, figures)     # index.html reads the platforms from the archive
     _rewrite(fmu_path, {INDEX: index_html(fmu_path, description, experiment, files).encode("utf-8")})
-    files.update(index=INDEX, figure=FIGURE)
-    return files
+    return dict(files, index=INDEX)
+
+
+def add_documentation(fmu_path):
+    """Give the FMU ``fmu_path``, which carries its reference result (fmi-ls-ref), its
+    ``documentation/``, in place; returns {role: archive path} of the reference files and
+    what it wrote."""
+    from fmpy import read_model_description
+
+    fmu_path = Path(fmu_path)
+    with zipfile.ZipFile(fmu_path) as archive:
+        experiment, stimuli_file, result_file = read_manifest(archive)
+        result = read_csv_bytes(archive.read(result_file))
+        inputs = read_csv_bytes(archive.read(stimuli_file)) if stimuli_file else None
+    files = {"manifest": MANIFEST, "result": result_file}
+    if stimuli_file:
+        files["stimuli"] = stimuli_file
+    return _document(fmu_path, read_model_description(str(fmu_path)), experiment, result, inputs, files)

@@ -10,7 +10,12 @@ front (``c_family/fmi3/``). Each FMU holds:
   FMI 2.0) and ``fmi3_model.h``, and ``buildDescription.xml`` listing what a tool compiles;
 - ``binaries/x86_64-linux/<Model>.so`` and ``binaries/x86_64-windows/<Model>.dll`` (mingw-w64;
   left out with a warning without it), built as the FMI 2.0 ones are;
-- ``resources/parameters.json`` and ``extra/`` (the reference result), as in FMI 2.0;
+- ``resources/parameters.json``, as in FMI 2.0;
+- ``extra/org.fmi-standard.fmi-ls-ref/`` (the manifest, stimuli and reference result of the
+  default experiment, fmi-ls-ref's FMI 3 layout, which is FMI 2.0's) and ``documentation/``
+  (index.html, result.png), as in FMI 2.0 (:func:`.extras.add_documentation_and_reference`):
+  the reference result is this FMU's own, run in fmpy's FMI 3.0 simulation; it equals the FMI
+  2.0 twin's byte for byte (tests/test_fmi3_documentation.py);
 - the plant's ``terminalsAndIcons/terminalsAndIcons.xml`` (:mod:`.fmi3_terminals`).
 """
 import shutil
@@ -24,6 +29,7 @@ from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarn
 from sma_fmu.fmi.packaging.c_family_description import (model_starts, native_description,
                                                         variables_header)
 from sma_fmu.fmi.packaging.cross_build import TARGETS
+from sma_fmu.fmi.packaging.extras import add_documentation_and_reference
 from sma_fmu.fmi.packaging.fmi3_description import (annotate_platforms, build_description,
                                                     fmi3_description, fmi3_model_header)
 from sma_fmu.fmi.packaging.fmi3_terminals import terminals_and_icons
@@ -85,9 +91,8 @@ def _build_one(model_name, python_fmu, folder, work):
         # every parameter file (issue 40), as in the FMI 2.0 build
         archive.writestr("resources/model_starts.json",
                          model_starts(fmi2_description, starts, defaults))
-        for extra in sorted((unpacked / "extra").rglob("*")) if (unpacked / "extra").is_dir() else ():
-            if extra.is_file():  # the twin's reference result (fmi-ls-ref): the same numbers
-                archive.write(extra, extra.relative_to(unpacked).as_posix())
+    # the default experiment run by this FMU: extra/ (fmi-ls-ref) and documentation/ (extras.py)
+    add_documentation_and_reference(fmu)
     fix_timestamps(fmu)  # reproducible.py: the same inputs, the same bytes
     return problems
 
