@@ -185,3 +185,33 @@ def test_both_hosts_take_the_pwm_drivers_early_returns(fmusim, fmil3_host, fmi3_
           f"{len(errors) - len(unknown)} known FMI Library parser error lines, {len(unknown)} other")
     assert result.returncode == 0 and bad == [] and early > 200
     assert unknown == [] and int(summary.group(5)) > 200 and summary.group(3) == "1"
+
+
+@pytest.mark.parametrize("model", list(INPUTS))
+def test_fmusim_resumes_each_fmi3_fmu_from_its_serialized_state(fmusim, fmi3_fmus, model, tmp_path):
+    """0 to 1 s saving the serialized state (--final-fmu-state-file), then 1 to 2 s from it
+    (--initial-fmu-state-file) in a new process: both clean, and the resumed rows exactly
+    those of a run 0 to 2 s."""
+    starts = [w for name, value in CONSTANTS[model].items() for w in ("--start-value", name, repr(value))]
+
+    def run(name, *options):
+        output = tmp_path / f"{name}.csv"
+        result = subprocess.run([fmusim, "--interface-type", "cs", "--output-interval", "0.001",
+                                 "--logging-on", *starts, *options, "--output-file", str(output),
+                                 str(fmi3_fmus[model])], capture_output=True, text=True, timeout=600)
+        lines = (result.stdout + result.stderr).splitlines()
+        assert result.returncode == 0 and not [l for l in lines if BAD_MESSAGE.match(l)], lines
+        return np.genfromtxt(output, delimiter=",", names=True)
+
+    state = tmp_path / "state.bin"
+    whole = run("whole", "--stop-time", "2")
+    run("first", "--stop-time", "1", "--final-fmu-state-file", str(state))
+    resumed = run("resumed", "--start-time", "1", "--stop-time", "2", "--initial-fmu-state-file", str(state))
+    tail = whole[-resumed.size:]
+    names = [n for n in whole.dtype.names if n != "time"]
+    worst, name = _largest(resumed, tail, names)
+    print(f"\nfmusim {model}: resumed from its state at 1 s ({state.stat().st_size} bytes), "
+          f"largest difference from the whole run {worst:.3g} of scale ({name})")
+    # exact: the saved state carries the run's h0, on which SmaScenarioSignals samples
+    # (tests/test_signals_restore_grid.py; before, its R_ref was 6.7e-14 of scale off)
+    assert np.allclose(resumed["time"], tail["time"], rtol=0, atol=1e-12) and worst == 0.0
