@@ -103,7 +103,7 @@ class SignalSource:
         self.reference = reference
         self.load = load
         self.start_time = self.time = require_finite("start time", start_time)
-        self.grid_step = None  # h_0 [s], from the first step (after a restore: the next one)
+        self.grid_step = None  # h_0 [s], from the first step (the FMU adapters set the run's h_0)
         self.outputs = self._sample(self.time)
 
     def _sample(self, time_s):

@@ -31,8 +31,14 @@ static int step(void *stepper, SmaValue *values, SmaRun *run, double time, doubl
                 SmaMessage *message)
 {
     SignalOutputs outputs;
-    (void)run;
-    if (signal_source_step((SignalSource *)stepper, time, step_size, &outputs, message))
+    SignalSource *source = (SignalSource *)stepper;
+    /* the grid's h0 is the run's first step, which a saved state keeps (SmaRun.first_step): a
+     * restored source would otherwise take the next step's size, which a host that steps
+     * from t to t_next passes a rounding error off h0, and sample off the saved run's grid */
+    if (!(run->first_step > 0.0)) run->first_step = step_size;
+    source->has_grid_step = 1;
+    source->grid_step = run->first_step;
+    if (signal_source_step(source, time, step_size, &outputs, message))
         return 1;
     values[VAR_R_ref].real = outputs.R_ref;
     values[VAR_load].real = outputs.load;

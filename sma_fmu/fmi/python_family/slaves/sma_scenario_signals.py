@@ -60,4 +60,12 @@ class SmaScenarioSignals(StepperSlave):
         self.start_time = start_time
 
     def _advance(self, current_time, step_size):
+        # the grid's h0 is the run's first step (the interface's, as the native adapter's
+        # SmaRun.first_step): a source restored from a saved state would otherwise take the
+        # next step's size, which a host that steps from t to t_next passes a rounding error
+        # off h0, and sample off the saved run's grid
+        interface = self.interface
+        if interface.first_step is None:
+            interface.first_step = step_size
+        self.stepper.grid_step = interface.first_step
         return self.stepper.step(current_time, step_size)
