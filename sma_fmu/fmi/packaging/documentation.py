@@ -202,7 +202,7 @@ def index_html(fmu_path, description, experiment, files):
     source, wire = _wire_rows(document)
     e = html.escape
     stimuli = files.get("stimuli")
-    run = (f"import numpy as np\nfrom fmpy import simulate_fmu\n"
+    run = ("import numpy as np\nfrom fmpy import simulate_fmu\n"
            + (f"inputs = np.genfromtxt('{stimuli}', delimiter=',', names=True)  # unpacked\n"
               if stimuli else "inputs = None\n")
            + f"result = simulate_fmu('{name}.fmu', start_time={experiment.start!r}, "

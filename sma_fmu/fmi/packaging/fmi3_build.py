@@ -4,8 +4,10 @@ The same C models and core as the FMI 2.0 build (:mod:`.c_family_build`), under 
 front (``c_family/fmi3/``). Each FMU holds:
 
 - ``modelDescription.xml`` (FMI 3.0, :mod:`.fmi3_description`): the native FMI 2.0
-  description in FMI 3.0's terms (instantiation token, ``time``, Enumerations), with the
-  platforms annotation ``sma-fmu check`` reads;
+  description in FMI 3.0's terms (instantiation token, ``time``, Enumerations);
+- ``extra/org.sma-fmu.platforms/platforms.xml``: the platforms and how each was tested,
+  which ``sma-fmu check`` reads (not a top-level ``<Annotations>``: the FMI Library 3.0.4
+  logs an error for that);
 - ``sources/``: the C files, flat, the generated ``<Model>_variables.h`` (the same table as
   FMI 2.0) and ``fmi3_model.h``, and ``buildDescription.xml`` listing what a tool compiles;
 - ``binaries/x86_64-linux/<Model>.so`` and ``binaries/x86_64-windows/<Model>.dll`` (mingw-w64;
@@ -30,9 +32,11 @@ from sma_fmu.fmi.packaging.c_family_description import (model_starts, native_des
                                                         variables_header)
 from sma_fmu.fmi.packaging.cross_build import TARGETS
 from sma_fmu.fmi.packaging.extras import add_documentation_and_reference
-from sma_fmu.fmi.packaging.fmi3_description import (annotate_platforms, build_description,
-                                                    fmi3_description, fmi3_model_header)
+from sma_fmu.fmi.packaging.fmi3_description import (build_description,
+                                                    fmi3_description, fmi3_model_header,
+                                                    platforms_document)
 from sma_fmu.fmi.packaging.fmi3_terminals import terminals_and_icons
+from sma_fmu.fmi.packaging.platforms import PLATFORMS_FILE
 from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
 __all__ = ["PLATFORMS", "build_fmi3_fmus"]
@@ -74,9 +78,10 @@ def _build_one(model_name, python_fmu, folder, work):
         if NATIVE_MARKER not in output.read_bytes():
             raise RuntimeError(f"{platform}: the native marker is missing (layer_calls.c)")
     fmu = folder / f"{model_name}.fmu"
-    annotated = annotate_platforms(description, {b.split("/")[1]: b for b in binaries})
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
-        archive.writestr("modelDescription.xml", annotated)
+        archive.writestr("modelDescription.xml", description)
+        archive.writestr(PLATFORMS_FILE,
+                         platforms_document({b.split("/")[1]: b for b in binaries}))
         terminals = terminals_and_icons(description)
         if terminals:
             archive.writestr("terminalsAndIcons/terminalsAndIcons.xml", terminals)

@@ -23,7 +23,7 @@ import xml.etree.ElementTree as ET
 from sma_fmu.fmi.packaging.cross_build import RUNS_HERE, TARGETS
 from sma_fmu.fmi.python_family.slave_support.choices import CHOICES
 
-__all__ = ["EVENT_MODELS", "fmi3_description", "annotate_platforms", "build_description",
+__all__ = ["EVENT_MODELS", "fmi3_description", "platforms_document", "build_description",
            "fmi3_model_header", "time_reference"]
 
 EVENT_MODELS = {"SmaPwmDriver", "SmaScenarioSignals"}  # their C adapter has next_event (models/<Model>.c)
@@ -106,14 +106,12 @@ def fmi3_description(fmi2_description):
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
 
 
-def annotate_platforms(fmi3_description_bytes, binaries):
-    """The description with ``<Annotation type="sma-fmu">`` naming the native ``binaries``
-    ({platform tuple: path in the FMU}), which ``sma-fmu check`` reads (platforms.py)."""
-    root = ET.fromstring(fmi3_description_bytes)
-    note = ET.SubElement(ET.SubElement(root, "Annotations"), "Annotation", type="sma-fmu")
-    platforms = ET.SubElement(note, "Platforms")
+def platforms_document(binaries):
+    """The FMU's platforms.PLATFORMS_FILE (bytes; ``sma-fmu check`` reads it) naming the
+    native ``binaries`` ({platform tuple: path in the FMU}), attributes as in FMI 2.0."""
+    root = ET.Element("Platforms", tool="sma-fmu")
     for name, binary in binaries.items():
-        ET.SubElement(platforms, "Platform", name=name, binary=binary, front="false",
+        ET.SubElement(root, "Platform", name=name, binary=binary, front="false",
                       python="none (native C)", native="true",
                       tested=RUNS_HERE[TARGETS[name].runs])  # as the FMI 2.0 annotation says
     ET.indent(root, "\t")

@@ -17,7 +17,7 @@ from importlib import util
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-__all__ = ["FRONT_MARKER", "PLATFORMS", "DEGRADED", "UnsupportedPlatformError", "PlatformEntry",
+__all__ = ["FRONT_MARKER", "PLATFORMS", "PLATFORMS_FILE", "DEGRADED", "UnsupportedPlatformError", "PlatformEntry",
            "binary_architecture", "check_build_machine", "annotate", "platform_report",
            "platform_results"]
 
@@ -47,6 +47,10 @@ _MACHO_MACHINES = {0x01000007: "x86-64", 0x0100000C: "aarch64"}
 _MACHINES = {"x86_64": "x86-64", "amd64": "x86-64", "aarch64": "aarch64", "arm64": "aarch64",
              "i386": "x86", "i686": "x86", "x86": "x86"}
 _TOOL = "sma-fmu"
+# FMI 3.0 C-family FMUs list their platforms here rather than in a top-level <Annotations> of
+# modelDescription.xml: valid by the FMI 3.0 schema, but the FMI Library 3.0.4 (under
+# OMSimulator, libcosim and other C tools) logs an error for it (docs/systems.md)
+PLATFORMS_FILE = "extra/org.sma-fmu.platforms/platforms.xml"
 
 
 class UnsupportedPlatformError(ValueError):
@@ -135,18 +139,24 @@ def annotate(model_description, entries):
                         "\t<ModelVariables", 1)
 
 
-def _declared(model_description):
-    """{platform: attributes} from the sma-fmu VendorAnnotations, {} if there are none."""
+def _declared(model_description, archive, names):
+    """{platform: attributes} from the sma-fmu VendorAnnotations (FMI 2.0) or the FMU's
+    PLATFORMS_FILE (FMI 3.0), {} if there are none."""
     import xml.etree.ElementTree as ET
 
     root = ET.fromstring(model_description)
     found = {node.get("name"): dict(node.attrib)
              for tool in root.iterfind("VendorAnnotations/Tool") if tool.get("name") == _TOOL
              for node in tool.iterfind("Platforms/Platform")}
-    found.update({node.get("name"): dict(node.attrib)  # FMI 3.0: <Annotation type="sma-fmu">
-                  for note in root.iterfind("Annotations/Annotation") if note.get("type") == _TOOL
-                  for node in note.iterfind("Platforms/Platform")})
+    if PLATFORMS_FILE in names:
+        listed = ET.fromstring(archive.read(PLATFORMS_FILE))
+        found.update({node.get("name"): dict(node.attrib) for node in listed.iterfind("Platform")})
     return found
+
+
+def _declaring_file(names):
+    """The file of the FMU that declares its platforms (for messages)."""
+    return PLATFORMS_FILE if PLATFORMS_FILE in names else "modelDescription.xml"
 
 
 def platform_report(fmu_path):
@@ -163,7 +173,7 @@ def platform_report(fmu_path):
     with zipfile.ZipFile(fmu_path) as archive:
         names = archive.namelist()
         description = archive.read("modelDescription.xml").decode("utf-8")
-        declared = _declared(description)
+        declared = _declared(description, archive, names)
         if not declared and not _built_by_sma_fmu(archive, names):
             return [("n/a", "all", "not built by sma-fmu build (a container, another tool's FMU)")]
         root = ET.fromstring(description)
@@ -173,7 +183,7 @@ def platform_report(fmu_path):
                          and name.count("/") >= 2 and name.split("/")[2]})
         return [_platform_line(archive, names, identifier, name, declared.get(name))
                 for name in listed] + \
-            [("FAIL", name, "declared in modelDescription.xml but not in binaries/")
+            [("FAIL", name, f"declared in {_declaring_file(names)} but not in binaries/")
              for name in sorted(set(declared) - set(listed))]
 
 
@@ -184,6 +194,7 @@ def _built_by_sma_fmu(archive, names):
 
 
 def _platform_line(archive, names, identifier, name, said):
+    source = _declaring_file(names)
     binary = f"binaries/{name}/{identifier}{PLATFORMS.get(name) or FMI3_PLATFORMS.get(name, '')}"
     if binary not in names:
         return "FAIL", name, f"lists the platform but has no {binary}"
@@ -192,20 +203,20 @@ def _platform_line(archive, names, identifier, name, said):
     what = f"{binary} ({binary_architecture(data) or 'unknown format'})"
     if said is not None and said.get("native") == "true":
         if NATIVE_MARKER not in data:
-            return "FAIL", name, f"modelDescription.xml says native, but {what} is no sma-fmu C-family binary"
+            return "FAIL", name, f"{source} says native, but {what} is no sma-fmu C-family binary"
         tested = f"; {said['tested']}" if said.get("tested") else ""
         return "ok", name, f"{what}: native C (sma-fmu build --native), no Python{tested}"
     if said is None:
         return "FAIL", name, f"{what}, {'the front' if front else 'without this front'}, is not " \
-                             "declared in modelDescription.xml"
+                             f"declared in {source}"
     if (said.get("front") == "true") != front:
-        return "FAIL", name, f"modelDescription.xml says front={said.get('front')}, but {what} " \
+        return "FAIL", name, f"{source} says front={said.get('front')}, but {what} " \
                              f"is {'the front' if front else 'not the front'}"
     if front:
         return "ok", name, f"{what}: C front; Python: {said.get('python')}"
     if said.get("degraded"):
         return "warn", name, f"{what}: degraded: {said['degraded']}"
-    return "FAIL", name, f"{what} has no front and modelDescription.xml does not say what is degraded"
+    return "FAIL", name, f"{what} has no front and {source} does not say what is degraded"
 
 
 def platform_results(path):
