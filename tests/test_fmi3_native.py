@@ -474,10 +474,37 @@ def test_corrupted_states_are_refused_alike_in_both_versions(native_fmus, fmi3_f
 
 def test_sma_fmu_check_passes_each(fmi3_fmus, capsys):
     """fmpy validation, FMI checker, state round trip (FMU3Slave), reference result,
-    platforms from the FMI 3.0 annotation; libcosim's run is n/a (it runs no FMI 3.0)."""
+    platforms from extra/org.sma-fmu.platforms/platforms.xml; libcosim's run is n/a (it runs
+    no FMI 3.0)."""
     assert main(["check", *(str(fmi3_fmus[name]) for name in NAMES)]) == 0
     lines = capsys.readouterr().out.strip().splitlines()
     assert not [line for line in lines if line.startswith("FAIL")]
     for check in ("state round trip: FMI 3.0, serialized", "platform x86_64-linux: ",
                   "platform x86_64-windows: ", "C host (libcosim): libcosim runs no FMI 3.0"):
         assert sum(check in line for line in lines) == len(NAMES), check
+
+
+def test_platforms_are_listed_outside_the_model_description(fmi3_fmus, tmp_path):
+    """No top-level <Annotations> (the FMI Library 3.0.4 refuses one, docs/systems.md): the
+    platforms file names every binary; a listed platform without its binary is a FAIL."""
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    from sma_fmu.fmi.packaging.platforms import PLATFORMS_FILE, platform_report
+
+    for name in NAMES:
+        with zipfile.ZipFile(fmi3_fmus[name]) as archive:
+            root = ET.fromstring(archive.read("modelDescription.xml"))
+            listed = {node.get("binary") for node in
+                      ET.fromstring(archive.read(PLATFORMS_FILE)).iterfind("Platform")}
+            binaries = {n for n in archive.namelist() if n.startswith("binaries/")}
+        assert root.find("Annotations") is None
+        assert listed == binaries, name
+    source = fmi3_fmus["SmaPwmDriver"]
+    broken = tmp_path / "SmaPwmDriver.fmu"
+    with zipfile.ZipFile(source) as old, zipfile.ZipFile(broken, "w") as new:
+        for item in old.infolist():
+            if item.filename != "binaries/x86_64-windows/SmaPwmDriver.dll":
+                new.writestr(item, old.read(item.filename))
+    assert ("FAIL", "x86_64-windows", f"declared in {PLATFORMS_FILE} but not in binaries/") \
+        in platform_report(broken)
