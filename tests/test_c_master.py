@@ -16,7 +16,7 @@ import pytest
 from cli_failure import fails
 from sma_fmu.cosim.master import MissingFmuError, run_fmus
 from sma_fmu.cosim.metrics import scenario_metrics
-from sma_fmu.cosim.recording import read_timeseries
+from sma_fmu.cosim.recording import RunRecorder, interval_steps, read_timeseries
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios
 from sma_fmu.systems.c_master import CMasterError, run_c_master
 from sma_fmu.systems.runner import run_scenarios
@@ -214,3 +214,94 @@ def test_the_bench_section_compares_each_scenario_with_the_library(native_dir, t
     lines = c_master_lines(times)
     assert "heavy-pi (parquet)" in lines[-1] and f"target <= {TARGET:g}" in lines[-1]
     assert len(list(tmp_path.glob("heavy-pi-parquet-*/timeseries.parquet"))) == 2
+
+
+class _PythonCsv(RunRecorder):
+    """A recorder that keeps the CSV to itself: Python formats every row."""
+    csv_for_host = None
+
+
+@pytest.mark.parametrize("name", PAPER_SET + PWM)
+def test_the_csv_the_c_master_writes_is_the_recorders_byte_for_byte(native_dir, name, tmp_path):
+    """The host writes the CSV's rows itself ("csv" line); the file is the one the Python
+    recorder writes from the same rows, every step and every 7th (--output-interval), and
+    the metrics, figure rows and row counts are unchanged."""
+    scenario = _scenario(name)
+    for every in (1, interval_steps(0.007, scenario.step_s)):
+        made = {}
+        for kind, recorder_class in (("c", RunRecorder), ("python", _PythonCsv)):
+            folder = tmp_path / f"{kind}-{every}"
+            folder.mkdir()
+            recorder = recorder_class(scenario, folder, every, "csv")
+            run_c_master(scenario, native_dir, recorder)
+            metrics, figure = recorder.close()
+            made[kind] = ((folder / "timeseries.csv").read_bytes(), metrics, figure, recorder.writer.rows)
+        (c_text, c_metrics, c_figure, c_rows), (p_text, p_metrics, p_figure, p_rows) = made["c"], made["python"]
+        assert c_text == p_text and c_text.count(b"\n") == c_rows + 1
+        assert json.dumps(c_metrics) == json.dumps(p_metrics) and c_rows == p_rows
+        _same(c_figure, p_figure)
+    assert c_rows == len(range(0, scenario.steps + 1, every)) + (scenario.steps % every != 0)
+
+
+def test_a_discard_mid_run_leaves_the_same_csv_rows(native_dir, tmp_path):
+    """The failed step's rows: the C-written CSV holds those the Python recorder writes."""
+    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
+    scenario = load_scenario(tmp_path / "discard.toml")
+    texts = []
+    for kind, recorder_class in (("c", RunRecorder), ("python", _PythonCsv)):
+        folder = tmp_path / kind
+        folder.mkdir()
+        recorder = recorder_class(scenario, folder, 3, "csv")
+        with pytest.raises(CMasterError, match="501 rows kept"):
+            run_c_master(scenario, native_dir, recorder)
+        recorder.close()
+        texts.append((folder / "timeseries.csv").read_bytes())
+    assert texts[0] == texts[1] and texts[0].count(b"\n") == 1 + len(range(0, 501, 3))
+
+
+def _g10(values, windows=None):
+    """The loop host's "%.10g" of each of ``values`` (its "g10" test line)."""
+    import subprocess
+    import struct
+
+    from sma_fmu.fmi.hosts import compile_host
+    from sma_fmu.systems.loop_host import wine_executable
+
+    executable = compile_host("loop_host", windows=windows is not None)
+    line = "g10 " + " ".join(struct.pack(">d", v).hex() for v in values) + "\n"
+    command = [str(executable)] if windows is None else [wine_executable(), str(executable)]
+    done = subprocess.run(command, input=line.encode(), capture_output=True, check=True,
+                          env=windows, timeout=600)
+    return done.stdout.decode().split()
+
+
+def g10_cases(count=40_000, seed=41):
+    """Edge cases of "%.10g" and random doubles: any bit pattern, any decade, near-ties."""
+    import random
+    import struct
+
+    pick = random.Random(seed)
+    values = [0.0, -0.0, 1e-5, -1e-5, 1e-4, 9.99999999949999e-5, 1e-10, 1e10, 9999999999.5,
+              9999999999.4, 99999.999995, 1234567890.5, 1234567891.5, 123456789012.0, 1e20,
+              1e30, 1e-30, 1e-31, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308,
+              float("nan"), -float("nan"), float("inf"), -float("inf"), 0.1 + 0.2, 1 / 3, 30.0]
+    for _ in range(count):
+        r = pick.random()
+        if r < 0.3:
+            values.append(struct.unpack("<d", struct.pack("<Q", pick.getrandbits(64)))[0])
+        elif r < 0.6:
+            values.append(pick.uniform(-1, 1) * 10.0 ** pick.randint(-35, 35))
+        elif r < 0.8:   # 11 significant digits ending in 5: at or next to a tie
+            digits = pick.randint(10 ** 10, 10 ** 11 - 1) // 10 * 10 + 5
+            values.append(pick.choice((-1, 1)) * digits * 10.0 ** pick.randint(-25, 15))
+        else:
+            values.append(round(pick.uniform(-100, 100), pick.randint(0, 12)))
+    return values
+
+
+def test_the_hosts_g10_is_pythons_percent_10g():
+    values = g10_cases()
+    got = _g10(values)
+    assert len(got) == len(values)
+    wrong = [(v, text, "%.10g" % v) for v, text in zip(values, got) if text != "%.10g" % v]
+    assert wrong == []

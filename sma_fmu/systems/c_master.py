@@ -27,7 +27,7 @@ from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
 from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.hosts import CHostError, compile_host
-from sma_fmu.systems.c_master_rows import RowAssembler, check_variables, recorded_columns
+from sma_fmu.systems.c_master_rows import RowAssembler, check_variables, csv_columns, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
 
@@ -136,6 +136,12 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None):
     lines = loop_host_lines(system, {k: str(v) for k, v in folders.items()}, scenario.steps,
                             columns=columns)
     lines[-1] += f" binary {ROWS_PER_CHUNK}"
+    text = getattr(sink, "csv_for_host", None)   # a RunRecorder writing CSV: the host writes it
+    text = text() if text is not None else None
+    if text is not None:
+        path, every, last = text
+        path = str(path) if windows is None else wine_path(path)
+        lines.insert(-1, f"csv {path.encode('utf-8').hex()} {every} {last} {csv_columns(columns)}")
     command = [str(executable)] if windows is None else [wine_executable(), str(executable)]
     environment = dict(os.environ if windows is None else windows)
     environment.pop("LD_PRELOAD", None)

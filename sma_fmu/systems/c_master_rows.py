@@ -14,11 +14,11 @@ import math
 
 import numpy as np
 
-from sma_fmu.cosim.loop import ROWS_PER_CHUNK, TIMESERIES_DTYPE
+from sma_fmu.cosim.loop import COLUMNS, ROWS_PER_CHUNK, TIMESERIES_DTYPE
 from sma_fmu.systems.container import loop_outputs
 from sma_fmu.systems.hosts import NO_COMPENSATOR, STATE_COLUMNS, STEP_COLUMNS
 
-__all__ = ["recorded_columns", "check_variables", "RowAssembler"]
+__all__ = ["recorded_columns", "csv_columns", "check_variables", "RowAssembler"]
 
 
 def recorded_columns(system):
@@ -26,6 +26,27 @@ def recorded_columns(system):
     component (the host reads neighbouring columns of one component in one call)."""
     outputs = loop_outputs(system.scenario)
     return sorted(outputs, key=lambda column: (outputs[column][0], column == "saturated"))
+
+
+def csv_columns(columns):
+    """The loop host's words for the CSV's columns (:data:`~sma_fmu.cosim.loop.COLUMNS`, its
+    "csv" line) from the recorded ``columns``: the rows :class:`RowAssembler` makes, as text."""
+    index = {name: i for i, name in enumerate(columns)}
+    words = []
+    for name, _ in COLUMNS:
+        if name == "t":
+            words.append("t")
+        elif name == "stroke":
+            words.append(f"x:{index['x']}")
+        elif name in STATE_COLUMNS:
+            words.append(f"s:{index[name]}")
+        elif name not in index:   # a block the loop lacks (NO_COMPENSATOR): after each step
+            value = float(NO_COMPENSATOR[name])   # (the final row: nan, or False)
+            kind = "c" if name == "saturated" else "k"
+            words.append(f"{kind}:{'nan' if math.isnan(value) else repr(value)}")
+        else:
+            words.append(f"{'b' if name == 'saturated' else 'a'}:{index[name]}")
+    return " ".join(words)
 
 
 def _need(component, name, causality, types, why):
