@@ -305,3 +305,64 @@ def test_the_hosts_g10_is_pythons_percent_10g():
     assert len(got) == len(values)
     wrong = [(v, text, "%.10g" % v) for v, text in zip(values, got) if text != "%.10g" % v]
     assert wrong == []
+
+
+def _stopping_popen(monkeypatch, when):
+    """Popen for the C master's host that records each host and, ``when`` "spawned", stops
+    it at once with SIGSTOP (a host that hangs before its first row); the hosts started."""
+    import os
+    import signal
+    import subprocess
+
+    from sma_fmu.systems import c_master
+
+    hosts = []
+
+    class Stopping(subprocess.Popen):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            hosts.append(self)
+            if when == "spawned":
+                os.kill(self.pid, signal.SIGSTOP)
+
+    monkeypatch.setattr(c_master.subprocess, "Popen", Stopping)
+    return hosts
+
+
+def test_a_host_that_falls_silent_mid_run_is_killed_and_named(native_dir, tmp_path, monkeypatch):
+    """The host is stopped (SIGSTOP) when its first rows arrive: no frame comes for the
+    timeout, so the watchdog kills it and the error names the timeout and the time reached."""
+    import os
+    import signal
+
+    hosts = _stopping_popen(monkeypatch, "first rows")
+    (tmp_path / "hour.toml").write_text(DISCARD.format(stop=3600.0).replace("1e306", "0.3"))
+    got = []
+
+    def sink(block):
+        if not got:
+            os.kill(hosts[0].pid, signal.SIGSTOP)
+        got.append(block)
+
+    with pytest.raises(CMasterError, match=r"C master: no output for 1 s at t = \d+(\.\d+)? s: "
+                                           r"the host was stopped") as caught:
+        run_c_master(load_scenario(tmp_path / "hour.toml"), native_dir, sink, timeout_s=1.0)
+    assert hosts[0].returncode == -signal.SIGKILL
+    rows = sum(block.size for block in got)
+    assert 0 < rows < 3_600_001 and caught.value.time_s == pytest.approx(rows * 0.001)
+
+
+def test_the_cli_stops_a_hung_host_and_leaves_the_folder(native_dir, tmp_path, capsys, monkeypatch):
+    import signal
+
+    hosts = _stopping_popen(monkeypatch, "spawned")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "keep.txt").write_text("kept")
+    fails(capsys, ["run", "heavy-pi", "--fmus", str(native_dir), "--master", "c", "--timeout",
+                   "1", "--out", str(out), "--format", "csv"],
+          "scenario heavy-pi: C master: no output for 1 s at t = 0 s")
+    assert [p.name for p in out.iterdir()] == ["keep.txt"]
+    assert [host.returncode for host in hosts] == [-signal.SIGKILL]
+    fails(capsys, ["run", "heavy-pi", "--fmus", str(native_dir), "--timeout", "1", "--out",
+                   str(out)], "--timeout applies to the C master (--master c)")

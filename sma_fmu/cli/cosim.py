@@ -9,7 +9,8 @@ __all__ = ["register"]
 def _run(args):
     from sma_fmu.systems.runner import timed_run
     timed_run(scenario_paths(args), args.out, args.path, args.fmus,
-              output_interval_s=args.output_interval, fmt=args.format, master=args.master)
+              output_interval_s=args.output_interval, fmt=args.format, master=args.master,
+              timeout_s=args.timeout)
     return 0
 
 
@@ -26,6 +27,9 @@ def register(commands):
     run.add_argument("--master", choices=("fmpy", "c"), default="fmpy",  # runner.FMU_MASTERS
                      help="the FMU path's master: fmpy (default; Python) or c (the C master: "
                           "the FMUs stepped in one C process, the same results to the bit)")
+    run.add_argument("--timeout", type=positive_number, metavar="S",
+                     help="with --master c: stop a run whose C master sends no rows for S "
+                          "seconds (a hung FMU; default 60)")  # c_master.DEFAULT_TIMEOUT_S
     run.add_argument("--output-interval", type=positive_number, metavar="S",
                      help="record every k-th step in the time series and figures: S seconds, a "
                           "whole number of steps (default: the scenario's output_interval_s, else "

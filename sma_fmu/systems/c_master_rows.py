@@ -141,6 +141,11 @@ class RowAssembler:
         else:
             self.sink(block)
 
+    @property
+    def started(self):
+        """Whether a sample came (the time reached is then ``count`` steps)."""
+        return self._carry is not None
+
     def finish(self):
         """The last sample as the final row (no step outputs), the rows not yet sent; returns
         every row (a structured array) when there is no sink, else None."""

@@ -66,7 +66,7 @@ def comparison_labels(scenarios, names):
 
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print,
-                  output_interval_s=None, fmt="csv", master="fmpy"):
+                  output_interval_s=None, fmt="csv", master="fmpy", timeout_s=None):
     """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
@@ -74,7 +74,9 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     k-th step in the time series and figures (None: the scenario's ``[scenario]
     output_interval_s``, else every step); the metrics count every step. ``fmt``: the time
     series' format, "csv" or "parquet". ``master``: the FMU path's master, a key of
-    :data:`FMU_MASTERS` (``"c"`` only with ``path="fmu"``). Each run streams into its files
+    :data:`FMU_MASTERS` (``"c"`` only with ``path="fmu"``). ``timeout_s`` [s] (``--master c``
+    only): the longest the C master may send nothing before the run fails (None:
+    :data:`~sma_fmu.systems.c_master.DEFAULT_TIMEOUT_S`). Each run streams into its files
     (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
     """
     if path not in PATHS:
@@ -83,7 +85,14 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         raise ValueError(f"--master must be one of {', '.join(FMU_MASTERS)}, got {master!r}")
     if master != "fmpy" and path != "fmu":
         raise ValueError(f"--master {master} runs the FMUs (--path fmu), not --path {path}")
+    if timeout_s is not None and master != "c":
+        raise ValueError(f"--timeout applies to the C master (--master c), not --master {master}")
     run = FMU_MASTERS[master] if path == "fmu" else PATHS[path]
+    if timeout_s is not None:
+        if not timeout_s > 0:
+            raise ValueError(f"--timeout must be a number of seconds > 0, got {timeout_s!r}")
+        run = lambda scenario, fmu_dir, sink: run_c_master(scenario, fmu_dir, sink,  # noqa: E731
+                                                           timeout_s=timeout_s)
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
@@ -140,10 +149,11 @@ def _record_run(scenario, run, fmu_dir, folder, every, fmt):
 
 
 def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv",
-              master="fmpy"):
+              master="fmpy", timeout_s=None):
     """:func:`run_scenarios`, then print the summary table; returns the rows."""
     start = time.perf_counter()
-    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master)
+    rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master,
+                         timeout_s)
     progress(summary_table(rows))
     progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)")
     return rows
