@@ -89,6 +89,7 @@ class TimeseriesWriter:
                 if self._pending is None:
                     self._pending = {name: np.empty(PARQUET_ROW_GROUP, dtype=rows.dtype[name])
                                      for name, _ in COLUMNS}
+                    self._open()   # now, not at the first row group (a run's end, mostly)
                 count = min(rows.size - at, PARQUET_ROW_GROUP - self._pending_rows)
                 for name, column in self._pending.items():
                     column[self._pending_rows:self._pending_rows + count] = rows[name][at:at + count]
@@ -108,21 +109,31 @@ class TimeseriesWriter:
         self._stream, self.external = None, True
         return True
 
-    def _flush(self):
-        """Write the gathered rows as one Parquet row group (zstd)."""
+    def _open(self):
+        """The Parquet file, opened with the columns' schema (once)."""
+        if self._parquet is not None:
+            return
         import pyarrow as pa
         import pyarrow.parquet as pq
 
+        empty = np.empty(0, dtype=TIMESERIES_DTYPE)
+        schema = pa.Table.from_arrays([_arrow_column(empty[name]) for name, _ in COLUMNS],
+                                      names=list(COLUMN_NAMES)).schema
+        # no dictionary pages: float columns rarely repeat, and trying them took half the
+        # write time (30 s at 1 ms: 22 -> 10 ms, the file 2.5 -> 2.0 MB)
+        self._parquet = pq.ParquetWriter(str(self.path), schema, compression="zstd",
+                                         use_dictionary=False)
+
+    def _flush(self):
+        """Write the gathered rows as one Parquet row group (zstd)."""
+        import pyarrow as pa
+
+        self._open()
         empty = np.empty(0, dtype=TIMESERIES_DTYPE)
         columns = [self._pending[name][:self._pending_rows] if self._pending is not None
                    else empty[name] for name, _ in COLUMNS]
         table = pa.Table.from_arrays([_arrow_column(column) for column in columns],
                                      names=list(COLUMN_NAMES))
-        if self._parquet is None:
-            # no dictionary pages: float columns rarely repeat, and trying them took half the
-            # write time (30 s at 1 ms: 22 -> 10 ms, the file 2.5 -> 2.0 MB)
-            self._parquet = pq.ParquetWriter(str(self.path), table.schema, compression="zstd",
-                                             use_dictionary=False)
         if self._pending_rows or self.rows == 0:
             self._parquet.write_table(table)
         del table                # the Arrow columns share the buffers, reused from here

@@ -77,6 +77,20 @@ def unpacked_fmu(fmu, cache=None):
     return folder
 
 
+_HOSTS = {}   # the loop host's executable, by cache folder, platform and compiler settings
+
+
+def _loop_host(cache, windows):
+    """:func:`~sma_fmu.fmi.hosts.compile_host`'s loop host, looked up once per process (it
+    hashes the sources and looks for the compiler on every call)."""
+    key = (str(cache), windows, os.environ.get("CC"), os.environ.get("SMA_FMU_WIN64_CC"),
+           os.environ.get("PATH"))
+    executable = _HOSTS.get(key)
+    if executable is None or not executable.is_file():
+        executable = _HOSTS[key] = Path(compile_host("loop_host", cache, windows=windows))
+    return executable
+
+
 def _widen(pipe):
     """A 1 MiB pipe (Linux): the host steps on while the rows of two frames wait here."""
     try:
@@ -174,7 +188,7 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
     if windows is not None:
         folders = {name: wine_path(folder) for name, folder in folders.items()}
     try:
-        executable = compile_host("loop_host", cache, windows=windows is not None)
+        executable = _loop_host(cache, windows is not None)
     except CHostError as error:   # no compiler: one named error, not an internal one
         raise CMasterError(f"scenario {scenario.name}: C master: {error}", 3) from None
     columns = recorded_columns(system)
