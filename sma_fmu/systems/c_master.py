@@ -20,26 +20,22 @@ writes the CSV's rows itself (its "csv" line; the same text as the recorder's, b
 byte, about ten times faster than Python's formatting); the recorder still gets every
 row for the metrics and the figure.
 """
-import hashlib
 import os
 import re
-import shutil
 import subprocess
-import tempfile
 import threading
 import time
-import zipfile
 from pathlib import Path
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
-from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.driving.instance import FmuError
+from sma_fmu.fmi.driving.unpacked import acquire, release
 from sma_fmu.fmi.hosts import CHostError, compile_host
 from sma_fmu.systems.c_master_rows import RowAssembler, check_variables, csv_columns, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
 
-__all__ = ["MASTERS", "DEFAULT_TIMEOUT_S", "CMasterError", "unpacked_fmu", "run_c_master"]
+__all__ = ["MASTERS", "DEFAULT_TIMEOUT_S", "CMasterError", "run_c_master"]
 
 MASTERS = ("fmpy", "c")   # `sma-fmu run --master`: the fmpy master, or this one
 # [s] the longest the host may send nothing (choice: a frame of 4,096 steps takes about 1 ms,
@@ -55,26 +51,6 @@ class CMasterError(FmuError):
     def __init__(self, message, status, rows=None, time_s=None):
         super().__init__(message, status)
         self.rows, self.time_s = rows, time_s
-
-
-def unpacked_fmu(fmu, cache=None):
-    """The folder ``fmu`` is unpacked in, once per file version: under ``cache`` (default:
-    the temporary folder), keyed by its path, size and modification time [ns]."""
-    fmu = Path(fmu).resolve()
-    stat = fmu.stat()
-    key = hashlib.sha256(f"{fmu}\0{stat.st_size}\0{stat.st_mtime_ns}".encode()).hexdigest()[:16]
-    folder = Path(cache or tempfile.gettempdir()) / "sma-fmu-unpacked" / f"{fmu.stem}-{key}"
-    if not (folder / "modelDescription.xml").is_file():
-        require_safe_archive(fmu)
-        folder.parent.mkdir(parents=True, exist_ok=True)
-        stage = Path(tempfile.mkdtemp(dir=folder.parent, prefix=".stage-"))
-        with zipfile.ZipFile(fmu) as archive:
-            archive.extractall(stage)
-        try:
-            os.replace(stage, folder)   # atomic: a parallel run never sees half a folder
-        except OSError:                 # another run unpacked it first
-            shutil.rmtree(stage, ignore_errors=True)
-    return folder
 
 
 _HOSTS = {}   # the loop host's executable, by cache folder, platform and compiler settings
@@ -184,7 +160,20 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
     started = time.perf_counter()
     system = closed_loop(scenario, fmu_dir)
     check_variables(system)
-    folders = {c.name: unpacked_fmu(c.fmu, cache) for c in system.components}
+    unpacked = []   # each FMU unpacked once per process, removed at its exit (driving.unpacked)
+    try:
+        for component in system.components:
+            unpacked.append(acquire(component.fmu))
+        return _run(scenario, system, [u.folder for u in unpacked], sink, windows, cache,
+                    timeout_s, started)
+    finally:
+        for folder in unpacked:
+            release(folder)
+
+
+def _run(scenario, system, unpacked, sink, windows, cache, timeout_s, started):
+    """:func:`run_c_master` with the FMUs of ``system`` unpacked in the folders ``unpacked``."""
+    folders = {c.name: folder for c, folder in zip(system.components, unpacked)}
     if windows is not None:
         folders = {name: wine_path(folder) for name, folder in folders.items()}
     try:
