@@ -188,8 +188,8 @@ def _run(scenario, system, unpacked, sink, windows, cache, timeout_s, started):
     text = text() if text is not None else None
     if text is not None:
         path, every, last = text
-        path = str(path) if windows is None else wine_path(path)
-        lines.insert(-1, f"csv {path.encode('utf-8').hex()} {every} {last} {csv_columns(columns)}")
+        name = os.fsencode(path) if windows is None else wine_path(path).encode("utf-8")
+        lines.insert(-1, f"csv {name.hex()} {every} {last} {csv_columns(columns)}")
     command = [str(executable)] if windows is None else [wine_executable(), str(executable)]
     environment = dict(os.environ if windows is None else windows)
     environment.pop("LD_PRELOAD", None)
