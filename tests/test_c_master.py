@@ -16,7 +16,7 @@ import pytest
 from cli_failure import fails
 from sma_fmu.cosim.master import MissingFmuError, run_fmus
 from sma_fmu.cosim.metrics import scenario_metrics
-from sma_fmu.cosim.recording import read_timeseries
+from sma_fmu.cosim.recording import RunRecorder, interval_steps, read_timeseries
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios
 from sma_fmu.systems.c_master import CMasterError, run_c_master
 from sma_fmu.systems.runner import run_scenarios
@@ -214,3 +214,176 @@ def test_the_bench_section_compares_each_scenario_with_the_library(native_dir, t
     lines = c_master_lines(times)
     assert "heavy-pi (parquet)" in lines[-1] and f"target <= {TARGET:g}" in lines[-1]
     assert len(list(tmp_path.glob("heavy-pi-parquet-*/timeseries.parquet"))) == 2
+
+
+class _PythonCsv(RunRecorder):
+    """A recorder that keeps the CSV to itself: Python formats every row."""
+    csv_for_host = None
+
+
+@pytest.mark.parametrize("name", PAPER_SET + PWM)
+def test_the_csv_the_c_master_writes_is_the_recorders_byte_for_byte(native_dir, name, tmp_path):
+    """The host writes the CSV's rows itself ("csv" line); the file is the one the Python
+    recorder writes from the same rows, every step and every 7th (--output-interval), and
+    the metrics, figure rows and row counts are unchanged."""
+    scenario = _scenario(name)
+    for every in (1, interval_steps(0.007, scenario.step_s)):
+        made = {}
+        for kind, recorder_class in (("c", RunRecorder), ("python", _PythonCsv)):
+            folder = tmp_path / f"{kind}-{every}"
+            folder.mkdir()
+            recorder = recorder_class(scenario, folder, every, "csv")
+            run_c_master(scenario, native_dir, recorder)
+            metrics, figure = recorder.close()
+            made[kind] = ((folder / "timeseries.csv").read_bytes(), metrics, figure, recorder.writer.rows)
+        (c_text, c_metrics, c_figure, c_rows), (p_text, p_metrics, p_figure, p_rows) = made["c"], made["python"]
+        assert c_text == p_text and c_text.count(b"\n") == c_rows + 1
+        assert json.dumps(c_metrics) == json.dumps(p_metrics) and c_rows == p_rows
+        _same(c_figure, p_figure)
+    assert c_rows == len(range(0, scenario.steps + 1, every)) + (scenario.steps % every != 0)
+
+
+def test_a_discard_mid_run_leaves_the_same_csv_rows(native_dir, tmp_path):
+    """The failed step's rows: the C-written CSV holds those the Python recorder writes."""
+    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
+    scenario = load_scenario(tmp_path / "discard.toml")
+    texts = []
+    for kind, recorder_class in (("c", RunRecorder), ("python", _PythonCsv)):
+        folder = tmp_path / kind
+        folder.mkdir()
+        recorder = recorder_class(scenario, folder, 3, "csv")
+        with pytest.raises(CMasterError, match="501 rows kept"):
+            run_c_master(scenario, native_dir, recorder)
+        recorder.close()
+        texts.append((folder / "timeseries.csv").read_bytes())
+    assert texts[0] == texts[1] and texts[0].count(b"\n") == 1 + len(range(0, 501, 3))
+
+
+def _g10(values, windows=None):
+    """The loop host's "%.10g" of each of ``values`` (its "g10" test line)."""
+    import subprocess
+    import struct
+
+    from sma_fmu.fmi.hosts import compile_host
+    from sma_fmu.systems.loop_host import wine_executable
+
+    executable = compile_host("loop_host", windows=windows is not None)
+    line = "g10 " + " ".join(struct.pack(">d", v).hex() for v in values) + "\n"
+    command = [str(executable)] if windows is None else [wine_executable(), str(executable)]
+    done = subprocess.run(command, input=line.encode(), capture_output=True, check=True,
+                          env=windows, timeout=600)
+    return done.stdout.decode().split()
+
+
+def g10_cases(count=40_000, seed=41):
+    """Edge cases of "%.10g" and random doubles: any bit pattern, any decade, near-ties."""
+    import random
+    import struct
+
+    pick = random.Random(seed)
+    values = [0.0, -0.0, 1e-5, -1e-5, 1e-4, 9.99999999949999e-5, 1e-10, 1e10, 9999999999.5,
+              9999999999.4, 99999.999995, 1234567890.5, 1234567891.5, 123456789012.0, 1e20,
+              1e30, 1e-30, 1e-31, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308,
+              float("nan"), -float("nan"), float("inf"), -float("inf"), 0.1 + 0.2, 1 / 3, 30.0]
+    for _ in range(count):
+        r = pick.random()
+        if r < 0.3:
+            values.append(struct.unpack("<d", struct.pack("<Q", pick.getrandbits(64)))[0])
+        elif r < 0.6:
+            values.append(pick.uniform(-1, 1) * 10.0 ** pick.randint(-35, 35))
+        elif r < 0.8:   # 11 significant digits ending in 5: at or next to a tie
+            digits = pick.randint(10 ** 10, 10 ** 11 - 1) // 10 * 10 + 5
+            values.append(pick.choice((-1, 1)) * digits * 10.0 ** pick.randint(-25, 15))
+        else:
+            values.append(round(pick.uniform(-100, 100), pick.randint(0, 12)))
+    return values
+
+
+def test_the_hosts_g10_is_pythons_percent_10g():
+    values = g10_cases()
+    got = _g10(values)
+    assert len(got) == len(values)
+    wrong = [(v, text, "%.10g" % v) for v, text in zip(values, got) if text != "%.10g" % v]
+    assert wrong == []
+
+
+def _stopping_popen(monkeypatch, when):
+    """Popen for the C master's host that records each host and, ``when`` "spawned", stops
+    it at once with SIGSTOP (a host that hangs before its first row); the hosts started."""
+    import os
+    import signal
+    import subprocess
+
+    from sma_fmu.systems import c_master
+
+    hosts = []
+
+    class Stopping(subprocess.Popen):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            hosts.append(self)
+            if when == "spawned":
+                os.kill(self.pid, signal.SIGSTOP)
+
+    monkeypatch.setattr(c_master.subprocess, "Popen", Stopping)
+    return hosts
+
+
+def test_a_host_that_falls_silent_mid_run_is_killed_and_named(native_dir, tmp_path, monkeypatch):
+    """The host is stopped (SIGSTOP) when its first rows arrive: no frame comes for the
+    timeout, so the watchdog kills it and the error names the timeout and the time reached."""
+    import os
+    import signal
+
+    hosts = _stopping_popen(monkeypatch, "first rows")
+    (tmp_path / "hour.toml").write_text(DISCARD.format(stop=3600.0).replace("1e306", "0.3"))
+    got = []
+
+    def sink(block):
+        if not got:
+            os.kill(hosts[0].pid, signal.SIGSTOP)
+        got.append(block)
+
+    with pytest.raises(CMasterError, match=r"C master: no output for 1 s at t = \d+(\.\d+)? s: "
+                                           r"the host was stopped") as caught:
+        run_c_master(load_scenario(tmp_path / "hour.toml"), native_dir, sink, timeout_s=1.0)
+    assert hosts[0].returncode == -signal.SIGKILL
+    rows = sum(block.size for block in got)
+    assert 0 < rows < 3_600_001 and caught.value.time_s == pytest.approx(rows * 0.001)
+
+
+def test_the_cli_stops_a_hung_host_and_leaves_the_folder(native_dir, tmp_path, capsys, monkeypatch):
+    import signal
+
+    hosts = _stopping_popen(monkeypatch, "spawned")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "keep.txt").write_text("kept")
+    fails(capsys, ["run", "heavy-pi", "--fmus", str(native_dir), "--master", "c", "--timeout",
+                   "1", "--out", str(out), "--format", "csv"],
+          "scenario heavy-pi: C master: no output for 1 s at t = 0 s")
+    assert [p.name for p in out.iterdir()] == ["keep.txt"]
+    assert [host.returncode for host in hosts] == [-signal.SIGKILL]
+    fails(capsys, ["run", "heavy-pi", "--fmus", str(native_dir), "--timeout", "1", "--out",
+                   str(out)], "--timeout applies to the C master (--master c)")
+
+
+@pytest.mark.parametrize("compiler", ["gcc", "mingw-w64"])
+def test_the_loop_host_builds_without_a_warning_even_pedantic(compiler, tmp_path):
+    """loop_host.c with -Wall -Wextra -Wpedantic -Werror: gcc (linux64) and mingw-w64 (win64)."""
+    import subprocess
+    from importlib import resources
+
+    from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+    from system_needs import need
+
+    need(compiler)
+    hosts = resources.files("sma_fmu.fmi.hosts")
+    for name in ("loop_host.c", "host_platform.h"):
+        (tmp_path / name).write_bytes(hosts.joinpath(name).read_bytes())
+    command = windows_compiler() if compiler == "mingw-w64" else c_compiler()
+    built = subprocess.run([*command, "-std=c11", "-O2", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
+                            "-o", str(tmp_path / "loop_host.out"), str(tmp_path / "loop_host.c"),
+                            *([] if compiler == "mingw-w64" else ["-ldl"])],
+                           capture_output=True, text=True, timeout=300)
+    assert built.returncode == 0, built.stderr

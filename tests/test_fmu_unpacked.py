@@ -9,6 +9,7 @@ from pathlib import Path
 
 from sma_fmu.fmi.driving import unpacked
 from sma_fmu.fmi.driving.instance import FmuInstance
+from system_needs import needs
 
 PREFIX = "sma_fmu_unpacked_"
 
@@ -186,3 +187,84 @@ def test_unpack_each_gives_every_instance_its_own_folder(fmus, tmp_path, monkeyp
         first.close()
         second.close()
     assert _ours(tmp_path) == set()  # removed at close, as before the cache
+
+
+KILLED = """
+import os, signal, sys
+from sma_fmu.fmi.driving import unpacked
+print(unpacked.acquire(sys.argv[1]).folder, flush=True)
+os.kill(os.getpid(), signal.SIGKILL)   # no exit handler runs: the folder stays behind
+"""
+
+WAITING = """
+import sys
+from sma_fmu.fmi.driving import unpacked
+print(unpacked.acquire(sys.argv[1]).folder, flush=True)
+sys.stdin.read()   # alive until its stdin closes
+"""
+
+SWEEPING = """
+import sys
+from sma_fmu.fmi.driving import unpacked
+print(unpacked.acquire(sys.argv[1]).folder, flush=True)   # the first unpack sweeps
+"""
+
+
+def test_the_folders_of_a_killed_process_are_removed_by_the_next_one(fmus, tmp_path):
+    """A killed process leaves its folder; the next process to unpack removes it, but not
+    the folder of a process still alive; each removes its own at its exit."""
+    environment = {**os.environ, "TMPDIR": str(tmp_path)}
+    path = str(fmus["SmaActuator"])
+    killed = subprocess.run([sys.executable, "-c", KILLED, path], env=environment,
+                            capture_output=True, text=True, timeout=300)
+    assert killed.returncode == -9, killed.stderr[-2000:]
+    stale = Path(killed.stdout.strip())
+    assert stale.parent == tmp_path and (stale / "modelDescription.xml").is_file()
+    waiting = subprocess.Popen([sys.executable, "-c", WAITING, path], env=environment,
+                               stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        alive = Path(waiting.stdout.readline().strip())
+        assert alive.is_dir() and alive != stale
+        sweeping = subprocess.run([sys.executable, "-c", SWEEPING, path], env=environment,
+                                  capture_output=True, text=True, timeout=300)
+        assert sweeping.returncode == 0, sweeping.stderr[-2000:]
+        assert not stale.exists()                     # the killed process's: removed
+        assert alive.is_dir()                         # the living one's: kept
+        assert _ours(tmp_path) == {alive.name}        # the sweeper's own: removed at its exit
+    finally:
+        waiting.stdin.close()
+        waiting.wait(timeout=300)
+    assert _ours(tmp_path) == set()
+
+
+def test_remove_stale_names_what_it_removed_and_keeps_its_own(fmus, tmp_path):
+    environment = {**os.environ, "TMPDIR": str(tmp_path)}
+    killed = subprocess.run([sys.executable, "-c", KILLED, str(fmus["SmaFeedforward"])],
+                            env=environment, capture_output=True, text=True, timeout=300)
+    stale = Path(killed.stdout.strip())
+    own = tmp_path / f"{PREFIX}{os.getpid()}_mine"
+    own.mkdir()
+    other = tmp_path / "sma_fmu_unpacked_not-a-pid"
+    other.mkdir()
+    assert unpacked.remove_stale(tmp_path) == [stale.name]
+    assert own.is_dir() and other.is_dir() and not stale.exists()
+    assert unpacked.remove_stale(tmp_path) == []
+
+
+C_MASTER_RUN = """
+import sys
+from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
+from sma_fmu.systems.c_master import run_c_master
+scenario = load_scenario(resolve_scenarios(["heavy-pi"])[0])
+print(run_c_master(scenario, sys.argv[1]).data.size, flush=True)
+"""
+
+
+@needs("gcc")
+def test_the_c_master_unpacks_per_process_and_removes_them_at_exit(native_fmus, tmp_path):
+    environment = {**os.environ, "TMPDIR": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", C_MASTER_RUN, str(native_fmus["SmaActuator"].parent)],
+                          env=environment, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip() == "30001"
+    assert _ours(tmp_path) == set() and not (tmp_path / "sma-fmu-unpacked").exists()

@@ -142,3 +142,26 @@ def test_the_c_master_runs_the_win64_build_under_wine(native_dir, wine, tmp_path
                                            r"\(fmi2Discard\) at t = 0.5 s") as caught:
         run_c_master(load_scenario(tmp_path / "discard.toml"), native_dir, windows=wine)
     assert len(caught.value.rows) == 501
+
+
+@needs("wine64")
+def test_the_win64_c_master_writes_the_csv_the_recorder_would(native_dir, wine, tmp_path):
+    """Under wine the win64 host writes the CSV's rows too (mingw-w64's printf only where
+    format_g10 falls back): the file is the Python recorder's text of the win64 run's rows,
+    byte for byte, and its "%.10g" is Python's on the edge cases and random doubles."""
+    from sma_fmu.cosim.recording import RunRecorder
+    from sma_fmu.systems.c_master import run_c_master
+    from test_c_master import _g10, _PythonCsv, g10_cases
+
+    values = g10_cases(count=20_000, seed=7)
+    assert _g10(values, windows=wine) == ["%.10g" % v for v in values]
+    scenario = _scenario(SCENARIOS[0])
+    texts = []
+    for kind, recorder_class in (("c", RunRecorder), ("python", _PythonCsv)):
+        folder = tmp_path / kind
+        folder.mkdir()
+        recorder = recorder_class(scenario, folder, 3, "csv")
+        run_c_master(scenario, native_dir, recorder, windows=wine)
+        recorder.close()
+        texts.append((folder / "timeseries.csv").read_bytes())
+    assert texts[0] == texts[1] and texts[0].count(b"\n") == 1 + len(range(0, scenario.steps + 1, 3))

@@ -10,7 +10,7 @@ def _run(args):
     from sma_fmu.systems.runner import timed_run
     timed_run(scenario_paths(args), args.out, args.path, args.fmus,
               output_interval_s=args.output_interval, fmt=args.format, master=args.master,
-              events=args.events)
+              events=args.events, timeout_s=args.timeout)
     return 0
 
 
@@ -31,6 +31,9 @@ def register(commands):
                      help="FMI 3.0 FMUs only, fmpy master: instantiate with event mode and early "
                           "return; the plant steps from edge to edge of the PWM wave, the rows "
                           "stay on the fixed step grid")
+    run.add_argument("--timeout", type=positive_number, metavar="S",
+                     help="with --master c: stop a run whose C master sends no rows for S "
+                          "seconds (a hung FMU; default 60)")  # c_master.DEFAULT_TIMEOUT_S
     run.add_argument("--output-interval", type=positive_number, metavar="S",
                      help="record every k-th step in the time series and figures: S seconds, a "
                           "whole number of steps (default: the scenario's output_interval_s, else "

@@ -49,6 +49,9 @@ def band_edges(loads, params):
     The band is computed once per distinct load (loads are piecewise constant).
     """
     loads = np.asarray(loads, dtype=float)
+    if loads.size and loads[0] == loads[-1] and (loads == loads[0]).all():  # one load (mostly)
+        band = reachable_band(float(loads[0]), params)
+        return np.full_like(loads, band.hot), np.full_like(loads, band.cold)
     hot, cold = np.empty_like(loads), np.empty_like(loads)
     for load in np.unique(loads):
         band = reachable_band(float(load), params)
@@ -73,6 +76,8 @@ def unreachable_intervals(times, below, above):
     """
     intervals = []
     for mask, side in ((below, "below R_hot"), (above, "above R_cold")):
+        if not mask.any():
+            continue
         edges = np.diff(np.concatenate(([0], mask.astype(np.int8), [0])))
         starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
         intervals += [[float(times[a]), float(times[b]), side] for a, b in zip(starts, ends)]
@@ -156,12 +161,26 @@ class ErrorSums:
         """Count the errors [ohm] of one block (an array)."""
         if errors.size == 0:
             return
+        self.take(self.terms(errors))
+
+    @staticmethod
+    def terms(errors):
+        """(sum of squares, sum of magnitudes, largest magnitude, count) of a non-empty array
+        of errors [ohm]: what :meth:`add` counts, for :meth:`take` (one block's errors may
+        count in several sums)."""
         with np.errstate(over="ignore", invalid="ignore"):  # a diverged run gives inf, as such
             magnitudes = np.abs(errors)
-            self.squares += float(np.sum(np.square(errors)))
-            self.magnitudes += float(np.sum(magnitudes))
-            self.largest = float(np.maximum(self.largest, np.max(magnitudes)))  # NaN propagates
-        self.count += int(errors.size)
+            return (float(np.sum(np.square(errors))), float(np.sum(magnitudes)),
+                    np.max(magnitudes), int(errors.size))
+
+    def take(self, terms):
+        """Count a block's :meth:`terms`."""
+        squares, magnitudes, largest, count = terms
+        with np.errstate(over="ignore", invalid="ignore"):
+            self.squares += squares
+            self.magnitudes += magnitudes
+            self.largest = float(np.maximum(self.largest, largest))  # NaN propagates
+        self.count += count
 
     def metrics(self, step_size):
         """{"rmse_ohm", "max_abs_ohm", "iae_ohm_s", "samples"}; ``step_size`` [s]."""
@@ -191,15 +210,30 @@ class StreamingMetrics:
         window, segments = metric_windows(t, self.scenario)
         below, above = unreachable_samples(block["R_ref"], block["load"], self.scenario.params)
         unreachable = below | above
-        self.overall.add(error[window])
+        # the usual block lies wholly in the window, one segment and the reachable band: its
+        # errors are counted once and the same sums go to each (the same numbers, to the bit)
+        whole = bool(window.all())
+        reachable = not unreachable.any()
+        terms = ErrorSums.terms(error) if whole else None
+        if whole:
+            self.overall.take(terms)
+        else:
+            self.overall.add(error[window])
         for sums, inside in zip(self.segments, segments):
-            sums.add(error[inside])
-        self.reachable.add(error[window & ~unreachable])
-        self.window += int(np.count_nonzero(window))
-        self.saturated += int(np.count_nonzero(block["saturated"][window]))
+            if whole and inside.all():
+                sums.take(terms)
+            elif inside.any():
+                sums.add(error[inside])
+        if whole and reachable:
+            self.reachable.take(terms)
+        else:
+            self.reachable.add(error[window & ~unreachable])
+        inside = (lambda column: column) if whole else (lambda column: column[window])  # noqa: E731
+        self.window += int(block.size) if whole else int(np.count_nonzero(window))
+        self.saturated += int(np.count_nonzero(inside(block["saturated"])))
         # the final row's P is NaN, never 0: counting it changes nothing (see result)
-        self.clamped += int(np.count_nonzero(block["P"][window] == 0.0))
-        self.unreachable += int(np.count_nonzero(unreachable[window]))
+        self.clamped += int(np.count_nonzero(inside(block["P"]) == 0.0))
+        self.unreachable += 0 if reachable else int(np.count_nonzero(unreachable[window]))
         self._join(unreachable_intervals(t, below, above), float(t[0]))
         self._last_time = float(t[-1])
 

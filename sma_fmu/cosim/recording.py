@@ -66,6 +66,7 @@ class TimeseriesWriter:
         self.path, self.fmt, self.rows = Path(path), fmt, 0
         self._stream = self._parquet = None
         self._pending, self._pending_rows = None, 0   # Parquet rows not yet written (a row group)
+        self.external = False   # the CSV's rows are written by another program (hand_over)
         if fmt == "csv":
             self._stream = open(self.path, "w", encoding="utf-8", newline="\n")
             self._stream.write(",".join(COLUMN_NAMES) + "\n")
@@ -74,7 +75,9 @@ class TimeseriesWriter:
         """Append ``rows`` (a structured array with the fields of :data:`COLUMNS`)."""
         if rows.size == 0:
             return
-        if self.fmt == "csv":
+        if self.external:   # written by the program it was handed over to: only counted
+            pass
+        elif self.fmt == "csv":
             # one %-format over the whole block (what np.savetxt does row by row): same text,
             # 1.5x faster (30,001 rows x 12 columns: 77 -> 51 ms)
             table = np.column_stack([rows[name].astype(float) for name, _ in COLUMNS])
@@ -82,39 +85,65 @@ class TimeseriesWriter:
             self._stream.write((line * table.shape[0]) % tuple(table.ravel().tolist()))
         else:  # gathered into row groups of PARQUET_ROW_GROUP rows: they compress far better
             at = 0
-            while at < rows.size:  # copied once, into the row group's own buffer
+            while at < rows.size:  # copied once, into the row group's own columns
                 if self._pending is None:
-                    self._pending = np.empty(PARQUET_ROW_GROUP, dtype=rows.dtype)
+                    self._pending = {name: np.empty(PARQUET_ROW_GROUP, dtype=rows.dtype[name])
+                                     for name, _ in COLUMNS}
+                    self._open()   # now, not at the first row group (a run's end, mostly)
                 count = min(rows.size - at, PARQUET_ROW_GROUP - self._pending_rows)
-                self._pending[self._pending_rows:self._pending_rows + count] = rows[at:at + count]
+                for name, column in self._pending.items():
+                    column[self._pending_rows:self._pending_rows + count] = rows[name][at:at + count]
                 self._pending_rows += count
                 at += count
                 if self._pending_rows == PARQUET_ROW_GROUP:
                     self._flush()
         self.rows += rows.size
 
-    def _flush(self):
-        """Write the gathered rows as one Parquet row group (zstd)."""
+    def hand_over(self):
+        """Let another program append the CSV's rows (the C master writes them as this class
+        would, byte for byte): the header is written and the file closed; :meth:`write` then
+        only counts the rows. True if handed over (a CSV writer without rows yet)."""
+        if self.fmt != "csv" or self.rows or self.external:
+            return False
+        self._stream.close()
+        self._stream, self.external = None, True
+        return True
+
+    def _open(self):
+        """The Parquet file, opened with the columns' schema (once)."""
+        if self._parquet is not None:
+            return
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        rows = (self._pending[:self._pending_rows] if self._pending is not None
-                else np.empty(0, dtype=TIMESERIES_DTYPE))
-        table = pa.Table.from_arrays([_arrow_column(rows[name]) for name, _ in COLUMNS],
+        empty = np.empty(0, dtype=TIMESERIES_DTYPE)
+        schema = pa.Table.from_arrays([_arrow_column(empty[name]) for name, _ in COLUMNS],
+                                      names=list(COLUMN_NAMES)).schema
+        # no dictionary pages: float columns rarely repeat, and trying them took half the
+        # write time (30 s at 1 ms: 22 -> 10 ms, the file 2.5 -> 2.0 MB)
+        self._parquet = pq.ParquetWriter(str(self.path), schema, compression="zstd",
+                                         use_dictionary=False)
+
+    def _flush(self):
+        """Write the gathered rows as one Parquet row group (zstd)."""
+        import pyarrow as pa
+
+        self._open()
+        empty = np.empty(0, dtype=TIMESERIES_DTYPE)
+        columns = [self._pending[name][:self._pending_rows] if self._pending is not None
+                   else empty[name] for name, _ in COLUMNS]
+        table = pa.Table.from_arrays([_arrow_column(column) for column in columns],
                                      names=list(COLUMN_NAMES))
-        if self._parquet is None:
-            # no dictionary pages: float columns rarely repeat, and trying them took half the
-            # write time (30 s at 1 ms: 22 -> 10 ms, the file 2.5 -> 2.0 MB)
-            self._parquet = pq.ParquetWriter(str(self.path), table.schema, compression="zstd",
-                                             use_dictionary=False)
-        if rows.size or self.rows == 0:
+        if self._pending_rows or self.rows == 0:
             self._parquet.write_table(table)
-        self._pending_rows = 0   # the buffer is reused (the Arrow columns are copies of it)
+        del table                # the Arrow columns share the buffers, reused from here
+        self._pending_rows = 0
 
     def close(self):
         """Finish the file (an empty run still gets its header or schema)."""
-        if self._stream is not None:
-            self._stream.close()
+        if self._stream is not None or self.external:
+            if self._stream is not None:
+                self._stream.close()
             return
         if self._pending_rows or self._parquet is None:
             self._flush()
@@ -149,33 +178,45 @@ def _arrow_column(values):
 
 class FigureSeries:
     """The rows a figure draws: every ``stride``-th recorded row, at most ``2 * limit`` kept
-    between halvings; the last recorded row is always kept (the run's end)."""
+    between halvings; the last recorded row is always kept (the run's end). The kept rows
+    are copied once, into a buffer of their own (:meth:`rows` gives it without a copy)."""
 
     def __init__(self, limit=FIGURE_ROWS):
         self.limit, self.stride, self.count = limit, 1, 0
-        self._blocks, self._kept, self._last = [], 0, None
+        self._buffer, self._kept, self._last, self._given = None, 0, None, False
 
     def add(self, rows):
         """Offer recorded rows (consecutive, in order)."""
         if rows.size == 0:
             return
-        chosen = rows[(-self.count) % self.stride::self.stride].copy()  # ordinals % stride == 0
+        chosen = rows[(-self.count) % self.stride::self.stride]  # ordinals % stride == 0
         self.count += rows.size
         self._last = rows[-1:].copy()
-        self._blocks.append(chosen)
-        self._kept += chosen.size
+        need = self._kept + chosen.size
+        if self._buffer is None or need > len(self._buffer) or self._given:
+            # a larger buffer, or a fresh one after rows() gave this one away; the first is
+            # large enough for loop-sized blocks (np.empty: pages are taken as they are used)
+            capacity = max(need, 2 * self.limit + 4096,
+                           0 if self._buffer is None else 2 * len(self._buffer))
+            buffer = np.empty(capacity, dtype=rows.dtype)
+            if self._kept:
+                buffer[:self._kept] = self._buffer[:self._kept]
+            self._buffer, self._given = buffer, False
+        self._buffer[self._kept:need] = chosen
+        self._kept = need
         if self._kept > 2 * self.limit:  # halve: keep every other kept row
-            kept = _joined(self._blocks)
-            ordinals = np.arange(kept.size) * self.stride
+            ordinals = np.arange(self._kept) * self.stride
             self.stride *= 2
-            kept = kept[ordinals % self.stride == 0]
-            self._blocks, self._kept = [kept], kept.size
+            kept = self._buffer[:self._kept][ordinals % self.stride == 0]
+            self._buffer[:kept.size] = kept
+            self._kept = kept.size
 
     def rows(self):
         """The kept rows (a structured array), ending with the last row offered."""
         if self._last is None:
             return np.empty(0, dtype=TIMESERIES_DTYPE)
-        kept = _joined(self._blocks)
+        kept = self._buffer[:self._kept]
+        self._given = True
         if kept[-1]["t"] != self._last[0]["t"]:
             kept = _joined([kept, self._last])
         return kept
@@ -209,6 +250,15 @@ class RunRecorder:
         if self.progress is not None:
             self.progress(block.size)
         self.seconds += time.perf_counter() - started
+
+    def csv_for_host(self):
+        """(path, every, last row) for a host that writes this run's CSV rows itself (the C
+        master), with the file handed over to it (:meth:`TimeseriesWriter.hand_over`); None
+        when the time series is Parquet or rows were recorded already. The recorder then
+        counts the rows, the metrics and the figure as before."""
+        if self.seen or not self.writer.hand_over():
+            return None
+        return self.writer.path, self.every, self.last_row
 
     def feed(self, data):
         """Record a whole series kept by a host (SSP, container) in loop-sized blocks."""

@@ -14,11 +14,11 @@ import math
 
 import numpy as np
 
-from sma_fmu.cosim.loop import ROWS_PER_CHUNK, TIMESERIES_DTYPE
+from sma_fmu.cosim.loop import COLUMNS, ROWS_PER_CHUNK, TIMESERIES_DTYPE
 from sma_fmu.systems.container import loop_outputs
 from sma_fmu.systems.hosts import NO_COMPENSATOR, STATE_COLUMNS, STEP_COLUMNS
 
-__all__ = ["recorded_columns", "check_variables", "RowAssembler"]
+__all__ = ["recorded_columns", "csv_columns", "check_variables", "RowAssembler"]
 
 
 def recorded_columns(system):
@@ -26,6 +26,27 @@ def recorded_columns(system):
     component (the host reads neighbouring columns of one component in one call)."""
     outputs = loop_outputs(system.scenario)
     return sorted(outputs, key=lambda column: (outputs[column][0], column == "saturated"))
+
+
+def csv_columns(columns):
+    """The loop host's words for the CSV's columns (:data:`~sma_fmu.cosim.loop.COLUMNS`, its
+    "csv" line) from the recorded ``columns``: the rows :class:`RowAssembler` makes, as text."""
+    index = {name: i for i, name in enumerate(columns)}
+    words = []
+    for name, _ in COLUMNS:
+        if name == "t":
+            words.append("t")
+        elif name == "stroke":
+            words.append(f"x:{index['x']}")
+        elif name in STATE_COLUMNS:
+            words.append(f"s:{index[name]}")
+        elif name not in index:   # a block the loop lacks (NO_COMPENSATOR): after each step
+            value = float(NO_COMPENSATOR[name])   # (the final row: nan, or False)
+            kind = "c" if name == "saturated" else "k"
+            words.append(f"{kind}:{'nan' if math.isnan(value) else repr(value)}")
+        else:
+            words.append(f"{'b' if name == 'saturated' else 'a'}:{index[name]}")
+    return " ".join(words)
 
 
 def _need(component, name, causality, types, why):
@@ -70,20 +91,30 @@ class RowAssembler:
     def add(self, payload):
         """Take one frame of samples (bytes)."""
         samples = np.frombuffer(payload, dtype=np.float64).reshape(-1, self.width)
-        if self._carry is not None:
-            samples = np.concatenate([self._carry, samples])
-        if self._start_x is None:
+        if len(samples) == 0:
+            return
+        first = self._carry   # the sample before this frame (its row waited for this one)
+        if first is None:
             self._start_x = samples[0, self.index["x"]]
-        self._carry = samples[-1:].copy()
-        if len(samples) > 1:
-            self._rows(samples[:-1], samples[1:])
+        self._carry = samples[-1].copy()
+        if first is None:
+            if len(samples) > 1:
+                self._rows(None, samples[:-1], samples[1:])
+        else:
+            self._rows(first, samples[:-1], samples)
 
-    def _rows(self, now, after):
-        """Rows from the samples ``now`` and the samples after their step (None: no step)."""
-        block = np.empty(len(now), dtype=TIMESERIES_DTYPE)
-        block["t"] = np.arange(self.count, self.count + len(now), dtype=np.float64) * self.step_s
+    def _rows(self, first, now, after):
+        """Rows from the sample ``first`` (None: no such row) and the samples ``now``, and the
+        samples after their step, one for each row (``after`` None: no step)."""
+        lead = 0 if first is None else 1
+        size = lead + len(now)
+        block = np.empty(size, dtype=TIMESERIES_DTYPE)
+        block["t"] = np.arange(self.count, self.count + size, dtype=np.float64) * self.step_s
         for name in STATE_COLUMNS:
-            block[name] = now[:, self.index[name]]
+            column, index = block[name], self.index[name]
+            if lead:
+                column[0] = first[index]
+            column[lead:] = now[:, index]
         block["stroke"] = self._start_x - block["x"]
         for name in STEP_COLUMNS:
             if after is None:
@@ -94,7 +125,7 @@ class RowAssembler:
                 block[name] = after[:, self.index[name]] != 0.0
             else:
                 block[name] = after[:, self.index[name]]
-        self.count += len(now)
+        self.count += size
         self._emit(block)
 
     def _emit(self, block):
@@ -120,11 +151,16 @@ class RowAssembler:
         else:
             self.sink(block)
 
+    @property
+    def started(self):
+        """Whether a sample came (the time reached is then ``count`` steps)."""
+        return self._carry is not None
+
     def finish(self):
         """The last sample as the final row (no step outputs), the rows not yet sent; returns
         every row (a structured array) when there is no sink, else None."""
         if self._carry is not None:
-            self._rows(self._carry, None)
+            self._rows(self._carry, self._carry[:0].reshape(0, self.width), None)
             self._carry = None
         if self._filled:
             self._send()

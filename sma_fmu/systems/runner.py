@@ -9,6 +9,7 @@ Everything is written into a temporary folder and moved into ``out_dir`` at the 
 """
 import time
 from collections import Counter
+from functools import partial
 
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.master import run_fmus
@@ -66,7 +67,8 @@ def comparison_labels(scenarios, names):
 
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print,
-                  output_interval_s=None, fmt="csv", master="fmpy", events=False):
+                  output_interval_s=None, fmt="csv", master="fmpy", events=False,
+                  timeout_s=None):
     """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
@@ -76,7 +78,9 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     series' format, "csv" or "parquet". ``master``: the FMU path's master, a key of
     :data:`FMU_MASTERS` (``"c"`` only with ``path="fmu"``). ``events``: the fmpy master
     runs FMI 3.0 FMUs with event mode and early return (:mod:`sma_fmu.cosim.event_drive`;
-    only with ``path="fmu"``, ``master="fmpy"``). Each run streams into its files
+    only with ``path="fmu"``, ``master="fmpy"``). ``timeout_s`` [s] (``--master c``
+    only): the longest the C master may send nothing before the run fails (None:
+    :data:`~sma_fmu.systems.c_master.DEFAULT_TIMEOUT_S`). Each run streams into its files
     (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
     """
     if path not in PATHS:
@@ -88,10 +92,15 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     if events and (path != "fmu" or master != "fmpy"):
         raise ValueError(f"--events runs the FMUs through the fmpy master (--path fmu --master "
                          f"fmpy), not --path {path} --master {master}")
+    if timeout_s is not None and master != "c":
+        raise ValueError(f"--timeout applies to the C master (--master c), not --master {master}")
+    if timeout_s is not None and not timeout_s > 0:
+        raise ValueError(f"--timeout must be a number of seconds > 0, got {timeout_s!r}")
     run = FMU_MASTERS[master] if path == "fmu" else PATHS[path]
     if events:
-        def run(scenario, fmu_dir, sink):
-            return run_fmus(scenario, fmu_dir, sink, events=True)
+        run = partial(run_fmus, events=True)
+    elif timeout_s is not None:
+        run = partial(run_c_master, timeout_s=timeout_s)
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
@@ -150,11 +159,11 @@ def _record_run(scenario, run, fmu_dir, folder, every, fmt):
 
 
 def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv",
-              master="fmpy", events=False):
+              master="fmpy", events=False, timeout_s=None):
     """:func:`run_scenarios`, then print the summary table; returns the rows."""
     start = time.perf_counter()
     rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master,
-                         events)
+                         events, timeout_s)
     progress(summary_table(rows))
     progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)")
     return rows

@@ -11,12 +11,17 @@ path gets a fresh folder, and the old folder is removed once no instance uses it
 - Folders are removed when the process exits (``atexit``, and multiprocessing's exit
   finalizers, as its child processes skip ``atexit``). Each folder records the process that
   made it: a forked child may use its parent's folders but never removes them.
+- Folders of processes that died without removing them (killed, crashed) are removed by
+  the next process that unpacks (:func:`remove_stale`, once per process): a folder's name
+  holds the process id of its maker, and one whose process no longer exists is stale
+  (POSIX only: on Windows they stay).
 - A lock makes it thread-safe (dask may make instances from threads).
 - ``SMA_FMU_UNPACK_EACH=1`` in the environment: every :func:`acquire` unpacks into a folder
   of its own, removed at its :func:`release` (the behaviour before the cache).
 """
 import atexit
 import os
+import re
 import shutil
 import sys
 import tempfile
@@ -26,7 +31,7 @@ from pathlib import Path
 from sma_fmu.files.archives import require_safe_archive, safe_extract
 from sma_fmu.fmi.driving.description import read_description
 
-__all__ = ["Unpacked", "acquire", "release", "folders", "UNPACK_EACH_VARIABLE"]
+__all__ = ["Unpacked", "acquire", "release", "folders", "remove_stale", "UNPACK_EACH_VARIABLE"]
 
 UNPACK_EACH_VARIABLE = "SMA_FMU_UNPACK_EACH"
 _PREFIX = "sma_fmu_unpacked_"
@@ -49,6 +54,8 @@ _LOCK = threading.Lock()
 _CACHE = {}   # key -> Unpacked, the current folder of each file
 _OWNED = []   # every folder this process made and has not removed yet
 _FINALIZER_PID = [None]  # the process whose multiprocessing finalizer is registered
+_SWEPT_PID = [None]      # the process that looked for stale folders (remove_stale)
+_FOLDER_NAME = re.compile(re.escape(_PREFIX) + r"(\d+)_")
 
 
 def _after_fork_in_child():
@@ -96,8 +103,47 @@ def _register_child_exit():
         util.Finalize(None, _remove_own, exitpriority=0)
 
 
+def _process_exists(pid):
+    """Whether process ``pid`` exists (POSIX; True when it cannot be told)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:   # another user's process (EPERM), or no answer: it may exist
+        return True
+    return True
+
+
+def remove_stale(folder=None):
+    """Remove the unpacked folders in ``folder`` (default: the temporary folder) whose
+    process no longer exists (it was killed or crashed before its exit removed them); the
+    names of those removed. POSIX only (on Windows os.kill cannot ask): none there."""
+    if os.name != "posix":
+        return []
+    folder = Path(folder or tempfile.gettempdir())
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        match = _FOLDER_NAME.match(entry.name)
+        if match is None or not entry.is_dir(follow_symlinks=False):
+            continue
+        pid = int(match.group(1))
+        if pid == os.getpid() or _process_exists(pid):
+            continue
+        shutil.rmtree(entry.path, ignore_errors=True)
+        if not os.path.exists(entry.path):
+            removed.append(entry.name)
+    return removed
+
+
 def _unpack(path, key, cached):
     require_safe_archive(path)  # before fmpy reads anything of it
+    if _SWEPT_PID[0] != os.getpid():   # once per process: what killed ones left behind
+        _SWEPT_PID[0] = os.getpid()
+        remove_stale()
     description = read_description(path)
     folder = tempfile.mkdtemp(prefix=f"{_PREFIX}{os.getpid()}_")
     try:

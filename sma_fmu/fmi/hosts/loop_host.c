@@ -32,9 +32,23 @@
  *   FAIL  "NAME.CALL returned STATUS at t = T s" of a failed call (status > fmi2Warning),
  *         after the rows up to that step: the host then exits with status 1;
  *   DONE  the run ended (after the last rows).
+ * "csv PATH EVERY LAST SPEC..." (before the run line, with "binary"): the host also appends the
+ * loop's rows as CSV text to PATH (hex; its header already written), every EVERY-th row and
+ * row LAST (the final one), each number as Python's "%.10g" writes it (format_g10), the
+ * row's columns given by SPEC, one word each: "t" the time k STEP_S; "s:I" recorded column I
+ * now; "a:I" column I after the step (the final row: nan); "b:I" a Boolean after the step
+ * (the final row: 0); "x:I" the stroke, column I at t_0 minus now; "c:V" the number V; "k:V"
+ * the number V after the step (the final row: nan). A row
+ * is written when the sample after its step comes, the final row at the end of the run or
+ * at a failed call (before its FAIL frame).
+ * "g10 HEX..." (a test of format_g10): prints each double (its 16 hex digits of IEEE bits)
+ * as "%.10g" would, one a line, and exits.
  */
 #define _GNU_SOURCE
+#include <float.h>
+#include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 
 #include "host_platform.h"  /* loading a binary, the platform shim */
 #ifdef _WIN32
@@ -80,6 +94,18 @@ static Read reads[MAX_ITEMS];
 static unsigned read_vr[MAX_ITEMS];
 static int n_reads;
 
+/* "csv": the rows as text (see the header) */
+typedef struct { char kind; int index; double value; uint64_t bits; int size; char text[40]; } CsvColumn;
+static CsvColumn csv[MAX_ITEMS];
+static int csv_columns, csv_have_prev;
+static FILE* csv_file;
+static char csv_path[PATH_SIZE];
+static long csv_every, csv_last, csv_row;
+static double csv_step, csv_x0, csv_prev[MAX_ITEMS];
+static char* csv_buffer;
+static size_t csv_used;
+#define CSV_BUFFER (1u << 20)
+
 /* One frame: a 4-byte tag, the payload's length (4 bytes, little-endian), the payload. */
 static void frame(const char* tag, const void* payload, size_t size)
 {
@@ -88,6 +114,201 @@ static void frame(const char* tag, const void* payload, size_t size)
     for (int i = 0; i < 4; ++i) head[4 + i] = (unsigned char)((size >> (8 * i)) & 0xff);
     fwrite(head, 1, sizeof head, stdout);
     if (size) fwrite(payload, 1, size, stdout);
+}
+
+/* --- "%.10g" as Python (and a C library) writes it, several times faster than snprintf ---
+ * The ten significant digits are the correctly rounded ones (ties to even, as both do):
+ * - 1e-10 <= |v| < 1e10 (nearly every number of a run): exactly, in integers. |v| is
+ *   m 2^q (m < 2^53); N = m 10^p 2^q with p = 9 - e <= 19 fits 128 bits, and the bits
+ *   shifted out say how to round;
+ * - 1e-30 <= |v| < 1e-10 or 1e10 <= |v| < 1e30: |v| 10^p in long double (64-bit mantissa:
+ *   an error near 1e-9 of a unit of the last digit), rounded; where that lies within 1e-4
+ *   of a half, snprintf decides;
+ * - otherwise snprintf.
+ * Non-finite numbers as Python writes them: nan (never -nan), inf, -inf. */
+__extension__ typedef unsigned __int128 Wide;   /* gcc and mingw-w64 on 64-bit targets */
+static long double tens[81];  /* tens[i] = 10^(i - 40) */
+
+static void init_tens(void)
+{
+    long double up = 1.0L;
+    for (int i = 40; i <= 80; ++i, up *= 10.0L) tens[i] = up;   /* exact up to 10^27 */
+    for (int i = 39; i >= 0; --i) tens[i] = 1.0L / tens[80 - i];
+}
+
+static int format_fallback(double v, char* out)
+{
+    int size = snprintf(out, 40, "%.10g", v);
+    return size < 0 ? 0 : size;
+}
+
+/* N = round(m 2^q 10^p) exactly (0 <= p <= 19, q < 0, -q < 128 - 117). */
+static uint64_t scaled_exact(uint64_t m, int q, int p)
+{
+    static const uint64_t ten[20] = {1ULL, 10ULL, 100ULL, 1000ULL, 10000ULL, 100000ULL, 1000000ULL,
+        10000000ULL, 100000000ULL, 1000000000ULL, 10000000000ULL, 100000000000ULL,
+        1000000000000ULL, 10000000000000ULL, 100000000000000ULL, 1000000000000000ULL,
+        10000000000000000ULL, 100000000000000000ULL, 1000000000000000000ULL,
+        10000000000000000000ULL};
+    const Wide x = (Wide)m * ten[p];
+    if (q >= 0) return (uint64_t)(x << q);
+    const int s = -q;
+    const Wide rest = x & (((Wide)1 << s) - 1), half = (Wide)1 << (s - 1);
+    uint64_t n = (uint64_t)(x >> s);
+    if (rest > half || (rest == half && (n & 1))) ++n;
+    return n;
+}
+
+static int format_g10(double v, char* out)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    const int negative = (int)(bits >> 63), biased = (int)((bits >> 52) & 0x7ff);
+    if (biased == 0x7ff) {
+        if (bits & 0xfffffffffffffULL) { memcpy(out, "nan", 3); return 3; }
+        if (negative) { memcpy(out, "-inf", 4); return 4; }
+        memcpy(out, "inf", 3);
+        return 3;
+    }
+    if (v == 0.0) {
+        if (negative) { memcpy(out, "-0", 2); return 2; }
+        out[0] = '0';
+        return 1;
+    }
+    if (biased == 0) return format_fallback(v, out);  /* subnormal */
+    const uint64_t m = (bits & 0xfffffffffffffULL) | (1ULL << 52);
+    const int q = biased - 1075;
+    /* e: the decimal exponent, 10^e <= |v| < 10^(e+1); first a guess from the binary one
+     * (q + 52 = floor(log2 |v|); 78913 / 2^18 = log10 2 to 6 digits), then corrected */
+    const int t = (q + 52) * 78913;
+    int e = t >= 0 ? t >> 18 : -((-t + (1 << 18) - 1) >> 18);
+    uint64_t n = 0;
+    for (int tries = 0;; ++tries) {
+        if (tries == 4) return format_fallback(v, out);
+        const int p = 9 - e;
+        if (p >= 0 && p <= 19 && q < 0 && -q <= 11 + 64 + 30) {
+            n = scaled_exact(m, q, p);
+        } else {
+            if (LDBL_MANT_DIG < 64 || p < -20 || p > 40) return format_fallback(v, out);
+            const long double scaled = (negative ? -(long double)v : (long double)v) * tens[p + 40];
+            if (!(scaled >= 999999999.0L && scaled < 1e10L)) {
+                n = scaled < 999999999.0L ? 0 : 10000000000ULL;  /* retried below */
+            } else {
+                n = (uint64_t)scaled;
+                const long double fraction = scaled - (long double)n;
+                if (fraction > 0.4999L && fraction < 0.5001L) return format_fallback(v, out);
+                if (fraction > 0.5L) ++n;
+            }
+        }
+        if (n < 1000000000ULL) { --e; continue; }       /* e was too high */
+        if (n >= 10000000000ULL) { ++e; continue; }     /* too low, or rounded up to 10^10 */
+        break;
+    }
+    char digits[10];
+    uint32_t high = (uint32_t)(n / 100000), low = (uint32_t)(n % 100000);
+    for (int i = 9; i >= 5; --i) { digits[i] = (char)('0' + low % 10); low /= 10; }
+    for (int i = 4; i >= 0; --i) { digits[i] = (char)('0' + high % 10); high /= 10; }
+    int last = 9;   /* the last significant digit kept (trailing zeros go, as %g does) */
+    while (last > 0 && digits[last] == '0') --last;
+    char* o = out;
+    if (negative) *o++ = '-';
+    if (e < -4 || e >= 10) {
+        *o++ = digits[0];
+        if (last > 0) {
+            *o++ = '.';
+            memcpy(o, digits + 1, (size_t)last);
+            o += last;
+        }
+        *o++ = 'e';
+        *o++ = e < 0 ? '-' : '+';
+        const int x = e < 0 ? -e : e;
+        if (x >= 100) *o++ = (char)('0' + x / 100);
+        *o++ = (char)('0' + x / 10 % 10);
+        *o++ = (char)('0' + x % 10);
+    } else if (e >= 0) {
+        memcpy(o, digits, (size_t)e + 1);
+        o += e + 1;
+        if (last > e) {
+            *o++ = '.';
+            memcpy(o, digits + e + 1, (size_t)(last - e));
+            o += last - e;
+        }
+    } else {
+        *o++ = '0';
+        *o++ = '.';
+        for (int i = 0; i < -e - 1; ++i) *o++ = '0';
+        memcpy(o, digits, (size_t)last + 1);
+        o += last + 1;
+    }
+    return (int)(o - out);
+}
+
+static void csv_flush(void)
+{
+    if (csv_used && fwrite(csv_buffer, 1, csv_used, csv_file) != csv_used) {
+        fprintf(stderr, "loop_host: cannot write the CSV file %s\n", csv_path);
+        exit(1);
+    }
+    csv_used = 0;
+}
+
+/* Row csv_row: the sample `now` and the one after its step (NULL: the final row). */
+static void csv_write(const double* now, const double* after)
+{
+    const long row = csv_row++;
+    if (row % csv_every != 0 && row != csv_last) return;
+    if (csv_used + (size_t)csv_columns * 40 > CSV_BUFFER) csv_flush();
+    char* p = csv_buffer + csv_used;
+    for (int k = 0; k < csv_columns; ++k) {
+        CsvColumn* c = &csv[k];
+        double v;
+        switch (c->kind) {
+        case 't': v = (double)row * csv_step; break;
+        case 's': v = now[c->index]; break;
+        case 'a': v = after ? after[c->index] : NAN; break;
+        case 'b': v = after && after[c->index] != 0.0 ? 1.0 : 0.0; break;
+        case 'x': v = csv_x0 - now[c->index]; break;
+        case 'k': v = after ? c->value : NAN; break;
+        default: v = c->value; break;
+        }
+        uint64_t bits;
+        memcpy(&bits, &v, sizeof bits);
+        if (!c->size || bits != c->bits) {  /* a column that holds still is formatted once */
+            c->bits = bits;
+            c->size = format_g10(v, c->text);
+        }
+        if (k) *p++ = ',';
+        memcpy(p, c->text, (size_t)c->size);
+        p += c->size;
+    }
+    *p++ = '\n';
+    csv_used = (size_t)(p - csv_buffer);
+}
+
+/* A recorded sample (after initialization or a step): completes the row before it. */
+static void csv_sample(const double* sample)
+{
+    if (csv_have_prev) csv_write(csv_prev, sample);
+    else {
+        for (int k = 0; k < csv_columns; ++k)
+            if (csv[k].kind == 'x') csv_x0 = sample[csv[k].index];
+    }
+    memcpy(csv_prev, sample, sizeof(double) * (size_t)columns);
+    csv_have_prev = 1;
+}
+
+/* The end of the rows (the run's, or a failed call's): the last sample as the final row. */
+static void csv_finish(void)
+{
+    if (!csv_file) return;
+    if (csv_have_prev) csv_write(csv_prev, NULL);
+    csv_have_prev = 0;
+    csv_flush();
+    if (fclose(csv_file)) {
+        fprintf(stderr, "loop_host: cannot write the CSV file %s\n", csv_path);
+        exit(1);
+    }
+    csv_file = NULL;
 }
 
 static void flush_rows(void)
@@ -176,6 +397,7 @@ static void check(int status, const Fmu* f, const char* call)
             char text[512];
             int size = snprintf(text, sizeof text, "%s.%s returned %d at t = %.9g s", f->name, call,
                                 status, now);
+            csv_finish();
             flush_rows();
             frame("FAIL", text, size < 0 ? 0 : size < (int)sizeof text ? (size_t)size : sizeof text - 1);
             fflush(stdout);
@@ -215,6 +437,7 @@ static void print_row(void)
                       f, "fmi2GetReal");
             }
         }
+        if (csv_file) csv_sample(row);
         if (++block_rows == frame_size) {
             flush_rows();
             frame_size = block_size;
@@ -291,6 +514,7 @@ static void run(double h, long steps, int timing)
     now = (double)steps * h;
     const double total = host_now() - begin;
     if (binary) {
+        csv_finish();
         flush_rows();
         frame("DONE", NULL, 0);
     }
@@ -326,14 +550,62 @@ static void start_binary(long rows)
     binary = 1;
 }
 
+/* "csv PATH EVERY LAST SPEC..." (see the header): open PATH to append the rows' text. */
+static void start_csv(char** word, int n)
+{
+    char* path = unhex(word[1]);
+    if (!path) bad("out of memory for", "the CSV path");
+    snprintf(csv_path, sizeof csv_path, "%s", path);
+    free(path);
+    csv_every = atol(word[2]);
+    csv_last = atol(word[3]);
+    if (csv_every < 1 || n - 4 > MAX_ITEMS) bad("bad csv line", word[2]);
+    for (int k = 4; k < n; ++k) {
+        CsvColumn* c = &csv[csv_columns++];
+        const char* spec = word[k];
+        c->kind = spec[0];
+        if (c->kind == 't') continue;
+        if (spec[1] != ':' || !strchr("sabxck", c->kind)) bad("bad csv column", spec);
+        if (c->kind == 'c' || c->kind == 'k') {
+            c->value = !strcmp(spec + 2, "nan") ? NAN : strtod(spec + 2, NULL);
+        } else {
+            c->index = atoi(spec + 2);
+            if (c->index < 0 || c->index >= columns) bad("csv column out of the recorded ones", spec);
+        }
+    }
+    csv_buffer = malloc(CSV_BUFFER);
+    if (!csv_buffer) bad("out of memory for", "the CSV rows");
+    csv_file = fopen(csv_path, "ab");
+    if (!csv_file) bad("cannot open the CSV file", csv_path);
+}
+
+/* "g10 HEX..." (see the header). */
+static void print_g10(char* values)
+{
+    for (char* word = strtok(values, " \r\n"); word; word = strtok(NULL, " \r\n")) {
+        uint64_t bits = (uint64_t)strtoull(word, NULL, 16);
+        double v;
+        char text[48];
+        memcpy(&v, &bits, sizeof v);
+        text[format_g10(v, text)] = '\0';
+        puts(text);
+    }
+    fflush(stdout);
+}
+
 int main(void)
 {
     static char line[1 << 20];
+    init_tens();
     Callbacks callbacks = {logger, calloc, free, NULL, NULL};
     while (fgets(line, sizeof line, stdin)) {
-        char* word[MAX_COMPONENTS + 8];
+        if (!strncmp(line, "g10 ", 4)) {
+            print_g10(line + 4);
+            return 0;
+        }
+        char* word[MAX_ITEMS + 8];
         int n = 0;
-        for (char* p = strtok(line, " \r\n"); p && n < MAX_COMPONENTS + 8; p = strtok(NULL, " \r\n")) word[n++] = p;
+        for (char* p = strtok(line, " \r\n"); p && n < MAX_ITEMS + 8; p = strtok(NULL, " \r\n")) word[n++] = p;
         if (n == 0) continue;
         if (!strcmp(word[0], "fmu") && n == 3 && components < MAX_COMPONENTS) {
             Fmu* f = &fmu[components++];
@@ -358,11 +630,15 @@ int main(void)
         } else if (!strcmp(word[0], "record") && n == 4 && columns < MAX_ITEMS) {
             column[columns++] = (Column){!strcmp(word[1], "boolean"), find(word[2]),
                                          (unsigned)strtoul(word[3], NULL, 10)};
+        } else if (!strcmp(word[0], "csv") && n >= 5 && !csv_file) {
+            start_csv(word, n);
         } else if (!strcmp(word[0], "run") && (n == 3 || (n == 4 && !strcmp(word[3], "timing"))
                                                 || (n == 5 && !strcmp(word[3], "binary")))) {
             const double h = strtod(word[1], NULL);
             const long steps = atol(word[2]);
             if (!(h > 0.0) || steps < 1 || ordered != components) bad("bad run line or step order", word[1]);
+            if (csv_file && n != 5) bad("a csv line needs", "run ... binary ROWS");
+            csv_step = h;
             if (n == 5) start_binary(atol(word[4]));
             initialize((double)steps * h, &callbacks);
             run(h, steps, n == 4);
