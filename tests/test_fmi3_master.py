@@ -179,3 +179,12 @@ def test_the_cli_runs_with_events_and_refuses_them_elsewhere(fmi3_dir, tmp_path,
     assert metrics["events"] is True and metrics["master"] == "fmpy"
     fails(capsys, ["run", PWM[0], "--fmus", str(fmi3_dir), "--events", "--master", "c",
                    "--out", str(tmp_path / "c")], "--events", "--master c")
+
+
+def test_the_c_master_refuses_fmi3_fmus_by_name(fmi3_dir, tmp_path, capsys):
+    """The C master is an FMI 2.0 host: FMI 3.0 FMUs get one line naming the FMU and the
+    master that runs them, and the output folder is not made."""
+    out = tmp_path / "c"
+    fails(capsys, ["run", "load-step-pi", "--fmus", str(fmi3_dir), "--master", "c", "--out",
+                   str(out)], "is an FMI 3.0 FMU", "--master fmpy", str(fmi3_dir))
+    assert not out.exists()

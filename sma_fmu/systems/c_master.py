@@ -28,8 +28,10 @@ import time
 from pathlib import Path
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
+from sma_fmu.cosim.master import fmi_versions
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.unpacked import acquire, release
+from sma_fmu.fmi.packaging.fmu_names import default_fmu_paths
 from sma_fmu.fmi.hosts import CHostError, compile_host
 from sma_fmu.systems.c_master_rows import RowAssembler, check_variables, csv_columns, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
@@ -151,13 +153,19 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
     ``timeout_s``: the longest [s] the host may send nothing before it is killed.
 
     Raises :class:`~sma_fmu.cosim.master.MissingFmuError` for a missing FMU, ``ValueError``
-    naming the FMU and the variable when its variables do not match, and
+    naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and the variable when its
+    variables do not match, and
     :class:`CMasterError` when a call fails (the rows up to that step kept) or the host
     sends nothing for ``timeout_s`` s (killed; the rows so far are not kept).
     """
     if not (isinstance(timeout_s, (int, float)) and timeout_s > 0):
         raise ValueError(f"the C master's timeout must be a number of seconds > 0, got {timeout_s!r}")
     started = time.perf_counter()
+    newer = sorted(name for name, major in fmi_versions(scenario, fmu_dir).items() if major != "2")
+    if newer:  # the loop host is an FMI 2.0 host (fmi2 calls, fmi2 binaries)
+        raise ValueError(f"{default_fmu_paths(fmu_dir)[newer[0]]} is an FMI 3.0 FMU: the C master "
+                         f"runs FMI 2.0 FMUs (sma-fmu build --native); run FMI 3.0 FMUs with "
+                         f"--master fmpy")
     system = closed_loop(scenario, fmu_dir)
     check_variables(system)
     unpacked = []   # each FMU unpacked once per process, removed at its exit (driving.unpacked)
