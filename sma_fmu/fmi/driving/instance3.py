@@ -15,7 +15,8 @@ early return and where the step ended). :func:`open_instance` picks the adapter 
 ``fmiVersion``.
 """
 from ctypes import addressof, c_bool, c_double, c_int32, c_int64, c_size_t, c_void_p
-from functools import partial
+from functools import lru_cache, partial
+from pathlib import Path
 
 from fmpy.fmi3 import FMU3Slave
 
@@ -27,8 +28,18 @@ __all__ = ["Fmu3Instance", "open_instance", "fmi_major"]
 
 def fmi_major(path):
     """The FMI major version of the FMU file ``path``: "2" or "3" (its model description's
-    ``fmiVersion``; :class:`~sma_fmu.fmi.driving.description.FmuFileError` for no usable FMU)."""
-    return read_description(path).fmiVersion.split(".")[0]
+    ``fmiVersion``; :class:`~sma_fmu.fmi.driving.description.FmuFileError` for no usable FMU).
+    Read once per file version (path, size, modification time): masters ask on every run."""
+    path = Path(path)
+    if not path.is_file():
+        read_description(path)  # raises the named error
+    stat = path.stat()
+    return _major((str(path.resolve()), stat.st_size, stat.st_mtime_ns))
+
+
+@lru_cache(maxsize=64)
+def _major(version):
+    return read_description(version[0]).fmiVersion.split(".")[0]
 
 
 def open_instance(path, instance_name, start_values=None, start_time=0.0, events=False):
