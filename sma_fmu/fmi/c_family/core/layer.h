@@ -76,6 +76,7 @@ typedef struct Instance {
     /* FMI 3.0 only (its front sets and reads them; not in saved states): */
     int event_mode_used, early_return;  /* fmi3InstantiateCoSimulation's flags */
     int event_mode;                  /* in Event Mode (the core's state is then stepComplete) */
+    int configuration_mode;          /* in Configuration Mode (the core's state: instantiated) */
 } Instance;
 
 /* ---- calls (layer_calls.c) --------------------------------------------------------------- */
@@ -164,6 +165,18 @@ int layer_refresh_outputs(Instance *in, const char *function);
  * `why`. */
 int layer_run_initialization(Instance *in, char *why, size_t size);
 void layer_drop_stepper(Instance *in);
+
+/* ---- arrays (layer_arrays.c) ------------------------------------------------------------ */
+/* array_vrs[k] is the value reference of the model's array k, array_names[k] its name (both
+ * from the FMI 3.0 description). */
+size_t layer_array_of(const Instance *in, const unsigned int array_vrs[], unsigned int vr);
+size_t layer_array_length(const Instance *in);   /* elements per array (0: no arrays) */
+/* A Float64 get whose nValues counts array elements (values[], nValues, index); a wrong
+ * nValues is refused before anything is read, naming the arrays and their length. */
+SmaStatus layer_get_arrays(Instance *in, const char *function, const unsigned int vr[],
+                           size_t nvr, double values[], size_t nValues,
+                           const unsigned int array_vrs[], const char *const array_names[],
+                           unsigned int time_vr, double time);
 
 /* ---- saved states (layer_states.c, layer_state_bytes.c) ---------------------------------- */
 void layer_free_states(Instance *in);
