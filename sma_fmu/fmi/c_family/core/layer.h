@@ -166,18 +166,6 @@ int layer_refresh_outputs(Instance *in, const char *function);
 int layer_run_initialization(Instance *in, char *why, size_t size);
 void layer_drop_stepper(Instance *in);
 
-/* ---- arrays (layer_arrays.c) ------------------------------------------------------------ */
-/* array_vrs[k] is the value reference of the model's array k, array_names[k] its name (both
- * from the FMI 3.0 description). */
-size_t layer_array_of(const Instance *in, const unsigned int array_vrs[], unsigned int vr);
-size_t layer_array_length(const Instance *in);   /* elements per array (0: no arrays) */
-/* A Float64 get whose nValues counts array elements (values[], nValues, index); a wrong
- * nValues is refused before anything is read, naming the arrays and their length. */
-SmaStatus layer_get_arrays(Instance *in, const char *function, const unsigned int vr[],
-                           size_t nvr, double values[], size_t nValues,
-                           const unsigned int array_vrs[], const char *const array_names[],
-                           unsigned int time_vr, double time);
-
 /* ---- saved states (layer_states.c, layer_state_bytes.c) ---------------------------------- */
 void layer_free_states(Instance *in);
 SavedState *layer_find_state(Instance *in, const void *state);

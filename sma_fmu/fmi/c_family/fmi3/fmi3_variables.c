@@ -4,7 +4,7 @@
  * Float64, Integer Int32, a choice parameter (hysteresis_mode, inverse) an Enumeration read
  * and set as Int64, Boolean is bool. The plant's structural parameter memory_depth and its
  * reversal_count are UInt64 (fmi3_structural.c), its reversal arrays Float64 outputs of
- * memory_depth values each (core/layer_arrays.c): nValues counts array elements, and must
+ * memory_depth values each (fmi3_arrays.c): nValues counts array elements, and must
  * equal nValueReferences where all are scalars (another size: fmi3Error naming the arrays,
  * nothing read or set). In Configuration Mode only the structural parameter may be set. The
  * independent variable `time` (fmi3_time_vr) reads as the present communication point and
@@ -36,7 +36,7 @@ static int has_arrays(const Instance *in, const fmi3ValueReference vr[], size_t 
 {
     size_t i;
     for (i = 0; i < nvr; ++i)
-        if (layer_array_of(in, ARRAY_VR_LIST, vr[i]) < in->model->array_count) return 1;
+        if (fmi3_array_of(in, ARRAY_VR_LIST, vr[i]) < in->model->array_count) return 1;
     return 0;
 }
 
@@ -44,7 +44,7 @@ const char *fmi3_type_of(const Instance *in, unsigned int vr, const char **name)
 {
     static const char *const TYPES[] = {"Float64", "Int32", "Boolean", "String"};
     const SmaVariable *v = layer_variable(in->model, vr, NULL);
-    size_t k = layer_array_of(in, ARRAY_VR_LIST, vr);
+    size_t k = fmi3_array_of(in, ARRAY_VR_LIST, vr);
     if (vr == TIME_VR) { *name = "time"; return "Float64"; }
     if (k < in->model->array_count) { *name = ARRAY_NAME_LIST[k]; return "Float64"; }
     if (vr == STRUCTURAL_VR) { *name = v ? v->name : "?"; return "UInt64"; }
@@ -120,7 +120,7 @@ FMI3_Export fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueRefe
     ENTER;
     if (!arguments_ok(in, function, vr, nvr, values, nValues, &status)) DONE(status);
     if (has_arrays(in, vr, nvr))
-        DONE(layer_finish(in, layer_get_arrays(in, function, vr, nvr, values, nValues,
+        DONE(layer_finish(in, fmi3_get_arrays(in, function, vr, nvr, values, nValues,
                                                ARRAY_VR_LIST, ARRAY_NAME_LIST, TIME_VR,
                                                in->time_defined ? in->time : in->run.start_time)));
     if (!has_time(vr, nvr)) DONE(layer_finish(in, layer_get(in, function, SMA_REAL, vr, nvr, values)));
@@ -145,10 +145,10 @@ FMI3_Export fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueRefe
     if (has_arrays(in, vr, nvr)) {
         size_t i;
         char why[300];
-        for (i = 0; layer_array_of(in, ARRAY_VR_LIST, vr[i]) >= in->model->array_count; ++i) {}
+        for (i = 0; fmi3_array_of(in, ARRAY_VR_LIST, vr[i]) >= in->model->array_count; ++i) {}
         snprintf(why, sizeof why, "%s (value reference %u) cannot be set: it is an output; "
                  "only inputs and parameters can be set; nothing was set",
-                 ARRAY_NAME_LIST[layer_array_of(in, ARRAY_VR_LIST, vr[i])], vr[i]);
+                 ARRAY_NAME_LIST[fmi3_array_of(in, ARRAY_VR_LIST, vr[i])], vr[i]);
         DONE(layer_refuse(in, SMA_ERROR, function, why));
     }
     if (fmi3_configuring(in, function)) DONE(SMA_ERROR);

@@ -1,4 +1,5 @@
-/* A model's array outputs (FMI 3.0): a get whose values count array elements.
+/* A model's array outputs (FMI 3.0 only: FMI 2.0 declares no arrays): a get whose values
+ * count array elements, over the model contract's get_array (core/sma_model.h).
  *
  * As in the Reference-FMUs, `values` holds nValues elements and `index` advances through
  * them: a scalar takes one, an array the length its size parameter has now (the model's
@@ -9,10 +10,10 @@
 #include "fp_contract.h"
 #include <stdio.h>
 
-#include "layer.h"
+#include "fmi3_layer.h"
 
 /* The model's array number of `vr`, or array_count if it is none. */
-size_t layer_array_of(const Instance *in, const unsigned int array_vrs[], unsigned int vr)
+size_t fmi3_array_of(const Instance *in, const unsigned int array_vrs[], unsigned int vr)
 {
     size_t k, count = in->model->array_count;
     for (k = 0; k < count; ++k)
@@ -20,7 +21,7 @@ size_t layer_array_of(const Instance *in, const unsigned int array_vrs[], unsign
     return count;
 }
 
-size_t layer_array_length(const Instance *in)
+size_t fmi3_array_length(const Instance *in)
 {
     return in->model->array_count ? (size_t)in->values[in->model->array_size].integer : 0;
 }
@@ -31,12 +32,12 @@ static SmaStatus wrong_size(Instance *in, const char *function, const unsigned i
                             const unsigned int array_vrs[], const char *const array_names[])
 {
     char text[700];
-    size_t i, used, count = in->model->array_count, length = layer_array_length(in);
+    size_t i, used, count = in->model->array_count, length = fmi3_array_length(in);
     used = (size_t)snprintf(text, sizeof text, "nValues = %lu, but the %lu value references "
                             "take %lu values", (unsigned long)nValues, (unsigned long)nvr,
                             (unsigned long)needed);
     for (i = 0; i < nvr && used < sizeof text; ++i) {
-        size_t k = layer_array_of(in, array_vrs, vr[i]);
+        size_t k = fmi3_array_of(in, array_vrs, vr[i]);
         if (k < count)
             used += (size_t)snprintf(text + used, sizeof text - used, "; %s is an array of %lu "
                                      "(its length is %s)", array_names[k], (unsigned long)length,
@@ -46,15 +47,15 @@ static SmaStatus wrong_size(Instance *in, const char *function, const unsigned i
     return layer_reject(in, SMA_ERROR, function, text);
 }
 
-SmaStatus layer_get_arrays(Instance *in, const char *function, const unsigned int vr[],
+SmaStatus fmi3_get_arrays(Instance *in, const char *function, const unsigned int vr[],
                            size_t nvr, double values[], size_t nValues,
                            const unsigned int array_vrs[], const char *const array_names[],
                            unsigned int time_vr, double time)
 {
     size_t i, index = 0, needed = 0, count = in->model->array_count;
-    size_t length = layer_array_length(in);
+    size_t length = fmi3_array_length(in);
     for (i = 0; i < nvr; ++i)
-        needed += layer_array_of(in, array_vrs, vr[i]) < count ? length : 1;
+        needed += fmi3_array_of(in, array_vrs, vr[i]) < count ? length : 1;
     if (needed != nValues)
         return wrong_size(in, function, vr, nvr, nValues, needed, array_vrs, array_names);
     if (in->state == STATE_INSTANTIATED)
@@ -65,7 +66,7 @@ SmaStatus layer_get_arrays(Instance *in, const char *function, const unsigned in
         return layer_refuse(in, SMA_ERROR, function, "the arrays are undefined: the model "
                             "was not started");
     for (i = 0; i < nvr; ++i) {
-        size_t k = layer_array_of(in, array_vrs, vr[i]);
+        size_t k = fmi3_array_of(in, array_vrs, vr[i]);
         if (k < count) {
             if (in->model->get_array(in->stepper, in->values, k, values, nValues, &index))
                 return layer_refuse(in, SMA_ERROR, function, "an array does not fit");
