@@ -141,15 +141,19 @@ def _state_round_trip(path, description):
 
 
 def _state_round_trip3(path, description):
-    """The same round trip for an FMI 3.0 FMU, through fmpy's FMU3Slave (Float64 outputs)."""
+    """The same round trip for an FMI 3.0 FMU, through fmpy's FMU3Slave (Float64 outputs,
+    the plant's reversal arrays whole: nValues counts their elements)."""
+    import math
     import shutil
 
     from fmpy import extract
     from fmpy.fmi3 import FMU3Slave
 
     cs, step = description.coSimulation, _fmu_step(description)
-    outputs = [v.valueReference for v in description.modelVariables
-               if v.type == "Float64" and v.causality == "output"]
+    floats = [v for v in description.modelVariables
+              if v.type == "Float64" and v.causality == "output"]
+    outputs = [v.valueReference for v in floats]
+    count = sum(math.prod(v.shape) for v in floats)  # a scalar's shape is (): 1
     folder = extract(str(path))
     fmu = FMU3Slave(guid=description.instantiationToken, unzipDirectory=folder,
                     modelIdentifier=cs.modelIdentifier, instanceName="state_check")
@@ -162,7 +166,7 @@ def _state_round_trip3(path, description):
             values = []
             for k in range(first, first + STATE_STEPS):
                 fmu.doStep(k * step, step)
-                values.append(repr(fmu.getFloat64(outputs)))
+                values.append(repr(fmu.getFloat64(outputs, nValues=count)))
             return values
 
         run(0)

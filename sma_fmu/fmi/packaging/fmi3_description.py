@@ -12,15 +12,19 @@ one (:mod:`.c_family_description`) in FMI 3.0's terms:
 - Real -> Float64 (its unit kept), Integer -> Int32, Boolean, String (start as ``<Start>``),
   and the choice parameters (``hysteresis_mode``, ``inverse``) -> Enumerations of their
   named items;
+- the plant's reversal stack as Float64 array outputs sized by the structural parameter
+  ``memory_depth`` (:mod:`.array_outputs`), value references past ``time``;
 - ModelStructure by value reference; no ``<SourceFiles>``: ``sources/buildDescription.xml``
   lists the files (:func:`build_description`).
 
 :func:`fmi3_model_header` writes ``fmi3_model.h``: what the FMI 3.0 front needs to know of
-the model beyond the core's table (the value reference of ``time``, the Enumerations).
+the model beyond the core's table (the value reference of ``time``, the Enumerations, the
+structural parameter and the arrays).
 """
 import xml.etree.ElementTree as ET
 
 from sma_fmu.fmi.packaging.cross_build import RUNS_HERE, TARGETS
+from sma_fmu.fmi.packaging.array_outputs import ARRAYS
 from sma_fmu.fmi.python_family.slave_support.choices import CHOICES
 
 __all__ = ["EVENT_MODELS", "fmi3_description", "platforms_document", "build_description",
@@ -41,19 +45,46 @@ def time_reference(root):
     return max(int(v.get("valueReference")) for v in root.find("ModelVariables")) + 1
 
 
-def _variable(scalar, typed, parent):
-    """The FMI 3.0 element of one FMI 2.0 ScalarVariable (and its type element)."""
+def _variable(scalar, typed, parent, arrays=None):
+    """The FMI 3.0 element of one FMI 2.0 ScalarVariable (and its type element); the
+    ``arrays``' size parameter becomes a UInt64 structural parameter within its bounds."""
     name = scalar.get("name")
     kind = "Enumeration" if typed.tag == "Integer" and name in CHOICES else _TYPES[typed.tag]
+    structural = arrays is not None and name == arrays.size
+    if structural:
+        kind = "UInt64"
     element = ET.SubElement(parent, kind, {k: scalar.get(k) for k in _KEPT if scalar.get(k)})
+    if structural:
+        element.set("causality", "structuralParameter")
+        element.set("min", str(arrays.minimum))
+        element.set("max", str(arrays.maximum))
     if kind == "Enumeration":
         element.set("declaredType", f"{name}_type")
     for key, value in typed.attrib.items():
         if kind == "String" and key == "start":
             ET.SubElement(element, "Start", value=value)
         elif key in ("start", "unit", "displayUnit", "min", "max", "nominal", "quantity"):
-            element.set(key, value)
+            if not (structural and key in ("min", "max")):
+                element.set(key, value)
     return element
+
+
+def _array_variables(arrays, size_reference, first, parent):
+    """The arrays' Float64 outputs (one ``<Dimension>`` each, the size parameter's value
+    reference) and their UInt64 count, from value reference ``first`` on; their references."""
+    references = []
+    for offset, (name, unit, text) in enumerate(arrays.arrays):
+        reference = str(first + offset)
+        element = ET.SubElement(parent, "Float64", name=name, valueReference=reference,
+                                description=text, causality="output", variability="discrete",
+                                unit=unit)
+        ET.SubElement(element, "Dimension", valueReference=size_reference)
+        references.append(reference)
+    name, text = arrays.count
+    reference = str(first + len(arrays.arrays))
+    ET.SubElement(parent, "UInt64", name=name, valueReference=reference, description=text,
+                  causality="output", variability="discrete")
+    return references + [reference]
 
 
 def fmi3_description(fmi2_description):
@@ -93,15 +124,22 @@ def fmi3_description(fmi2_description):
     ET.SubElement(model_variables, "Float64", name="time", valueReference=str(time_reference(old)),
                   causality="independent", variability="continuous",
                   description="simulation time", unit="s")
+    arrays = ARRAYS.get(old.get("modelName"))
     for scalar in variables:
         typed = next(child for child in scalar if child.tag in _TYPES)
-        _variable(scalar, typed, model_variables)
+        _variable(scalar, typed, model_variables, arrays)
+    added = []
+    if arrays is not None:
+        size = next(v.get("valueReference") for v in variables if v.get("name") == arrays.size)
+        added = _array_variables(arrays, size, time_reference(old) + 1, model_variables)
     structure = ET.SubElement(root, "ModelStructure")
     references = [v.get("valueReference") for v in variables]
     for group, tag in (("Outputs", "Output"), ("InitialUnknowns", "InitialUnknown")):
         found = old.find("ModelStructure").find(group)
         for unknown in found if found is not None else ():
             ET.SubElement(structure, tag, valueReference=references[int(unknown.get("index")) - 1])
+        for reference in added:
+            ET.SubElement(structure, tag, valueReference=reference)
     ET.indent(root, "\t")
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
 
@@ -131,17 +169,35 @@ def build_description(model_identifier, source_files):
 
 
 def fmi3_model_header(fmi3_description_bytes):
-    """Text of ``fmi3_model.h``: the value reference of ``time`` and of the Enumerations."""
+    """Text of ``fmi3_model.h``: the value references of ``time``, the Enumerations, the
+    structural parameter, the arrays and their count (``time`` standing for none), all macros."""
     root = ET.fromstring(fmi3_description_bytes)
     variables = root.find("ModelVariables")
-    time = next(v for v in variables if v.get("causality") == "independent")
+    time = next(v for v in variables if v.get("causality") == "independent").get("valueReference")
     enumerations = [v.get("valueReference") + "u" for v in variables if v.tag == "Enumeration"]
-    listed = ", ".join(enumerations) if enumerations else time.get("valueReference") + "u"
+    arrays = ARRAYS.get(root.get("modelName"))
+    by_name = {v.get("name"): v.get("valueReference") for v in variables}
+    if arrays is None:
+        structural, bounds, count, count_name = time, (1, 1), time, "time"
+        array_vrs, array_names = [time + "u"], ['"time"']
+    else:
+        structural, bounds = by_name[arrays.size], (arrays.minimum, arrays.maximum)
+        count, count_name = by_name[arrays.count[0]], arrays.count[0]
+        array_vrs = [by_name[name] + "u" for name, _, _ in arrays.arrays]
+        array_names = [f'"{name}"' for name, _, _ in arrays.arrays]
     return "\n".join([
         f"/* {root.get('modelName')}: what the FMI 3.0 front knows of it beyond the core's table,",
         " * generated by `sma-fmu build --native --fmi 3` (sma_fmu/fmi/packaging/fmi3_description.py).",
         " * Do not edit. */",
         "#ifndef SMA_FMI3_MODEL_H", "#define SMA_FMI3_MODEL_H", "",
-        f"#define TIME_VR {time.get('valueReference')}u  /* the independent variable time [s] */",
+        f"#define TIME_VR {time}u  /* the independent variable time [s] */",
         "/* the Enumerations (read and set as Int64); time stands for none */",
-        f"static const unsigned int ENUMERATIONS[] = {{{listed}}};", "", "#endif", ""])
+        f"#define ENUMERATIONS {{{', '.join(enumerations or [time + 'u'])}}}",
+        "/* the UInt64 structural parameter sizing the arrays, its bounds, the UInt64 output",
+        " * counting their live entries, the Float64 arrays in the model's order (array_outputs.py);",
+        " * time stands for none */",
+        f"#define STRUCTURAL_VR {structural}u",
+        f"#define STRUCTURAL_MIN {bounds[0]}u", f"#define STRUCTURAL_MAX {bounds[1]}u",
+        f"#define COUNT_VR {count}u", f'#define COUNT_NAME "{count_name}"',
+        f"#define ARRAY_VRS {{{', '.join(array_vrs)}}}",
+        f"#define ARRAY_NAMES {{{', '.join(array_names)}}}", "", "#endif", ""])

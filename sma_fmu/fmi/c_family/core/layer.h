@@ -76,6 +76,7 @@ typedef struct Instance {
     /* FMI 3.0 only (its front sets and reads them; not in saved states): */
     int event_mode_used, early_return;  /* fmi3InstantiateCoSimulation's flags */
     int event_mode;                  /* in Event Mode (the core's state is then stepComplete) */
+    int configuration_mode;          /* in Configuration Mode (the core's state: instantiated) */
 } Instance;
 
 /* ---- calls (layer_calls.c) --------------------------------------------------------------- */

@@ -78,7 +78,19 @@ typedef struct {
     /* FMI 3.0 event mode: the time [s] of the model's next discontinuity after `time` [s]
      * with the present inputs; NULL: the model has no events of its own. */
     double (*next_event)(const void *stepper, const SmaValue *values, double time);
+    /* FMI 3.0 arrays (FMI 2.0 declares none): `array_count` Float64 array outputs, each as
+     * long as the value of the Integer parameter at `array_size` (in FMI 3.0 a structural
+     * parameter). get_array, the Reference-FMUs' accessor: array number `array` of the
+     * started stepper into values[*index ..], advancing *index by its length (live entries
+     * first, the rest NaN: docs/fmus.md, "Arrays"); nonzero, nothing written, if fewer than that many
+     * of nValues are left. live_count: its entries in use. NULL, 0: no arrays. */
+    size_t array_count;
+    size_t array_size;
+    int (*get_array)(const void *stepper, const SmaValue *values, size_t array, double values_out[],
+                     size_t nValues, size_t *index);
+    size_t (*live_count)(const void *stepper);
 } SmaModel;
+
 
 /* Each adapter defines this one object (models/<Model>.c). */
 extern const SmaModel SMA_MODEL;

@@ -11,6 +11,7 @@
  *    and the next event time of a model that has events (the PWM driver's edges), inputs
  *    may be set and outputs read, and fmi3DoStep is refused (fmi3_step.c);
  *  - fmi3EnterInitializationMode carries fmi2SetupExperiment's start and stop times;
+ *  - Configuration Mode, where the plant's structural parameter is set (fmi3_structural.c);
  *  - the messages go to the logger as text (FMI 3.0 passes no format). */
 #include "fp_contract.h"
 #include <stdio.h>
@@ -110,6 +111,9 @@ FMI3_Export fmi3Status fmi3EnterInitializationMode(fmi3Instance instance,
     ENTER;
     (void)toleranceDefined;
     (void)tolerance;
+    if (in->configuration_mode)
+        DONE(layer_refuse(in, SMA_ERROR, function, "illegal call in Configuration Mode; "
+                          "fmi3ExitConfigurationMode first"));
     status = layer_setup(in, function, startTime, stopTimeDefined, stopTime);
     if (status != SMA_OK) DONE(status);
     DONE(layer_enter_initialization(in, function));
@@ -147,7 +151,7 @@ FMI3_Export fmi3Status fmi3Reset(fmi3Instance instance)
 {
     char why[1200];
     ENTER;
-    in->event_mode = 0;
+    in->event_mode = in->configuration_mode = 0;
     if (!layer_initial_state(in, why, sizeof why)) {
         layer_log(in, SMA_ERROR, "fmi3Reset: %s", why);
         return fmi3Error;

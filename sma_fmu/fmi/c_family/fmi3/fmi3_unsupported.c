@@ -1,5 +1,6 @@
 /* The FMI 3.0 functions of what these FMUs do not have (Model Exchange, clocks, derivatives,
- * dependencies, Configuration Mode): each gives fmi3Error naming itself and why. */
+ * dependencies): each gives fmi3Error naming itself and why (Configuration Mode:
+ * fmi3_structural.c). */
 #include "fp_contract.h"
 
 #include "fmi3_layer.h"
@@ -30,18 +31,6 @@ FMI3_Export fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi
     ENTER;
     (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed; (void)sensitivity; (void)nSensitivity;
     DONE(layer_reject(in, SMA_ERROR, "fmi3GetAdjointDerivative", "not supported by this FMU (providesAdjointDerivatives is false)"));
-}
-
-FMI3_Export fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance)
-{
-    ENTER;
-    DONE(layer_reject(in, SMA_ERROR, "fmi3EnterConfigurationMode", "not supported by this FMU (it has no structural parameters)"));
-}
-
-FMI3_Export fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance)
-{
-    ENTER;
-    DONE(layer_reject(in, SMA_ERROR, "fmi3ExitConfigurationMode", "not supported by this FMU (it has no structural parameters)"));
 }
 
 FMI3_Export fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences, fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[])

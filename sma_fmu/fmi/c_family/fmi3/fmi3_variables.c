@@ -2,8 +2,11 @@
  *
  * The core keeps FMI 2.0's variables and rules; here they take FMI 3.0's types: Real is
  * Float64, Integer Int32, a choice parameter (hysteresis_mode, inverse) an Enumeration read
- * and set as Int64, Boolean is bool. Every variable is a scalar, so nValues must equal
- * nValueReferences (an array of another size: fmi3Error, nothing read or set). The
+ * and set as Int64, Boolean is bool. The plant's structural parameter memory_depth and its
+ * reversal_count are UInt64 (fmi3_structural.c), its reversal arrays Float64 outputs of
+ * memory_depth values each (fmi3_arrays.c): nValues counts array elements, and must
+ * equal nValueReferences where all are scalars (another size: fmi3Error naming the arrays,
+ * nothing read or set). In Configuration Mode only the structural parameter may be set. The
  * independent variable `time` (fmi3_time_vr) reads as the present communication point and
  * cannot be set. Types this FMU has no variables of refuse every value reference, naming
  * what it is. */
@@ -13,24 +16,39 @@
 #include <string.h>
 
 #include "fmi3_layer.h"
-#include "fmi3_model.h"   /* generated: TIME_VR, ENUMERATIONS */
+#include "fmi3_model.h"   /* generated: TIME_VR, ENUMERATIONS, the arrays */
 
 unsigned int fmi3_time_vr(void) { return TIME_VR; }
 
+static const unsigned int ARRAY_VR_LIST[] = ARRAY_VRS;
+static const char *const ARRAY_NAME_LIST[] = ARRAY_NAMES;
+
 static int is_enumeration(unsigned int vr)
 {
+    static const unsigned int enumerations[] = ENUMERATIONS;
     size_t i;
-    for (i = 0; i < sizeof ENUMERATIONS / sizeof ENUMERATIONS[0]; ++i)
-        if (ENUMERATIONS[i] == vr && vr != TIME_VR) return 1;
+    for (i = 0; i < sizeof enumerations / sizeof enumerations[0]; ++i)
+        if (enumerations[i] == vr && vr != TIME_VR) return 1;
     return 0;
 }
 
-/* The FMI 3.0 type of the variable at `vr` ("Float64", "Enumeration", ...), or NULL. */
-static const char *type_of(const Instance *in, unsigned int vr, const char **name)
+static int has_arrays(const Instance *in, const fmi3ValueReference vr[], size_t nvr)
+{
+    size_t i;
+    for (i = 0; i < nvr; ++i)
+        if (fmi3_array_of(in, ARRAY_VR_LIST, vr[i]) < in->model->array_count) return 1;
+    return 0;
+}
+
+const char *fmi3_type_of(const Instance *in, unsigned int vr, const char **name)
 {
     static const char *const TYPES[] = {"Float64", "Int32", "Boolean", "String"};
     const SmaVariable *v = layer_variable(in->model, vr, NULL);
+    size_t k = fmi3_array_of(in, ARRAY_VR_LIST, vr);
     if (vr == TIME_VR) { *name = "time"; return "Float64"; }
+    if (k < in->model->array_count) { *name = ARRAY_NAME_LIST[k]; return "Float64"; }
+    if (vr == STRUCTURAL_VR) { *name = v ? v->name : "?"; return "UInt64"; }
+    if (vr == COUNT_VR) { *name = COUNT_NAME; return "UInt64"; }
     if (!v) return NULL;
     *name = v->name;
     return v->kind == SMA_INTEGER && is_enumeration(vr) ? "Enumeration" : TYPES[v->kind];
@@ -42,7 +60,7 @@ static int arguments_ok(Instance *in, const char *function, const fmi3ValueRefer
 {
     char why[200];
     if (!layer_arrays_ok(in, function, vr, nvr, values, status)) return 0;
-    if (nValues != nvr) {
+    if (nValues != nvr && !(values && has_arrays(in, vr, nvr))) {
         snprintf(why, sizeof why, "nValues = %lu, but the %lu value references are scalars "
                  "and take %lu values; nothing was done", (unsigned long)nValues,
                  (unsigned long)nvr, (unsigned long)nvr);
@@ -52,14 +70,26 @@ static int arguments_ok(Instance *in, const char *function, const fmi3ValueRefer
     return 1;
 }
 
+int fmi3_configuring(Instance *in, const char *function)
+{
+    char why[200];
+    const char *name = "?";
+    if (!in->configuration_mode) return 0;
+    fmi3_type_of(in, STRUCTURAL_VR, &name);
+    snprintf(why, sizeof why, "in Configuration Mode only the structural parameter %s can be "
+             "set; nothing was set", name);
+    layer_refuse(in, SMA_ERROR, function, why);
+    return 1;
+}
+
 /* Refuses the first value reference that is not of FMI 3.0 type `type` (0), or 1. */
-static int all_of_type(Instance *in, const char *function, const char *type,
+int fmi3_all_of_type(Instance *in, const char *function, const char *type,
                        const fmi3ValueReference vr[], size_t nvr)
 {
     char why[300];
     size_t i;
     for (i = 0; i < nvr; ++i) {
-        const char *name = NULL, *found = type_of(in, vr[i], &name);
+        const char *name = NULL, *found = fmi3_type_of(in, vr[i], &name);
         if (found && strcmp(found, type) == 0) continue;
         if (!found)
             snprintf(why, sizeof why, "value reference %u is not a variable of %s; nothing was "
@@ -89,6 +119,10 @@ FMI3_Export fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueRefe
     size_t i;
     ENTER;
     if (!arguments_ok(in, function, vr, nvr, values, nValues, &status)) DONE(status);
+    if (has_arrays(in, vr, nvr))
+        DONE(layer_finish(in, fmi3_get_arrays(in, function, vr, nvr, values, nValues,
+                                               ARRAY_VR_LIST, ARRAY_NAME_LIST, TIME_VR,
+                                               in->time_defined ? in->time : in->run.start_time)));
     if (!has_time(vr, nvr)) DONE(layer_finish(in, layer_get(in, function, SMA_REAL, vr, nvr, values)));
     for (i = 0; i < nvr; ++i) {  /* with time: one by one (rare) */
         if (vr[i] == TIME_VR) values[i] = in->time_defined ? in->time : in->run.start_time;
@@ -108,6 +142,16 @@ FMI3_Export fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueRefe
     if (has_time(vr, nvr))
         DONE(layer_refuse(in, SMA_ERROR, function, "time cannot be set: it is the independent "
                           "variable; nothing was set"));
+    if (has_arrays(in, vr, nvr)) {
+        size_t i;
+        char why[300];
+        for (i = 0; fmi3_array_of(in, ARRAY_VR_LIST, vr[i]) >= in->model->array_count; ++i) {}
+        snprintf(why, sizeof why, "%s (value reference %u) cannot be set: it is an output; "
+                 "only inputs and parameters can be set; nothing was set",
+                 ARRAY_NAME_LIST[fmi3_array_of(in, ARRAY_VR_LIST, vr[i])], vr[i]);
+        DONE(layer_refuse(in, SMA_ERROR, function, why));
+    }
+    if (fmi3_configuring(in, function)) DONE(SMA_ERROR);
     DONE(layer_finish(in, layer_set(in, function, SMA_REAL, vr, nvr, values)));
 }
 
@@ -119,7 +163,7 @@ static SmaStatus get_ints(Instance *in, const char *function, const char *type, 
     size_t i;
     int *buffer;
     if (!arguments_ok(in, function, vr, nvr, values, nValues, &status)) return status;
-    if (!all_of_type(in, function, type, vr, nvr)) return SMA_ERROR;
+    if (!fmi3_all_of_type(in, function, type, vr, nvr)) return SMA_ERROR;
     buffer = (int *)malloc(nvr * sizeof *buffer);
     if (!buffer) return layer_refuse(in, SMA_ERROR, function, "out of memory");
     status = layer_get(in, function, kind, vr, nvr, buffer);
@@ -141,7 +185,8 @@ static SmaStatus set_ints(Instance *in, const char *function, const char *type, 
     size_t i;
     int *buffer;
     if (!arguments_ok(in, function, vr, nvr, values, nValues, &status)) return status;
-    if (!all_of_type(in, function, type, vr, nvr)) return SMA_ERROR;
+    if (!fmi3_all_of_type(in, function, type, vr, nvr) || fmi3_configuring(in, function))
+        return SMA_ERROR;
     buffer = (int *)malloc(nvr * sizeof *buffer);
     if (!buffer) return layer_refuse(in, SMA_ERROR, function, "out of memory");
     for (i = 0; i < nvr; ++i) {
@@ -151,7 +196,7 @@ static SmaStatus set_ints(Instance *in, const char *function, const char *type, 
             fmi3Int64 value = ((const fmi3Int64 *)values)[i];
             if (value < -2147483647 - 1 || value > 2147483647) {
                 const char *name = "?";
-                type_of(in, vr[i], &name);
+                fmi3_type_of(in, vr[i], &name);
                 snprintf(why, sizeof why, "%s (value reference %u) cannot be set: %lld is no "
                          "item of the Enumeration; nothing was set", name, vr[i], (long long)value);
                 free(buffer);
@@ -223,6 +268,7 @@ FMI3_Export fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueRefer
     size_t i;
     ENTER;
     if (!arguments_ok(in, "fmi3SetString", vr, nvr, values, nValues, &status)) DONE(status);
+    if (fmi3_configuring(in, "fmi3SetString")) DONE(SMA_ERROR);
     for (i = 0; i < nvr; ++i) {
         if (!values[i] || !layer_valid_utf8(values[i])) {
             layer_plain(in, SMA_ERROR, "fmi3SetString: values[%lu] for value reference %u is %s; "
@@ -239,7 +285,7 @@ static SmaStatus no_such_type(Instance *in, const char *function, const char *ty
 {
     SmaStatus status;
     if (!layer_arrays_ok(in, function, vr, nvr, values, &status)) return status;
-    all_of_type(in, function, type, vr, nvr);
+    fmi3_all_of_type(in, function, type, vr, nvr);
     return SMA_ERROR;
 }
 
@@ -264,7 +310,6 @@ NO_SUCH_TYPE(UInt8)
 NO_SUCH_TYPE(Int16)
 NO_SUCH_TYPE(UInt16)
 NO_SUCH_TYPE(UInt32)
-NO_SUCH_TYPE(UInt64)
 
 FMI3_Export fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[],
                                      size_t nvr, size_t valueSizes[], fmi3Binary values[],

@@ -4,8 +4,14 @@
  * doStep(t, h) holds P_in and load over the step (P_in <= 0 is applied as 0 W); the outputs
  * are then the state at t + h. After initialization the outputs reflect T_start and the
  * load. Invalid parameters refuse fmi2ExitInitializationMode; hysteresis_mode is an Integer
- * (1 = continuous, 2 = switch); a step leaving the validity range logs fmi2Warning. */
+ * (1 = continuous, 2 = switch); a step leaving the validity range logs fmi2Warning.
+ *
+ * FMI 3.0 arrays (get_array): the reversal stack, oldest first, as two arrays of
+ * memory_depth values, 0: the reversal temperatures T_i [degC], 1: their xi_MF_i [1];
+ * the elements past the stack's reversal_count entries are NaN. */
 #include "fp_contract.h"
+#include <math.h>
+
 #include "plant.h"
 #include "sma_choices.h"
 #include "sma_wire.h"
@@ -69,6 +75,27 @@ static int state_read(void *stepper, const double *in, size_t count, SmaMessage 
     return plant_stepper_state_read((PlantStepper *)stepper, in, count, message);
 }
 
+static int get_array(const void *stepper, const SmaValue *values, size_t array,
+                     double values_out[], size_t nValues, size_t *index)
+{
+    const PlantStepper *plant = (const PlantStepper *)stepper;
+    size_t size = (size_t)values[VAR_memory_depth].integer, i;
+    if (*index > nValues || nValues - *index < size) return 1;
+    for (i = 0; i < size; ++i) {
+        if (i >= plant->reversal_count) values_out[*index + i] = NAN;
+        else if (array == 0) values_out[*index + i] = plant->reversals[i].temperature;
+        else values_out[*index + i] = plant->reversals[i].xi_MF;
+    }
+    *index += size;
+    return 0;
+}
+
+static size_t live_count(const void *stepper)
+{
+    return ((const PlantStepper *)stepper)->reversal_count;
+}
+
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, PLANT_STATE_FORMAT, LOG_CATEGORIES, VARIABLES, VAR_COUNT,
-    1, sizeof(PlantStepper), start, step, release, warning, state_size, state_write, state_read, NULL};
+    1, sizeof(PlantStepper), start, step, release, warning, state_size, state_write, state_read, NULL,
+    2, VAR_memory_depth, get_array, live_count};
