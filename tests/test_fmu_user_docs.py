@@ -170,15 +170,28 @@ def test_the_calling_sequence_is_the_fmus_version(family):
             assert "Event mode" not in sequence, (label, model)
 
 
+def _csv_columns(data):
+    """{column name: its cells as written} of a reference CSV (bytes)."""
+    rows = [line.split(",") for line in data.decode("utf-8").splitlines()]
+    return {name.strip('"'): [row[i] for row in rows[1:]] for i, name in enumerate(rows[0])}
+
+
 def test_fmi3_fmus_carry_their_own_reference_equal_to_the_fmi2_twins(fmi3_fmus, fmus):
-    """Run by the FMI 3.0 FMU at build time; byte for byte the pythonfmu FMI 2.0 twin's."""
+    """Run by the FMI 3.0 FMU at build time; the pythonfmu FMI 2.0 twin's, byte for byte, in
+    every file and column they share (FMI 3.0's plant adds one output: reversal_count)."""
     for model in NAMES:
         names = set(zipfile.ZipFile(fmi3_fmus[model]).namelist())
         files = [MANIFEST, f"{LS_REF_FOLDER}/{model}_out.csv"] + \
             ([f"{LS_REF_FOLDER}/{model}_in.csv"] if model != "SmaScenarioSignals" else [])
         assert set(files) | {"documentation/index.html", "documentation/result.png"} <= names, model
         for name in files:
-            assert _read(fmi3_fmus[model], name) == _read(fmus[model], name), (model, name)
+            if name.endswith("_out.csv"):
+                three, two = (_csv_columns(_read(f[model], name)) for f in (fmi3_fmus, fmus))
+                extra = {"reversal_count"} if model == "SmaActuator" else set()
+                assert set(three) == set(two) | extra, (model, sorted(three), sorted(two))
+                assert all(three[column] == two[column] for column in two), (model, name)
+            else:
+                assert _read(fmi3_fmus[model], name) == _read(fmus[model], name), (model, name)
         root = ET.fromstring(_read(fmi3_fmus[model], MANIFEST))   # FMI 3.0's layered-standard manifest
         assert root.get(f"{LS}fmi-ls-name") == LS_REF_FOLDER.split("/")[1], model
         assert root.get(f"{LS}fmi-ls-version") and root.get(f"{LS}fmi-ls-description"), model
