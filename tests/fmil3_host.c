@@ -98,6 +98,10 @@ static void add_output(struct outputs *o, fmi3_import_variable_t *v)
 {
     fmi3_value_reference_t vr = fmi3_import_get_variable_vr(v);
     const char *name = fmi3_import_get_variable_name(v);
+    if (fmi3_import_variable_is_array(v)) { /* scalars only: the outputs a loop connects */
+        printf("[HOST Note] output %s: an array, not read\n", name);
+        return;
+    }
     switch (fmi3_import_get_variable_base_type(v)) {
     case fmi3_base_type_float64:
         o->vr_float64[o->n_float64] = vr;
