@@ -77,6 +77,15 @@ void fast_free(FastPath* fast)
     memset(fast, 0, sizeof *fast);
 }
 
+/* The fast path off for this instance, the buffer kept: the slave was given its address and
+ * writes into it after every call it still gets (slave_support/fast_path.py: write_step),
+ * so it may be freed only with the instance or when fmi2Reset replaces the slave. */
+static void fast_detach(FastPath* fast)
+{
+    fast->attached = 0;
+    fast->step = NULL;
+}
+
 /* Parses "SMAFAST1 <n> (<kind> <vr> <settable>)*n" into the tables; 1 on success. */
 static int parse_table(FastPath* fast, const char* text)
 {
@@ -162,6 +171,7 @@ void fast_attach(Instance* in)
     char off[16];
     if (environment("SMA_FMU_NO_FAST_PATH", off, sizeof off) && strcmp(off, "0") != 0) return;
     fmi2Status logged = in->logged_status;
+    int given = 0;
     const fmi2ValueReference describe = FAST_DESCRIBE_VR, attach = FAST_ATTACH_VR;
     fmi2String text = NULL;
     if (backend.GetString(in->backend, &describe, 1, &text) == fmi2OK && text &&
@@ -170,6 +180,7 @@ void fast_attach(Instance* in)
         snprintf(address, sizeof address, "%llu %zu",
                  (unsigned long long)(size_t)in->fast.buffer, in->fast.n);
         fmi2String value = address;
+        given = 1; /* from here the slave may hold the buffer's address */
         if (backend.SetString(in->backend, &attach, 1, &value) == fmi2OK &&
             in->logged_status == fmi2OK && in->fast.buffer[H_FRESH] == 1.0) {
             in->fast.attached = 1;
@@ -180,7 +191,10 @@ void fast_attach(Instance* in)
             if (direct) attach_direct_step(&in->fast);
         }
     }
-    if (!in->fast.attached) fast_free(&in->fast);
+    if (!in->fast.attached) {
+        if (given) fast_detach(&in->fast); /* the slave may have taken it: kept */
+        else fast_free(&in->fast);
+    }
     in->logged_status = logged;
 }
 
@@ -199,7 +213,7 @@ static int sync(Instance* in)
     int ok = status == fmi2OK && in->logged_status == fmi2OK && b[H_FRESH] == 1.0;
     in->logged_status = logged;
     if (!ok) {
-        fast_free(&in->fast);
+        fast_detach(&in->fast); /* not freed: the slave still writes into it */
         return 0;
     }
     in->fast.stale = 0;
