@@ -249,12 +249,19 @@ _STUB = '''"""The module pythonfmu loads: {name} itself is in {package}.{script}
 pythonfmu 0.7.0 (findClass) executes this file again at every fmi2Instantiate, with this
 module's dict as globals, never frees the list it makes of each class's bases (the class
 in it), and releases the dict once too often. A class defined here would stay in memory once
-per instance (about 12 KiB); an imported one is the same class every time, and the entry
-appended per run makes up for the extra release.
+per instance (about 12 KiB); an imported one is the same class every time. Each run takes
+one reference to the dict that nothing releases, for the one pythonfmu releases: a list
+holding the dict would release them all when the interpreter clears it at exit, freeing the
+dict under its module (a heap corruption at exit). Where libpython's symbols are not global
+(pythonfmu without the C front), the list is the fallback.
 """
 from {package}.{script} import {name}  # noqa: F401
 
-globals().setdefault("_pythonfmu_runs", []).append(globals())
+try:
+    import ctypes as _ctypes
+    _ctypes.pythonapi.Py_IncRef(_ctypes.py_object(globals()))
+except (AttributeError, OSError):
+    globals().setdefault("_pythonfmu_runs", []).append(globals())
 '''
 
 
