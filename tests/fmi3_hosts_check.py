@@ -36,7 +36,7 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from fmusim_check import _input_file  # the same inputs as the FMI 2.0 check
+from fmusim_check import _run as _fmusim  # the same run as the FMI 2.0 check
 from system_needs import by_hand_executable
 from test_native_hosts import INPUTS, STOP_S, _input
 
@@ -86,18 +86,6 @@ def _largest(table, expected, names):
         if difference > worst[0]:
             worst = (difference, name)
     return worst
-
-
-def _fmusim(fmusim, path, model, folder, *options):
-    output = folder / f"{model}{'-'.join(options)}_out.csv"
-    command = [fmusim, "--interface-type", "cs", "--stop-time", repr(STOP_S), "--output-interval",
-               "0.001", "--logging-on", "--log-fmi-calls", *options, *_input_file(model, folder),
-               "--output-file", str(output), str(path)]
-    result = subprocess.run(command, capture_output=True, text=True, timeout=600)
-    lines = (result.stdout + result.stderr).splitlines()
-    bad = [line for line in lines if BAD_CALL.search(line) or BAD_MESSAGE.match(line)]
-    warnings = sum(1 for line in lines if "-> Warning" in line or line.startswith("[Warning]"))
-    return result.returncode, bad, output, f"{len(lines)} log lines, {warnings} warning"
 
 
 @pytest.mark.parametrize("model", list(INPUTS))

@@ -50,10 +50,12 @@ def _input_file(model, folder):
     return ["--input-file", str(path)]
 
 
-def _run(fmusim, path, model, folder):
-    output = folder / f"{model}_out.csv"
+def _run(fmusim, path, model, folder, *options):
+    """fmusim over ``path`` (co-simulation, 1 ms, with the model's inputs and ``options``):
+    (exit status, bad lines, the output CSV, "N log lines, M warning")."""
+    output = folder / f"{model}{'-'.join(options)}_out.csv"
     command = [fmusim, "--interface-type", "cs", "--stop-time", repr(STOP_S), "--output-interval",
-               "0.001", "--logging-on", "--log-fmi-calls", *_input_file(model, folder),
+               "0.001", "--logging-on", "--log-fmi-calls", *options, *_input_file(model, folder),
                "--output-file", str(output), str(path)]
     result = subprocess.run(command, capture_output=True, text=True, timeout=600)
     lines = (result.stdout + result.stderr).splitlines()
