@@ -82,7 +82,8 @@ NEEDS = {
     "qemu-user": (lambda: shutil.which("qemu-aarch64") is not None and Path(AARCH64_SYSROOT).is_dir(),
                   f"qemu-aarch64 and the aarch64 C library ({AARCH64_SYSROOT})",
                   "apt-get install qemu-user libc6-arm64-cross"),
-    "root": (lambda: os.geteuid() == 0, "root (unshare --mount, chroot)",
+    "root": (lambda: os.geteuid() == 0 and all(shutil.which(tool) for tool in ("unshare", "chroot")),
+             "root (unshare --mount, chroot)",  # both looked up on PATH (/usr/sbin)
              "run the tests as root, e.g. sudo -E python -m pytest -q"),
 }
 
