@@ -17,7 +17,7 @@ from system_needs import by_hand_executable
 from test_ssp_hosts import LOAD_STEP, TOLERANCE, _scenario, fmu_dir  # noqa: F401 (fixture)
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.systems.closed_loop import closed_loop
-from sma_fmu.systems.container import loop_outputs
+from sma_fmu.fmi.loop.wiring import loop_outputs
 from sma_fmu.systems.hosts import loop_series
 from sma_fmu.systems.ssp import write_ssp
 
@@ -43,7 +43,7 @@ def test_omsimulator_runs_the_ssp_as_the_library_jacobi_loop(family_dir, tmp_pat
 
     scenario = _scenario("heavy-pi+ff-adaptive", stop_time_s=2.2, load=LOAD_STEP)
     path = write_ssp(closed_loop(scenario, family_dir), tmp_path / "loop.ssp")
-    samples, log = run_ssp_omsimulator(path, scenario.step_s, scenario.steps, loop_outputs(scenario))
+    samples, log = run_ssp_omsimulator(path, scenario.step_s, scenario.steps, loop_outputs(scenario.controller.feedforward))
     data = loop_series(scenario, samples, scenario.steps)
     assert deviation(data, run_library(scenario, "jacobi").data) <= TOLERANCE
     # no error line: the SSD binds no String (OMSimulator's importStartValuesHelper logs

@@ -14,7 +14,8 @@ import pandas as pd
 import pytest
 
 from cli_failure import fails
-from sma_fmu.cosim.master import MissingFmuError, run_fmus
+from sma_fmu.cosim.master import run_fmus
+from sma_fmu.fmi.loop.system import MissingFmuError
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.recording import RunRecorder, interval_steps, read_timeseries
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios

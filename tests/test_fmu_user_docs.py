@@ -15,7 +15,7 @@ from sma_fmu.fmi.packaging.reference_results import LS_REF_FOLDER, MANIFEST, ref
 from sma_fmu.runtime.pwm import MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ
 from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.systems.check import check_file
-from sma_fmu.fmi.packaging.loop_wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
+from sma_fmu.fmi.loop.wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
 from sma_fmu.wire.parameter_file import load_parameters
 
 pytestmark = pytest.mark.needs("gcc")

@@ -25,7 +25,7 @@ PREFIX_EXCEPTIONS = {"fmi/python_family/slaves": ("sma", "pythonfmu slave script
 LONG_MODULE_EXCEPTIONS = {}   # path -> why it may stay over MAX_LINES (none now)
 SUBPACKAGES = ("identification/isobaric", "studies/batch", "cosim/scenario")   # made in issue 30
 # the rooms of sma_fmu/fmi (issue 37), lowest first: a room imports only from rooms before it
-FMI_ROOMS = ["c_common", "python_family", "c_family", "hosts", "driving", "packaging"]
+FMI_ROOMS = ["c_common", "python_family", "c_family", "hosts", "driving", "loop", "packaging"]
 
 
 def _imports_between_subpackages():

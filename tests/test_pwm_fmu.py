@@ -23,7 +23,8 @@ from fmpy.ssp.ssd import read_ssd
 
 from fmu_signals import STEP
 from sma_fmu.cosim.loop import COLUMNS, run_library
-from sma_fmu.cosim.master import MissingFmuError, run_fmus
+from sma_fmu.cosim.master import run_fmus
+from sma_fmu.fmi.loop.system import MissingFmuError
 from sma_fmu.cosim.scenario import DriveSettings, load_scenario, resolve_scenarios
 from sma_fmu.fmi.packaging.build import validate_fmus
 from sma_fmu.fmi.driving.instance import FmuError, FmuInstance

@@ -10,7 +10,7 @@ import pytest
 
 from sma_fmu.cli import main
 from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
-from sma_fmu.systems.closed_loop import LoopSystem, closed_loop
+from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.ssp import write_ssp
 from system_needs import needs
 
@@ -91,7 +91,7 @@ def test_check_fails_on_a_system_that_cannot_run(fmu_dir, tmp_path, capsys):
     plant = system.component("plant")
     broken = dataclasses.replace(plant, parameters={**plant.parameters, "hysteresis_mode": 7})
     components = tuple(broken if c is plant else c for c in system.components)
-    path = write_ssp(LoopSystem(scenario, components, system.connections), tmp_path / "bogus.ssp")
+    path = write_ssp(dataclasses.replace(system, components=components), tmp_path / "bogus.ssp")
     (tmp_path / "not-an-fmu.fmu").write_text("plain text")
     assert main(["check", str(path), str(tmp_path / "not-an-fmu.fmu")]) == 1
     lines = capsys.readouterr().out.splitlines()

@@ -117,9 +117,9 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
 def test_each_fmu_is_read_once_for_the_ssp_and_the_container(fmu_dir, tmp_path, monkeypatch):
     import fmpy
 
-    from sma_fmu.systems import closed_loop as loop_module
+    from sma_fmu.fmi.loop import system as loop_module
 
-    loop_module._checked_variables.cache_clear()   # earlier tests read these files already
+    loop_module._read_fmu.cache_clear()   # earlier tests read these files already
     reads, read = [], fmpy.read_model_description
     monkeypatch.setattr(fmpy, "read_model_description",
                         lambda filename, *args, **kwargs: reads.append(Path(filename).name)
@@ -155,11 +155,11 @@ def test_pi_controller_ssp_has_no_compensator_and_matches_in_both_ssp_hosts(fmu_
 def test_every_host_fails_on_a_feedforward_system_without_its_compensator(fmu_dir, tmp_path):
     """A loop with feedforward must give its compensator's outputs: none is taken as 0 W."""
     from sma_fmu.systems import hosts
-    from sma_fmu.systems.container import loop_outputs
+    from sma_fmu.fmi.loop.wiring import loop_outputs
 
     system = closed_loop(short("heavy-pi", stop_time_s=0.01, load=None), fmu_dir)
     ssp, container = write_ssp(system, tmp_path / "pi.ssp"), build_container(system, tmp_path / "pi.fmu")
-    expected = loop_outputs(short("heavy-pi+ff-fixed", stop_time_s=0.01))
+    expected = loop_outputs(feedforward=True)
     assert expected["P_ff"] == ("compensator", "P_ff")
     runs = [(lambda: hosts.run_ssp_libcosim(ssp, 10, expected), "has no variable compensator.P_ff"),
             (lambda: hosts.run_ssp_ecos(ssp, 1e-3, 10, expected), "cannot read compensator::P_ff"),

@@ -5,6 +5,8 @@ loop and the PI block are those of :mod:`sma_fmu.cosim.loop`; the compensator FM
 stepped before the plant (Gauss-Seidel), so u_ff,k reaches the plant's step k. A scenario
 with a PWM drive puts the SmaPwmDriver FMU between the PI and the plant, stepped after the
 PI and before the plant in the same step: the plant gets the wave's mean over that step.
+Which FMUs a scenario needs and their start values are the loop system's
+(:func:`~sma_fmu.fmi.loop.system.loop_system`), as for the C master and the system tools.
 
 Each step is one fmi2SetReal, one fmi2DoStep and one fmi2GetReal per FMU (the compensator
 also one fmi2GetBoolean), called through ctypes with argument objects built once
@@ -18,34 +20,19 @@ lookup per step.
 import time
 from ctypes import POINTER, Structure, byref, c_double, c_int, c_size_t, c_uint, c_void_p, sizeof
 from functools import partial
-from pathlib import Path
 
 from sma_fmu.cosim.event_drive import EventDrivenPlant, PassThroughDriver, traced_driver
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
-from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
-from sma_fmu.fmi.driving.description import read_description
-from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.fmi.driving.instance import FmuError
-from sma_fmu.fmi.driving.instance3 import fmi_major, open_instance
+from sma_fmu.fmi.driving.instance3 import open_instance
+from sma_fmu.fmi.loop.system import loop_system
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
 
-__all__ = ["FmuPlant", "FmuCompensator", "FmuDriver", "LeanStep", "needed_fmus", "run_fmus",
-           "MissingFmuError", "model_parameter_values", "fmi_versions"]
+__all__ = ["FMU_BLOCKS", "FmuPlant", "FmuCompensator", "FmuDriver", "LeanStep", "run_fmus"]
 
-
-class MissingFmuError(FileNotFoundError):
-    """A needed FMU has not been built."""
-
-
-def model_parameter_values(fmu_path, params, variables=None):
-    """Start values for every wire parameter the FMU exposes, from ``params``.
-
-    ``variables``: the FMU's model variables if already read (else they are read from
-    ``fmu_path``).
-    """
-    values = params.values()
-    variables = read_description(fmu_path).modelVariables if variables is None else variables
-    return {v.name: values[v.name] for v in variables
-            if v.causality == "parameter" and v.name in values}
+# the loop's components this master runs as FMUs (the PI and the signals are Python's: the
+# PI of :func:`~sma_fmu.cosim.loop.run_loop`, the scenario's signals)
+FMU_BLOCKS = ("compensator", "driver", "plant")
 
 
 class SmaFmuStep(Structure):
@@ -157,15 +144,17 @@ class LeanStep:
         return step
 
 
-class FmuPlant:
-    """The SmaActuator FMU as a loop plant."""
+def _starts(component):
+    """The start values of ``component`` (a :class:`~sma_fmu.fmi.loop.system.Component`):
+    its parameters, then its inputs at t = 0 (this master sets the inputs itself)."""
+    return {**component.parameters, **component.input_starts}
 
-    def __init__(self, scenario, fmu_path, instance_name="plant", combined=None, events=False):
-        start = model_parameter_values(fmu_path, scenario.params)
-        start.update(T_start=scenario.T_start,
-                     hysteresis_mode=choice_code("hysteresis_mode", scenario.hysteresis_mode),
-                     load=scenario.load.value(0.0))
-        self.fmu = open_instance(fmu_path, instance_name, start, events=events)
+
+class FmuPlant:
+    """The SmaActuator FMU (``component`` "plant" of the loop system) as a loop plant."""
+
+    def __init__(self, component, instance_name="plant", combined=None, events=False):
+        self.fmu = open_instance(component.fmu, instance_name, _starts(component), events=events)
         self._outputs = self.fmu.port(PLANT_OUTPUTS)
         lean = LeanStep(self.fmu, ("P_in", "load"), PLANT_OUTPUTS, combined=combined)
         inputs, values, lean_step = lean.inputs, lean.outputs, lean.step
@@ -188,16 +177,10 @@ class FmuPlant:
 
 
 class FmuCompensator:
-    """The SmaFeedforward FMU as the loop's compensator."""
+    """The SmaFeedforward FMU (``component`` "compensator") as the loop's compensator."""
 
-    def __init__(self, scenario, fmu_path, instance_name="feedforward", combined=None, events=False):
-        c = scenario.controller
-        start = model_parameter_values(fmu_path, scenario.compensator_params)
-        start.update(alpha=c.alpha, beta=c.beta, model_load=c.model_load,
-                     adapt_to_load=c.adapt_to_load, inverse=choice_code("inverse", c.inverse),
-                     R_ref=scenario.reference.value(0.0),
-                     load=scenario.load.value(0.0))
-        self.fmu = open_instance(fmu_path, instance_name, start, events=events)
+    def __init__(self, component, instance_name="feedforward", combined=None, events=False):
+        self.fmu = open_instance(component.fmu, instance_name, _starts(component), events=events)
         lean = LeanStep(self.fmu, ("R_ref", "load"), ("P_ff", "T_ref"), ("saturated",),
                         combined=combined)
         inputs, outputs, saturated, lean_step = lean.inputs, lean.outputs, lean.flags, lean.step
@@ -216,13 +199,11 @@ class FmuCompensator:
 
 
 class FmuDriver:
-    """The SmaPwmDriver FMU as the loop's driver (the hook of :func:`~sma_fmu.cosim.loop.run_loop`)."""
+    """The SmaPwmDriver FMU (``component`` "driver") as the loop's driver (the hook of
+    :func:`~sma_fmu.cosim.loop.run_loop`)."""
 
-    def __init__(self, scenario, fmu_path, instance_name="driver", combined=None, events=False):
-        drive = scenario.drive
-        self.fmu = open_instance(fmu_path, instance_name,
-                                 {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W},
-                                 events=events)
+    def __init__(self, component, instance_name="driver", combined=None, events=False):
+        self.fmu = open_instance(component.fmu, instance_name, _starts(component), events=events)
         self._initial = self.fmu.port(("P_in",))
         lean = LeanStep(self.fmu, ("P_demand",), ("P_in",), combined=combined)
         inputs, outputs, lean_step = lean.inputs, lean.outputs, lean.step
@@ -243,24 +224,6 @@ class FmuDriver:
         self.fmu.close()
 
 
-def needed_fmus(scenario):
-    """Names of the FMUs the FMU path of ``scenario`` runs: the plant, and the compensator
-    and the PWM driver when the scenario has them."""
-    return (["SmaActuator"] + (["SmaFeedforward"] if scenario.controller.feedforward else [])
-            + (["SmaPwmDriver"] if scenario.drive.pwm else []))
-
-
-def fmi_versions(scenario, fmu_dir):
-    """{FMU name: FMI major version ("2" or "3")} of the FMUs ``scenario`` needs in ``fmu_dir``;
-    :class:`MissingFmuError` names one not built."""
-    paths = default_fmu_paths(fmu_dir)
-    for name in needed_fmus(scenario):
-        if not paths[name].is_file():
-            raise MissingFmuError(f"{paths[name]} not found; build the FMUs first: "
-                                  f"sma-fmu build --out {Path(fmu_dir)}")
-    return {name: fmi_major(paths[name]) for name in needed_fmus(scenario)}
-
-
 def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events=False,
              power_trace=None):
     """Run ``scenario`` through the FMUs in ``fmu_dir``; returns a :class:`LoopResult`.
@@ -273,23 +236,22 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
     ``power_trace``: a list that gets (start [s], end [s], P_demand [W], P_in [W]) of every
     step the plant makes behind the PWM driver (scenarios with ``[drive] kind = "pwm"``).
     """
-    versions = fmi_versions(scenario, fmu_dir)
-    paths = default_fmu_paths(fmu_dir)
+    system = loop_system(scenario, default_fmu_paths(fmu_dir), only=FMU_BLOCKS)
     if events:
-        older = [name for name, version in versions.items() if version != "3"]
+        older = [c for c in system.components if c.fmi_version != "3"]
         if older:
-            raise ValueError(f"--events: {paths[older[0]]} is an FMI {versions[older[0]]}.0 FMU; "
+            raise ValueError(f"--events: {older[0].fmu} is an FMI {older[0].fmi_version}.0 FMU; "
                              f"event mode and early return need FMI 3.0 FMUs (sma-fmu build "
                              f"--native --fmi 3)")
     start = time.perf_counter()
     parts = {}
     try:
-        parts["plant"] = FmuPlant(scenario, paths["SmaActuator"], combined=combined, events=events)
+        parts["plant"] = FmuPlant(system.component("plant"), combined=combined, events=events)
         if scenario.controller.feedforward:
-            parts["compensator"] = FmuCompensator(scenario, paths["SmaFeedforward"],
+            parts["compensator"] = FmuCompensator(system.component("compensator"),
                                                   combined=combined, events=events)
         if scenario.drive.pwm:
-            parts["driver"] = FmuDriver(scenario, paths["SmaPwmDriver"], combined=combined,
+            parts["driver"] = FmuDriver(system.component("driver"), combined=combined,
                                         events=events)
         plant, driver = parts["plant"], parts.get("driver")
         if events and driver is not None:

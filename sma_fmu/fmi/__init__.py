@@ -11,6 +11,8 @@ Lowest room first; each imports only from rooms before it (``tests/test_layout.p
   physics in C99), ``fmi2/`` (the FMI 2.0 layer) and ``models/`` (the five adapters);
 - ``hosts/``: small C programs that run FMUs the way non-Python tools do, and their build;
 - ``driving/``: running an FMU from Python through fmpy (:mod:`.driving.instance`);
+- ``loop/``: the closed loop of the five FMUs, described once (:mod:`.loop.system`): what
+  the masters run, the exports write and each FMU's page shows;
 - ``packaging/``: building either family (:mod:`.packaging.build`), model descriptions,
   documentation, reference results, the cross-check tree, platform tables.
 """

@@ -26,15 +26,14 @@ from pathlib import Path
 
 from sma_fmu.cosim.scenario import (Scenario, ScenarioError, read_scenario_document,
                                     resolve_scenarios, scenario_from_document)
+from sma_fmu.fmi.loop.gains import GAIN_KEYS
 from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError
 
 __all__ = ["StudyError", "SECTIONS", "ScenarioTemplate", "template", "with_overrides"]
 
 SECTIONS = ("scenario", "reference", "load", "controller", "plant", "wire", "model")
-_CONTROL = {"Kp": "Kp_W_per_ohm", "Ki": "Ki_W_per_ohm_s", "alpha": "alpha_s", "beta": "beta_s",
-            "model_load": "model_load_kg"}
-_WIRE = {spec.name for spec in PARAMETER_SPECS} - set(_CONTROL)
+_WIRE = {spec.name for spec in PARAMETER_SPECS} - set(GAIN_KEYS)   # the gains are the controller's
 
 
 class StudyError(ValueError):
@@ -83,9 +82,9 @@ def _split(overrides):
             raise StudyError(f"override {name!r}: expected SECTION.KEY with SECTION one of "
                              f"{', '.join(SECTIONS)} (e.g. controller.Kp_W_per_ohm)")
         if section in ("wire", "model"):
-            if key in _CONTROL:
+            if key in GAIN_KEYS:
                 raise StudyError(f"override {name!r}: a controller setting; use "
-                                 f"controller.{_CONTROL[key]}")
+                                 f"controller.{GAIN_KEYS[key]}")
             if key not in _WIRE:
                 raise StudyError(f"override {name!r}: unknown wire parameter {key!r}; expected "
                                  f"one of {', '.join(sorted(_WIRE))}")

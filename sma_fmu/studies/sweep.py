@@ -93,7 +93,7 @@ def _check_folder(out, spec, path="batch"):
 def _check_fmus(spec, fmu_dir):
     """Every base scenario's loop in ``fmu_dir``: a missing FMU or one whose variables do
     not match is refused before the sweep starts (the message names it)."""
-    from sma_fmu.systems.c_master_rows import check_variables
+    from sma_fmu.fmi.loop.system import check_variables
     from sma_fmu.systems.closed_loop import closed_loop
 
     for template in spec.templates:

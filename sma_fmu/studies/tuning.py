@@ -23,17 +23,17 @@ from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
+from sma_fmu.fmi.loop.gains import GAIN_KEYS
 from sma_fmu.studies.batch import run_batch, unsupported_reason
 from sma_fmu.studies.overrides import StudyError, template
 
-__all__ = ["BOUNDS", "TUNED", "KEYS", "tune_scenario", "controller_snippet", "run_tuning",
+__all__ = ["BOUNDS", "TUNED", "tune_scenario", "controller_snippet", "run_tuning",
            "ranking_markdown"]
 
 # search ranges; units: Kp [W/ohm], Ki [W/(ohm.s)], alpha and beta [s]
 BOUNDS = {"Kp": (0.0, 5.0), "Ki": (0.0, 20.0), "alpha": (0.0, 3.0), "beta": (0.02, 1.5)}
 TUNED = {"pi": ("Kp", "Ki"), "pi+ff-fixed": ("Kp", "Ki", "alpha", "beta"),
          "pi+ff-adaptive": ("Kp", "Ki", "alpha", "beta")}
-KEYS = {"Kp": "Kp_W_per_ohm", "Ki": "Ki_W_per_ohm_s", "alpha": "alpha_s", "beta": "beta_s"}
 _FAILED_RMSE = 1e6   # what a run that fails costs the optimiser [ohm]
 
 
@@ -98,7 +98,7 @@ def controller_snippet(record):
              "[controller]", f"kind = {json.dumps(record['controller'])}"]
     if record.get("inverse", "major") != "major":
         lines.append(f"inverse = {json.dumps(record['inverse'])}")
-    lines += [f"{KEYS[name]} = {value!r}" for name, value in record["tuned"].items()]
+    lines += [f"{GAIN_KEYS[name]} = {value!r}" for name, value in record["tuned"].items()]
     return "\n".join(lines) + "\n"
 
 

@@ -1,6 +1,7 @@
 """The closed loop in system-level tools: SSP packages, a container FMU, hosts, compliance checks.
 
-- :mod:`.closed_loop`: a scenario's loop as components, parameter values and connections;
+- :mod:`.closed_loop`: a scenario's loop system (:mod:`sma_fmu.fmi.loop`) with the FMUs
+  built in a folder, and identifiers as hosts need them;
 - :mod:`.ssp`: the SSP 1.0 package (SystemStructure.ssd + the FMUs);
 - :mod:`.packed`: the FMUs packed with the scenario's values as their defaults;
 - :mod:`.container`: the whole loop as one FMI 2.0 FMU (fmu-manipulation-toolbox);

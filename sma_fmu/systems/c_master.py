@@ -1,7 +1,7 @@
 """The C master (``sma-fmu run --master c``): a scenario's closed loop stepped in C.
 
 The loop host (``sma_fmu/fmi/hosts/loop_host.c``, mode "binary") loads the FMUs' binaries
-through FMI and steps them Gauss-Seidel in :data:`~.closed_loop.STEP_ORDER`, the order of
+through FMI and steps them Gauss-Seidel in :data:`~sma_fmu.fmi.loop.wiring.STEP_ORDER`, the order of
 the fmpy master (:func:`~sma_fmu.cosim.master.run_fmus`): compensator, PI, driver, plant,
 then the signals (SmaScenarioSignals, on the grid t_k = k h). It writes the recorded
 outputs after initialization and after every step as raw doubles, in frames of
@@ -28,12 +28,11 @@ import time
 from pathlib import Path
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
-from sma_fmu.cosim.master import fmi_versions
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.unpacked import acquire, release
-from sma_fmu.fmi.packaging.fmu_names import default_fmu_paths
 from sma_fmu.fmi.hosts import CHostError, compile_host
-from sma_fmu.systems.c_master_rows import RowAssembler, check_variables, csv_columns, recorded_columns
+from sma_fmu.fmi.loop.system import check_variables
+from sma_fmu.systems.c_master_rows import RowAssembler, csv_columns, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
 
@@ -152,7 +151,7 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
     environment of a wine64 prefix (the win64 host with the FMUs' win64 binaries).
     ``timeout_s``: the longest [s] the host may send nothing before it is killed.
 
-    Raises :class:`~sma_fmu.cosim.master.MissingFmuError` for a missing FMU, ``ValueError``
+    Raises :class:`~sma_fmu.fmi.loop.system.MissingFmuError` for a missing FMU, ``ValueError``
     naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and the variable when its
     variables do not match, and
     :class:`CMasterError` when a call fails (the rows up to that step kept) or the host
@@ -161,12 +160,11 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
     if not (isinstance(timeout_s, (int, float)) and timeout_s > 0):
         raise ValueError(f"the C master's timeout must be a number of seconds > 0, got {timeout_s!r}")
     started = time.perf_counter()
-    newer = sorted(name for name, major in fmi_versions(scenario, fmu_dir).items() if major != "2")
-    if newer:  # the loop host is an FMI 2.0 host (fmi2 calls, fmi2 binaries)
-        raise ValueError(f"{default_fmu_paths(fmu_dir)[newer[0]]} is an FMI 3.0 FMU: the C master "
-                         f"runs FMI 2.0 FMUs (sma-fmu build --native); run FMI 3.0 FMUs with "
-                         f"--master fmpy")
     system = closed_loop(scenario, fmu_dir)
+    newer = sorted((c.model, str(c.fmu)) for c in system.components if c.fmi_version != "2")
+    if newer:  # the loop host is an FMI 2.0 host (fmi2 calls, fmi2 binaries)
+        raise ValueError(f"{newer[0][1]} is an FMI 3.0 FMU: the C master runs FMI 2.0 FMUs "
+                         f"(sma-fmu build --native); run FMI 3.0 FMUs with --master fmpy")
     check_variables(system)
     unpacked = []   # each FMU unpacked once per process, removed at its exit (driving.unpacked)
     try:

@@ -1,4 +1,4 @@
-"""The C master's samples as the loop's rows, and the check that a system's FMUs fit the loop.
+"""The C master's samples as the loop's rows.
 
 The host sends the recorded outputs at t_0 (after initialization) ... t_n (after each
 step); row k of the loop holds the states and signals at t_k and the blocks' outputs of
@@ -15,16 +15,15 @@ import math
 import numpy as np
 
 from sma_fmu.cosim.loop import COLUMNS, ROWS_PER_CHUNK, TIMESERIES_DTYPE
-from sma_fmu.systems.container import loop_outputs
 from sma_fmu.systems.hosts import NO_COMPENSATOR, STATE_COLUMNS, STEP_COLUMNS
 
-__all__ = ["recorded_columns", "csv_columns", "check_variables", "RowAssembler"]
+__all__ = ["recorded_columns", "csv_columns", "RowAssembler"]
 
 
 def recorded_columns(system):
     """The columns the host records for ``system``, in the order of its samples: grouped by
     component (the host reads neighbouring columns of one component in one call)."""
-    outputs = loop_outputs(system.scenario)
+    outputs = system.outputs
     return sorted(outputs, key=lambda column: (outputs[column][0], column == "saturated"))
 
 
@@ -47,32 +46,6 @@ def csv_columns(columns):
         else:
             words.append(f"{'b' if name == 'saturated' else 'a'}:{index[name]}")
     return " ".join(words)
-
-
-def _need(component, name, causality, types, why):
-    variable = component.variables.get(name)
-    if variable is None or variable.causality != causality or variable.type not in types:
-        found = ("none" if variable is None
-                 else f"a {variable.causality} {variable.type}")
-        raise ValueError(f"{component.fmu}: the model's variables do not match the loop: "
-                         f"{component.name} needs {causality} {name!r} ({'/'.join(types)}; {why}), "
-                         f"the FMU has {found}")
-
-
-def check_variables(system):
-    """``ValueError`` naming the FMU and the variable when a component of ``system`` lacks an
-    input, output or parameter the loop uses (or has it with another causality or type)."""
-    for c in system.connections:
-        _need(system.component(c.source), c.output, "output", ("Real",), f"feeds {c.target}.{c.input}")
-        _need(system.component(c.target), c.input, "input", ("Real",), f"fed by {c.source}.{c.output}")
-    for column, (name, variable) in loop_outputs(system.scenario).items():
-        types = ("Boolean",) if column == "saturated" else ("Real",)
-        _need(system.component(name), variable, "output", types, f"the {column} column")
-    for component in system.components:
-        for name in component.parameters:
-            if name not in component.variables:
-                raise ValueError(f"{component.fmu}: the model's variables do not match the loop: "
-                                 f"no variable {name!r} for the scenario's value")
 
 
 class RowAssembler:

@@ -1,12 +1,13 @@
 """The closed loop of one scenario as a single FMI 2.0 co-simulation FMU (an FMU container).
 
 Built with fmu-manipulation-toolbox's container builder in sequential mode: inside each
-doStep the embedded FMUs step one after another in :data:`~.closed_loop.STEP_ORDER`
+doStep the embedded FMUs step one after another in :data:`~sma_fmu.fmi.loop.wiring.STEP_ORDER`
 (compensator, PI, plant, signals), each with the outputs just computed by the ones before
 it (Gauss-Seidel), so the container computes exactly what the library loop computes.
 Every embedded FMU is named as in the SSP, packed with the scenario's values as its
-defaults (:mod:`.packed`), and its parameters are also set to them as start values. The container has no inputs; its outputs are :data:`OUTPUTS`, with
-the units of the embedded FMUs (added to the builder's modelDescription.xml, which has none).
+defaults (:mod:`.packed`), and its parameters are also set to them as start values. The
+container has no inputs; its outputs are the loop system's (:data:`~sma_fmu.fmi.loop.wiring.OUTPUTS`),
+with the units of the embedded FMUs (added to the builder's modelDescription.xml, which has none).
 """
 import io
 import tempfile
@@ -21,25 +22,7 @@ from sma_fmu.systems.closed_loop import closed_loop, identifier
 from sma_fmu.systems.packed import packed_fmu
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
-__all__ = ["OUTPUTS", "loop_outputs", "build_container", "export_container"]
-
-# container output -> (component, variable): what the time-series CSV needs
-OUTPUTS = {
-    "R": ("plant", "R"), "R_ref": ("signals", "R_ref"), "P": ("plant", "P"), "T": ("plant", "T"),
-    "load": ("signals", "load"), "x": ("plant", "x"), "xi_P": ("plant", "xi_P"),
-    "xi_M": ("plant", "xi_M"), "xi_F": ("plant", "xi_F"), "P_fb": ("pi", "P_fb"),
-    "P_ff": ("compensator", "P_ff"), "T_ref": ("compensator", "T_ref"),
-    "saturated": ("compensator", "saturated"),
-}
-
-
-def loop_outputs(scenario):
-    """The :data:`OUTPUTS` the loop of ``scenario`` has: its container's outputs and what
-    every host must read. Without feedforward (the "pi" controller) there is no
-    compensator, so no P_ff, T_ref, saturated."""
-    feedforward = scenario.controller.feedforward
-    return {name: source for name, source in OUTPUTS.items()
-            if feedforward or source[0] != "compensator"}
+__all__ = ["build_container", "export_container"]
 
 
 def _text(value):
@@ -69,7 +52,7 @@ def _configure(container, system):
         container.get_fmu(Path(component.fmu).name, name=component.name)
     for connection in system.connections:
         container.add_link(connection.source, connection.output, connection.target, connection.input)
-    for exposed, (component, variable) in loop_outputs(system.scenario).items():
+    for exposed, (component, variable) in system.outputs.items():
         container.add_output(component, variable, exposed)
     for component in system.components:
         for name, value in component.parameters.items():
@@ -81,7 +64,7 @@ def _configure(container, system):
 def _units(system):
     """{container output: unit} from the embedded FMUs' model variables."""
     units = {}
-    for exposed, (name, variable) in loop_outputs(system.scenario).items():
+    for exposed, (name, variable) in system.outputs.items():
         unit = system.component(name).variables[variable].unit
         if unit:
             units[exposed] = unit
@@ -103,7 +86,7 @@ def _with_units(archive, units):
 
 
 def build_container(system, out, step_size=None, argument="--out"):
-    """Write the container FMU of ``system`` (a :class:`~.closed_loop.LoopSystem`) to ``out``.
+    """Write the container FMU of ``system`` (a :class:`~sma_fmu.fmi.loop.system.LoopSystem`) to ``out``.
 
     ``step_size`` [s]: the internal step (default: the scenario's). Returns ``out``.
     Anything the builder reports beyond what this loop makes it say (``_EXPECTED``) is an

@@ -7,7 +7,7 @@
   too) and :mod:`.fmpy_ssp` (the connectors it records).
 
 Each takes the ``outputs`` the system has ({column: (component, variable)}, from
-:func:`~.container.loop_outputs`): a missing one is an error. Each returns their samples
+:func:`~sma_fmu.fmi.loop.wiring.loop_outputs`): a missing one is an error. Each returns their samples
 at the communication points t_0 ... t_n (t_0: after initialization) as {column of
 :data:`~sma_fmu.cosim.loop.COLUMNS`: array};
 :func:`loop_series` turns them into the loop's time-series array, row k holding the
@@ -19,7 +19,7 @@ import numpy as np
 
 from sma_fmu.cosim.loop import COLUMNS
 from sma_fmu.files.archives import require_safe_archive
-from sma_fmu.systems.container import loop_outputs
+from sma_fmu.fmi.loop.wiring import loop_outputs
 from sma_fmu.systems.ssp import PARAMETER_SET
 
 __all__ = ["HostError", "STATE_COLUMNS", "STEP_COLUMNS", "NO_COMPENSATOR", "loop_series",
@@ -41,11 +41,11 @@ class HostError(RuntimeError):
 def loop_series(scenario, samples, steps):
     """The loop's time-series array from host ``samples`` ({column: n + 1 values}).
 
-    Columns the loop lacks (not in :func:`~.container.loop_outputs`: the compensator's,
+    Columns the loop lacks (not in :func:`~sma_fmu.fmi.loop.wiring.loop_outputs`: the compensator's,
     for the "pi" controller) get the values the library loop writes; the last row has no
     step outputs (nan), as there.
     """
-    present = loop_outputs(scenario)
+    present = loop_outputs(scenario.controller.feedforward)
     dtype = [(name, bool if name == "saturated" else float) for name, _ in COLUMNS]
     data = np.zeros(steps + 1, dtype=dtype)
     data["t"] = np.arange(steps + 1) * scenario.step_s

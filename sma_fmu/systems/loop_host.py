@@ -2,7 +2,7 @@
 
 The loop host is what an embedded or HIL master is: one C process that loads the FMUs'
 binaries itself (no libpython, no FMI library) and steps them one after the other in
-:data:`~.closed_loop.STEP_ORDER` (Gauss-Seidel), each with the outputs just computed by the
+:data:`~sma_fmu.fmi.loop.wiring.STEP_ORDER` (Gauss-Seidel), each with the outputs just computed by the
 ones before it, so it computes what the library's Gauss-Seidel loop computes. With the
 native (C) family nothing in that process is Python: the HIL case of the benchmark.
 
@@ -19,7 +19,6 @@ import numpy as np
 
 from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.hosts import CHostError, compile_host
-from sma_fmu.systems.container import loop_outputs
 
 __all__ = ["loop_host_lines", "run_loop_host", "wine_executable", "wine_path"]
 
@@ -46,10 +45,9 @@ def _value(kind, value):
 
 
 def loop_host_lines(system, folders, steps, timing=False, columns=None):
-    """The loop host's input for ``system`` (a :class:`~.closed_loop.LoopSystem`) whose FMUs
-    are unpacked in ``folders`` ({component: folder text}); a list of lines. The recorded
-    columns are ``columns`` (default: :func:`~.container.loop_outputs` of its scenario), in
-    that order."""
+    """The loop host's input for ``system`` (a :class:`~sma_fmu.fmi.loop.system.LoopSystem`)
+    whose FMUs are unpacked in ``folders`` ({component: folder text}); a list of lines. The
+    recorded columns are ``columns`` (default: the system's outputs), in that order."""
     lines = []
     for component in system.components:
         lines.append(f"fmu {component.name} {folders[component.name]}")
@@ -62,7 +60,7 @@ def loop_host_lines(system, folders, steps, timing=False, columns=None):
         lines.append(f"connect {c.source} {source.variables[c.output].valueReference} "
                      f"{c.target} {target.variables[c.input].valueReference}")
     lines.append("order " + " ".join(component.name for component in system.in_step_order()))
-    outputs = loop_outputs(system.scenario)
+    outputs = system.outputs
     for name, variable in (outputs[column] for column in (columns or outputs)):
         v = system.component(name).variables[variable]
         lines.append(f"record {'boolean' if v.type == 'Boolean' else 'real'} {name} {v.valueReference}")
@@ -112,7 +110,7 @@ def run_loop_host(system, steps, work, windows=None, timing=False, timeout=3600)
         elif words[:1] == ["timing"]:
             measured = dict(zip(("p50_us", "p99_us", "p99_9_us", "max_us", "total_s"),
                                 map(float, words[1:])))
-    names = list(loop_outputs(system.scenario))
+    names = list(system.outputs)
     table = np.array(rows, dtype=float).reshape(len(rows), len(names))
     samples = {name: (table[:, i] != 0.0 if name == "saturated" else table[:, i])
                for i, name in enumerate(names)}

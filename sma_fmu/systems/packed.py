@@ -20,6 +20,7 @@ import zipfile
 import xml.etree.ElementTree as ET
 
 from sma_fmu import __version__
+from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.python_family.slave_support.start_values import (START_VALUES_FILE, parse_start_value,
                                                     start_value, start_value_text)
 
@@ -65,8 +66,10 @@ def _set_experiment(root, scenario):
 
 
 def packed_fmu(component, scenario):
-    """The bytes of ``component``'s FMU with its parameter values as defaults (see the module)."""
+    """The bytes of ``component``'s FMU with its parameter values as defaults (see the module);
+    its archive is inspected first (an export packs it for hosts that unpack it)."""
     label = f"{component.name} ({component.model}.fmu)"
+    require_safe_archive(component.fmu)
     buffer = io.BytesIO()
     with zipfile.ZipFile(component.fmu) as source, \
             zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as target:

@@ -13,7 +13,8 @@ from pathlib import Path
 from sma_fmu.cosim.loop import LoopResult
 from sma_fmu.systems import hosts
 from sma_fmu.systems.closed_loop import closed_loop
-from sma_fmu.systems.container import build_container, loop_outputs
+from sma_fmu.fmi.loop.wiring import loop_outputs
+from sma_fmu.systems.container import build_container
 from sma_fmu.systems.omsimulator import run_ssp_omsimulator
 from sma_fmu.systems.ssp import write_ssp
 
@@ -57,7 +58,7 @@ def run_host(host, scenario, fmu_dir, artifact=None):
     with tempfile.TemporaryDirectory(prefix="sma_fmu_run_") as folder:
         if artifact is None:
             artifact = write_artifact(kind, closed_loop(scenario, fmu_dir), folder)
-        samples = run(artifact, scenario, loop_outputs(scenario))
+        samples = run(artifact, scenario, loop_outputs(scenario.controller.feedforward))
         data = hosts.loop_series(scenario, samples, scenario.steps)
     return LoopResult(scenario, data, f"{kind} ({host})", time.perf_counter() - start)
 

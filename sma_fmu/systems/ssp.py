@@ -105,7 +105,7 @@ def _component(elements, component, connectors, units):
 
 
 def ssd_document(system):
-    """SystemStructure.ssd of ``system`` (a :class:`~.closed_loop.LoopSystem`) as bytes."""
+    """SystemStructure.ssd of ``system`` (a :class:`~sma_fmu.fmi.loop.system.LoopSystem`) as bytes."""
     scenario = system.scenario
     name = identifier(scenario.name)
     root = ET.Element(_tag("ssd:SystemStructureDescription"), version="1.0", name=name,

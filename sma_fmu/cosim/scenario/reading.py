@@ -47,6 +47,7 @@ from sma_fmu.cosim.recording import interval_steps
 from sma_fmu.cosim.scenario.settings import (CONTROLLERS, AnalysisWindow, ControllerSettings,
                                              DriveSettings, Scenario, ScenarioError,
                                              default_analysis)
+from sma_fmu.fmi.loop.gains import GAINS
 from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.constant_load import branch_constants
@@ -66,15 +67,11 @@ _SECTIONS = {
     "scenario": {"description", "stop_time_s", "step_s", "model", "group", "output_interval_s"},
     "reference": None,  # checked by signals.reference_from_table
     "load": None,       # checked by signals.load_from_table
-    "controller": {"kind", "Kp_W_per_ohm", "Ki_W_per_ohm_s", "alpha_s", "beta_s", "model_load_kg",
-                   "inverse"},
+    "controller": {"kind", "inverse", *(gain.key for gain in GAINS)},
     "plant": {"hysteresis_mode", "T_start_degC"},
     "analysis": {"metrics_start_s", "zoom_start_s", "zoom_end_s"},
     "drive": {"kind", "frequency_Hz", "peak_W"},
 }
-
-_GAIN_KEYS = {"Kp_W_per_ohm": "Kp", "Ki_W_per_ohm_s": "Ki", "alpha_s": "phase_lag_alpha",
-              "beta_s": "beta", "model_load_kg": "model_load"}
 
 def _fail(path, message):
     raise ScenarioError(f"{path}: {message}")
@@ -142,19 +139,19 @@ def _controller(path, table, params):
     if kind not in CONTROLLERS:
         _fail(path, f"[controller] kind must be one of {', '.join(CONTROLLERS)}, got {kind!r}")
     values = {}
-    for key, attribute in _GAIN_KEYS.items():
-        value = _number(path, "controller", table, key, default=getattr(params, attribute))
-        if value < 0 or (key == "beta_s" and value == 0):
-            _fail(path, f"[controller] {key} must be {'> 0' if key == 'beta_s' else '>= 0'}, got {value!r}")
-        values[attribute] = value
+    for gain in GAINS:
+        value = _number(path, "controller", table, gain.key, default=getattr(params, gain.default))
+        positive = gain.name == "beta"   # the phase-lag filter's lag time, its pole: not 0
+        if value < 0 or (positive and value == 0):
+            _fail(path, f"[controller] {gain.key} must be {'> 0' if positive else '>= 0'}, got {value!r}")
+        values[gain.name] = value
     inverse = table.get("inverse", "major")
     if inverse not in INVERSES:
         _fail(path, f"[controller] inverse must be one of {', '.join(INVERSES)}, got {inverse!r}")
     if inverse != "major" and kind == "pi":
         _fail(path, f"[controller] inverse = {inverse!r} needs a feedforward controller "
                     f"(kind pi+ff-fixed or pi+ff-adaptive), got kind 'pi'")
-    return ControllerSettings(kind, values["Kp"], values["Ki"], values["phase_lag_alpha"],
-                              values["beta"], values["model_load"], inverse)
+    return ControllerSettings(kind, inverse=inverse, **values)
 
 
 def _check_filter(path, controller, step):

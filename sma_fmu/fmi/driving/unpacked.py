@@ -140,14 +140,13 @@ def remove_stale(folder=None):
 
 
 def _unpack(path, key, cached):
-    require_safe_archive(path)  # before fmpy reads anything of it
     if _SWEPT_PID[0] != os.getpid():   # once per process: what killed ones left behind
         _SWEPT_PID[0] = os.getpid()
         remove_stale()
-    description = read_description(path)
     folder = tempfile.mkdtemp(prefix=f"{_PREFIX}{os.getpid()}_")
     try:
-        safe_extract(path, folder)
+        safe_extract(path, folder)   # the archive inspected once, before fmpy reads anything of it
+        description = read_description(path)
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)
         raise

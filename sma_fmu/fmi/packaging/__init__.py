@@ -6,7 +6,7 @@
 - :mod:`.fmu_names`: the five models and their slave scripts;
 - :mod:`.documentation`, :mod:`.reference_results`, :mod:`.extras`: ``documentation/`` and
   the fmi-ls-ref reference results every FMU carries; :mod:`.user_guide` with ``user_pages/``:
-  each model's page in it; :mod:`.loop_wiring`: how the five make the closed loop;
+  each model's page in it (the loop's wiring is :mod:`sma_fmu.fmi.loop.wiring`'s);
 - :mod:`.cross_check`: the FMI Cross-Check tree; :mod:`.platforms`: the platform tables;
   :mod:`.variable_table`: the variable tables of docs/fmus.md.
 """

@@ -7,15 +7,15 @@ as ``<span class="limit" data-name="name" data-value="repr">value unit</span>`` 
 sees the value with its unit and a test can read the exact number back.
 
 :func:`loop_section` says how to connect the FMU in the closed loop: the connections of
-:func:`.loop_wiring.loop_connections` that touch the model, and its place in
-the Gauss-Seidel order :data:`~.loop_wiring.STEP_ORDER`.
+:func:`sma_fmu.fmi.loop.wiring.loop_connections` that touch the model, and its place in
+the Gauss-Seidel order :data:`~sma_fmu.fmi.loop.wiring.STEP_ORDER`.
 """
 import html
 import math
 from importlib import resources
 from string import Template
 
-from sma_fmu.fmi.packaging.loop_wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
+from sma_fmu.fmi.loop.wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
 
 __all__ = ["PAGES", "limits", "page_template", "model_section", "loop_section"]
 

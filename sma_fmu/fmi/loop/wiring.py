@@ -1,8 +1,8 @@
-"""How the five FMUs make the closed loop: components, connections, Gauss-Seidel order.
+"""How the five FMUs make the closed loop: components, connections, Gauss-Seidel order, outputs.
 
-One description for every place that wires the loop: the systems (SSP package, container
-FMU, hosts: :mod:`sma_fmu.systems.closed_loop`) and each FMU's documentation
-(:mod:`.user_guide`)::
+One description for every place that wires the loop: the loop system (:mod:`.system`: the
+fmpy master, the C master, the SSP package, the container FMU) and each FMU's documentation
+(:mod:`sma_fmu.fmi.packaging.user_guide`)::
 
     signals.R_ref --> compensator.R_ref, pi.R_ref        signals.load --> compensator.load, plant.load
     compensator.P_ff --> pi.P_ff     pi.P --> plant.P_in     plant.R --> pi.R
@@ -14,9 +14,10 @@ the PI and the plant::
 """
 from dataclasses import dataclass
 
-__all__ = ["Connection", "COMPONENT_MODELS", "STEP_ORDER", "loop_connections"]
+__all__ = ["Connection", "COMPONENT_MODELS", "STEP_ORDER", "OUTPUTS", "loop_components",
+           "loop_connections", "loop_outputs"]
 
-# component name in the system -> its FMU's model name
+# component name in the system -> its FMU's model name, in data-flow order
 COMPONENT_MODELS = {"signals": "SmaScenarioSignals", "compensator": "SmaFeedforward",
                     "pi": "SmaPiController", "driver": "SmaPwmDriver", "plant": "SmaActuator"}
 
@@ -27,6 +28,16 @@ COMPONENT_MODELS = {"signals": "SmaScenarioSignals", "compensator": "SmaFeedforw
 # and driver power just computed, as in the library loop
 STEP_ORDER = ("compensator", "pi", "driver", "plant", "signals")
 
+# a column of the loop's time series -> (component, output variable) it is read from: the
+# container FMU's outputs and what every host records
+OUTPUTS = {
+    "R": ("plant", "R"), "R_ref": ("signals", "R_ref"), "P": ("plant", "P"), "T": ("plant", "T"),
+    "load": ("signals", "load"), "x": ("plant", "x"), "xi_P": ("plant", "xi_P"),
+    "xi_M": ("plant", "xi_M"), "xi_F": ("plant", "xi_F"), "P_fb": ("pi", "P_fb"),
+    "P_ff": ("compensator", "P_ff"), "T_ref": ("compensator", "T_ref"),
+    "saturated": ("compensator", "saturated"),
+}
+
 
 @dataclass(frozen=True)
 class Connection:
@@ -36,6 +47,13 @@ class Connection:
     output: str
     target: str
     input: str
+
+
+def loop_components(feedforward, pwm):
+    """The loop's component names in data-flow order, with the compensator (``feedforward``)
+    and the PWM driver (``pwm``) or without them."""
+    return [name for name in COMPONENT_MODELS
+            if (name != "compensator" or feedforward) and (name != "driver" or pwm)]
 
 
 def loop_connections(feedforward, pwm):
@@ -51,3 +69,10 @@ def loop_connections(feedforward, pwm):
                             Connection("signals", "load", "compensator", "load"),
                             Connection("compensator", "P_ff", "pi", "P_ff")]
     return connections
+
+
+def loop_outputs(feedforward):
+    """The :data:`OUTPUTS` of the loop with the compensator (``feedforward``) or without it
+    (the "pi" controller: no P_ff, T_ref, saturated)."""
+    return {name: source for name, source in OUTPUTS.items()
+            if feedforward or source[0] != "compensator"}

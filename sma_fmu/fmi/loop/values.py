@@ -1,0 +1,66 @@
+"""What a scenario sets in each component of its loop: parameter values and input starts.
+
+Computed here once for every master and system tool. Each component's parameters are,
+besides the wire parameters its FMU exposes (:data:`WIRES`, filtered by the FMU in
+:mod:`.system`): the signals as JSON tables (SmaScenarioSignals), the compensator's
+filter, model load, adaptation and inverse, the PI's gains (:data:`~.gains.GAINS`), the
+driver's frequency and peak power, the plant's start temperature and hysteresis mode.
+Choices (the hysteresis mode, the inverse) are the Integer codes of
+:mod:`sma_fmu.fmi.python_family.slave_support.choices`.
+
+An input the signals feed starts at the signal's value at t = 0 (:func:`input_starts`): what
+a master that sets the inputs itself, without the signals component, starts the FMU with
+(the fmpy master); a system tool connects those inputs instead.
+"""
+from sma_fmu.fmi.loop.gains import GAINS
+from sma_fmu.fmi.python_family.slave_support.choices import choice_code
+from sma_fmu.runtime.scenario_signals import table_text
+
+__all__ = ["WIRES", "component_settings", "wire_of", "input_starts"]
+
+# component -> the scenario's attribute holding the wire parameters its FMU gets: the
+# plant is the wire, the compensator inverts its model of it (the wire's, unless a study
+# changes it)
+WIRES = {"compensator": "compensator_params", "plant": "params"}
+
+
+def _gains(controller, component):
+    return {gain.name: getattr(controller, gain.name) for gain in GAINS
+            if gain.component == component}
+
+
+def component_settings(scenario, name):
+    """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters."""
+    c, drive = scenario.controller, scenario.drive
+    if name == "signals":
+        return {"reference": table_text(scenario.reference.as_table()),
+                "load_profile": table_text(scenario.load.as_table())}
+    if name == "compensator":
+        return {**_gains(c, name), "adapt_to_load": c.adapt_to_load,
+                "inverse": choice_code("inverse", c.inverse)}
+    if name == "pi":
+        return _gains(c, name)
+    if name == "driver":
+        return {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W}
+    if name == "plant":
+        return {"T_start": scenario.T_start,
+                "hysteresis_mode": choice_code("hysteresis_mode", scenario.hysteresis_mode)}
+    raise KeyError(name)
+
+
+def wire_of(scenario, name):
+    """The WireParameters whose values component ``name``'s FMU gets, or None."""
+    attribute = WIRES.get(name)
+    return None if attribute is None else getattr(scenario, attribute)
+
+
+def input_starts(scenario, connections):
+    """{component: {input: value}} of the inputs the signals feed (``connections``): the
+    signal's value at t = 0 (R_ref [ohm], load [kg])."""
+    at_start = {"R_ref": lambda: scenario.reference.value(0.0),
+                "load": lambda: scenario.load.value(0.0)}
+    starts = {}
+    for c in connections:
+        if c.source == "signals":
+            starts.setdefault(c.target, {})[c.input] = at_start[c.output]()
+    return starts
