@@ -69,9 +69,13 @@ def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference
     if stress is not None:
         load = load_of_stress(stress, params.diameter)
     reference = params.x0 if reference_length is None else reference_length
-    data = read_isobaric(Path(path), load, reference, params.diameter)
+    source = "--reference-length" if reference_length is not None else \
+        f"x0 of {Path(params_set.path).name}"
+    data = read_isobaric(Path(path), load, reference, params.diameter, reference_source=source)
     result = predict_file(data, params, lag)
-    report = dict(result["report"], model=str(params_set.path))
+    report = dict(result["report"], model=str(params_set.path),
+                  reference_length_m=data.reference_length, reference_length_source=source,
+                  reading_notes=data.notes)
     if data.load > params.load_max:   # the FMU warns there too, and runs on
         report["warning"] = (f"load {data.load:.4g} kg is above the model's validity limit "
                              f"{params.load_max:.4g} kg (validity.stress_max of "
@@ -98,6 +102,7 @@ def format_predict_report(report):
         lines.append(f"{key + ' [degC]':<14}{m:>10.2f}{p:>11.2f}{p - m:>12.2f}")
     if report.get("warning"):
         lines.insert(1, f"warning: {report['warning']}")
+    lines[1:1] = [f"{Path(report['file']).name}: {note}" for note in report.get("reading_notes", [])]
     m, p = tt["measured"]["transformation_strain"], tt["predicted"]["transformation_strain"]
     lines.append(f"{'strain span %':<14}{100 * m:>10.3f}{100 * p:>11.3f}{100 * (p - m):>12.3f}")
     return "\n".join(lines)
