@@ -43,7 +43,7 @@ from sma_fmu.identification.isobaric.columns import SCALE, choose_strain, find_c
 from sma_fmu.identification.isobaric.cycles import (Branch, select_cycles, smooth,
                                                    split_branches)
 from sma_fmu.identification.isobaric.stress import constant_load_rows, file_stress
-from sma_fmu.identification.isobaric.synthetic import load_of_stress
+from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
 from sma_fmu.identification.isobaric.table import number, read_table
 from sma_fmu.identification.isobaric.timebase import time_seconds
 from sma_fmu.identification.measurements import MeasurementError
@@ -172,9 +172,10 @@ def noise_level(values):
     return float(1.4826 * np.median(np.abs(second - np.median(second))) / math.sqrt(6.0))
 
 
-def _constant_load(path, table, columns):
+def _constant_load(path, table, columns, given):
     """(slice of the rows at constant load, stress [MPa] or None, notes): a stress column's
-    load ramp and unloading left out, its limit and spread checked."""
+    load ramp and unloading left out, its limit and spread checked (``given``: the stress
+    [MPa] the caller gave, or None)."""
     if "stress" not in columns:
         return slice(None), None, []
     index, unit = columns["stress"]
@@ -182,7 +183,8 @@ def _constant_load(path, table, columns):
     values = _numbers(path, table.names, table.rows, index, table.decimal_comma)[0] * SCALE[unit]
     lines = np.array([line for line, _ in table.rows])
     keep, notes = constant_load_rows(name, values, lines, unit)
-    return keep, file_stress(path, name, values[keep], lines[keep], unit), notes
+    stress, checked = file_stress(path, name, values[keep], lines[keep], unit, given)
+    return keep, stress, notes + checked
 
 
 def _reference_note(shape, name, unit, reference, source):
@@ -211,7 +213,9 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     if not table.rows:
         raise MeasurementError(f"{path}: no data rows after the column row")
     columns = find_columns(path, names)
-    keep, stress, notes = _constant_load(path, table, columns)
+    diameter = diameter if diameter else 0.15e-3
+    given = None if load is None else stress_of_load(load, diameter)
+    keep, stress, notes = _constant_load(path, table, columns, given)
     rows = table.rows[keep]
 
     def column(quantity):
@@ -251,9 +255,9 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     if len(rows) < 50:
         raise MeasurementError(f"{path}: only {len(rows)} data rows; a thermal cycle needs more")
     if load is None and stress is not None:
-        load = load_of_stress(stress, diameter if diameter else 0.15e-3)
+        load = load_of_stress(stress, diameter)
     if load is None:
-        load = _metadata_load(table.preamble, diameter if diameter else 0.15e-3)
+        load = _metadata_load(table.preamble, diameter)
         if load is None:
             raise MeasurementError(f"{path}: no load given: pass --load KG or --stress MPa, give "
                                    f"a stress column (stress_MPa), or state it in the header "

@@ -6,6 +6,7 @@ temperatures of both, how the plant was driven) and ``predict_isobaric.png`` (st
 temperature, measured and predicted, and the residual against sample). Everything is
 computed first; a failure leaves DIR as it was.
 """
+import math
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import check_folder, staged_folder
 from sma_fmu.files.png_output import png_bytes
 from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.missing import Reasons
 from sma_fmu.identification.isobaric.predict import predict_file
 from sma_fmu.identification.isobaric.synthetic import load_of_stress
 from sma_fmu.runtime.constants import HEATING
@@ -97,12 +99,21 @@ def format_predict_report(report):
              f"strain residual RMS {report['residual_rms']['strain']:.3g} (offset "
              f"{report['strain_offset']:.3g})",
              f"{'':<14}{'measured':>10}{'predicted':>11}{'difference':>12}"]
-    for key in ("A_s", "A_f", "M_s", "M_f", "half_heating", "half_cooling"):
-        m, p = tt["measured"][key], tt["predicted"][key]
-        lines.append(f"{key + ' [degC]':<14}{m:>10.2f}{p:>11.2f}{p - m:>12.2f}")
+    why, reasons = tt.get("why_missing", {}), Reasons()
+    for key, label, scale in [(k, f"{k} [degC]", 1.0) for k in ("A_s", "A_f", "M_s", "M_f",
+                                                                "half_heating", "half_cooling")] \
+            + [("transformation_strain", "strain span %", 100.0)]:
+        cells = []
+        for source in ("measured", "predicted"):
+            value = tt[source][key]
+            cells.append(f"{scale * value:.{2 if scale == 1.0 else 3}f}" if math.isfinite(value)
+                         else reasons.mark(f"{source}: {why.get(source, {}).get(key, '')}"))
+        difference = tt["predicted"][key] - tt["measured"][key]
+        cells.append(f"{scale * difference:.{2 if scale == 1.0 else 3}f}"
+                     if math.isfinite(difference) else "n/a")
+        lines.append(f"{label:<14}{cells[0]:>10}{cells[1]:>11}{cells[2]:>12}")
+    lines += reasons.lines()
     if report.get("warning"):
         lines.insert(1, f"warning: {report['warning']}")
     lines[1:1] = [f"{Path(report['file']).name}: {note}" for note in report.get("reading_notes", [])]
-    m, p = tt["measured"]["transformation_strain"], tt["predicted"]["transformation_strain"]
-    lines.append(f"{'strain span %':<14}{100 * m:>10.3f}{100 * p:>11.3f}{100 * (p - m):>12.3f}")
     return "\n".join(lines)

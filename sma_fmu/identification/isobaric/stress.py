@@ -63,27 +63,44 @@ def constant_load_rows(name, values, lines, unit="MPa"):
     return slice(start, stop), notes
 
 
-def file_stress(path, name, values, lines, unit="MPa"):
-    """Median stress [MPa] of a stress column (``values`` in MPa, ``lines`` the rows' line
-    numbers); raises when it is outside (0, MAX_STRESS_MPA] or moves more than STRESS_SPREAD."""
-    scale = SCALE[unit]
-    median = float(np.median(values))
+def _problem(name, values, lines, unit, median):
+    """Why a column's median stress [MPa] cannot be the file's load, or ""."""
     if not median > 0:
-        raise MeasurementError(f"{path}: column {name}: median stress {_plain(median / scale)} "
-                               f"{unit} must be > 0")
-    if median > MAX_STRESS_MPA:
-        row = int(np.argmax(values > MAX_STRESS_MPA))
-        shown = f"{_plain(values[row] / scale)} {unit}" + \
-            ("" if unit == "MPa" else f" = {_plain(values[row])} MPa")
-        raise MeasurementError(f"{path}: line {lines[row]}: {name} = {shown}: the file's stress "
-                               f"(median {_plain(median)} MPa) is above {MAX_STRESS_MPA:g} MPa, "
-                               f"the most --stress accepts (beyond any Ti-Ni wire's breaking "
-                               f"stress); is the column in {unit}?")
-    blocks = [float(np.median(part)) for part in np.array_split(values, 10) if part.size]
-    spread = (max(blocks) - min(blocks)) / median
-    if spread > STRESS_SPREAD:
-        raise MeasurementError(f"{path}: column {name}: the stress moves from {min(blocks):.4g} to "
-                               f"{max(blocks):.4g} MPa inside the file ({100 * spread:.0f} % of its "
-                               f"median {median:.4g} MPa; at most {100 * STRESS_SPREAD:.0f} %): "
-                               f"the fit needs one load per file")
-    return median
+        return f"column {name}: median stress {_plain(median / SCALE[unit])} {unit} must be > 0"
+    if median <= MAX_STRESS_MPA:
+        return ""
+    row = int(np.argmax(values > MAX_STRESS_MPA))
+    shown = f"{_plain(values[row] / SCALE[unit])} {unit}" + \
+        ("" if unit == "MPa" else f" = {_plain(values[row])} MPa")
+    return (f"line {lines[row]}: {name} = {shown}: the file's stress (median {_plain(median)} "
+            f"MPa) is above {MAX_STRESS_MPA:g} MPa, the most --stress accepts (beyond any Ti-Ni "
+            f"wire's breaking stress); is the column in {unit}?")
+
+
+def file_stress(path, name, values, lines, unit="MPa", given=None):
+    """(median stress [MPa], notes) of a stress column, ``values`` in MPa, ``lines`` the rows'
+    line numbers. Raises when the stress moves more than STRESS_SPREAD, and, unless the caller
+    gives the stress (``given`` [MPa], from --load or --stress), when the median is outside
+    (0, MAX_STRESS_MPA]; with one given, that and a median more than STRESS_SPREAD from it
+    are notes."""
+    median = float(np.median(values))
+    problem = _problem(name, values, lines, unit, median)
+    if problem and given is None:
+        raise MeasurementError(f"{path}: {problem}")
+    if median > 0:
+        blocks = [float(np.median(part)) for part in np.array_split(values, 10) if part.size]
+        spread = (max(blocks) - min(blocks)) / median
+        if spread > STRESS_SPREAD:
+            raise MeasurementError(
+                f"{path}: column {name}: the stress moves from {min(blocks):.4g} to "
+                f"{max(blocks):.4g} MPa inside the file ({100 * spread:.0f} % of its median "
+                f"{median:.4g} MPa; at most {100 * STRESS_SPREAD:.0f} %): the fit needs one "
+                f"load per file")
+    if given is None:
+        return median, []
+    if problem:
+        return median, [f"{problem} Not used: the stress is given ({_plain(given)} MPa)"]
+    if given > 0 and abs(median - given) > STRESS_SPREAD * given:
+        return median, [f"column {name}: median {_plain(median)} MPa, {_plain(given)} MPa given "
+                        f"({100 * (median / given - 1):+.0f} %); the given one is used"]
+    return median, []
