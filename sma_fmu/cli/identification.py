@@ -189,11 +189,11 @@ def register(commands):
     fit.add_argument("--model", metavar="FILE",
                      help="base parameter file for everything not fitted (default: reference wire)")
     fit.add_argument("--load", type=number_list, metavar="KG[,KG...]",
-                     help=f"isobaric: the hung mass [kg] in [0, {MAX_LOAD_KG:g}], one for all files or one "
-                          "per file (default: the file header's 'load: ... kg')")
+                     help=f"isobaric: the hung mass [kg] in [0, {MAX_LOAD_KG:g}], one for all files "
+                          "or one per file (default: the file header's 'load: ... kg')")
     fit.add_argument("--stress", type=number_list, metavar="MPA[,MPA...]",
-                     help=f"isobaric: the stress [MPa] in (0, {MAX_STRESS_MPA:g}] instead of --load (uses the "
-                          "wire diameter)")
+                     help=f"isobaric: the stress [MPa] in (0, {MAX_STRESS_MPA:g}] instead of "
+                          "--load (uses the wire diameter)")
     fit.add_argument("--residual-strain", choices=("per-cycle", "none"),
                      help="isobaric: a strain offset per residual-strain level (each cycle may "
                           "leave strain behind), or one per file (default: per-cycle)")

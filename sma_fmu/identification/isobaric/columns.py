@@ -47,6 +47,7 @@ SCALE = {"ms": 1e-3, "s": 1.0, "min": 60.0, "h": 3600.0, "m": 1.0, "mm": 1e-3, "
 def classify(name):
     """(quantity, unit) of a column name, or None."""
     text = name.strip().replace("°", "deg").replace("Ω", "ohm").replace("²", "2")
+    text = text.replace("μ", "µ")      # Greek mu as the micro sign
     tokens = [t for t in re.split(r"[^A-Za-z0-9%/µ]+", text) if t]
     if not tokens:
         return None

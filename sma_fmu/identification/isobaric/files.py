@@ -9,14 +9,15 @@ ignored):
 | quantity | names start with | units (from the name; default first) |
 |---|---|---|
 | temperature | ``temp``, ``T_`` | C (``C``, ``degC``, ``°C``), K, F |
-| strain | ``strain``, ``eps`` | fraction (``1``, ``mm/mm``), percent (``%``, ``percent``, ``pct``) |
+| strain | ``strain``, ``eps`` | fraction (``1``, ``mm/mm``), percent (``%``, ``pct``) |
 | length | ``length``, ``L_`` | m, mm, um |
-| extension | ``extension``, ``elongation``, ``displacement`` | m, mm, um (over the reference length) |
+| extension | ``extension``, ``elongation``, ``displacement`` | m, mm, um |
 | resistance (optional) | ``resistance``, ``R_`` | ohm |
 | time (optional) | ``time`` | s, ms, min, h |
-| stress (optional) | ``stress`` | MPa, kPa, GPa, Pa, psi, ksi (per row; the file's load from its median) |
+| stress (optional) | ``stress`` | MPa, kPa, GPa, Pa, psi, ksi (per row) |
 
-Exactly one of strain, length or extension; a strain both in percent (``Strain_p``, ``%``)
+Exactly one of strain, length or extension (length and extension over the reference length;
+the file's load from the stress column's median); a strain both in percent (``Strain_p``, ``%``)
 and as a fraction is read twice and the finer one used. A stress column's load ramp (and
 unloading) is left out first (:mod:`~.stress`, which also checks its limit and spread); a time
 column may repeat stamps at its resolution (:mod:`~.timebase`). What reading changed or
@@ -187,25 +188,34 @@ def _constant_load(path, table, columns, given):
     return keep, stress, notes + checked
 
 
-def _reference_note(shape, name, unit, reference, source):
-    """How a length or extension column became strain, naming the reference length."""
-    if shape == "strain":
-        return []
-    formula = f"{name} / {_plain(reference / SCALE[unit])} {unit}" + \
-        (" - 1" if shape == "length" else "")
-    return [f"strain = {formula}: the reference length {_plain(reference)} m ({source}; "
-            f"--reference-length sets it)"]
+def _reference_notes(shape, name, unit, reference, source, model_length):
+    """How a length or extension column became strain, naming the reference length, and
+    what a reference length unlike the model's x0 does to the identified wire."""
+    notes = []
+    if shape != "strain":
+        formula = f"{name} / {_plain(reference / SCALE[unit])} {unit}" + \
+            (" - 1" if shape == "length" else "")
+        notes.append(f"strain = {formula}: the reference length {_plain(reference)} m "
+                     f"({source}; --reference-length sets it)")
+    if model_length and abs(reference / model_length - 1.0) > 1e-9:
+        notes.append(f"the reference length {_plain(reference)} m differs from the model's x0 "
+                     f"{_plain(model_length)} m: the model's length is compared over "
+                     f"{_plain(reference)} m too, so its own strain (over x0) is "
+                     f"{_plain(reference / model_length)} times the data's; give a --model "
+                     f"with the specimen's x0 instead")
+    return notes
 
 
 def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=None,
-                  reference_source="given"):
+                  reference_source="given", model_length=None):
     """Read one isobaric file as :class:`IsobaricData`.
 
     ``load`` [kg] wins over a load stated in the preamble; ``reference_length`` [m] is the
     length strain is measured from (length and extension columns are converted with it),
-    ``reference_source`` says where it came from (for the notes); ``diameter`` [m] converts
-    a preamble ``stress: ... MPa``; ``cycles`` = (first, last) cycle numbers to keep (None:
-    all; an end None: open), see ``cycles.parse_cycles``.
+    ``reference_source`` says where it came from and ``model_length`` is the model's x0 [m]
+    (both for the notes); ``diameter`` [m] converts a preamble ``stress: ... MPa``;
+    ``cycles`` = (first, last) cycle numbers to keep (None: all; an end None: open), see
+    ``cycles.parse_cycles``.
     """
     path = Path(path)
     table = read_table(path)
@@ -228,7 +238,8 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     shape = next(q for q in ("strain", "length", "extension") if q in columns)
     s_index, s_unit = columns[shape]
     strain = _strain(path, shape, names[s_index], s_unit, column(shape), reference_length)
-    notes += _reference_note(shape, names[s_index], s_unit, reference_length, reference_source)
+    notes += _reference_notes(shape, names[s_index], s_unit, reference_length, reference_source,
+                              model_length)
     strain_note = ""
     if "strain_other" in columns:
         o_index, o_unit = columns["strain_other"]

@@ -73,7 +73,8 @@ def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference
     reference = params.x0 if reference_length is None else reference_length
     source = "--reference-length" if reference_length is not None else \
         f"x0 of {Path(params_set.path).name}"
-    data = read_isobaric(Path(path), load, reference, params.diameter, reference_source=source)
+    data = read_isobaric(Path(path), load, reference, params.diameter, reference_source=source,
+                         model_length=params.x0)
     result = predict_file(data, params, lag)
     report = dict(result["report"], model=str(params_set.path),
                   reference_length_m=data.reference_length, reference_length_source=source,
@@ -115,5 +116,6 @@ def format_predict_report(report):
     lines += reasons.lines()
     if report.get("warning"):
         lines.insert(1, f"warning: {report['warning']}")
-    lines[1:1] = [f"{Path(report['file']).name}: {note}" for note in report.get("reading_notes", [])]
+    name = Path(report["file"]).name
+    lines[1:1] = [f"{name}: {note}" for note in report.get("reading_notes", [])]
     return "\n".join(lines)

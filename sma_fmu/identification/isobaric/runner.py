@@ -218,7 +218,7 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
     source = "--reference-length" if reference_length is not None else \
         f"x0 of {Path(base_set.path).name}"
     per_file = file_loads(files, loads, stresses, base.diameter)
-    data = [read_isobaric(Path(f), load, reference, base.diameter, selection, source)
+    data = [read_isobaric(Path(f), load, reference, base.diameter, selection, source, base.x0)
             for f, load in zip(files, per_file)]
     for d in data:
         for note in d.notes:

@@ -139,8 +139,8 @@ def rows_markdown(rows):
              "actuation strain; actuation strain recovered on heating; residual strain left by "
              "the cycle at its lowest temperature. Data: strain against the measured (smoothed) "
              "temperature; data, wire T: against the fitted wire temperature (the thermocouple's "
-             "lag removed), the footing of the model and of model - data. n/a [k]: the construction "
-             "cannot be made; why is listed once under the file's table."]
+             "lag removed), the footing of the model and of model - data. n/a [k]: the "
+             "construction cannot be made; why is listed once under the file's table."]
     files = []
     for row in rows:
         if (row["file"], row["load_kg"]) not in files:

@@ -7,9 +7,10 @@ RESOLUTION_STEPS resolutions; the resolution is the last decimal written). The r
 the straight line through the stamps against the row number when every stamp lies within one
 resolution of it (a steady sampling rate, so the lag's time step comes out right); otherwise
 each stamp goes to the middle of the rows sharing it, with the rows between interpolated. A
-note says how many rows repeat, at which resolution, and which of the two was done. A stamp repeated while the stamps step by far more than
-the resolution (a duplicated row), or earlier than the row before, is an error naming the
-line, the column and the values in the column's unit.
+note says how many rows repeat, at which resolution, and which of the two was done. A stamp
+repeated while the stamps step by far more than the resolution (a duplicated row), or earlier
+than the row before, is an error naming the line, the column and the values in the column's
+unit.
 """
 import numpy as np
 
