@@ -3,12 +3,11 @@ ramp, missing values named once; and the shared real files read as an independen
 reads them (../shared/data/real-isobaric/; skipped where absent, failed under CI=true)."""
 import csv
 import math
-import os
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from real_isobaric import real_folder
 from sma_fmu.cli import main
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.identification.isobaric.files import read_isobaric
@@ -18,18 +17,6 @@ from sma_fmu.identification.isobaric.tables import rows_markdown
 from sma_fmu.identification.isobaric.timebase import time_seconds
 from sma_fmu.identification.isobaric.synthetic import load_of_stress
 from sma_fmu.identification.measurements import MeasurementError
-
-REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real-isobaric"
-
-
-def _real(name):
-    folder = REAL / name
-    if not folder.is_dir():
-        if os.environ.get("CI") == "true":
-            pytest.fail(f"the shared real isobaric data are missing: {folder}")
-        pytest.skip(f"the shared real isobaric data are not here: {folder}")
-    return folder
-
 
 @pytest.mark.parametrize("line", [
     'Time (h);"Temperature, (°C)";"Extension, (mm)"',                # a separator in a name
@@ -92,6 +79,18 @@ def test_a_ramp_is_cut_where_the_stress_reaches_its_load():
                            f"({keep.start} rows, Stress 0 -> ")
 
 
+@pytest.mark.parametrize("header, words", [
+    ("# load: 12 kg", "12 kg is above 10 kg, the most --load accepts"),
+    ("# stress: 2401 MPa", "2401 MPa is above 2000 MPa, the most --stress accepts"),
+])
+def test_a_header_load_beyond_the_limits(tmp_path, header, words):
+    path = tmp_path / "h.csv"
+    path.write_text("\n".join([header, "temperature_C,strain"]
+                              + [f"{20 + k % 100},{0.01 * (k % 100 < 50)}" for k in range(400)]))
+    with pytest.raises(MeasurementError, match=f"header line '{header}': {words}"):
+        read_isobaric(path)
+
+
 def test_each_missing_value_names_its_reason_once():
     base = {"file": "a.txt", "load_kg": 0.1, "unit": "degC"}
     reason = "heating: transformation not finished before the turn (no austenite baseline)"
@@ -108,7 +107,7 @@ def test_each_missing_value_names_its_reason_once():
 
 
 def test_predict_names_why_a_tangent_temperature_is_missing(tmp_path, capsys, params):
-    path = _real("niti-hf-karaman") / "isobaric_600MPa.txt"
+    path = real_folder("niti-hf-karaman") / "isobaric_600MPa.txt"
     out = tmp_path / "p"
     assert main(["predict", "isobaric", str(path), "--model",
                  str(shipped_file("models", "reference_wire.toml")), "--stress", "600",
@@ -131,7 +130,7 @@ def _loadtxt(path, delimiter=None):
 
 @pytest.mark.parametrize("stress", [50, 100, 172, 200])
 def test_the_flexinol_files_read_as_written(params, stress):
-    path = _real("flexinol-niti") / f"isobaric_{stress}MPa.txt"
+    path = real_folder("flexinol-niti") / f"isobaric_{stress}MPa.txt"
     names, table = _loadtxt(path)
     data = read_isobaric(path)
     assert names == ["Temperature", "Strain", "Stress"] and data.notes == []
@@ -142,7 +141,7 @@ def test_the_flexinol_files_read_as_written(params, stress):
 
 @pytest.mark.parametrize("stress", [50, 600])
 def test_the_nitihf_files_read_as_written(params, stress):
-    path = _real("niti-hf-karaman") / f"isobaric_{stress}MPa.txt"
+    path = real_folder("niti-hf-karaman") / f"isobaric_{stress}MPa.txt"
     names, table = _loadtxt(path, "\t")
     data = read_isobaric(path, load_of_stress(stress, params.diameter))
     assert names == ["Temperature", "Strain_p", "Strain"] and data.notes == []
@@ -151,7 +150,7 @@ def test_the_nitihf_files_read_as_written(params, stress):
 
 
 def test_the_asmada_file_reads_as_written():
-    path = _real("asmada-raw") / "isobaric_100cycles.csv"
+    path = real_folder("asmada-raw") / "isobaric_100cycles.csv"
     names, table = _loadtxt(path, ",")
     data = read_isobaric(path, 1.0)
     assert names == ["temperature_C", "strain"] and data.notes == []

@@ -47,6 +47,7 @@ from sma_fmu.identification.isobaric.stress import constant_load_rows, file_stre
 from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
 from sma_fmu.identification.isobaric.table import number, read_table
 from sma_fmu.identification.isobaric.timebase import time_seconds
+from sma_fmu.identification.limits import MAX_LOAD_KG, MAX_STRESS_MPA
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 
@@ -86,17 +87,26 @@ def _plain(value):
     return f"{value:.6g}"
 
 
-def _metadata_load(lines, diameter):
-    """Load [kg] stated in preamble lines, or None."""
+def _metadata_load(path, lines, diameter):
+    """Load [kg] stated in preamble lines, or None; raises beyond the limits of --load and
+    --stress."""
     for line in lines:
         text = line.lstrip("#%/! ").lower()
         match = re.search(r"\b(load|mass|force)\s*[:=,]?\s*([-+0-9.eE]+)\s*(kg|g|n)\b", text)
         if match:
             value, unit = float(match.group(2)), match.group(3)
-            return value * {"kg": 1.0, "g": 1e-3, "n": 1.0 / STANDARD_GRAVITY}[unit]
+            load = value * {"kg": 1.0, "g": 1e-3, "n": 1.0 / STANDARD_GRAVITY}[unit]
+            if load > MAX_LOAD_KG:
+                raise MeasurementError(f"{path}: header line {line!r}: {_plain(load)} kg is "
+                                       f"above {MAX_LOAD_KG:g} kg, the most --load accepts")
+            return load
         match = re.search(r"\bstress\s*[:=,]?\s*([-+0-9.eE]+)\s*mpa\b", text)
         if match:
-            return load_of_stress(float(match.group(1)), diameter)
+            stress = float(match.group(1))
+            if stress > MAX_STRESS_MPA:
+                raise MeasurementError(f"{path}: header line {line!r}: {_plain(stress)} MPa is "
+                                       f"above {MAX_STRESS_MPA:g} MPa, the most --stress accepts")
+            return load_of_stress(stress, diameter)
     return None
 
 
@@ -268,7 +278,7 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     if load is None and stress is not None:
         load = load_of_stress(stress, diameter)
     if load is None:
-        load = _metadata_load(table.preamble, diameter)
+        load = _metadata_load(path, table.preamble, diameter)
         if load is None:
             raise MeasurementError(f"{path}: no load given: pass --load KG or --stress MPa, give "
                                    f"a stress column (stress_MPa), or state it in the header "

@@ -2,10 +2,10 @@
 module, however the lab's machine wrote it.
 
 - Cells quoted or not (``"Time (h)","Temperature (°C)"``): the csv module removes the quotes.
-- Whole rows quoted as one cell, the quotes inside doubled (a column row
-  ``"(3 quotes)Time (h)(2),(2)Stress (MPa)(3)``, then rows ``"0.157,23.4,170.759"``), as
-  some exports write them: a line the csv module reads as a single quoted cell is read again
-  as the row inside it.
+- Whole rows written as one quoted cell, the quotes inside doubled (rows such as
+  ``"0.157,23.4,170.759"``, the column row with its quoted names inside), as some exports
+  write them: a line the csv module reads as a single quoted cell is read again as the row
+  inside it.
 - The separator (comma, semicolon, tab or blanks) comes from the csv module's ``Sniffer`` on
   the column row and the rows after it (by counting them in the column row where it cannot
   tell); with semicolons a decimal comma is accepted, with blanks tabs count as blanks. A
