@@ -33,6 +33,14 @@ def test_quoted_names_with_separators_inside(tmp_path, line):
     assert table.decimal_comma
 
 
+def test_a_quote_left_open_names_its_line(tmp_path):
+    path = tmp_path / "open.csv"
+    path.write_text('temperature_C,strain\n20,0.01\n"21,0.02\n22,0.03\n', encoding="utf-8")
+    with pytest.raises(MeasurementError, match="line 3: a quote opened on this line is not "
+                                               "closed on it"):
+        read_table(path)
+
+
 def _stamps(true_s, decimals=3):
     """Hours written to ``decimals`` decimals, as a machine does."""
     texts = [f"{t / 3600.0:.{decimals}f}" for t in true_s]

@@ -106,12 +106,22 @@ def _separator(lines):
     return (None if found == " " else found), (quote if quote in "\"'" else '"')
 
 
-def _cells(line, separator, quote):
-    if separator is None:
-        line = line.replace("\t", " ")
-    row = next(csv.reader([line], delimiter=separator or " ", quotechar=quote,
-                          skipinitialspace=True), [])
-    return [cell.strip() for cell in row]
+def _rows(path, numbered, separator, quote):
+    """[(line number, cells)] of ``numbered`` [(line number, text)], one csv reader over all
+    of them; a quote left open at the end of a line is an error naming it."""
+    lines = [text.replace("\t", " ") if separator is None else text for _, text in numbered]
+    reader = csv.reader(lines, delimiter=separator or " ", quotechar=quote, skipinitialspace=True)
+    rows = []
+    for cells in reader:
+        if reader.line_num != len(rows) + 1:
+            raise MeasurementError(f"{path}: line {numbered[len(rows)][0]}: a quote opened on "
+                                   f"this line is not closed on it")
+        rows.append((numbered[len(rows)][0], [cell.strip() for cell in cells]))
+    return rows
+
+
+def _cells(path, numbered, separator, quote):
+    return _rows(path, [numbered], separator, quote)[0][1]
 
 
 def read_table(path):
@@ -124,7 +134,7 @@ def read_table(path):
     preamble = [line for _, line in lines if line.startswith(COMMENT)]
     for i, (number_, line) in enumerate(content):
         separator, quote = _separator([text for _, text in content[i:i + 1 + _SNIFF_ROWS]])
-        names = _cells(line, separator, quote)
+        names = _cells(path, (number_, line), separator, quote)
         if all(is_number(c, True) for c in names):
             if len(names) < 2:
                 raise MeasurementError(f"{path}: line {number_}: only one column ({line!r}); "
@@ -132,11 +142,12 @@ def read_table(path):
             raise MeasurementError(f"{path}: line {number_}: numbers without a column row "
                                    f"before them; expected names such as "
                                    f"temperature_C,strain_percent")
-        following = _cells(content[i + 1][1], separator, quote) if i + 1 < len(content) else []
+        following = _cells(path, content[i + 1], separator, quote) \
+            if i + 1 < len(content) else []
         if (len(names) >= 2 and len(following) == len(names)
                 and sum(is_number(c, True) for c in following) >= 2):
             check_separators(path, separator, content[i + 1:])
-            rows = [(n, _cells(row, separator, quote)) for n, row in content[i + 1:]]
+            rows = _rows(path, content[i + 1:], separator, quote)
             return Table(preamble, names, rows, separator == ";")
         if len(names) < 2 and i + 1 < len(content) and len(following) < 2 \
                 and all(is_number(c, True) for c in following):
