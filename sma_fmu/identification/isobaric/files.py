@@ -45,7 +45,7 @@ from sma_fmu.identification.isobaric.cycles import (Branch, select_cycles, smoot
                                                    split_branches)
 from sma_fmu.identification.isobaric.stress import constant_load_rows, file_stress
 from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
-from sma_fmu.identification.isobaric.table import number, read_table
+from sma_fmu.identification.isobaric.table import number, plain, read_table
 from sma_fmu.identification.isobaric.timebase import time_seconds
 from sma_fmu.identification.limits import MAX_LOAD_KG, MAX_STRESS_MPA
 from sma_fmu.identification.measurements import MeasurementError
@@ -83,10 +83,6 @@ class IsobaricData:
         return 1 + sum(1 for b in self.branches if b.direction == COOLING)
 
 
-def _plain(value):
-    return f"{value:.6g}"
-
-
 def _metadata_load(path, lines, diameter):
     """Load [kg] stated in preamble lines, or None; raises beyond the limits of --load and
     --stress."""
@@ -97,14 +93,14 @@ def _metadata_load(path, lines, diameter):
             value, unit = float(match.group(2)), match.group(3)
             load = value * {"kg": 1.0, "g": 1e-3, "n": 1.0 / STANDARD_GRAVITY}[unit]
             if load > MAX_LOAD_KG:
-                raise MeasurementError(f"{path}: header line {line!r}: {_plain(load)} kg is "
+                raise MeasurementError(f"{path}: header line {line!r}: {plain(load)} kg is "
                                        f"above {MAX_LOAD_KG:g} kg, the most --load accepts")
             return load
         match = re.search(r"\bstress\s*[:=,]?\s*([-+0-9.eE]+)\s*mpa\b", text)
         if match:
             stress = float(match.group(1))
             if stress > MAX_STRESS_MPA:
-                raise MeasurementError(f"{path}: header line {line!r}: {_plain(stress)} MPa is "
+                raise MeasurementError(f"{path}: header line {line!r}: {plain(stress)} MPa is "
                                        f"above {MAX_STRESS_MPA:g} MPa, the most --stress accepts")
             return load_of_stress(stress, diameter)
     return None
@@ -203,15 +199,15 @@ def _reference_notes(shape, name, unit, reference, source, model_length):
     what a reference length unlike the model's x0 does to the identified wire."""
     notes = []
     if shape != "strain":
-        formula = f"{name} / {_plain(reference / SCALE[unit])} {unit}" + \
+        formula = f"{name} / {plain(reference / SCALE[unit])} {unit}" + \
             (" - 1" if shape == "length" else "")
-        notes.append(f"strain = {formula}: the reference length {_plain(reference)} m "
+        notes.append(f"strain = {formula}: the reference length {plain(reference)} m "
                      f"({source}; --reference-length sets it)")
     if model_length and abs(reference / model_length - 1.0) > 1e-9:
-        notes.append(f"the reference length {_plain(reference)} m differs from the model's x0 "
-                     f"{_plain(model_length)} m: the model's length is compared over "
-                     f"{_plain(reference)} m too, so its own strain (over x0) is "
-                     f"{_plain(reference / model_length)} times the data's; give a --model "
+        notes.append(f"the reference length {plain(reference)} m differs from the model's x0 "
+                     f"{plain(model_length)} m: the model's length is compared over "
+                     f"{plain(reference)} m too, so its own strain (over x0) is "
+                     f"{plain(reference / model_length)} times the data's; give a --model "
                      f"with the specimen's x0 instead")
     return notes
 
@@ -265,7 +261,7 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     if resistance is not None and not (resistance > 0).all():
         bad = int(np.argmin(resistance))
         raise MeasurementError(f"{path}: line {rows[bad][0]}: {names[columns['resistance'][0]]} "
-                               f"= {_plain(resistance[bad])} ohm must be > 0")
+                               f"= {plain(resistance[bad])} ohm must be > 0")
     time = None
     if "time" in columns:
         index, unit = columns["time"]
@@ -284,7 +280,7 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
                                    f"a stress column (stress_MPa), or state it in the header "
                                    f"(# load: 0.15 kg)")
     if not load >= 0:
-        raise MeasurementError(f"{path}: load = {_plain(load)} kg must be >= 0")
+        raise MeasurementError(f"{path}: load = {plain(load)} kg must be >= 0")
     branches, _, splitting = split_branches(temperature, path)
     if cycles is not None:
         keep, branches = select_cycles(branches, cycles, path)

@@ -7,7 +7,7 @@ before the turn (no austenite baseline)`` once, however many cells it explains.
 """
 import math
 
-__all__ = ["Reasons", "why_missing"]
+__all__ = ["Reasons"]
 
 
 class Reasons:
@@ -27,16 +27,7 @@ class Reasons:
         """``value`` with ``digits`` significant digits, or its mark when it is not finite."""
         return f"{value:.{digits}g}" if math.isfinite(value) else self.mark(reason)
 
-    def lines(self, prefix="n/a "):
+    def lines(self):
         """``["n/a [1] reason", ...]``: each reason once."""
-        return [f"{prefix}[{k}] {text}" for k, text in enumerate(self.texts, start=1)]
+        return [f"n/a [{k}] {text}" for k, text in enumerate(self.texts, start=1)]
 
-
-def why_missing(values, reasons):
-    """{reason: [keys]} of the non-finite ``values`` ({key: number}) with ``reasons`` ({key:
-    why}): keys sharing a reason named together."""
-    grouped = {}
-    for key, value in values.items():
-        if not math.isfinite(value):
-            grouped.setdefault(reasons.get(key) or "no value", []).append(key)
-    return grouped

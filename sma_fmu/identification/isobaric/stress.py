@@ -15,6 +15,7 @@ import numpy as np
 from scipy import ndimage
 
 from sma_fmu.identification.isobaric.columns import SCALE
+from sma_fmu.identification.isobaric.table import plain
 from sma_fmu.identification.limits import MAX_STRESS_MPA
 from sma_fmu.identification.measurements import MeasurementError
 
@@ -23,10 +24,6 @@ __all__ = ["constant_load_rows", "file_stress", "STRESS_SPREAD", "RAMP_WINDOW"]
 STRESS_SPREAD = 0.10
 RAMP_WINDOW = 11       # rows of the running median that finds a load ramp
 RAMP_BAND = 0.01       # the ramp ends within this share of the median stress (or 3 noise sigma)
-
-
-def _plain(value):
-    return f"{value:.6g}"
 
 
 def constant_load_rows(name, values, lines, unit="MPa"):
@@ -56,9 +53,9 @@ def constant_load_rows(name, values, lines, unit="MPa"):
         part = values[rows]
         if part.size:
             notes.append(f"{what}: lines {lines[rows.start]}-{lines[rows.stop - 1]} "
-                         f"({part.size} rows, {name} {_plain(part[0] / scale)} -> "
-                         f"{_plain(part[-1] / scale)} {unit}) left out; the constant load "
-                         f"(median {_plain(np.median(values[start:stop]) / scale)} {unit}) runs "
+                         f"({part.size} rows, {name} {plain(part[0] / scale)} -> "
+                         f"{plain(part[-1] / scale)} {unit}) left out; the constant load "
+                         f"(median {plain(np.median(values[start:stop]) / scale)} {unit}) runs "
                          f"over lines {lines[start]}-{lines[stop - 1]}")
     return slice(start, stop), notes
 
@@ -66,13 +63,13 @@ def constant_load_rows(name, values, lines, unit="MPa"):
 def _problem(name, values, lines, unit, median):
     """Why a column's median stress [MPa] cannot be the file's load, or ""."""
     if not median > 0:
-        return f"column {name}: median stress {_plain(median / SCALE[unit])} {unit} must be > 0"
+        return f"column {name}: median stress {plain(median / SCALE[unit])} {unit} must be > 0"
     if median <= MAX_STRESS_MPA:
         return ""
     row = int(np.argmax(values > MAX_STRESS_MPA))
-    shown = f"{_plain(values[row] / SCALE[unit])} {unit}" + \
-        ("" if unit == "MPa" else f" = {_plain(values[row])} MPa")
-    return (f"line {lines[row]}: {name} = {shown}: the file's stress (median {_plain(median)} "
+    shown = f"{plain(values[row] / SCALE[unit])} {unit}" + \
+        ("" if unit == "MPa" else f" = {plain(values[row])} MPa")
+    return (f"line {lines[row]}: {name} = {shown}: the file's stress (median {plain(median)} "
             f"MPa) is above {MAX_STRESS_MPA:g} MPa, the most --stress accepts (beyond any Ti-Ni "
             f"wire's breaking stress); is the column in {unit}?")
 
@@ -99,8 +96,8 @@ def file_stress(path, name, values, lines, unit="MPa", given=None):
     if given is None:
         return median, []
     if problem:
-        return median, [f"{problem} Not used: the stress is given ({_plain(given)} MPa)"]
+        return median, [f"{problem} Not used: the stress is given ({plain(given)} MPa)"]
     if given > 0 and abs(median - given) > STRESS_SPREAD * given:
-        return median, [f"column {name}: median {_plain(median)} MPa, {_plain(given)} MPa given "
+        return median, [f"column {name}: median {plain(median)} MPa, {plain(given)} MPa given "
                         f"({100 * (median / given - 1):+.0f} %); the given one is used"]
     return median, []

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from sma_fmu.identification.measurements import MeasurementError
 
-__all__ = ["Table", "read_table", "number", "is_number", "check_separators"]
+__all__ = ["Table", "read_table", "number", "is_number", "plain", "check_separators"]
 
 COMMENT = ("#", "%", "//", "!")
 SEPARATORS = (",", ";", "\t", " ")
@@ -42,6 +42,11 @@ class Table:
 def number(text, decimal_comma=False):
     """The float a cell holds (ValueError if none)."""
     return float(text.replace(",", ".") if decimal_comma else text)
+
+
+def plain(value):
+    """A value for a message: a plain number of six significant digits (never a numpy repr)."""
+    return f"{value:.6g}"
 
 
 def is_number(text, decimal_comma=False):

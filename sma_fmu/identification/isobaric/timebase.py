@@ -15,15 +15,12 @@ unit.
 import numpy as np
 
 from sma_fmu.identification.isobaric.columns import SCALE
+from sma_fmu.identification.isobaric.table import plain
 from sma_fmu.identification.measurements import MeasurementError
 
 __all__ = ["time_seconds", "resolution", "RESOLUTION_STEPS"]
 
 RESOLUTION_STEPS = 2.0
-
-
-def _plain(value):
-    return f"{value:.6g}"
 
 
 def resolution(texts, values):
@@ -46,8 +43,8 @@ def time_seconds(path, name, unit, values, texts, lines):
     back = np.nonzero(steps < 0)[0]
     if back.size:
         k = int(back[0]) + 1
-        raise MeasurementError(f"{path}: line {lines[k]}: {name} = {_plain(values[k])} {unit} "
-                               f"is earlier than line {lines[k - 1]}'s {_plain(values[k - 1])} "
+        raise MeasurementError(f"{path}: line {lines[k]}: {name} = {plain(values[k])} {unit} "
+                               f"is earlier than line {lines[k - 1]}'s {plain(values[k - 1])} "
                                f"{unit}; rows must be in time order")
     seconds = values * SCALE[unit]
     repeats = np.nonzero(steps == 0)[0]
@@ -56,17 +53,17 @@ def time_seconds(path, name, unit, values, texts, lines):
     k = int(repeats[0]) + 1
     moving = steps[steps > 0]
     if moving.size == 0:
-        raise MeasurementError(f"{path}: line {lines[k]}: {name} stays at {_plain(values[0])} "
+        raise MeasurementError(f"{path}: line {lines[k]}: {name} stays at {plain(values[0])} "
                                f"{unit} on every row; rows must be in time order")
     step, written = float(np.median(moving)), resolution(texts, values)
     if step > RESOLUTION_STEPS * written * (1 + 1e-9):
-        raise MeasurementError(f"{path}: line {lines[k]}: {name} = {_plain(values[k])} {unit} "
+        raise MeasurementError(f"{path}: line {lines[k]}: {name} = {plain(values[k])} {unit} "
                                f"repeats line {lines[k - 1]}'s, though the time stamps step by "
-                               f"{_plain(step)} {unit} elsewhere (written to {_plain(written)} "
+                               f"{plain(step)} {unit} elsewhere (written to {plain(written)} "
                                f"{unit}): a repeated row? Rows must be in time order")
     spread, how = _spread(values, written, SCALE[unit])
     note = (f"{name}: {repeats.size} of {values.size} rows repeat the time stamp before them "
-            f"(written to {_plain(written)} {unit} = {_plain(written * SCALE[unit])} s); {how}")
+            f"(written to {plain(written)} {unit} = {plain(written * SCALE[unit])} s); {how}")
     return spread * SCALE[unit], [note]
 
 
@@ -79,7 +76,7 @@ def _spread(values, written, scale):
     slope, intercept = np.polyfit(rows, values, 1)
     line = intercept + slope * rows
     if np.max(np.abs(values - line)) <= written * (1 + 1e-9):
-        return line, f"the rows are evenly spaced, {_plain(slope * scale)} s apart (the line " \
+        return line, f"the rows are evenly spaced, {plain(slope * scale)} s apart (the line " \
                      f"through the stamps; every stamp lies within its resolution of it)"
     first = np.nonzero(np.concatenate([[True], np.diff(values) > 0]))[0]
     middle = (first + np.append(first[1:], values.size) - 1) / 2.0
