@@ -5,37 +5,26 @@ The files have no licence: they are read in place, never copied into the project
 folder is absent the tests skip naming it; under CI=true they fail instead.
 """
 import json
-import os
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from real_isobaric import real_folder
 from sma_fmu.cli import main
 from sma_fmu.identification.isobaric.files import read_isobaric
 from sma_fmu.identification.isobaric.fit import fit_isobaric
 from sma_fmu.identification.isobaric.synthetic import load_of_stress
 
-REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real-isobaric"
 FLEXINOL = (50, 100, 172, 200)
 NITIHF = (50, 100, 200, 300, 400, 500, 600)
 
 
-def _folder(name):
-    folder = REAL / name
-    if not folder.is_dir():
-        if os.environ.get("CI") == "true":
-            pytest.fail(f"the shared real isobaric data are missing: {folder}")
-        pytest.skip(f"the shared real isobaric data are not here: {folder}")
-    return folder
-
-
 def _flexinol(stress):
-    return _folder("flexinol-niti") / f"isobaric_{stress}MPa.txt"
+    return real_folder("flexinol-niti") / f"isobaric_{stress}MPa.txt"
 
 
 def _nitihf(stress):
-    return _folder("niti-hf-karaman") / f"isobaric_{stress}MPa.txt"
+    return real_folder("niti-hf-karaman") / f"isobaric_{stress}MPa.txt"
 
 
 def test_the_shared_files_read_as_they_are(params):
@@ -112,11 +101,11 @@ def test_a_held_out_stress_is_predicted_by_the_plant_runtime(tmp_path):
 
 
 def test_a_missing_data_folder_skips_naming_it_and_fails_under_ci(monkeypatch, tmp_path):
-    import test_isobaric_real as here
+    import real_isobaric as here
     monkeypatch.setattr(here, "REAL", tmp_path / "absent")
     monkeypatch.delenv("CI", raising=False)
     with pytest.raises(pytest.skip.Exception, match="absent"):
-        here._folder("flexinol-niti")
+        here.real_folder("flexinol-niti")
     monkeypatch.setenv("CI", "true")
     with pytest.raises(pytest.fail.Exception, match="absent"):
-        here._folder("flexinol-niti")
+        here.real_folder("flexinol-niti")

@@ -5,6 +5,8 @@ Experiments: constant-load, constant-temperature (resistance, the paper's two) a
 import dataclasses
 from pathlib import Path
 
+from sma_fmu.identification.limits import MAX_LOAD_KG, MAX_STRESS_MPA
+
 from .arguments import bounded_integer, bounded_number, finite_number, number_list
 
 __all__ = ["register"]
@@ -18,7 +20,6 @@ _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
 # choice: synth's limits, wide for any real test file and checked before anything is made
 MAX_ROWS = 1_000_000          # rows (or samples) one synth call may write
 MAX_NOISE_OHM, MAX_NOISE_K, MAX_NOISE_STRAIN = 10.0, 50.0, 0.1
-MAX_FIT_LOAD_KG, MAX_FIT_STRESS_MPA = 10.0, 2000.0   # beyond any Ti-Ni wire's breaking load
 
 
 def _only_for(args, names, experiment, command):
@@ -29,9 +30,9 @@ def _only_for(args, names, experiment, command):
 
 
 def _check_fit_loads(args):
-    """--load in [0, MAX_FIT_LOAD_KG] kg, --stress in (0, MAX_FIT_STRESS_MPA] MPa."""
-    for name, values, low_open, high, unit in (("--load", args.load, False, MAX_FIT_LOAD_KG, "kg"),
-                                               ("--stress", args.stress, True, MAX_FIT_STRESS_MPA,
+    """--load in [0, MAX_LOAD_KG] kg, --stress in (0, MAX_STRESS_MPA] MPa."""
+    for name, values, low_open, high, unit in (("--load", args.load, False, MAX_LOAD_KG, "kg"),
+                                               ("--stress", args.stress, True, MAX_STRESS_MPA,
                                                 "MPa")):
         for value in values or []:
             if not ((value > 0.0) if low_open else (value >= 0.0)) or value > high:
@@ -166,8 +167,8 @@ def _synth(args):
 def _predict(args):
     from sma_fmu.identification.isobaric.predict_runner import (format_predict_report,
                                                                 run_isobaric_predict)
-    for name, value, high, unit in (("--load", args.load, MAX_FIT_LOAD_KG, "kg"),
-                                    ("--stress", args.stress, MAX_FIT_STRESS_MPA, "MPa")):
+    for name, value, high, unit in (("--load", args.load, MAX_LOAD_KG, "kg"),
+                                    ("--stress", args.stress, MAX_STRESS_MPA, "MPa")):
         if value is not None and not 0.0 < value <= high:
             raise ValueError(f"predict: {name} {value!r} {unit} is outside (0, {high:g}] {unit}")
     out = args.out or Path("results") / "predict-isobaric"
@@ -188,11 +189,11 @@ def register(commands):
     fit.add_argument("--model", metavar="FILE",
                      help="base parameter file for everything not fitted (default: reference wire)")
     fit.add_argument("--load", type=number_list, metavar="KG[,KG...]",
-                     help="isobaric: the hung mass [kg] in [0, 10], one for all files or one "
-                          "per file (default: the file header's 'load: ... kg')")
+                     help=f"isobaric: the hung mass [kg] in [0, {MAX_LOAD_KG:g}], one for all files "
+                          "or one per file (default: the file header's 'load: ... kg')")
     fit.add_argument("--stress", type=number_list, metavar="MPA[,MPA...]",
-                     help="isobaric: the stress [MPa] in (0, 2000] instead of --load (uses the "
-                          "wire diameter)")
+                     help=f"isobaric: the stress [MPa] in (0, {MAX_STRESS_MPA:g}] instead of "
+                          "--load (uses the wire diameter)")
     fit.add_argument("--residual-strain", choices=("per-cycle", "none"),
                      help="isobaric: a strain offset per residual-strain level (each cycle may "
                           "leave strain behind), or one per file (default: per-cycle)")

@@ -5,7 +5,10 @@ The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` w
 
 - :mod:`~.files`: read lab files (columns, units, preamble) into branches and cycles
   (:func:`read_isobaric`), splitting them with :mod:`~.cycles`;
-- :mod:`~.columns`: separators, a strain given twice, a stress column;
+- :mod:`~.table` (quoted cells and rows, separators), :mod:`~.columns` (which quantity a
+  column holds, a strain given twice), :mod:`~.stress` (a stress column's load ramp, limit
+  and spread), :mod:`~.timebase` (time stamps repeated at their resolution): the pieces of
+  reading; :mod:`~.missing`: why a number is missing, named once;
 - :mod:`~.fit`: the joint fit of parameters, temperature profile and lag (:func:`fit_isobaric`),
   on :mod:`~.terms` (the model with the issue-36 terms, vectorised), :mod:`~.profile` and
   :mod:`~.lag` (the wire's temperature), :mod:`~.layout` and :mod:`~.starts` (the unknowns,

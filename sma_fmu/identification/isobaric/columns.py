@@ -1,42 +1,92 @@
-"""Column checks of isobaric files beyond one quantity per column: mixed separators, a strain
-given twice (in percent and as a fraction), and a stress column.
+"""Which quantity each column of an isobaric file holds, from its name, and a strain given twice.
 
-- Separators: the column row decides (comma, semicolon, tab or blanks); a data row with
-  another separator (or without the column row's) is an error naming the line. With blanks,
-  tabs count as blanks; with semicolons, commas are decimal commas.
-- Strain twice: files such as the NiTiHf ones carry ``Strain_p`` [%] and ``Strain`` [1].
-  Both are read and must agree to within their resolution; the one with the finer
-  resolution (the smallest step between its distinct values, as a fraction) is used, and the
-  report says which and why.
-- Stress [MPa]: per row. The file's load is the median stress's (with the wire's diameter),
-  unless ``--load`` or ``--stress`` gives one; a stress that moves more than 10 % inside the
-  file (the medians of ten consecutive blocks of rows span more than 10 % of the file's
-  median) is an error: one load per file is what the fit assumes.
+Names: case, brackets, quotes and blanks do not matter; the first word says the quantity and
+any later word its unit (``"Temperature (°C)"``, ``Temp [K]``, ``time_s``, ``"Time (h)"``,
+``Extension (mm)``, ``Stress (MPa)``). :data:`QUANTITIES` is the table; :data:`SCALE` turns
+units into the ones the fit uses (s, m, MPa). Columns it does not know are ignored.
+
+Strain twice: files such as the NiTiHf ones carry ``Strain_p`` [%] and ``Strain`` [1].
+Both are read and must agree to within their resolution; the one with the finer resolution
+(the smallest step between its distinct values, as a fraction) is used, and the report says
+which and why.
 """
+import re
+
 import numpy as np
 
 from sma_fmu.identification.measurements import MeasurementError
 
-__all__ = ["check_separators", "choose_strain", "file_stress", "STRESS_SPREAD"]
+__all__ = ["QUANTITIES", "SCALE", "classify", "find_columns", "choose_strain"]
 
-STRESS_SPREAD = 0.10
-_WORD = {",": "commas", ";": "semicolons", "\t": "tabs", None: "blanks"}
+_TEMPERATURE = {"": "C", "c": "C", "degc": "C", "celsius": "C", "k": "K", "kelvin": "K",
+                "f": "F", "degf": "F", "fahrenheit": "F"}
+_STRAIN = {"": "fraction", "1": "fraction", "mm/mm": "fraction", "m/m": "fraction",
+           "fraction": "fraction", "%": "percent", "p": "percent", "percent": "percent",
+           "pct": "percent"}
+_LENGTH = {"": "m", "m": "m", "mm": "mm", "um": "um", "µm": "um", "micron": "um"}
+_STRESS = {"": "MPa", "mpa": "MPa", "n/mm2": "MPa", "n/mm": "MPa", "kpa": "kPa", "gpa": "GPa",
+           "pa": "Pa", "psi": "psi", "ksi": "ksi"}
+_TIME = {"": "s", "s": "s", "sec": "s", "secs": "s", "second": "s", "seconds": "s", "ms": "ms",
+         "min": "min", "mins": "min", "minute": "min", "minutes": "min", "h": "h", "hr": "h",
+         "hrs": "h", "hour": "h", "hours": "h"}
+# quantity: (first words it starts with, short names that need a unit after them, units)
+QUANTITIES = {
+    "temperature": (("temp",), ("t",), _TEMPERATURE),
+    "strain": (("strain", "eps"), (), _STRAIN),
+    "stress": (("stress",), (), _STRESS),
+    "length": (("length",), ("l",), _LENGTH),
+    "extension": (("extension", "elongation", "displacement"), (), _LENGTH),
+    "resistance": (("resist",), ("r",), {"": "ohm", "ohm": "ohm", "ohms": "ohm"}),
+    "time": (("time",), (), _TIME),
+}
+# unit: factor to s, m or MPa
+SCALE = {"ms": 1e-3, "s": 1.0, "min": 60.0, "h": 3600.0, "m": 1.0, "mm": 1e-3, "um": 1e-6,
+         "MPa": 1.0, "kPa": 1e-3, "GPa": 1e3, "Pa": 1e-6, "psi": 6.894757e-3, "ksi": 6.894757}
 
 
-def check_separators(path, delimiter, lines):
-    """Raise naming the first of ``lines`` [(number, text)] separated unlike the column row."""
-    foreign = [d for d in (",", ";", "\t") if d != delimiter
-               and not (delimiter == ";" and d == ",") and not (delimiter is None and d == "\t")]
-    for number, line in lines:
-        for d in foreign:
-            if d in line:
-                raise MeasurementError(f"{path}: line {number}: separated by {_WORD[d]}, but the "
-                                       f"column row by {_WORD[delimiter]}; use one separator "
-                                       f"throughout the file")
-        if delimiter is not None and delimiter not in line:
-            raise MeasurementError(f"{path}: line {number}: no {_WORD[delimiter][:-1]} in "
-                                   f"{line[:40]!r}, but the column row is separated by "
-                                   f"{_WORD[delimiter]}; use one separator throughout the file")
+def classify(name):
+    """(quantity, unit) of a column name, or None."""
+    text = name.strip().replace("°", "deg").replace("Ω", "ohm").replace("²", "2")
+    text = text.replace("μ", "µ")      # Greek mu as the micro sign
+    tokens = [t for t in re.split(r"[^A-Za-z0-9%/µ]+", text) if t]
+    if not tokens:
+        return None
+    first, rest = tokens[0].lower(), [t.lower() for t in tokens[1:]]
+    for quantity, (prefixes, exact, units) in QUANTITIES.items():
+        if any(first.startswith(p) for p in prefixes) or (first in exact and rest):
+            unit = next((units[t] for t in rest if t in units), None)
+            if unit is None and rest and first in exact:
+                continue
+            return quantity, unit or units[""]
+    return None
+
+
+def find_columns(path, names):
+    """{quantity: (index, unit)} of the column names; ``strain_other`` for a second strain."""
+    found = {}
+    for index, name in enumerate(names):
+        kind = classify(name)
+        if kind is None:
+            continue
+        quantity, unit = kind
+        if quantity == "strain" and "strain" in found and "strain_other" not in found \
+                and unit != found["strain"][1]:
+            found["strain_other"] = (index, unit)   # the strain twice: % and fraction
+            continue
+        if quantity in found:
+            raise MeasurementError(f"{path}: column row: two {quantity} columns, "
+                                   f"{names[found[quantity][0]]!r} and {name!r}; keep one")
+        found[quantity] = (index, unit)
+    if "temperature" not in found:
+        raise MeasurementError(f"{path}: no temperature column among {', '.join(names)}; name it "
+                               f"e.g. temperature_C or temperature_K")
+    shapes = [q for q in ("strain", "length", "extension") if q in found]
+    if len(shapes) != 1:
+        what = "no strain, length or extension column" if not shapes else \
+            f"both {' and '.join(shapes)} columns"
+        raise MeasurementError(f"{path}: {what} among {', '.join(names)}; give one of "
+                               f"strain_percent, strain, length_m, extension_mm")
+    return found
 
 
 def _resolution(values):
@@ -61,18 +111,3 @@ def choose_strain(path, first, second):
     note = (f"strain from {name} (resolution {fine:.3g}, finer than {other}'s {coarse:.3g}; "
             f"the two agree within {worst:.3g})")
     return values, name, note
-
-
-def file_stress(path, name, values):
-    """Median stress [MPa] of a stress column; raises when it moves more than STRESS_SPREAD."""
-    median = float(np.median(values))
-    if not median > 0:
-        raise MeasurementError(f"{path}: column {name}: median stress {median:.4g} MPa must be > 0")
-    blocks = [float(np.median(part)) for part in np.array_split(values, 10) if part.size]
-    spread = (max(blocks) - min(blocks)) / median
-    if spread > STRESS_SPREAD:
-        raise MeasurementError(f"{path}: column {name}: the stress moves from {min(blocks):.4g} to "
-                               f"{max(blocks):.4g} MPa inside the file ({100 * spread:.0f} % of its "
-                               f"median {median:.4g} MPa; at most {100 * STRESS_SPREAD:.0f} %): "
-                               f"the fit needs one load per file")
-    return median

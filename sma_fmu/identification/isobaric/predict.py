@@ -62,27 +62,35 @@ def drive_plant(params, temperature, load, step_s=1.0):
 
 
 def _tangents(temperature, strain, branches):
-    """{"A_s", "A_f", "M_s", "M_f", "half_heating", "half_cooling" [degC],
-    "transformation_strain" [1]}: medians over the complete branches (NaN where none)."""
+    """({"A_s", "A_f", "M_s", "M_f", "half_heating", "half_cooling" [degC],
+    "transformation_strain" [1]}: medians over the complete branches, NaN where none gives
+    one; {key: why} of the NaN ones)."""
     found = {key: [] for key in ("A_s", "A_f", "M_s", "M_f", "half_heating", "half_cooling",
                                  "transformation_strain")}
+    why = {}
     for b in branches:
         if not b.complete:
             continue
         t, e = temperature[b.start:b.stop], strain[b.start:b.stop]
-        tangents, _ = branch_tangents_or_reason(t, e, b.direction)
+        tangents, reason = branch_tangents_or_reason(t, e, b.direction)
         start, finish = TANGENT_KEYS[b.direction]
+        word = "heating" if b.direction == HEATING else "cooling"
         if tangents is not None:
             found[start].append(tangents["start"])
             found[finish].append(tangents["finish"])
-        word = "heating" if b.direction == HEATING else "cooling"
+        else:
+            why.setdefault(start, f"{word}: {reason}")
+            why.setdefault(finish, f"{word}: {reason}")
         found[f"half_{word}"].append(half_strain_temperature(t, e, b.direction))
         found["transformation_strain"].append(transformation_strain(t, e, b.direction))
+        for key in (f"half_{word}", "transformation_strain"):
+            why.setdefault(key, f"{word}: no half-strain crossing between the baselines")
     out = {}
     for key, values in found.items():
         values = [v for v in values if math.isfinite(v)]
         out[key] = float(np.median(values)) if values else math.nan
-    return out
+    return out, {key: why.get(key, "no complete branch of that direction")
+                 for key, value in out.items() if not math.isfinite(value)}
 
 
 def predict_file(data, params, lag=0.0):
@@ -100,8 +108,8 @@ def predict_file(data, params, lag=0.0):
     predicted = raw + offset
     residual = predicted - data.strain
     seconds = time.perf_counter() - began
-    measured_t = _tangents(data.smoothed, data.strain, data.branches)
-    model_t = _tangents(data.smoothed, predicted, data.branches)
+    measured_t, measured_why = _tangents(data.smoothed, data.strain, data.branches)
+    model_t, model_why = _tangents(data.smoothed, predicted, data.branches)
     report = {
         "experiment": "isobaric",
         "file": str(data.path), "points": int(data.strain.size), "load_kg": data.load,
@@ -113,7 +121,9 @@ def predict_file(data, params, lag=0.0):
         "strain_offset": offset,
         "transformation_temperatures": {"measured": measured_t, "predicted": model_t,
                                         "predicted_minus_measured": {
-                                            k: model_t[k] - measured_t[k] for k in model_t}},
+                                            k: model_t[k] - measured_t[k] for k in model_t},
+                                        "why_missing": {"measured": measured_why,
+                                                        "predicted": model_why}},
         "drive": {"temperature": "the file's temperature profile (piecewise linear, knots by "
                                  "AIC), fed to the plant runtime sample by sample",
                   "step_s": step, "largest_temperature_deviation_K": deviation,

@@ -6,6 +6,7 @@ temperatures of both, how the plant was driven) and ``predict_isobaric.png`` (st
 temperature, measured and predicted, and the residual against sample). Everything is
 computed first; a failure leaves DIR as it was.
 """
+import math
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import check_folder, staged_folder
 from sma_fmu.files.png_output import png_bytes
 from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.missing import Reasons
 from sma_fmu.identification.isobaric.predict import predict_file
 from sma_fmu.identification.isobaric.synthetic import load_of_stress
 from sma_fmu.runtime.constants import HEATING
@@ -69,9 +71,14 @@ def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference
     if stress is not None:
         load = load_of_stress(stress, params.diameter)
     reference = params.x0 if reference_length is None else reference_length
-    data = read_isobaric(Path(path), load, reference, params.diameter)
+    source = "--reference-length" if reference_length is not None else \
+        f"x0 of {Path(params_set.path).name}"
+    data = read_isobaric(Path(path), load, reference, params.diameter, reference_source=source,
+                         model_length=params.x0)
     result = predict_file(data, params, lag)
-    report = dict(result["report"], model=str(params_set.path))
+    report = dict(result["report"], model=str(params_set.path),
+                  reference_length_m=data.reference_length, reference_length_source=source,
+                  reading_notes=data.notes)
     if data.load > params.load_max:   # the FMU warns there too, and runs on
         report["warning"] = (f"load {data.load:.4g} kg is above the model's validity limit "
                              f"{params.load_max:.4g} kg (validity.stress_max of "
@@ -93,11 +100,22 @@ def format_predict_report(report):
              f"strain residual RMS {report['residual_rms']['strain']:.3g} (offset "
              f"{report['strain_offset']:.3g})",
              f"{'':<14}{'measured':>10}{'predicted':>11}{'difference':>12}"]
-    for key in ("A_s", "A_f", "M_s", "M_f", "half_heating", "half_cooling"):
-        m, p = tt["measured"][key], tt["predicted"][key]
-        lines.append(f"{key + ' [degC]':<14}{m:>10.2f}{p:>11.2f}{p - m:>12.2f}")
+    why, reasons = tt.get("why_missing", {}), Reasons()
+    for key, label, scale in [(k, f"{k} [degC]", 1.0) for k in ("A_s", "A_f", "M_s", "M_f",
+                                                                "half_heating", "half_cooling")] \
+            + [("transformation_strain", "strain span %", 100.0)]:
+        cells = []
+        for source in ("measured", "predicted"):
+            value = tt[source][key]
+            cells.append(f"{scale * value:.{2 if scale == 1.0 else 3}f}" if math.isfinite(value)
+                         else reasons.mark(f"{source}: {why.get(source, {}).get(key, '')}"))
+        difference = tt["predicted"][key] - tt["measured"][key]
+        cells.append(f"{scale * difference:.{2 if scale == 1.0 else 3}f}"
+                     if math.isfinite(difference) else "n/a")
+        lines.append(f"{label:<14}{cells[0]:>10}{cells[1]:>11}{cells[2]:>12}")
+    lines += reasons.lines()
     if report.get("warning"):
         lines.insert(1, f"warning: {report['warning']}")
-    m, p = tt["measured"]["transformation_strain"], tt["predicted"]["transformation_strain"]
-    lines.append(f"{'strain span %':<14}{100 * m:>10.3f}{100 * p:>11.3f}{100 * (p - m):>12.3f}")
+    name = Path(report["file"]).name
+    lines[1:1] = [f"{name}: {note}" for note in report.get("reading_notes", [])]
     return "\n".join(lines)

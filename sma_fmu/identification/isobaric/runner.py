@@ -118,6 +118,9 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
             "columns": {q: list(v) for q, v in data.columns.items()},
             "strain_column_note": data.strain_note,
             "stress_column_MPa": data.stress_column,
+            "reference_length_m": data.reference_length,
+            "reference_length_source": data.reference_source,
+            "reading_notes": data.notes,
             "branches": len(data.branches),
             "cycles": len({b.cycle for b in data.branches if b.complete}),
             "noise_estimates": sigma,
@@ -212,10 +215,14 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
     base_set = load_parameter_set(model)
     base = base_set.params
     reference = base.x0 if reference_length is None else reference_length
+    source = "--reference-length" if reference_length is not None else \
+        f"x0 of {Path(base_set.path).name}"
     per_file = file_loads(files, loads, stresses, base.diameter)
-    data = [read_isobaric(Path(f), load, reference, base.diameter, selection)
+    data = [read_isobaric(Path(f), load, reference, base.diameter, selection, source, base.x0)
             for f, load in zip(files, per_file)]
     for d in data:
+        for note in d.notes:
+            progress(f"{d.path.name}: {note}")
         progress(f"{d.path.name}: {splitting_note(d.splitting, d.branches, d.time is not None)}")
     lag, lag_note = resolve_lag(lag, data)
     if lag_note:

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from sma_fmu.identification.isobaric.missing import Reasons
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.identification.transformation_temperatures import (QUANTITIES,
                                                                 branch_tangents_or_reason,
@@ -117,11 +118,6 @@ def _text(value, digits=4):
         f"{value:.{digits}g}"
 
 
-def _cell(row, source):
-    value = row[source]
-    return _text(value) if math.isfinite(value) else f"n/a: {row[source + '_note']}"
-
-
 def rows_csv(rows):
     """CSV text of :func:`cycle_rows` rows (NaN as an empty cell, its reason in the note)."""
     stream = io.StringIO(newline="")
@@ -143,8 +139,8 @@ def rows_markdown(rows):
              "actuation strain; actuation strain recovered on heating; residual strain left by "
              "the cycle at its lowest temperature. Data: strain against the measured (smoothed) "
              "temperature; data, wire T: against the fitted wire temperature (the thermocouple's "
-             "lag removed), the footing of the model and of model - data. n/a: the construction "
-             "cannot be made, and why."]
+             "lag removed), the footing of the model and of model - data. n/a [k]: the "
+             "construction cannot be made; why is listed once under the file's table."]
     files = []
     for row in rows:
         if (row["file"], row["load_kg"]) not in files:
@@ -153,11 +149,15 @@ def rows_markdown(rows):
         lines += ["", f"## {name} (load {load:g} kg)", "",
                   "| cycle | quantity | unit | data | data, wire T | model | model - data, wire T |",
                   "|---:|---|---|---:|---:|---:|---:|"]
+        reasons = Reasons()
         for row in rows:
             if (row["file"], row["load_kg"]) != (name, load):
                 continue
-            difference = row["model"] - row["data_wire"]
+            cells = [reasons.cell(row[s], row[f"{s}_note"]) for s in SOURCES]
+            missing = next((s for s in ("data_wire", "model") if not math.isfinite(row[s])), None)
+            difference = reasons.mark(row[f"{missing}_note"]) if missing else \
+                _text(row["model"] - row["data_wire"], 2)
             lines.append(f"| {row['cycle']} | {row['quantity']} | {row['unit']} | "
-                         f"{_cell(row, 'data')} | {_cell(row, 'data_wire')} | {_cell(row, 'model')} | "
-                         f"{_text(difference, 2) or 'n/a: needs both'} |")
+                         f"{' | '.join(cells)} | {difference} |")
+        lines += [""] + [f"- {line}" for line in reasons.lines()] if reasons.texts else []
     return "\n".join(lines) + "\n"
