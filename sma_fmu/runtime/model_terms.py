@@ -20,8 +20,9 @@ from collections import namedtuple
 
 from .constants import STANDARD_GRAVITY
 
-__all__ = ["ModelTerms", "TERM_DEFAULTS", "model_terms", "stress_of_load", "stress_ratio",
-           "stressed_lengths", "wire_length", "DEFAULT_T_ALPHA", "DEFAULT_SPAN_STRESS"]
+__all__ = ["ModelTerms", "TERM_DEFAULTS", "model_terms", "domain_widths", "stress_of_load",
+           "stress_ratio", "stressed_lengths", "wire_length", "DEFAULT_T_ALPHA",
+           "DEFAULT_SPAN_STRESS"]
 
 DEFAULT_T_ALPHA = 20.0        # degC: where l_P, l_M, l_F are the given lengths
 DEFAULT_SPAN_STRESS = 100.0   # MPa
@@ -46,6 +47,18 @@ are not given); b2_h, b2_c [degC/kg]; alpha_P, alpha_MF [1/K]; T_alpha [degC]; s
 span_ratio_sat [1]; span_stress [MPa]; two_stage: w2 > 0; strain: a thermal expansion or a
 stress law is on; area: the wire's cross-section pi d^2/4 [m2].
 """
+
+
+def domain_widths(values):
+    """{"nu_h", "nu_c", "nu"} [1] of ``values`` ({name: value}) holding one shared ``nu`` or
+    the widths ``nu_h`` and ``nu_c`` of heating and cooling. One nu is both widths (as in a
+    parameter file that omits them: :data:`TERM_DEFAULTS`); two widths give nu = their
+    geometric mean (nu_h if either is not > 0), so one nu gives itself back."""
+    if "nu_h" in values and "nu_c" in values:
+        nu_h, nu_c = values["nu_h"], values["nu_c"]
+        return {"nu_h": nu_h, "nu_c": nu_c,
+                "nu": math.sqrt(nu_h * nu_c) if nu_h > 0 and nu_c > 0 else nu_h}
+    return {"nu_h": values["nu"], "nu_c": values["nu"], "nu": values["nu"]}
 
 
 def _in_use(params):
