@@ -4,7 +4,9 @@
 plant.c) into a shared library with gcc and the C family's flags (docs: notes on the C
 contract: C99, -Wall -Wextra -Wpedantic -Werror, -ffp-contract=off so no fused multiply-add
 changes the last bits) and loads it with ctypes. :func:`compile_win64` compiles the same
-files with mingw-w64 under the same flags, to prove the win64 build is clean.
+files with mingw-w64 under the same flags, to prove the win64 build is clean. Both include
+the headers generated from the Python schema (:data:`INCLUDES`: the runtime folder and
+parameter_table's generated folder), as every build of the C family does.
 """
 import ctypes
 import shutil
@@ -13,7 +15,10 @@ from pathlib import Path
 
 from system_needs import need
 
+from sma_fmu.fmi.packaging.parameter_table import generated_folder
+
 RUNTIME_DIR = Path(__file__).resolve().parent.parent / "sma_fmu" / "fmi" / "c_family" / "runtime"
+INCLUDES = ("-I", RUNTIME_DIR, "-I", generated_folder())
 FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off", "-O2")
 MINGW = "x86_64-w64-mingw32-gcc"
 
@@ -44,7 +49,7 @@ def compile_runtime(modules, folder, extra_source=None, name="runtime"):
         shim.write_text(extra_source)
         sources.append(shim)
     library = folder / f"lib{name}.so"
-    _run(["gcc", *FLAGS, "-fPIC", "-shared", "-I", RUNTIME_DIR, "-o", library, *sources, "-lm"])
+    _run(["gcc", *FLAGS, "-fPIC", "-shared", *INCLUDES, "-o", library, *sources, "-lm"])
     return ctypes.CDLL(str(library))
 
 
@@ -69,7 +74,7 @@ def compile_win64(modules, folder):
     objects = []
     for source in _sources(modules):
         target = folder / f"{source.stem}.obj"
-        _run([MINGW, *FLAGS, "-c", "-o", target, source])
+        _run([MINGW, *FLAGS, *INCLUDES, "-c", "-o", target, source])
         objects.append(target)
     return objects
 

@@ -16,6 +16,7 @@ import pytest
 from system_needs import need
 
 import sma_fmu.fmi.c_family as c_family
+from sma_fmu.fmi.packaging.parameter_table import generated_folder
 
 ROOT = Path(c_family.__file__).parent
 CONTRACTING = ("-std=c99", "-O2", "-march=x86-64-v3", "-ffp-contract=fast", "-c")
@@ -24,7 +25,7 @@ CONTRACTING = ("-std=c99", "-O2", "-march=x86-64-v3", "-ffp-contract=fast", "-c"
 def _objects(folder, include_guard=True):
     need("gcc")
     sources = sorted(ROOT.glob("runtime/*.c"))
-    includes = [f"-I{ROOT / sub}" for sub in ("runtime",)]
+    includes = [f"-I{ROOT / 'runtime'}", f"-I{generated_folder()}"]
     objects = []
     for source in sources:
         target = folder / f"{source.stem}.o"

@@ -11,6 +11,7 @@ import pytest
 from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
 from sma_fmu.runtime.constants import BOLTZMANN, KELVIN_OFFSET, STANDARD_GRAVITY
 from sma_fmu.runtime.feedforward import FeedforwardStepper
+from sma_fmu.runtime.model_terms import domain_widths
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.sensing import sense_temperature, temperature_of_fractions
@@ -226,3 +227,14 @@ def test_a_broad_second_stage_inverts_where_its_own_closed_form_diverges(params)
     assert checked == 4
     with pytest.raises(ValueError, match="does not reach the target at any temperature"):
         temperature_of_fractions(0.5 * floor, constants.M - 0.5 * floor, constants, 1e-9)
+
+
+def test_one_width_is_both_and_two_widths_give_their_geometric_mean(params):
+    """domain_widths: a file's one nu is both widths, as the runtime's terms read it; two
+    widths give nu = sqrt(nu_h nu_c) (written out here), and one nu gives itself back."""
+    assert domain_widths({"nu": params.nu}) == {"nu_h": params.terms.nu_h,
+                                                "nu_c": params.terms.nu_c, "nu": params.nu}
+    two = domain_widths({"nu_h": 150.0, "nu_c": 96.0, "other": 1.0})
+    assert two == {"nu_h": 150.0, "nu_c": 96.0, "nu": 120.0}
+    assert domain_widths(domain_widths({"nu": 130.0}))["nu"] == 130.0
+    assert domain_widths({"nu_h": -1.0, "nu_c": 4.0})["nu"] == -1.0   # no mean of a negative

@@ -10,24 +10,36 @@ law of the transformation strain, and the wire length with thermal expansion.
                          l_i(T,f) = [l_P + s (l_i - l_P)] (1 + alpha_MF (T - T_alpha)),  i = M, F
 
 Every default reproduces the paper's model bit for bit: the steppers take the old code path
-when ``two_stage`` or ``strain`` is False. The C family has the same numbers
-(c_family/runtime/parameters.c, constant_load.c).
+when ``two_stage`` or ``strain`` is False. :data:`TERM_DEFAULTS` is the one table of the
+defaults: the C family's ModelTerms and its defaults are generated from it at build time
+(sma_fmu/fmi/packaging/parameter_table.py); the terms' C physics is in
+c_family/runtime/constant_load.c.
 """
 import math
 from collections import namedtuple
 
 from .constants import STANDARD_GRAVITY
 
-__all__ = ["ModelTerms", "model_terms", "stress_of_load", "stress_ratio", "stressed_lengths",
-           "wire_length", "DEFAULT_T_ALPHA", "DEFAULT_SPAN_STRESS"]
+__all__ = ["ModelTerms", "TERM_DEFAULTS", "model_terms", "domain_widths", "stress_of_load",
+           "stress_ratio", "stressed_lengths", "wire_length", "DEFAULT_T_ALPHA",
+           "DEFAULT_SPAN_STRESS"]
 
 DEFAULT_T_ALPHA = 20.0        # degC: where l_P, l_M, l_F are the given lengths
 DEFAULT_SPAN_STRESS = 100.0   # MPa
 
-ModelTerms = namedtuple("ModelTerms", [
-    "nu_h", "nu_c", "w2", "a2_h", "b2_h", "a2_c", "b2_c", "nu2_h", "nu2_c",
-    "alpha_P", "alpha_MF", "T_alpha", "span_ratio_0", "span_ratio_sat", "span_stress",
-    "two_stage", "strain", "area"])
+# (term, its value when the parameter file omits it): a number, None (stays None), the name
+# of a term above (its value in use) or of a parameter of WireParameters (its value). Each
+# term is an optional parameter of PARAMETER_SPECS; a new one is a row here.
+TERM_DEFAULTS = (
+    ("nu_h", "nu"), ("nu_c", "nu"), ("w2", 0.0),
+    ("a2_h", None), ("b2_h", "b_h"), ("a2_c", None), ("b2_c", "b_c"),
+    ("nu2_h", "nu_h"), ("nu2_c", "nu_c"),
+    ("alpha_P", 0.0), ("alpha_MF", 0.0), ("T_alpha", DEFAULT_T_ALPHA),
+    ("span_ratio_0", 1.0), ("span_ratio_sat", 1.0), ("span_stress", DEFAULT_SPAN_STRESS),
+)
+
+ModelTerms = namedtuple("ModelTerms", [name for name, _ in TERM_DEFAULTS] +
+                        ["two_stage", "strain", "area"])
 ModelTerms.__doc__ = """The optional terms' values in use (defaults filled in).
 
 nu_h, nu_c, nu2_h, nu2_c [1]; w2 [1]; a2_h, a2_c [degC] (None when stage 2 is off and they
@@ -37,15 +49,34 @@ stress law is on; area: the wire's cross-section pi d^2/4 [m2].
 """
 
 
-def _given(value, default):
-    return default if value is None else value
+def domain_widths(values):
+    """{"nu_h", "nu_c", "nu"} [1] of ``values`` ({name: value}) holding one shared ``nu`` or
+    the widths ``nu_h`` and ``nu_c`` of heating and cooling. One nu is both widths (as in a
+    parameter file that omits them: :data:`TERM_DEFAULTS`); two widths give nu = their
+    geometric mean (nu_h if either is not > 0), so one nu gives itself back."""
+    if "nu_h" in values and "nu_c" in values:
+        nu_h, nu_c = values["nu_h"], values["nu_c"]
+        return {"nu_h": nu_h, "nu_c": nu_c,
+                "nu": math.sqrt(nu_h * nu_c) if nu_h > 0 and nu_c > 0 else nu_h}
+    return {"nu_h": values["nu"], "nu_c": values["nu"], "nu": values["nu"]}
+
+
+def _in_use(params):
+    """{term: value in use} of :data:`TERM_DEFAULTS` for ``params``."""
+    values = {}
+    for name, default in TERM_DEFAULTS:
+        value = getattr(params, name)
+        if value is None and isinstance(default, str):
+            value = values[default] if default in values else getattr(params, default)
+        values[name] = default if value is None else value
+    return values
 
 
 def model_terms(params, fail):
     """:class:`ModelTerms` of a :class:`~.parameters.WireParameters` whose own values are
     checked; ``fail(message)`` raises the ParameterError (the file is named by it)."""
-    nu_h, nu_c = _given(params.nu_h, params.nu), _given(params.nu_c, params.nu)
-    w2 = _given(params.w2, 0.0)
+    values = _in_use(params)
+    w2 = values["w2"]
     if w2 > 0.0:
         for key in ("a2_h", "a2_c"):
             if getattr(params, key) is None:
@@ -53,17 +84,11 @@ def model_terms(params, fail):
     if params.a2_h is not None and params.a2_c is not None and not params.a2_h >= params.a2_c:
         fail(f"parameter second_stage.a2_h = {params.a2_h!r} degC must be >= second_stage.a2_c = "
              f"{params.a2_c!r} degC: the heating centre may not lie below the cooling one")
-    alpha_p, alpha_mf = _given(params.alpha_P, 0.0), _given(params.alpha_MF, 0.0)
-    ratio_0, ratio_sat = _given(params.span_ratio_0, 1.0), _given(params.span_ratio_sat, 1.0)
     return ModelTerms(
-        nu_h=nu_h, nu_c=nu_c, w2=w2, a2_h=params.a2_h, b2_h=_given(params.b2_h, params.b_h),
-        a2_c=params.a2_c, b2_c=_given(params.b2_c, params.b_c),
-        nu2_h=_given(params.nu2_h, nu_h), nu2_c=_given(params.nu2_c, nu_c),
-        alpha_P=alpha_p, alpha_MF=alpha_mf, T_alpha=_given(params.T_alpha, DEFAULT_T_ALPHA),
-        span_ratio_0=ratio_0, span_ratio_sat=ratio_sat,
-        span_stress=_given(params.span_stress, DEFAULT_SPAN_STRESS),
+        **values,
         two_stage=w2 > 0.0,
-        strain=alpha_p != 0.0 or alpha_mf != 0.0 or ratio_0 != 1.0 or ratio_sat != 1.0,
+        strain=values["alpha_P"] != 0.0 or values["alpha_MF"] != 0.0
+        or values["span_ratio_0"] != 1.0 or values["span_ratio_sat"] != 1.0,
         area=math.pi * params.diameter * params.diameter / 4.0,
     )
 

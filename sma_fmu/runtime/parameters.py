@@ -14,7 +14,8 @@ from .lattice import lattice_constants
 from .model_terms import ModelTerms, model_terms
 from .thermal import thermal_gain, thermal_time_constant
 
-__all__ = ["ParameterError", "ParameterSpec", "PARAMETER_SPECS", "WireParameters", "DEFAULT_STRESS_MAX"]
+__all__ = ["ParameterError", "ParameterSpec", "PARAMETER_SPECS", "RULE_TEXT", "WireParameters",
+           "DEFAULT_STRESS_MAX"]
 
 
 class ParameterError(ValueError):
@@ -79,7 +80,7 @@ PARAMETER_SPECS = (
 
 SPEC_BY_NAME = {spec.name: spec for spec in PARAMETER_SPECS}
 
-_RULE_TEXT = {
+RULE_TEXT = {
     "positive": "must be > 0",
     "nonnegative": "must be >= 0",
     "fraction": "must be in [0, 1)",
@@ -210,7 +211,7 @@ class WireParameters:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self._fail(f"parameter {key} must be a number [{spec.unit}], got {value!r}")
         if not _rule_holds(spec.rule, float(value)):  # the value as given: an Integer stays one
-            self._fail(f"parameter {key} = {value!r} {_RULE_TEXT[spec.rule]} [{spec.unit}]")
+            self._fail(f"parameter {key} = {value!r} {RULE_TEXT[spec.rule]} [{spec.unit}]")
         value = float(value)
         object.__setattr__(self, spec.name, int(value) if spec.rule == "depth" else value)
 

@@ -3,6 +3,7 @@
 - :mod:`.build`: ``sma-fmu build`` (either family) and fmpy's validation;
 - :mod:`.pythonfmu_build`, :mod:`.front_build`: the Python family and its C front;
 - :mod:`.c_family_build`, :mod:`.c_family_description`: the C family (``--native``);
+  :mod:`.parameter_table`: its wire parameter table, generated from the Python schema;
 - :mod:`.fmu_names`: the five models and their slave scripts;
 - :mod:`.documentation`, :mod:`.reference_results`, :mod:`.extras`: ``documentation/`` and
   the fmi-ls-ref reference results every FMU carries; :mod:`.user_guide` with ``user_pages/``:

@@ -5,7 +5,8 @@ Each native FMU holds:
   with ``<SourceFiles>`` listing ``sources/``;
 - ``sources/``: the C files it needs, flat (the FMI 2.0 layer ``fmi2/``, its adapter
   ``models/<Model>.c``, the runtime modules it includes, transitively, the FMI headers) and
-  the generated ``<Model>_variables.h``: what a tool compiles (fmpy's
+  the generated ``<Model>_variables.h`` and ``sma_parameters_table.h`` (the wire parameter
+  schema, :mod:`.parameter_table`): what a tool compiles (fmpy's
   ``build_platform_binary`` does, with sources/ as its include folder);
 - a binary for each FMI 2.0 platform of :mod:`.cross_build`'s table:
   ``binaries/linux64/<Model>.so`` (gcc), ``binaries/win64/<Model>.dll`` (mingw-w64),
@@ -36,6 +37,7 @@ from sma_fmu.fmi.packaging.cross_build import FLAGS, RUNS_HERE, compile_shared, 
 from sma_fmu.fmi.packaging.c_family_description import model_starts, native_description, variables_header
 from sma_fmu.fmi.packaging.extras import add_documentation
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.parameter_table import generated_folder
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.platforms import NATIVE_MARKER, PlatformEntry, annotate
 from sma_fmu.fmi.packaging.prebuilt import find_prebuilt, sources_digest
@@ -56,10 +58,11 @@ class NativeBuildWarning(FrontWarning):
 
 
 def _c_files():
-    """{file name: path} of the C family's shipped files (flat names are unique)."""
+    """{file name: path} of the C family's shipped files and of those generated from the
+    Python schema (:mod:`.parameter_table`); flat names are unique."""
     files = {}
     for folder in (C_FAMILY / "fmi2", C_FAMILY / "fmi3", C_FAMILY / "core", C_FAMILY / "runtime",
-                   C_FAMILY / "models", C_COMMON):
+                   C_FAMILY / "models", C_COMMON, generated_folder()):
         if not folder.is_dir():
             continue
         for path in sorted(folder.iterdir()):

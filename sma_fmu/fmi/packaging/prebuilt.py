@@ -1,8 +1,9 @@
 """Prebuilt C-family binaries, shipped in the wheel: ``sma-fmu build --native`` without a compiler.
 
 A C-family binary depends only on the model's ``sources/`` (the layer, the runtime, the
-adapter and the generated ``<Model>_variables.h``, which holds the structure and the GUID
-but no parameter file's values: :mod:`.c_family_description`), so one binary per model and
+adapter, the generated ``<Model>_variables.h``, which holds the structure and the GUID
+but no parameter file's values: :mod:`.c_family_description`, and the generated wire
+parameter table: :mod:`.parameter_table`), so one binary per model and
 platform serves every build. They live in ``sma_fmu/fmi/packaging/prebuilt_binaries/``
 (package data of the wheel, not of the sdist, which builds from source; never committed) with ``manifest.json``: for each model, the SHA-256 of the
 sources they were compiled from, and the file of each FMI 2.0 platform.

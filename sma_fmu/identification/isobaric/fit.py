@@ -55,6 +55,7 @@ from sma_fmu.identification.isobaric.starts import starts
 from sma_fmu.identification.isobaric.profile import temperature_profile
 from sma_fmu.identification.isobaric.solver import levenberg_marquardt
 from sma_fmu.identification.measurements import MeasurementError
+from sma_fmu.runtime.model_terms import domain_widths
 
 __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "OUTLIER_OPTIONS", "IsobaricFit", "fit_isobaric", "prepare",
            "residual_blocks",
@@ -224,14 +225,13 @@ _State = namedtuple("_State", ["layout", "solution", "jacobian", "solve", "order
 
 def _carry(old_layout, old_x, layout, vector):
     """``vector`` with every unknown the two layouts share taken from ``old_x`` (one width
-    nu gives both nu_h and nu_c)."""
+    nu gives both nu_h and nu_c: :func:`~sma_fmu.runtime.model_terms.domain_widths`)."""
     out = vector.copy()
-    old = {name: i for i, name in enumerate(old_layout.phys)}
-    if "nu" in old:
-        old["nu_h"] = old["nu_c"] = old["nu"]
+    old = dict(zip(old_layout.phys, old_x))
+    old.update(domain_widths(old))
     for i, name in enumerate(layout.phys):
         if name in old:
-            out[i] = old_x[old[name]]
+            out[i] = old[name]
     k_old, k = len(old_layout.phys), len(layout.phys)
     out[k:layout.size] = old_x[k_old:old_layout.size]
     return out

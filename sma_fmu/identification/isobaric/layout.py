@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from sma_fmu.identification.measurements import MeasurementError
+from sma_fmu.runtime.model_terms import domain_widths
 from sma_fmu.runtime.parameters import ParameterError
 
 __all__ = ["Layout"]
@@ -82,12 +83,9 @@ class Layout:
         for name, value in u.items():
             if not (name.startswith(("a_c", "b_c", "a2_c", "b2_c", "gap"))):
                 out[name] = value
-        if "nu_h" in out:
-            out["nu"] = math.sqrt(out["nu_h"] * out["nu_c"]) if out["nu_h"] > 0 and \
-                out["nu_c"] > 0 else out["nu_h"]
-        else:   # one width for both directions
-            out["nu_h"] = out["nu_c"] = out.pop("nu")
-            out["nu"] = out["nu_h"]
+        widths = domain_widths(out)   # one width for both directions, or two and their nu
+        out.pop("nu", None)
+        out.update(widths)
         return out
 
     def transform(self, vector):

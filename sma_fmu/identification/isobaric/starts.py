@@ -16,6 +16,7 @@ from sma_fmu.identification.isobaric.terms import stress_MPa
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constant_load import residual_f_fraction
 from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
+from sma_fmu.runtime.model_terms import domain_widths
 
 __all__ = ["starts", "LAG_LIMIT", "BOUNDS"]
 
@@ -134,8 +135,7 @@ def starts(files, layout, base, lag_fraction=0.01):
                                    f"{'heating' if d == HEATING else 'cooling'} branch crosses "
                                    f"the transformation")
     start = _centre_starts(centres, layout, base)
-    start.update(_energy_starts(widths, base))
-    start["nu"] = math.sqrt(start["nu_h"] * start["nu_c"])
+    start.update(domain_widths(_energy_starts(widths, base)))
     span = float(np.median([s for _, s, _, _ in spans]))
     if not span > 0:
         raise MeasurementError(f"{layout.paths}: the strain is lower when cold than when hot; "

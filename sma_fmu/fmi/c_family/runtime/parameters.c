@@ -9,61 +9,17 @@
 #include "constants.h"
 #include "thermal.h"
 
+#define SMA_SPEC_ROW(name, section, unit, rule, required) {#name, section, unit, rule, required},
 const ParameterSpec PARAMETER_SPECS[PARAM_COUNT] = {
-    {"x0", "geometry", "m", RULE_POSITIVE, 1},
-    {"x_min", "geometry", "m", RULE_POSITIVE, 1},
-    {"diameter", "geometry", "m", RULE_POSITIVE, 1},
-    {"theta", "geometry", "1", RULE_FRACTION, 1},
-    {"mass", "geometry", "kg", RULE_POSITIVE, 1},
-    {"R_P", "phases", "ohm", RULE_POSITIVE, 1},
-    {"R_M", "phases", "ohm", RULE_POSITIVE, 1},
-    {"R_F", "phases", "ohm", RULE_POSITIVE, 1},
-    {"l_M", "phases", "m", RULE_POSITIVE, 1},
-    {"l_F", "phases", "m", RULE_POSITIVE, 1},
-    {"a_h", "hysteresis", "degC", RULE_FINITE, 1},
-    {"b_h", "hysteresis", "degC/kg", RULE_FINITE, 1},
-    {"a_c", "hysteresis", "degC", RULE_FINITE, 1},
-    {"b_c", "hysteresis", "degC/kg", RULE_FINITE, 1},
-    {"memory_depth", "hysteresis", "1", RULE_DEPTH, 0},
-    {"xi_F_inf", "constant_load", "1", RULE_FRACTION, 1},
-    {"f_F", "constant_load", "kg", RULE_POSITIVE, 1},
-    {"eps_T", "constant_load", "J", RULE_POSITIVE, 1},
-    {"nu", "constant_load", "1", RULE_POSITIVE, 1},
-    {"nu_h", "constant_load", "1", RULE_POSITIVE, 0},
-    {"nu_c", "constant_load", "1", RULE_POSITIVE, 0},
-    {"w2", "second_stage", "1", RULE_FRACTION, 0},
-    {"a2_h", "second_stage", "degC", RULE_FINITE, 0},
-    {"b2_h", "second_stage", "degC/kg", RULE_FINITE, 0},
-    {"a2_c", "second_stage", "degC", RULE_FINITE, 0},
-    {"b2_c", "second_stage", "degC/kg", RULE_FINITE, 0},
-    {"nu2_h", "second_stage", "1", RULE_POSITIVE, 0},
-    {"nu2_c", "second_stage", "1", RULE_POSITIVE, 0},
-    {"alpha_P", "strain", "1/K", RULE_FINITE, 0},
-    {"alpha_MF", "strain", "1/K", RULE_FINITE, 0},
-    {"T_alpha", "strain", "degC", RULE_FINITE, 0},
-    {"span_ratio_0", "strain", "1", RULE_POSITIVE, 0},
-    {"span_ratio_sat", "strain", "1", RULE_POSITIVE, 0},
-    {"span_stress", "strain", "MPa", RULE_POSITIVE, 0},
-    {"eps_f", "constant_temperature", "J", RULE_FINITE, 1},
-    {"nu_f", "constant_temperature", "1", RULE_POSITIVE, 1},
-    {"A_s", "thermal", "m2", RULE_POSITIVE, 1},
-    {"c_p", "thermal", "J/(kg.K)", RULE_POSITIVE, 1},
-    {"h_c", "thermal", "W/(m2.K)", RULE_POSITIVE, 1},
-    {"T_room", "thermal", "degC", RULE_FINITE, 1},
-    {"saturation_margin", "sensing", "1", RULE_MARGIN, 1},
-    {"model_load", "control", "kg", RULE_NONNEGATIVE, 1},
-    {"alpha", "control", "s", RULE_NONNEGATIVE, 0},
-    {"beta", "control", "s", RULE_POSITIVE, 1},
-    {"Kp", "control", "W/ohm", RULE_NONNEGATIVE, 1},
-    {"Ki", "control", "W/(ohm.s)", RULE_NONNEGATIVE, 1},
-    {"T_max", "validity", "degC", RULE_FINITE, 1},
-    {"stress_max", "validity", "MPa", RULE_POSITIVE, 0},
+    SMA_PARAMETER_SPECS(SMA_SPEC_ROW)
 };
+#undef SMA_SPEC_ROW
 
-static const char *const RULE_TEXT[] = {
-    "must be > 0", "must be >= 0", "must be in [0, 1)", "must be finite",
-    "must be in (0, 0.5)", "must be a whole number in [2, 100000]",
+#define SMA_RULE_TEXT(rule, text) text,
+static const char *const RULE_TEXT[RULE_COUNT] = {
+    SMA_PARAMETER_RULES(SMA_RULE_TEXT)
 };
+#undef SMA_RULE_TEXT
 
 static int rule_holds(ParameterRule rule, double value)
 {
@@ -127,9 +83,9 @@ static int model_terms(const WireParameters *p, const double v[], ModelTerms *t,
                        SmaMessage *message)
 {
     double a2_h = v[PARAM_a2_h], a2_c = v[PARAM_a2_c];
-    t->nu_h = value_or(v[PARAM_nu_h], p->nu);
-    t->nu_c = value_or(v[PARAM_nu_c], p->nu);
-    t->w2 = value_or(v[PARAM_w2], 0.0);
+#define SMA_TERM_IN_USE(name, fallback) t->name = value_or(v[PARAM_##name], fallback);
+    SMA_MODEL_TERMS(SMA_TERM_IN_USE)
+#undef SMA_TERM_IN_USE
     if (t->w2 > 0.0) {
         if (isnan(a2_h) || isnan(a2_c)) {
             return sma_message_set(message, "%s: parameter second_stage.%s is required when "
@@ -142,22 +98,24 @@ static int model_terms(const WireParameters *p, const double v[], ModelTerms *t,
                                "second_stage.a2_c = %.17g degC: the heating centre may not lie "
                                "below the cooling one", p->source, a2_h, a2_c);
     }
-    t->a2_h = a2_h;
-    t->a2_c = a2_c;
-    t->b2_h = value_or(v[PARAM_b2_h], p->b_h);
-    t->b2_c = value_or(v[PARAM_b2_c], p->b_c);
-    t->nu2_h = value_or(v[PARAM_nu2_h], t->nu_h);
-    t->nu2_c = value_or(v[PARAM_nu2_c], t->nu_c);
-    t->alpha_P = value_or(v[PARAM_alpha_P], 0.0);
-    t->alpha_MF = value_or(v[PARAM_alpha_MF], 0.0);
-    t->T_alpha = value_or(v[PARAM_T_alpha], DEFAULT_T_ALPHA);
-    t->span_ratio_0 = value_or(v[PARAM_span_ratio_0], 1.0);
-    t->span_ratio_sat = value_or(v[PARAM_span_ratio_sat], 1.0);
-    t->span_stress = value_or(v[PARAM_span_stress], DEFAULT_SPAN_STRESS);
     t->two_stage = t->w2 > 0.0;
     t->strain = t->alpha_P != 0.0 || t->alpha_MF != 0.0 || t->span_ratio_0 != 1.0
                 || t->span_ratio_sat != 1.0;
     t->area = SMA_PI * p->diameter * p->diameter / 4.0;
+    return 0;
+}
+
+/* The default of the optional parameter `index` not given: 1 with *value, or 0 when it
+ * has none (None: NaN). */
+static int default_of(int index, double *value)
+{
+#define SMA_DEFAULT_OF(name, number) \
+    if (index == PARAM_##name) {     \
+        *value = number;             \
+        return 1;                    \
+    }
+    SMA_PARAMETER_DEFAULTS(SMA_DEFAULT_OF)
+#undef SMA_DEFAULT_OF
     return 0;
 }
 
@@ -171,15 +129,10 @@ static int check_values(WireParameters *p, const double values[], const unsigned
     for (index = 0; index < PARAM_COUNT; index++) {
         const ParameterSpec *spec = &PARAMETER_SPECS[index];
         double value = values[index];
-        if (!spec->required && (given != NULL ? !given[index] : isnan(value))) {
-            if (index == PARAM_memory_depth) {
-                value = DEFAULT_DEPTH;
-            } else if (index == PARAM_stress_max) {
-                value = DEFAULT_STRESS_MAX;
-            } else {
-                checked[index] = NAN;     /* alpha and the terms: None (NaN below) */
-                continue;
-            }
+        if (!spec->required && (given != NULL ? !given[index] : isnan(value))
+                && !default_of(index, &value)) {
+            checked[index] = NAN;     /* alpha and the terms: None (NaN below) */
+            continue;
         }
         if (!rule_holds(spec->rule, value)) {
             return sma_message_set(message, "%s: parameter %s.%s = %.17g %s [%s]", p->source,
@@ -217,18 +170,9 @@ int wire_parameters_from_given(WireParameters *out, const double values[],
     if (check_values(&p, values, given, v, message)) {
         return 1;
     }
-    p.x0 = v[PARAM_x0]; p.x_min = v[PARAM_x_min]; p.diameter = v[PARAM_diameter];
-    p.theta = v[PARAM_theta]; p.mass = v[PARAM_mass];
-    p.R_P = v[PARAM_R_P]; p.R_M = v[PARAM_R_M]; p.R_F = v[PARAM_R_F];
-    p.l_M = v[PARAM_l_M]; p.l_F = v[PARAM_l_F];
-    p.a_h = v[PARAM_a_h]; p.b_h = v[PARAM_b_h]; p.a_c = v[PARAM_a_c]; p.b_c = v[PARAM_b_c];
-    p.memory_depth = (int)v[PARAM_memory_depth];
-    p.xi_F_inf = v[PARAM_xi_F_inf]; p.f_F = v[PARAM_f_F]; p.eps_T = v[PARAM_eps_T];
-    p.nu = v[PARAM_nu]; p.eps_f = v[PARAM_eps_f]; p.nu_f = v[PARAM_nu_f];
-    p.A_s = v[PARAM_A_s]; p.c_p = v[PARAM_c_p]; p.h_c = v[PARAM_h_c]; p.T_room = v[PARAM_T_room];
-    p.saturation_margin = v[PARAM_saturation_margin]; p.model_load = v[PARAM_model_load];
-    p.alpha = v[PARAM_alpha]; p.beta = v[PARAM_beta]; p.Kp = v[PARAM_Kp]; p.Ki = v[PARAM_Ki];
-    p.T_max = v[PARAM_T_max]; p.stress_max = v[PARAM_stress_max];
+#define SMA_COPY_FIELD(type, name) p.name = (type)v[PARAM_##name];
+    SMA_WIRE_FIELDS(SMA_COPY_FIELD)
+#undef SMA_COPY_FIELD
 
     p.line_density = p.mass / p.x0;
     if (derived_failure(&p, v, "line density mass/x0", "kg/m", MASS_X0, 2, &p.line_density, 1,
