@@ -18,16 +18,16 @@ import pytest
 
 from system_needs import WITHOUT_VARIABLE, missing, need
 
-TESTS = Path(__file__).parent
+TESTS = Path(__file__).parents[1]
 CHOSEN = [
-    "test_platforms.py::test_every_listed_platform_carries_the_front",            # mingw-w64
-    "test_platforms_windows.py::test_a_python_of_the_registry_is_found_and_an_old_one_refused",
-    "test_c_host.py::test_remove_front_gives_back_pythonfmus_binary",             # mingw-w64
-    "test_systems_cli.py::test_check_passes_on_everything_built",                 # gcc, mingw-w64
-    "test_platforms_linux.py::test_no_python_at_all_gives_null_and_one_line_naming_what_was_tried",
-    "test_c_host.py::test_plain_c_host_equals_the_library",                       # fixtures: gcc
-    "test_platforms.py::test_a_machine_pythonfmu_has_no_binary_for_is_refused",   # nothing (3)
-    "test_c_host.py::test_host_environment_drops_ld_preload_and_the_keys_asked",  # nothing
+    "hosts/test_platforms.py::test_every_listed_platform_carries_the_front",            # mingw-w64
+    "hosts/test_platforms_windows.py::test_a_python_of_the_registry_is_found_and_an_old_one_refused",
+    "hosts/test_c_host.py::test_remove_front_gives_back_pythonfmus_binary",             # mingw-w64
+    "systems/test_systems_cli.py::test_check_passes_on_everything_built",               # gcc, mingw-w64
+    "hosts/test_platforms_linux.py::test_no_python_at_all_gives_null_and_one_line_naming_what_was_tried",
+    "hosts/test_c_host.py::test_plain_c_host_equals_the_library",                       # fixtures: gcc
+    "hosts/test_platforms.py::test_a_machine_pythonfmu_has_no_binary_for_is_refused",   # nothing (3)
+    "hosts/test_c_host.py::test_host_environment_drops_ld_preload_and_the_keys_asked",  # nothing
 ]
 REASONS = {
     "mingw-w64": "needs mingw-w64: apt-get install gcc-mingw-w64-x86-64",

@@ -15,7 +15,7 @@ from system_needs import need
 from sma_fmu.fmi.packaging.cross_build import TARGETS, compile_shared, target
 from sma_fmu.fmi.packaging.platforms import binary_architecture
 
-FMI = Path(__file__).parents[1] / "sma_fmu" / "fmi"
+FMI = Path(__file__).parents[2] / "sma_fmu" / "fmi"
 LIBC_MACROS = ("DOMAIN", "SING", "OVERFLOW", "UNDERFLOW", "TLOSS", "PLOSS")
 
 

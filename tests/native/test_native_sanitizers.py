@@ -22,7 +22,7 @@ pytestmark = pytest.mark.needs("gcc")
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=undefined",
             "-fno-omit-frame-pointer", "-g", "-O1"]
 ENV = dict(os.environ, ASAN_OPTIONS="detect_leaks=1", UBSAN_OPTIONS="print_stacktrace=1")
-HOSTS = Path(__file__).parents[1] / "sma_fmu" / "fmi" / "hosts"
+HOSTS = Path(__file__).parents[2] / "sma_fmu" / "fmi" / "hosts"
 
 
 @pytest.fixture(scope="module")
@@ -108,7 +108,7 @@ def test_load_unload_cycles_under_sanitizers(sanitized, tmp_path):
     exe, folders = sanitized
     host = tmp_path / "unload_host"
     subprocess.run(["gcc", "-std=c99", *SANITIZE, "-o", str(host),
-                    str(Path(__file__).with_name("native_unload_host.c")), "-ldl"], check=True)
+                    str(Path(__file__).parents[1] / "support" / "native_unload_host.c"), "-ldl"], check=True)
     folder = folders["SmaActuator"]
     guid = read_model_description(str(folder / "modelDescription.xml")).guid
     result = subprocess.run([str(host), str(folder / "binaries" / "linux64" / "SmaActuator.so"),
@@ -124,8 +124,8 @@ def test_load_unload_cycles_under_sanitizers(sanitized, tmp_path):
 # allocations (numpy, lxml, the interpreter) leak by LeakSanitizer's measure, so that run
 # checks no leaks; the FMI 3.0 walk host (tests/fmi3_walk_host.c), a plain C host, runs each
 # sanitized FMI 3.0 FMU with leak detection on.
-TESTS = Path(__file__).parent
-FMI3_HEADERS = Path(__file__).parents[1] / "sma_fmu" / "fmi" / "c_family" / "fmi3"
+SUPPORT = Path(__file__).parents[1] / "support"   # the tests' helpers
+FMI3_HEADERS = Path(__file__).parents[2] / "sma_fmu" / "fmi" / "c_family" / "fmi3"
 MODELS = ["SmaActuator", "SmaFeedforward", "SmaPiController", "SmaPwmDriver", "SmaScenarioSignals"]
 
 
@@ -176,8 +176,8 @@ def test_fuzz_cases_of_both_fronts_under_sanitizers(sanitized3):
     libasan = subprocess.run(["gcc", "-print-file-name=libasan.so"], capture_output=True,
                              text=True, check=True).stdout.strip()
     env = dict(ENV, LD_PRELOAD=libasan, ASAN_OPTIONS="detect_leaks=0",
-               PYTHONPATH=os.pathsep.join([str(TESTS), str(TESTS.parent)]))
-    result = subprocess.run([sys.executable, str(TESTS / "fmi3_fuzz_cases.py"), str(fmi2),
+               PYTHONPATH=os.pathsep.join([str(SUPPORT), str(SUPPORT.parents[1])]))
+    result = subprocess.run([sys.executable, str(SUPPORT / "fmi3_fuzz_cases.py"), str(fmi2),
                              str(fmi3), "150"], capture_output=True, text=True, env=env,
                             timeout=1200)
     assert result.returncode == 0 and not _reports(result.stderr), result.stderr[-3000:]
@@ -191,7 +191,7 @@ def test_fmi3_walk_host_under_sanitizers_leaks_included(sanitized3, tmp_path, mo
     _, _, unpacked = sanitized3
     host = tmp_path / "walk"
     subprocess.run(["gcc", "-std=c99", *SANITIZE, "-I", str(FMI3_HEADERS), "-o", str(host),
-                    str(TESTS / "fmi3_walk_host.c"), "-ldl", "-lm"], check=True)
+                    str(SUPPORT / "fmi3_walk_host.c"), "-ldl", "-lm"], check=True)
     description = read_model_description(str(unpacked[model] / "modelDescription.xml"))
     floats = [v for v in description.modelVariables if v.type == "Float64"]
     inputs = [v.valueReference for v in floats if v.causality == "input"]

@@ -4,7 +4,7 @@ from pathlib import Path
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.variable_table import markdown_table, render_document
 
-DOC = Path(__file__).parent.parent / "docs" / "fmus.md"
+DOC = Path(__file__).parents[2] / "docs" / "fmus.md"
 
 
 def test_variable_tables_in_docs_match_the_built_fmus(fmus):

@@ -9,7 +9,7 @@ import pytest
 from sma_fmu.cli import build_parser
 from sma_fmu.cli.readme_blocks import BLOCKS, command_list, markers, render_blocks
 
-README = Path(__file__).parent.parent / "README.md"
+README = Path(__file__).parents[2] / "README.md"
 _OPTION = re.compile(r"^--?[A-Za-z][-\w]*")
 _PLACEHOLDER = re.compile(r"^[A-Z_.0-9]|^\{|\.\.\.|<")   # FILE, SCENARIO..., <x>: not a literal
 

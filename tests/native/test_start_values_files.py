@@ -138,7 +138,7 @@ def _child(fmu_path, kind):
 @pytest.mark.parametrize("kind", ["fifo", "folder", "dev-zero"])
 def test_a_start_values_file_that_is_not_a_regular_file_is_refused_at_once(fmus, native_fmus, kind):
     for family, fmu in (("python", fmus[MODEL]), ("native", native_fmus[MODEL])):
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parent),
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).parents[1] / "support"),
                                                            os.environ.get("PYTHONPATH", "")]))
         result = subprocess.run([sys.executable, __file__, str(fmu), kind], capture_output=True,
                                 text=True, timeout=120, env=env)  # a hang fails here

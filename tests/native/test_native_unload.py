@@ -12,7 +12,7 @@ from fmpy import read_model_description
 
 pytestmark = pytest.mark.needs("gcc")
 
-HOST = Path(__file__).with_name("native_unload_host.c")
+HOST = Path(__file__).parents[1] / "support" / "native_unload_host.c"
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from system_needs import need
 
-RUNTIME_DIR = Path(__file__).resolve().parent.parent / "sma_fmu" / "fmi" / "c_family" / "runtime"
+RUNTIME_DIR = Path(__file__).resolve().parents[2] / "sma_fmu" / "fmi" / "c_family" / "runtime"
 FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off", "-O2")
 MINGW = "x86_64-w64-mingw32-gcc"
 

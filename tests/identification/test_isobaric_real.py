@@ -16,7 +16,7 @@ from sma_fmu.identification.isobaric.files import read_isobaric
 from sma_fmu.identification.isobaric.fit import fit_isobaric
 from sma_fmu.identification.isobaric.synthetic import load_of_stress
 
-REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real-isobaric"
+REAL = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "real-isobaric"
 FLEXINOL = (50, 100, 172, 200)
 NITIHF = (50, 100, 200, 300, 400, 500, 600)
 

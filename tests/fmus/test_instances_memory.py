@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-PROBE = Path(__file__).with_name("instance_memory_probe.py")
+PROBE = Path(__file__).parents[1] / "support" / "instance_memory_probe.py"
 KIB_PER_INSTANCE = 5.0
 OBJECTS_PER_INSTANCE = 1.5
 
