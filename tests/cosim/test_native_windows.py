@@ -11,8 +11,6 @@ P_fb (the PI's output, a difference of nearly equal resistances) can differ by m
 1e-12 relative where it crosses zero; relative to its scale it stays near 1e-15.
 """
 import dataclasses
-import os
-import subprocess
 import zipfile
 
 import numpy as np
@@ -24,7 +22,7 @@ from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.comparison import deviation
 from sma_fmu.systems.hosts import loop_series
 from sma_fmu.systems.loop_host import run_loop_host
-from system_needs import need, needs, wine_command
+from system_needs import needs
 
 pytestmark = needs("gcc", "mingw-w64")
 TOLERANCE = 1e-12
@@ -43,18 +41,6 @@ def native_dir(native_fmus):
             names = archive.namelist()
         assert f"binaries/win64/{path.stem}.dll" in names, f"{path}: no win64 binary"
     return folder
-
-
-@pytest.fixture(scope="module")
-def wine(tmp_path_factory):
-    """The environment of a wine64 prefix of its own."""
-    need("wine64", "mingw-w64")
-    root = tmp_path_factory.mktemp("wine")
-    environment = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
-    environment.update(WINEPREFIX=str(root / "prefix"), WINEDEBUG="-all", DISPLAY="")
-    subprocess.run([wine_command(), "wineboot", "--init"], env=environment, capture_output=True,
-                   timeout=600, check=True)
-    return environment
 
 
 @pytest.fixture(scope="module")

@@ -38,12 +38,6 @@ LIMITS = {"SmaActuator": ("T_max", "stress_max", "load_max", "P_T_max", "R_hot_0
           "SmaScenarioSignals": ("load_max", "stress_max", "R_hot_0", "R_cold_max")}
 
 
-@pytest.fixture(scope="module")
-def fmi3_fmus(tmp_path_factory):
-    from sma_fmu.fmi.packaging.build import build_fmus
-    return build_fmus(tmp_path_factory.mktemp("fmi3_docs"), native=True, fmi_version=3)
-
-
 @pytest.fixture(params=FAMILIES)
 def family(request):
     fixture = {"pythonfmu-fmi2": "fmus", "c-fmi2": "native_fmus", "c-fmi3": "fmi3_fmus"}[request.param]

@@ -4,13 +4,13 @@ family (``sma-fmu build --native --fmi 3``): by hand, not in CI.
 Neither host is in a package registry, so CI cannot have them, and pytest does not collect
 this file by default (it does not match test_*.py). docs/systems.md, "FMI 3.0 hosts built by
 hand", says how to build fmusim and the FMI Library from their repositories and how to
-compile tests/fmil3_host.c; then:
+compile tests/support/fmil3_host.c; then:
 
     SMA_FMU_FMUSIM=/path/to/fmusim SMA_FMU_FMIL3_HOST=/path/to/fmil3_host \\
-        python -m pytest -s tests/fmi3_hosts_check.py
+        python -m pytest -s tests/hosts/fmi3_hosts_check.py
 
 fmusim: each FMU runs 2 s of co-simulation at 1 ms with the inputs of
-tests/test_native_hosts.py from a CSV file, FMU logging and FMI-call logging on, once plain
+tests/hosts/test_native_hosts.py from a CSV file, FMU logging and FMI-call logging on, once plain
 and once with ``--event-mode-used --early-return-allowed``: exit status 0, no call returning
 Discard, Error or Fatal, no [Error]/[Fatal] message, and the plain run equal to fmpy's
 ``simulate_fmu`` of the same FMU with the same inputs and step to 1e-12 of each output's
@@ -58,20 +58,9 @@ CONSTANTS = {  # constant inputs for the FMI Library host, moving each model
 
 
 @pytest.fixture(scope="module")
-def fmusim():
-    return by_hand_executable("SMA_FMU_FMUSIM", "an fmusim executable of Reference-FMUs v0.0.39")
-
-
-@pytest.fixture(scope="module")
 def fmil3_host():
     return by_hand_executable("SMA_FMU_FMIL3_HOST",
-                              "tests/fmil3_host.c built on the FMI Library 3.0.4")
-
-
-@pytest.fixture(scope="module")
-def fmi3_fmus(tmp_path_factory):
-    from sma_fmu.fmi.packaging.build import build_fmus
-    return build_fmus(tmp_path_factory.mktemp("fmi3"), native=True, fmi_version=3)
+                              "tests/support/fmil3_host.c built on the FMI Library 3.0.4")
 
 
 def _largest(table, expected, names):
@@ -191,5 +180,5 @@ def test_fmusim_resumes_each_fmi3_fmu_from_its_serialized_state(fmusim, fmi3_fmu
     print(f"\nfmusim {model}: resumed from its state at 1 s ({state.stat().st_size} bytes), "
           f"largest difference from the whole run {worst:.3g} of scale ({name})")
     # exact: the saved state carries the run's h0, on which SmaScenarioSignals samples
-    # (tests/test_signals_restore_grid.py; before, its R_ref was 6.7e-14 of scale off)
+    # (tests/fmus/test_signals_restore_grid.py; before, its R_ref was 6.7e-14 of scale off)
     assert np.allclose(resumed["time"], tail["time"], rtol=0, atol=1e-12) and worst == 0.0

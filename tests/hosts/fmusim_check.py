@@ -6,10 +6,10 @@ by default (it does not match test_*.py). Build fmusim of Reference-FMUs v0.0.39
 fmusim/ sources with libxml2, zlib, minizip and SUNDIALS' CVODE: Debian's libxml2-dev,
 libminizip-dev, libsundials-dev), then:
 
-    SMA_FMU_FMUSIM=/path/to/fmusim python -m pytest tests/fmusim_check.py
+    SMA_FMU_FMUSIM=/path/to/fmusim python -m pytest tests/hosts/fmusim_check.py
 
 Each native FMU (and the pythonfmu SmaActuator, for comparison) runs 2 s of co-simulation
-at 1 ms with the inputs of tests/test_native_hosts.py from a CSV file, with FMU logging on
+at 1 ms with the inputs of tests/hosts/test_native_hosts.py from a CSV file, with FMU logging on
 and every FMI call logged: exit status 0, no FMI call returning Discard, Error or Fatal, no
 [Error]/[Fatal] message, and the result equal to fmpy's run of the same FMU to 1e-12 of each
 output's scale (fmusim's communication points differ from fmpy's in the last bit, and so do
@@ -24,17 +24,10 @@ import subprocess
 import numpy as np
 import pytest
 
-from system_needs import by_hand_executable
 from test_native_hosts import INPUTS, STOP_S, _simulate, _times
 
 BAD_CALL = re.compile(r"-> (Discard|Error|Fatal|Unknown status)")
 BAD_MESSAGE = re.compile(r"^\[(Discard|Error|Fatal)\]")
-
-
-@pytest.fixture(scope="module")
-def fmusim():
-    """The executable SMA_FMU_FMUSIM names; a missing one fails the check."""
-    return by_hand_executable("SMA_FMU_FMUSIM", "an fmusim executable of Reference-FMUs v0.0.39")
 
 
 def _input_file(model, folder):

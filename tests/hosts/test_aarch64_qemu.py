@@ -15,6 +15,7 @@ import pytest
 from fmpy import read_model_description
 
 from fmi_host import FmiHost
+from fmu_signals import plant_walk
 from system_needs import AARCH64_SYSROOT, need
 from sma_fmu.fmi.packaging.cross_build import TARGETS, compile_host_for, compile_shared
 
@@ -42,17 +43,8 @@ def aarch64(native_fmus, tmp_path_factory):
 
 
 def _walk(rng):
-    """Power held for random spans with swings shrinking and growing (nested reversals), load
-    changes now and then: (P_in, load) per step."""
-    inputs, power, load, amplitude = [], 0.0, 0.2, 2.0
-    for k in range(STEPS):
-        if k % rng.randint(40, 300) == 0:
-            amplitude = 2.0 if amplitude < 0.05 else amplitude * rng.uniform(0.5, 0.9)
-            power = max(0.0, 1.0 + rng.choice((-1, 1)) * amplitude * rng.random())
-        if rng.random() < 0.002:
-            load = rng.uniform(0.0, 0.4)
-        inputs.append((power, load))
-    return inputs
+    """The plant's random walk (nested reversals, load changes): (P_in, load) per step."""
+    return [(step["P_in"], step["load"]) for step in plant_walk(rng, STEPS)]
 
 
 def _run(host, folder, inputs, mode):

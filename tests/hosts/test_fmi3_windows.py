@@ -1,13 +1,12 @@
 """The FMI 3.0 C-family FMUs' x86_64-windows binaries step under wine64 as x86_64-linux does.
 
-A small FMI 3.0 host (tests/fmi3_walk_host.c) is built twice, with gcc and with mingw-w64
+A small FMI 3.0 host (tests/support/fmi3_walk_host.c) is built twice, with gcc and with mingw-w64
 (-Wall -Wextra -Wpedantic -Werror), and steps the plant and the PWM driver through the same
 deterministic input walk: every call returns fmi3OK, nothing is logged at warning or worse,
 and every output of the windows run equals the linux run to 1e-12 of the output's scale
 (the FMI 2.0 tolerance: mingw-w64's exp/log/pow may differ from glibc's in the last bit).
 The largest difference is printed (pytest -s).
 """
-import os
 import subprocess
 import zipfile
 from pathlib import Path
@@ -16,7 +15,7 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from system_needs import need, needs, wine_command
+from system_needs import needs, wine_command
 
 pytestmark = needs("gcc", "mingw-w64")
 TOLERANCE = 1e-12
@@ -48,17 +47,6 @@ def hosts(tmp_path_factory):
     subprocess.run([*c_compiler(), *FLAGS, "-o", str(linux), str(HOST), "-ldl", "-lm"], check=True)
     subprocess.run([*windows_compiler(), *FLAGS, "-o", str(windows), str(HOST)], check=True)
     return linux, windows
-
-
-@pytest.fixture(scope="module")
-def wine(tmp_path_factory):
-    need("wine64")
-    root = tmp_path_factory.mktemp("wine3")
-    environment = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
-    environment.update(WINEPREFIX=str(root / "prefix"), WINEDEBUG="-all", DISPLAY="")
-    subprocess.run([wine_command(), "wineboot", "--init"], env=environment, capture_output=True,
-                   timeout=600, check=True)
-    return environment
 
 
 def _arguments(folder, name, steps, windows=False):

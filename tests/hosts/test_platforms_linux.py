@@ -14,7 +14,7 @@ has another one, or none. The tests make that machine out of this one:
   for refused versions (issue 21: Python 3.6 and 2.7 used to fail with a SyntaxError or an
   undefined symbol).
 Needs root (unshare, chroot), gcc, and Debian's libpython3.11: skipped without them, failed
-under CI=true (.ci/run installs them; tests/system_needs.py).
+under CI=true (.ci/run installs them; tests/support/system_needs.py).
 """
 import os
 import re
@@ -81,11 +81,6 @@ def _fake_libpython(folder, name, version):
     subprocess.run([*c_compiler(), "-shared", "-fPIC", f'-DVERSION="{version}"', "-o", str(folder / name),
                     str(source)], check=True, capture_output=True)
     return folder / name
-
-
-@pytest.fixture(scope="module")
-def plant_folder(fmus, tmp_path_factory):
-    return unpack(fmus["SmaActuator"], tmp_path_factory.mktemp("plant"))
 
 
 @needs("root", "libpython3.11")

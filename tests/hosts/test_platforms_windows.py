@@ -11,16 +11,15 @@ What can be checked here, and is:
 The "Pythons" are fakes: a few lines of C reporting a version. Running the FMU through a
 real Windows Python was not done here (docs/fmus.md, "Platforms"). Needs gcc,
 gcc-mingw-w64-x86-64 and, under wine, wine64: skipped without them, failed under CI=true
-(.ci/run installs them; tests/system_needs.py).
+(.ci/run installs them; tests/support/system_needs.py).
 """
-import os
 import struct
 import subprocess
 from pathlib import Path
 
 import pytest
 
-from fmi_host import ERROR, FmiHost, text, unpack
+from fmi_host import ERROR, FmiHost, text
 from sma_fmu.fmi.hosts import compile_host, windows_compiler
 from sma_fmu.fmi.packaging.platforms import FRONT_MARKER
 from system_needs import need, needs, wine_command
@@ -90,11 +89,6 @@ def pe_imports(data):
 
 
 @pytest.fixture(scope="module")
-def plant_folder(fmus, tmp_path_factory):
-    return unpack(fmus["SmaActuator"], tmp_path_factory.mktemp("plant"))
-
-
-@pytest.fixture(scope="module")
 def windows_dll(plant_folder):
     need("mingw-w64")
     dll = plant_folder / "binaries/win64/SmaActuator.dll"
@@ -118,19 +112,16 @@ def test_the_dll_needs_only_what_every_windows_has(windows_dll, plant_folder):
 
 
 @pytest.fixture(scope="module")
-def wine(tmp_path_factory):
-    """(environment, host runner) for wine64 with a prefix of its own."""
-    need("wine64", "mingw-w64")
-    root = tmp_path_factory.mktemp("wine")
-    environment = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
-    environment.update(WINEPREFIX=str(root / "prefix"), WINEDEBUG="-all", DISPLAY="")
-    subprocess.run([WINE, "wineboot", "--init"], env=environment, capture_output=True, timeout=600,
-                   check=True)
+def wine(wine, tmp_path_factory):
+    """(environment, host runner): the module's wine64 prefix (the conftest's ``wine``) and a
+    script running the Windows build of the plain C host under it."""
+    need("mingw-w64")
+    root = tmp_path_factory.mktemp("wine_host")
     exe = compile_host("fmi_host", root / "hosts", windows=True)
     runner = root / "fmi_host_under_wine"
     runner.write_text(f'#!/bin/sh\nexec "{WINE}" "{exe}" "$1"\n')
     runner.chmod(0o755)
-    return environment, runner
+    return wine, runner
 
 
 def _windows(path):

@@ -14,7 +14,7 @@ import random
 import pytest
 
 from fmi3_twins import Instance3
-from test_native_equivalence import _plant_inputs
+from fmu_signals import plant_walk
 from sma_fmu.runtime.parameters import MAX_MEMORY_DEPTH
 from sma_fmu.runtime.plant import PlantStepper
 
@@ -47,7 +47,7 @@ def test_the_arrays_are_the_runtime_stack(actuator3, params, mode, depth):
         assert fmu.start({"hysteresis_mode": mode, "memory_depth": depth, "load": 0.2}) == 0
         plant = PlantStepper(params.replace(memory_depth=depth), mode=MODES[mode], load=0.2)
         counts, time = set(), 0.0
-        for values in _plant_inputs(rng, 6000):
+        for values in plant_walk(rng, 6000):
             for name, value in values.items():
                 assert fmu.set(name, value) == 0
             assert fmu.step(time, 1e-3) <= 1, fmu.log[-1:]
@@ -162,7 +162,7 @@ def test_saved_states_replay_the_arrays(actuator3):
     """A state taken mid-walk, set and deserialized, replays the arrays bit for bit (NaN
     compared by repr)."""
     rng = random.Random(3939)
-    inputs = _plant_inputs(rng, 3000)
+    inputs = plant_walk(rng, 3000)
     fmu = Instance3(actuator3, "arrays-states")
     try:
         assert fmu.start({"memory_depth": 6, "load": 0.2}) == 0

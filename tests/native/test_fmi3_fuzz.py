@@ -1,19 +1,13 @@
 """The C family's fuzz cases through the FMI 3.0 front (issue 39: "bad input gets the same
 refusals as in FMI 2.0"): the pinned refusals and 400 random calls per model go to each of
-the five models as FMI 2.0 and FMI 3.0 (tests/fmi3_fuzz_cases.py); every call gets the same
+the five models as FMI 2.0 and FMI 3.0 (tests/support/fmi3_fuzz_cases.py); every call gets the same
 status from both fronts, and every discard or error a logged message naming the same
-variables. The same cases run on sanitized binaries in tests/test_native_sanitizers.py."""
+variables. The same cases run on sanitized binaries in tests/native/test_native_sanitizers.py."""
 import pytest
 
 from fmi3_fuzz_cases import MODELS, run_all
 
 pytestmark = pytest.mark.needs("gcc")
-
-
-@pytest.fixture(scope="module")
-def fmi3_fmus(tmp_path_factory):
-    from sma_fmu.fmi.packaging.fmi3_build import build_fmi3_fmus
-    return build_fmi3_fmus(tmp_path_factory.mktemp("fmi3_fuzz"))
 
 
 def test_fuzz_cases_are_refused_alike_in_both_versions(native_fmus, fmi3_fmus, capsys):

@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 
 from fmi3_twins import Instance3
+from fmu_signals import plant_walk
 from native_twins import Instance
-from test_native_equivalence import _plant_inputs, _reference_inputs
+from test_native_equivalence import _reference_inputs
 from sma_fmu.cli import main
 from sma_fmu.runtime.reachable_band import reachable_band
 
@@ -120,7 +121,7 @@ def test_plant_walks_equal_fmi2(native_fmus, fmi3_fmus, mode):
         start = {"hysteresis_mode": mode, "memory_depth": 3, "load": 0.2}
         assert twins.both("start", start) == [0, 0]
         twins.compare()
-        inputs = _plant_inputs(rng, 6000)
+        inputs = plant_walk(rng, 6000)
         _, time = twins.walk(inputs[:4000])
         # saved states, taken in both versions: set and deserialized, they replay alike
         saved = (twins.v2.fmu.getFMUstate(), twins.v3.fmu.getFMUState())
@@ -139,7 +140,7 @@ def test_plant_walks_equal_fmi2(native_fmus, fmi3_fmus, mode):
 
 def test_saved_states_replay_and_a_corrupted_one_is_refused(fmi3_fmus):
     rng = random.Random(3)
-    inputs = _plant_inputs(rng, 1500)
+    inputs = plant_walk(rng, 1500)
     one = Instance3(fmi3_fmus["SmaActuator"], "states3")
     try:
         assert one.start({"memory_depth": 3, "load": 0.2}) == 0
@@ -277,7 +278,7 @@ def test_event_mode_without_events_changes_nothing(fmi3_fmus):
     """The plant in event mode: Event Mode after initialization, no discrete update, no
     event asked for; stepping as without event mode."""
     rng = random.Random(5)
-    inputs = _plant_inputs(rng, 300)
+    inputs = plant_walk(rng, 300)
     runs = []
     for events in (False, True):
         one = Instance3(fmi3_fmus["SmaActuator"], f"ev{events}", event_mode=events, early_return=events)

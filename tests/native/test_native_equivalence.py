@@ -18,6 +18,7 @@ import sys
 
 import pytest
 
+from fmu_signals import plant_walk
 from native_twins import Instance
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.reachable_band import reachable_band
@@ -120,20 +121,6 @@ def _states_replay(twins, inputs, time):
     return end
 
 
-def _plant_inputs(rng, count):
-    """Power held for random spans, its swings shrinking then growing again (nested
-    reversals), and load changes now and then."""
-    inputs, power, load, amplitude = [], 0.0, 0.2, 2.0
-    for k in range(count):
-        if k % rng.randint(40, 300) == 0:
-            amplitude = 2.0 if amplitude < 0.05 else amplitude * rng.uniform(0.5, 0.9)
-            power = max(0.0, 1.0 + rng.choice((-1, 1)) * amplitude * rng.random())
-        if rng.random() < 0.002:
-            load = rng.uniform(0.0, 0.4)
-        inputs.append({"P_in": power, "load": load})
-    return inputs
-
-
 @pytest.mark.parametrize("mode", [1, 2])
 def test_plant_walks_agree(families, params, mode):
     rng = random.Random(25 + mode)
@@ -142,7 +129,7 @@ def test_plant_walks_agree(families, params, mode):
         start = {"hysteresis_mode": mode, "memory_depth": 3, "load": 0.2}
         assert twins.both("start", start) == [0, 0]
         twins.compare()
-        inputs = _plant_inputs(rng, 24000)
+        inputs = plant_walk(rng, 24000)
         # the walk fills the reversal memory (continuous mode): the library plant on the same
         # inputs says so
         library = PlantStepper(params.replace(memory_depth=3), mode={1: "continuous", 2: "switch"}[mode],

@@ -1,22 +1,23 @@
 """One FMI 3.0 instance driven through fmpy's FMU3Slave, every call returning its FMI status,
-with the same interface as native_twins.Instance (FMI 2.0), so the two versions of a C-family
-FMU can be driven side by side. Each instance has its own logger (FMI 3.0 passes no instance
-name to it); Enumerations are read and set as Int64; structural parameters (the plant's
-memory_depth) are set in Configuration Mode.
+with the same interface as native_twins.Instance (FMI 2.0; both are native_twins.Driven), so
+the two versions of a C-family FMU can be driven side by side. Each instance has its own
+logger (FMI 3.0 passes no instance name to it); Enumerations are read and set as Int64;
+structural parameters (the plant's memory_depth) are set in Configuration Mode.
 """
-import shutil
+from ctypes import byref
 
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64
-from ctypes import byref
+
+from native_twins import Driven
 
 __all__ = ["Instance3"]
 
 _ACCESSOR = {"Enumeration": "Int64"}
 
 
-class Instance3:
+class Instance3(Driven):
     """An instantiated FMI 3.0 FMU (``path``) named ``name``; ``self.log``: its messages."""
 
     def __init__(self, path, name, event_mode=False, early_return=False):
@@ -36,13 +37,6 @@ class Instance3:
 
     def _logger(self, environment, status, category, message):
         self.log.append((status, message.decode("utf-8", "replace")))
-
-    def call(self, method, *args, **kwargs):
-        """(status, result) of an FMU3Slave method."""
-        try:
-            return 0, getattr(self.fmu, method)(*args, **kwargs)
-        except FMICallException as error:
-            return error.status, None
 
     def configure(self, values):
         """Configuration Mode with the structural parameters of ``values`` set (FMI 3.0 sets
@@ -88,15 +82,6 @@ class Instance3:
                 size *= length
         return self.call("getFloat64", [variable.valueReference], nValues=size)
 
-    def values(self, names=None):
-        """{name: value} of the outputs (or ``names``); every get must succeed."""
-        found = {}
-        for name in names or self.outputs:
-            status, value = self.get(name)
-            assert status <= 1, (self.name, name, self.log[-2:])
-            found[name] = value
-        return found
-
     def do_step(self, time, step):
         """(status, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime)."""
         flags = [fmi3Boolean(), fmi3Boolean(), fmi3Boolean()]
@@ -110,11 +95,3 @@ class Instance3:
 
     def step(self, time, step):
         return self.do_step(time, step)[0]
-
-    def close(self):
-        try:
-            self.fmu.terminate()
-        except FMICallException:
-            pass
-        self.fmu.freeInstance()
-        shutil.rmtree(self.folder, ignore_errors=True)

@@ -13,7 +13,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.logging import addLoggerProxy
 
-__all__ = ["LOGS", "Instance", "STATUS"]
+__all__ = ["LOGS", "Driven", "Instance", "STATUS"]
 
 STATUS = {"ok": 0, "warning": 1, "discard": 2, "error": 3, "fatal": 4}
 LOGS = {}  # instance name -> [(status, text)]
@@ -26,7 +26,37 @@ def _logger(environment, instance_name, status, category, message):
 _LOGGER = fmi2CallbackLoggerTYPE(_logger)
 
 
-class Instance:
+class Driven:
+    """What an instance of either FMI version shares (``fmu``: fmpy's FMU2Slave or FMU3Slave,
+    ``outputs``, ``log``, ``folder``, ``get``): calls that return their status, outputs read,
+    the end."""
+
+    def call(self, method, *args, **kwargs):
+        """(status, result) of a method of the fmpy slave."""
+        try:
+            return 0, getattr(self.fmu, method)(*args, **kwargs)
+        except FMICallException as error:
+            return error.status, None
+
+    def values(self, names=None):
+        """{name: value} of the outputs (or ``names``); every get must succeed."""
+        found = {}
+        for name in names or self.outputs:
+            status, value = self.get(name)
+            assert status <= 1, (self.name, name, self.log[-2:])
+            found[name] = value
+        return found
+
+    def close(self):
+        try:
+            self.fmu.terminate()
+        except FMICallException:
+            pass
+        self.fmu.freeInstance()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+
+class Instance(Driven):
     """An instantiated FMU (``path``) named ``name``; ``self.log`` holds its messages."""
 
     def __init__(self, path, name):
@@ -47,13 +77,6 @@ class Instance:
         addLoggerProxy(byref(self.callbacks))
         self.fmu.instantiate(callbacks=self.callbacks, loggingOn=False)
 
-    def call(self, method, *args, **kwargs):
-        """(status, result) of an FMU2Slave method."""
-        try:
-            return 0, getattr(self.fmu, method)(*args, **kwargs)
-        except FMICallException as error:
-            return error.status, None
-
     def start(self, values=None, start_time=0.0):
         """setupExperiment, Initialization Mode with ``values`` set; status of exit."""
         self.fmu.setupExperiment(startTime=start_time)
@@ -72,27 +95,10 @@ class Instance:
         status, values = self.call("get" + variable.type, [variable.valueReference])
         return status, None if values is None else values[0]
 
-    def values(self, names=None):
-        """{name: value} of the outputs (or ``names``); every get must succeed."""
-        found = {}
-        for name in names or self.outputs:
-            status, value = self.get(name)
-            assert status <= 1, (self.name, name, self.log[-2:])
-            found[name] = value
-        return found
-
     def step(self, time, step):
         """doStep's status (fmpy's doStep drops it: a warning would read as fmi2OK)."""
         try:
             return self.fmu.fmi2DoStep(self.fmu.component, time, step, 1)
         except FMICallException as error:
             return error.status
-
-    def close(self):
-        try:
-            self.fmu.terminate()
-        except FMICallException:
-            pass
-        self.fmu.freeInstance()
-        shutil.rmtree(self.folder, ignore_errors=True)
 

@@ -4,7 +4,7 @@ OMSimulator is in no package registry, so CI cannot have it, and pytest does not
 file by default (it does not match test_*.py). Build OMSimulator v3.0.0 (docs/systems.md),
 then:
 
-    SMA_FMU_OMSIMULATOR=/path/to/OMSimulator python -m pytest tests/omsimulator_check.py
+    SMA_FMU_OMSIMULATOR=/path/to/OMSimulator python -m pytest tests/systems/omsimulator_check.py
 
 Without SMA_FMU_OMSIMULATOR the check fails (it never skips). It runs both FMU families:
 pythonfmu's (``sma-fmu build``) and the native C one (``sma-fmu build --native``).
@@ -14,7 +14,7 @@ import re
 import pytest
 
 from system_needs import by_hand_executable
-from test_ssp_hosts import LOAD_STEP, TOLERANCE, _scenario, fmu_dir  # noqa: F401 (fixture)
+from test_ssp_hosts import LOAD_STEP, TOLERANCE, _scenario
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.container import loop_outputs

@@ -27,11 +27,6 @@ SCENARIO = "load-step-pi+ff-adaptive"
 
 
 @pytest.fixture(scope="module")
-def fmu_dir(fmus):
-    return fmus["SmaActuator"].parent
-
-
-@pytest.fixture(scope="module")
 def good_ssp(fmu_dir, tmp_path_factory):
     folder = tmp_path_factory.mktemp("ssp")
     assert main(["export", "ssp", SCENARIO, "--out", str(folder), "--fmus", str(fmu_dir)]) == 0

@@ -56,11 +56,6 @@ def pwm_scenario(name, frequency_Hz=50.0, peak_W=PEAK, stop_time_s=2.2, load=LOA
                                drive=DriveSettings("pwm", frequency_Hz, peak_W))
 
 
-@pytest.fixture(scope="module")
-def fmu_dir(fmus):
-    return fmus["SmaActuator"].parent
-
-
 # ---------------------------------------------------------------------------- the FMU alone
 def test_driver_fmu_is_valid_and_declares_its_variables_with_units(fmus):
     path = fmus["SmaPwmDriver"]
@@ -230,7 +225,7 @@ def test_fmu_path_equals_library_path_with_pwm(fmu_dir, name):
 def test_shipped_pwm_scenarios_on_the_fmu_path_and_in_libcosim(fmu_dir, name):
     """The first 5 s (a hold, a ramp at 4 s, the next hold): FMU path = library, SSP in
     libcosim = library Jacobi. (Containers and Ecos through the end of a hold at 7 s:
-    tests/test_ssp_hosts_grid.py.)"""
+    tests/systems/test_ssp_hosts_grid.py.)"""
     scenario = dataclasses.replace(load_scenario(resolve_scenarios([name])[0]), stop_time_s=5.0)
     assert scenario.drive.pwm
     assert deviation(run_fmus(scenario, fmu_dir).data, run_library(scenario).data) <= TOLERANCE

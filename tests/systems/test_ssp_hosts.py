@@ -51,11 +51,6 @@ def _scenario(name, stop_time_s=None, load=None):
 
 
 @pytest.fixture(scope="module")
-def fmu_dir(fmus):
-    return fmus["SmaActuator"].parent
-
-
-@pytest.fixture(scope="module")
 def exported(fmu_dir, tmp_path_factory):
     """{name: .ssp} of the six paper scenarios and the two PWM ones, exported by the CLI."""
     folder = tmp_path_factory.mktemp("ssp")
@@ -308,5 +303,5 @@ def test_check_fails_a_package_without_the_annotation_a_host_reads(exported, tmp
     assert lines["host libcosim 0.11"][0] == "ok"
 
 
-# OMSimulator (on no registry, so not in CI): tests/omsimulator_check.py, run by hand with
+# OMSimulator (on no registry, so not in CI): tests/systems/omsimulator_check.py, run by hand with
 # SMA_FMU_OMSIMULATOR naming the executable (docs/systems.md).

@@ -16,11 +16,6 @@ from system_needs import needs
 
 
 @pytest.fixture(scope="module")
-def fmu_dir(fmus):
-    return fmus["SmaActuator"].parent
-
-
-@pytest.fixture(scope="module")
 def exported(fmu_dir, tmp_path_factory):
     """Every paper scenario's SSP (a folder) and two containers, exported by the CLI."""
     folder = tmp_path_factory.mktemp("exported")

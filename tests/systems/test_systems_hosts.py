@@ -43,11 +43,6 @@ def short(name, stop_time_s=2.2, load=LOAD_STEP):
 
 
 @pytest.fixture(scope="module")
-def fmu_dir(fmus):
-    return fmus["SmaActuator"].parent
-
-
-@pytest.fixture(scope="module")
 def adaptive(fmu_dir, tmp_path_factory):
     """The paper's adaptive loop, 2.2 s, load step at 0.6 s: its SSP and its container."""
     scenario = short("load-step-pi+ff-adaptive")
