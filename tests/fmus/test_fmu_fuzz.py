@@ -1,4 +1,4 @@
-"""Fuzzing the FMUs through a plain C host process (tests/c_host/fmi_host.c), with hypothesis.
+"""Fuzzing the FMUs through a plain C host process (sma_fmu/fmi/hosts/fmi_host.c), with hypothesis.
 
 Random instance names, resource URIs, call sequences, value references, values, strings
 and state bytes go to every FMU of FMU_SCRIPTS. After every call: the host process is

@@ -15,7 +15,7 @@ The first 200 or so instances take 5 to 10 KiB each once (the allocators' pools,
 front's table of freed instances) and then no more. What is left is pythonfmu 0.7.0's: one
 object per instance, the list of the slave class's bases that findClass never frees, with
 their names.
-Run by hand: ``python tests/instance_memory_probe.py FMU --warm 200 --instances 200``.
+Run by hand: ``python tests/support/instance_memory_probe.py FMU --warm 200 --instances 200``.
 """
 import json
 import subprocess

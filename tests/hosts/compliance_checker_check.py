@@ -6,10 +6,10 @@ this file by default (it does not match test_*.py). Build it with its CMake file
 Library checked out into its FMIL/ folder; CMake 3.x, e.g. Debian's cmake), then:
 
     SMA_FMU_COMPLIANCE_CHECKER=/path/to/fmuCheck.linux64 \
-        python -m pytest tests/compliance_checker_check.py
+        python -m pytest tests/hosts/compliance_checker_check.py
 
 Each native FMU (and the pythonfmu SmaActuator, for comparison) is checked as a
-co-simulation FMU and simulated 2 s at 1 ms with the inputs of tests/test_native_hosts.py
+co-simulation FMU and simulated 2 s at 1 ms with the inputs of tests/hosts/test_native_hosts.py
 (log level 4, info): exit status 0, no [ERROR] or [FATAL] line, and the summary "Checker
 reported: 0 Error(s)" with no error the FMU reported. Without SMA_FMU_COMPLIANCE_CHECKER
 the check fails (it never skips).

@@ -6,10 +6,11 @@
   the <SourceFiles> of the model description), and that binary gives what the shipped one
   gives;
 - an SSP and a container exported from the native build with `sma-fmu export` run in
-  libcosim, Ecos and fmpy (the hosts of tests/test_systems_hosts.py) and in sma-fmu's C
+  libcosim, Ecos and fmpy (the hosts of tests/systems/test_systems_hosts.py) and in sma-fmu's C
   host on libcosim's C API, each equal to the library loop of its coupling to 1e-9.
 fmusim, the FMU Compliance Checker and OMSimulator are in no package registry: they run by
-hand (tests/fmusim_check.py, tests/compliance_checker_check.py, tests/omsimulator_check.py).
+hand (tests/hosts/fmusim_check.py, tests/hosts/compliance_checker_check.py,
+tests/systems/omsimulator_check.py).
 """
 import itertools
 import math
@@ -66,7 +67,7 @@ def _input(model, path):
 def _simulate(path, model):
     """(result, [(status, message)] logged) of fmpy's simulate_fmu over STOP_S at 1 ms.
 
-    The instance is made with the permanent logger of tests/native_twins.py: fmpy's own
+    The instance is made with the permanent logger of tests/support/native_twins.py: fmpy's own
     ``simulate_fmu(logger=...)`` leaves its process-wide logger proxy pointing at a freed
     callback, and a later FMU that logs in the same process crashes it (either family)."""
     instance = Instance(path, f"simulate-{model}-{next(_NAMES)}")

@@ -6,7 +6,7 @@ with none of the front's guarantees and nothing saying so. Now:
 - with mingw-w64 the win64 binary is the front; without it, win64 is left out (warned);
 - without a C compiler, linux64 keeps pythonfmu's binary, and the FMU says what that loses;
 - ``sma-fmu build`` refuses a machine whose architecture pythonfmu's binaries do not match.
-What needs gcc or mingw-w64 says so (tests/system_needs.py).
+What needs gcc or mingw-w64 says so (tests/support/system_needs.py).
 """
 import warnings
 import zipfile

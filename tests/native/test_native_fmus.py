@@ -5,7 +5,7 @@ fmpy validates them and runs them (simulate_fmu), and compiles one from its sour
 functions; the interface is the pythonfmu twin's; packed start values are read; a host
 without callbacks or with a '%' in the instance name crashes nothing; saved-state bytes
 that are not one are refused with a message; a build without mingw-w64 warns and leaves
-win64 out. (Equality with the pythonfmu FMUs: tests/test_native_equivalence.py.)
+win64 out. (Equality with the pythonfmu FMUs: tests/native/test_native_equivalence.py.)
 """
 import ctypes
 import json

@@ -1,7 +1,7 @@
 """The C family built with AddressSanitizer (leaks included) and UndefinedBehaviorSanitizer
 stays clean through the cases of issue 38: every corruption of a saved state of the five FMUs
-(tests/test_state_integrity.py), the start-values documents and non-regular files
-(tests/test_start_values_files.py), non-finite parameters, a foreign resources folder, and
+(tests/native/test_state_integrity.py), the start-values documents and non-regular files
+(tests/native/test_start_values_files.py), non-finite parameters, a foreign resources folder, and
 load/unload cycles. The binaries and the plain C host (sma_fmu/fmi/hosts/fmi_host.c) are
 built here with -fsanitize=address,undefined; any report ends the host with a non-zero
 status (UBSan does not recover), which the test shows with the host's stderr."""
@@ -118,11 +118,11 @@ def test_load_unload_cycles_under_sanitizers(sanitized, tmp_path):
 
 
 # ---- the FMI 3.0 front (issue 39) ----------------------------------------------------------
-# The C family's fuzz cases (tests/fmi3_fuzz_cases.py: pinned refusals, random calls, the
+# The C family's fuzz cases (tests/support/fmi3_fuzz_cases.py: pinned refusals, random calls, the
 # plant's arrays with wrong sizes) run through both fronts on binaries built from each FMU's
 # sources/ with the sanitizers, in a child Python that preloads libasan. Python's own
 # allocations (numpy, lxml, the interpreter) leak by LeakSanitizer's measure, so that run
-# checks no leaks; the FMI 3.0 walk host (tests/fmi3_walk_host.c), a plain C host, runs each
+# checks no leaks; the FMI 3.0 walk host (tests/support/fmi3_walk_host.c), a plain C host, runs each
 # sanitized FMI 3.0 FMU with leak detection on.
 SUPPORT = Path(__file__).parents[1] / "support"   # the tests' helpers
 FMI3_HEADERS = Path(__file__).parents[2] / "sma_fmu" / "fmi" / "c_family" / "fmi3"

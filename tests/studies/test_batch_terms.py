@@ -1,4 +1,4 @@
-"""The batch engine equals the scalar library path (<= 1e-10, as tests/test_batch.py) with
+"""The batch engine equals the scalar library path (<= 1e-10, as tests/studies/test_batch.py) with
 every issue-36 term on (nu_h != nu_c, a second stage, thermal expansion, the stress law):
 random sets of every controller in both hysteresis modes, half the runs with the terms and
 half without in one batch, and nested minor loops in the plant and the compensator."""

@@ -1,5 +1,5 @@
 """ctypes wrappers of the C control blocks (c_family/runtime: pi_control, pwm, signals,
-scenario_signals, json_text) for tests/test_c_runtime_control.py.
+scenario_signals, json_text) for tests/native/test_c_runtime_control.py.
 
 Each wrapper mirrors its Python class: the same calls, ``ValueError`` with the C message on a
 refusal, and the saved state through the C state_write/state_read.

@@ -1,5 +1,5 @@
 """A ctypes front over the C PlantStepper (sma_fmu/fmi/c_family/runtime/plant.c) for
-tests/test_c_runtime_plant.py: parameters and steppers on the heap, refusals as ValueError,
+tests/native/test_c_runtime_plant.py: parameters and steppers on the heap, refusals as ValueError,
 saved states in both layouts, message normalization, and the random power/load walks."""
 import ctypes
 import math

@@ -35,7 +35,7 @@ def _run(command):
 def compile_runtime(modules, folder, extra_source=None, name="runtime"):
     """The runtime ``modules`` (and ``extra_source``, C text such as a test-only shim that
     includes runtime headers) built with gcc into ``folder``/lib<name>.so; a ctypes.CDLL."""
-    need("gcc")  # skipped without it, failed under CI=true (tests/system_needs.py)
+    need("gcc")  # skipped without it, failed under CI=true (tests/support/system_needs.py)
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     sources = _sources(modules)
@@ -61,7 +61,7 @@ def load_with_signatures(modules, folder, shim, signatures):
 def compile_win64(modules, folder):
     """Compile the runtime ``modules`` to win64 objects with mingw-w64 under the same flags
     (-c, no link); returns the object paths, or None when mingw-w64 is not installed."""
-    need("mingw-w64")  # skipped without it, failed under CI=true (tests/system_needs.py)
+    need("mingw-w64")  # skipped without it, failed under CI=true (tests/support/system_needs.py)
     if shutil.which(MINGW) is None:
         return None
     folder = Path(folder)

@@ -6,10 +6,10 @@ logged message in both, naming the same variables.
 The cases: the refusals the native equivalence and fuzz findings pinned (illegal calls per
 state, bad parameters refusing initialization, absurd loads, non-finite inputs, steps off
 the time line) and random call sequences over every scalar variable with the fuzz suite's
-special values (tests/test_fmu_fuzz.py's SPECIAL_FLOATS); and, FMI 3.0 only, the plant's
+special values (tests/fmus/test_fmu_fuzz.py's SPECIAL_FLOATS); and, FMI 3.0 only, the plant's
 arrays read with good and wrong sizes (array_cases). Used in-process by
-tests/test_fmi3_fuzz.py and, on binaries built with AddressSanitizer and UBSan, in a child
-process by tests/test_native_sanitizers.py (``python fmi3_fuzz_cases.py FMI2_DIR FMI3_DIR``).
+tests/native/test_fmi3_fuzz.py and, on binaries built with AddressSanitizer and UBSan, in a child
+process by tests/native/test_native_sanitizers.py (``python fmi3_fuzz_cases.py FMI2_DIR FMI3_DIR``).
 """
 import math
 import random
@@ -78,7 +78,7 @@ class Pair:
 
 def _settable(pair):
     """The scalar variables the random cases set: all but the plant's structural
-    memory_depth (FMI 3.0 sets it in Configuration Mode alone: tests/test_fmi3_arrays.py)."""
+    memory_depth (FMI 3.0 sets it in Configuration Mode alone: tests/native/test_fmi3_arrays.py)."""
     return [n for n, v in pair.v2.variables.items()
             if not (n == "memory_depth" and pair.v3.variables[n].causality == "structuralParameter")]
 

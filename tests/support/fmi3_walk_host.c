@@ -1,4 +1,4 @@
-/* A small FMI 3.0 co-simulation host for the tests (tests/test_fmi3_windows.py): loads
+/* A small FMI 3.0 co-simulation host for the tests (tests/hosts/test_fmi3_windows.py): loads
  * DIR/binaries/<x86_64-linux|x86_64-windows>/<MODEL><.so|.dll>, instantiates it with TOKEN,
  * sets INPUT (a Float64 value reference, or -1 for none) to a fixed deterministic walk, steps
  * STEPS steps of H s and prints after each step the Float64 outputs OUT... with %.17g.

@@ -2,7 +2,7 @@
 (as fmpy's simulate_fmu does, and FmuInstance with SMA_FMU_UNPACK_EACH=1, which this probe
 sets unless ``--shared``), and measure the process before and after.
 
-    python tests/instance_memory_probe.py FMU [--warm 50] [--instances 200] [--fmpy] [--shared]
+    python tests/support/instance_memory_probe.py FMU [--warm 50] [--instances 200] [--fmpy] [--shared]
 
 Prints one JSON object: resident memory growth per instance [KiB], growth of the mappings
 of FMU binaries, of sys.path, of sys.path_importer_cache and of Python objects. ``--fmpy``

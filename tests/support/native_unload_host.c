@@ -1,6 +1,6 @@
 /* Loads and unloads a native FMU binary many times, with instances made and freed in each
  * cycle, and prints the process's resident memory (VmRSS, kB) after the warm-up cycles and
- * at the end (tests/test_native_unload.py). Usage:
+ * at the end (tests/native/test_native_unload.py). Usage:
  *   native_unload_host BINARY GUID RESOURCE_URI WARMUP CYCLES INSTANCES */
 #define _POSIX_C_SOURCE 200809L
 #include <dlfcn.h>

@@ -13,7 +13,7 @@ PATH, mingw-w64 is :func:`~sma_fmu.fmi.hosts.windows_compiler` (``$SMA_FMU_WIN64
 ``x86_64-w64-mingw32-gcc``) found on the PATH. ``SMA_FMU_TESTS_WITHOUT`` (names below,
 separated by spaces or commas) makes needs count as missing that a PATH cannot hide (wine64
 lives in /usr/lib/wine, libpython in /usr/lib, root is who runs): the simulated fresh
-machine of ``tests/test_system_needs.py`` uses it.
+machine of ``tests/project/test_system_needs.py`` uses it.
 """
 import importlib.util
 import os
@@ -37,7 +37,7 @@ STANDARD_FOLDERS = ("/usr/local/lib", "/usr/local/lib64", "/usr/lib/x86_64-linux
 
 def by_hand_executable(variable, what):
     """The executable the environment variable ``variable`` names, for the by-hand checks
-    (tests/*_check.py: tools in no registry); a missing one fails, naming ``what`` to set."""
+    (tests/*/*_check.py: tools in no registry); a missing one fails, naming ``what`` to set."""
     path = os.environ.get(variable)
     assert path and os.access(path, os.X_OK), f"set {variable} to {what}"
     return path
