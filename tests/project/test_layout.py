@@ -1,6 +1,7 @@
 """The package's layout shows its architecture: no loose module at the top, every import
 between subpackages goes down the layers (so there is no package cycle either), a concern of
-four modules or more is a subpackage, not a name prefix, and no module is over 400 lines."""
+four modules or more is a subpackage, not a name prefix, and no module is over 400 lines.
+The tests' layout too: folders by concern, helpers in tests/support."""
 import ast
 from collections import defaultdict
 from pathlib import Path
@@ -26,6 +27,12 @@ LONG_MODULE_EXCEPTIONS = {}   # path -> why it may stay over MAX_LINES (none now
 SUBPACKAGES = ("identification/isobaric", "studies/batch", "cosim/scenario")   # made in issue 30
 # the rooms of sma_fmu/fmi (issue 37), lowest first: a room imports only from rooms before it
 FMI_ROOMS = ["c_common", "python_family", "c_family", "hosts", "driving", "packaging"]
+TESTS = Path(__file__).parents[1]
+# tests/ by concern: a folder of test modules each (and the by-hand *_check.py modules beside
+# the tests they import from); support/ holds what is not a test (helpers, C hosts, scripts),
+# on sys.path through pyproject.toml's pythonpath
+TEST_FOLDERS = {"runtime", "fmus", "native", "hosts", "cosim", "systems", "identification",
+                "studies", "bench", "cli", "project", "support"}
 
 
 def _imports_between_subpackages():
@@ -202,3 +209,28 @@ def test_fmi_rooms_import_down_only():
     assert sorted(upward) == []
     packaging = _module_imports()["sma_fmu.fmi.packaging.build"]
     assert "sma_fmu.fmi.driving.description" in packaging   # the walk sees the rooms' imports
+
+
+def test_tests_are_in_their_folders_only():
+    """tests/ holds the session's conftest.py and the concern folders; no test module lies
+    loose, and support/ holds none."""
+    assert sorted(p.name for p in TESTS.glob("*.py")) == ["conftest.py"]
+    folders = {p.name for p in TESTS.iterdir() if p.is_dir() and p.name != "__pycache__"}
+    assert folders == TEST_FOLDERS
+    assert not list((TESTS / "support").glob("test_*.py"))
+    assert all(list((TESTS / folder).glob("test_*.py")) for folder in TEST_FOLDERS - {"support"})
+
+
+def test_a_test_module_imports_test_modules_of_its_own_folder_only():
+    """pytest puts a test's own folder on sys.path (and tests/support, by pythonpath), so a
+    module of another folder imports only when that folder was imported first: by chance."""
+    modules = {p.stem: p.parent.name for p in TESTS.glob("*/*.py") if p.parent.name != "support"}
+    assert len(modules) > 100   # the walk sees the tests
+    strays = []
+    for path in TESTS.glob("*/*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = [alias.name for alias in node.names] if isinstance(node, ast.Import) else \
+                [node.module] if isinstance(node, ast.ImportFrom) and node.level == 0 else []
+            strays += [f"{path.relative_to(TESTS)} imports {name} of {modules[name]}/"
+                       for name in names if modules.get(name, path.parent.name) != path.parent.name]
+    assert strays == []
