@@ -1,6 +1,6 @@
 """FMI: the two families of FMUs, building them, driving them from Python, and the C hosts.
 
-Lowest room first; each imports only from rooms before it (``tests/test_layout.py``):
+Lowest room first; each imports only from rooms before it (``tests/project/test_layout.py``):
 
 - ``c_common/``: C code both families compile (the resource-location URI, log categories,
   the saved-state frame);

@@ -17,7 +17,7 @@ front (``c_family/fmi3/``). Each FMU holds:
   default experiment, fmi-ls-ref's FMI 3 layout, which is FMI 2.0's) and ``documentation/``
   (index.html, result.png), as in FMI 2.0 (:func:`.extras.add_documentation_and_reference`):
   the reference result is this FMU's own, run in fmpy's FMI 3.0 simulation; it equals the FMI
-  2.0 twin's byte for byte (tests/test_fmi3_documentation.py);
+  2.0 twin's byte for byte (tests/fmus/test_fmu_user_docs.py);
 - the plant's ``terminalsAndIcons/terminalsAndIcons.xml`` (:mod:`.fmi3_terminals`).
 """
 import shutil

@@ -12,8 +12,8 @@ differences of the vectorised model (the model is smooth, each column costs two 
 evaluations of the file, and a new model term needs no new derivative code); the offsets
 enter linearly with weights 1 (heating), 1 - q and q (cooling). Rows: temperature
 (profile - measured)/sigma_T, strain, resistance, each times the sample's weight (0 for a
-left-out cycle's strain). tests/test_isobaric.py checks it against central differences of
-the whole residual.
+left-out cycle's strain). tests/identification/test_isobaric.py checks it against central
+differences of the whole residual.
 """
 import numpy as np
 from scipy import sparse

@@ -20,8 +20,8 @@ On a major branch of direction d at load f [kg] and temperature T [degC]:
     R   = R_P xi_P + R_M xi_MF/2 + R_F (xi_Fmin + xi_MF/2)                                 [ohm]
 
 The terms in use (defaults filled in) are the runtime's ``params.terms``
-(:mod:`sma_fmu.runtime.model_terms`); tests/test_isobaric_terms.py checks this numpy version
-against the runtime's plant with every term on.
+(:mod:`sma_fmu.runtime.model_terms`); tests/identification/test_isobaric_terms.py checks this
+numpy version against the runtime's plant with every term on.
 """
 import math
 

@@ -1,7 +1,7 @@
 """N plants (:class:`~sma_fmu.runtime.plant.PlantStepper`) advanced in lock-step with numpy.
 
 A second implementation of the scalar plant, operation by operation, so the two agree to
-rounding (tests/test_batch.py binds them): the zero-order-hold thermal step, the direction
+rounding (tests/studies/test_batch.py binds them): the zero-order-hold thermal step, the direction
 sgn(T+ - T), the major branch through the overflow-free logistic split of
 :func:`~sma_fmu.runtime.constant_load.logistic_split`, and in mode "continuous" the minor
 branches of :mod:`~sma_fmu.runtime.minor_loops`: a stack of reversal points per run with
