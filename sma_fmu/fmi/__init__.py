@@ -3,7 +3,8 @@
 Lowest room first; each imports only from rooms before it (``tests/test_layout.py``):
 
 - ``c_common/``: C code both families compile (the resource-location URI, log categories,
-  the saved-state frame);
+  the saved-state frame) and ``include/``, the FMI standard's headers (the one declaration of
+  the FMI ABI: both families, the hosts and the bench's C FMU compile with it);
 - ``python_family/``: the pythonfmu FMUs' code: ``slaves/`` (one slave script per FMU),
   ``slave_support/`` (the FMI glue every such FMU ships) and ``front/`` (the C front, the
   FMU's binary in front of pythonfmu's);

@@ -1,10 +1,12 @@
 /*
  * host_platform.h - what every sma-fmu C host needs to load an FMI 2.0 binary, for Linux
  * (dlopen) and Windows (LoadLibrary, the mingw-w64 build run under wine): the platform's
- * folder and suffix, the callback struct, reading the GUID and model identifier, opening
+ * folder and suffix, the FMI 2.0 types (the standard's fmi2FunctionTypes.h, in
+ * fmi/c_common/include/), reading the GUID and model identifier, opening
  * DIR/binaries/<platform>/<model><suffix>, looking up a function, absolute paths and a
- * monotonic clock. Header-only (static functions): each host is one translation unit, and
- * `compile_host` (hosts/__init__.py) stages this file beside it.
+ * monotonic clock. Header-only (static functions): each host is one translation unit, which
+ * `compile_host` (hosts/__init__.py) compiles with this folder and the standard's headers on
+ * the include path.
  */
 #ifndef SMA_FMU_HOST_PLATFORM_H
 #define SMA_FMU_HOST_PLATFORM_H
@@ -26,16 +28,9 @@
 #define SUFFIX ".so"
 #endif
 
-#define PATH_SIZE 4096
+#include "fmi2FunctionTypes.h"
 
-typedef void* Component;
-typedef struct {
-    void (*logger)(void*, const char*, int, const char*, const char*, ...);
-    void* (*allocate)(size_t, size_t);
-    void (*release)(void*);
-    void* step_finished;
-    void* environment;
-} Callbacks;
+#define PATH_SIZE 4096
 
 /* Read the GUID and modelIdentifier of DIR/modelDescription.xml (each at most 255 bytes);
  * 0 on success, else 1 with `why` saying what failed. */

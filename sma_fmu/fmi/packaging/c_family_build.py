@@ -32,6 +32,7 @@ from pathlib import Path
 
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
+from sma_fmu.fmi.c_common import C_COMMON, FMI_HEADERS
 from sma_fmu.fmi.packaging.cross_build import FLAGS, RUNS_HERE, compile_shared, fmi2_targets, target
 from sma_fmu.fmi.packaging.c_family_description import model_starts, native_description, variables_header
 from sma_fmu.fmi.packaging.extras import add_documentation
@@ -47,7 +48,6 @@ __all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_so
            "build_from_twins", "build_native_fmus", "compile_binary"]
 
 C_FAMILY = Path(__file__).parents[1] / "c_family"
-C_COMMON = Path(__file__).parents[1] / "c_common"   # C code both families compile
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -59,7 +59,7 @@ def _c_files():
     """{file name: path} of the C family's shipped files (flat names are unique)."""
     files = {}
     for folder in (C_FAMILY / "fmi2", C_FAMILY / "fmi3", C_FAMILY / "core", C_FAMILY / "runtime",
-                   C_FAMILY / "models", C_COMMON):
+                   C_FAMILY / "models", C_COMMON, FMI_HEADERS):
         if not folder.is_dir():
             continue
         for path in sorted(folder.iterdir()):
