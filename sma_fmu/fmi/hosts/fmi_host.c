@@ -28,32 +28,8 @@
 
 #define SLOTS 8
 #define MAXN 64
-static struct {  /* the functions, typed by the standard's fmi2FunctionTypes.h */
-    fmi2InstantiateTYPE* Instantiate;
-    fmi2FreeInstanceTYPE* FreeInstance;
-    fmi2SetupExperimentTYPE* SetupExperiment;
-    fmi2EnterInitializationModeTYPE* EnterInitializationMode;
-    fmi2ExitInitializationModeTYPE* ExitInitializationMode;
-    fmi2TerminateTYPE* Terminate;
-    fmi2ResetTYPE* Reset;
-    fmi2SetRealTYPE* SetReal;
-    fmi2GetRealTYPE* GetReal;
-    fmi2SetIntegerTYPE* SetInteger;
-    fmi2GetIntegerTYPE* GetInteger;
-    fmi2SetBooleanTYPE* SetBoolean;
-    fmi2GetBooleanTYPE* GetBoolean;
-    fmi2SetStringTYPE* SetString;
-    fmi2GetStringTYPE* GetString;
-    fmi2DoStepTYPE* DoStep;
-    fmi2GetFMUstateTYPE* GetFMUstate;
-    fmi2SetFMUstateTYPE* SetFMUstate;
-    fmi2FreeFMUstateTYPE* FreeFMUstate;
-    fmi2SerializedFMUstateSizeTYPE* SerializedFMUstateSize;
-    fmi2SerializeFMUstateTYPE* SerializeFMUstate;
-    fmi2DeSerializeFMUstateTYPE* DeSerializeFMUstate;
-    fmi2GetBooleanStatusTYPE* GetBooleanStatus;
-    fmi2GetRealStatusTYPE* GetRealStatus;
-    fmi2SetDebugLoggingTYPE* SetDebugLogging;
+static struct {
+    HOST_FMI2_FUNCTIONS(HOST_FMI2_POINTER)  /* the FMU's functions (host_platform.h) */
 } F;
 
 static char dir[PATH_SIZE], guid[256], model[256];
@@ -129,12 +105,7 @@ static void load(void)
     void* library = host_open_library(dir, model, path, sizeof path, why, sizeof why);
     if (!library) { fprintf(stderr, "fmi_host: %s\n", why); exit(3); }
 #define SYM(n) if (!(*(void**)&F.n = host_symbol(library, "fmi2" #n))) { fprintf(stderr, "no fmi2" #n "\n"); exit(3); }
-    SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
-    SYM(ExitInitializationMode) SYM(Terminate) SYM(Reset) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
-    SYM(GetInteger) SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(GetString) SYM(DoStep)
-    SYM(GetFMUstate) SYM(SetFMUstate) SYM(FreeFMUstate) SYM(SerializedFMUstateSize)
-    SYM(SerializeFMUstate) SYM(DeSerializeFMUstate) SYM(GetBooleanStatus) SYM(GetRealStatus)
-    SYM(SetDebugLogging)
+    HOST_FMI2_FUNCTIONS(SYM)
 #undef SYM
 }
 

@@ -32,6 +32,17 @@
 
 #define PATH_SIZE 4096
 
+/* The FMI 2.0 functions the hosts call, named once: HOST_FMI2_FUNCTIONS(X) applies X to each
+ * name, HOST_FMI2_POINTER declares its pointer, typed fmi2<name>TYPE by the standard. */
+#define HOST_FMI2_FUNCTIONS(X)                                                                  \
+    X(Instantiate) X(FreeInstance) X(SetupExperiment) X(EnterInitializationMode)                \
+    X(ExitInitializationMode) X(Terminate) X(Reset) X(SetReal) X(GetReal) X(SetInteger)         \
+    X(GetInteger) X(SetBoolean) X(GetBoolean) X(SetString) X(GetString) X(DoStep)               \
+    X(GetFMUstate) X(SetFMUstate) X(FreeFMUstate) X(SerializedFMUstateSize)                     \
+    X(SerializeFMUstate) X(DeSerializeFMUstate) X(GetBooleanStatus) X(GetRealStatus)            \
+    X(SetDebugLogging)
+#define HOST_FMI2_POINTER(name) fmi2##name##TYPE* name;
+
 /* Read the GUID and modelIdentifier of DIR/modelDescription.xml (each at most 255 bytes);
  * 0 on success, else 1 with `why` saying what failed. */
 static int host_model_description(const char* dir, char* guid, char* model, char* why, size_t size)

@@ -62,20 +62,7 @@
 typedef struct {
     char name[64], dir[PATH_SIZE], guid[256], model[256];
     fmi2Component c;
-    /* its functions, typed by the standard's fmi2FunctionTypes.h */
-    fmi2InstantiateTYPE* Instantiate;
-    fmi2FreeInstanceTYPE* FreeInstance;
-    fmi2SetupExperimentTYPE* SetupExperiment;
-    fmi2EnterInitializationModeTYPE* EnterInitializationMode;
-    fmi2ExitInitializationModeTYPE* ExitInitializationMode;
-    fmi2TerminateTYPE* Terminate;
-    fmi2SetRealTYPE* SetReal;
-    fmi2GetRealTYPE* GetReal;
-    fmi2SetIntegerTYPE* SetInteger;
-    fmi2SetBooleanTYPE* SetBoolean;
-    fmi2GetBooleanTYPE* GetBoolean;
-    fmi2SetStringTYPE* SetString;
-    fmi2DoStepTYPE* DoStep;
+    HOST_FMI2_FUNCTIONS(HOST_FMI2_POINTER)  /* its functions (host_platform.h) */
 } Fmu;
 
 typedef struct { int kind, component; unsigned vr; double real; int integer; char* text; } Start;
@@ -374,9 +361,7 @@ static void load(Fmu* f)
     void* library = host_open_library(f->dir, f->model, path, sizeof path, why, sizeof why);
     if (!library) { fprintf(stderr, "loop_host: %s\n", why); exit(1); }
 #define SYM(n) if (!(*(void**)&f->n = host_symbol(library, "fmi2" #n))) bad("no fmi2" #n " in", path);
-    SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
-    SYM(ExitInitializationMode) SYM(Terminate) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
-    SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(DoStep)
+    HOST_FMI2_FUNCTIONS(SYM)
 #undef SYM
 }
 
