@@ -373,18 +373,16 @@ def test_the_cli_stops_a_hung_host_and_leaves_the_folder(native_dir, tmp_path, c
 def test_the_loop_host_builds_without_a_warning_even_pedantic(compiler, tmp_path):
     """loop_host.c with -Wall -Wextra -Wpedantic -Werror: gcc (linux64) and mingw-w64 (win64)."""
     import subprocess
-    from importlib import resources
 
-    from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+    from sma_fmu.fmi.c_common import include_flags
+    from sma_fmu.fmi.hosts import HOSTS, c_compiler, windows_compiler
     from system_needs import need
 
     need(compiler)
-    hosts = resources.files("sma_fmu.fmi.hosts")
-    for name in ("loop_host.c", "host_platform.h"):
-        (tmp_path / name).write_bytes(hosts.joinpath(name).read_bytes())
     command = windows_compiler() if compiler == "mingw-w64" else c_compiler()
     built = subprocess.run([*command, "-std=c11", "-O2", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
-                            "-o", str(tmp_path / "loop_host.out"), str(tmp_path / "loop_host.c"),
+                            *include_flags(HOSTS), "-o", str(tmp_path / "loop_host.out"),
+                            str(HOSTS / "loop_host.c"),
                             *([] if compiler == "mingw-w64" else ["-ldl"])],
                            capture_output=True, text=True, timeout=300)
     assert built.returncode == 0, built.stderr

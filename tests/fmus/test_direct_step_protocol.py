@@ -10,7 +10,7 @@ import ctypes
 import importlib
 import math
 
-from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.models import declaration
 from sma_fmu.fmi.python_family.slave_support.fast_path import ATTACH, DESCRIBE, _CHANGING, _HEADER, _TIME, _WRITTEN
 
 STEP = 1e-3
@@ -18,7 +18,7 @@ STEP = 1e-3
 
 def _attached(unpacked, name, start=None):
     """(slave, buffer, direct step) of a slave in stepComplete with a front's buffer."""
-    module = importlib.import_module(f"sma_fmu.fmi.python_family.slaves.{FMU_SCRIPTS[name][:-3]}")
+    module = importlib.import_module(declaration(name).slave_module)
     slave = getattr(module, name)(instance_name="protocol", resources=str(unpacked[name] / "resources"))
     slave.setup_experiment(0.0, None, None)
     slave.enter_initialization_mode()

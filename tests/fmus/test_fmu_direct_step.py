@@ -148,11 +148,10 @@ def test_three_slaves_declare_the_step_the_front_inlines():
     step inlines it); the PWM driver and the signal source keep their own and get the
     general form."""
     import importlib
-    from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+    from sma_fmu.fmi.models import declarations
     declared = {}
-    for name, script in FMU_SCRIPTS.items():
-        module = importlib.import_module(f"sma_fmu.fmi.python_family.slaves.{script[:-3]}")
-        declared[name] = getattr(module, name).declared_step
+    for fmu in declarations():
+        declared[fmu.name] = getattr(importlib.import_module(fmu.slave_module), fmu.name).declared_step
     assert {name for name, step in declared.items() if step} == {
         "SmaActuator", "SmaFeedforward", "SmaPiController"}
     assert declared["SmaActuator"][:2] == ("step", ("P_in", "load"))

@@ -1,6 +1,6 @@
 """The guard's stepComplete fast paths (fmi2GetReal, fmi2SetReal) use complete variable tables.
 
-The slave classes run in this process (the scripts of ``sma_fmu/fmi/python_family/slaves/`` with the
+The slave classes run in this process (the slave scripts of ``sma_fmu/fmi/models/<Model>/`` with the
 resources of a built FMU), so the guard's tables can be compared with the FMU's
 modelDescription.xml: every Real variable is readable, every Real input settable, including
 the last ones a slave's ``__init__`` declares.
@@ -10,12 +10,13 @@ import importlib
 import pytest
 from fmpy import read_model_description
 
+from sma_fmu.fmi.models import declaration
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 
 
 @pytest.mark.parametrize("name", sorted(FMU_SCRIPTS))
 def test_fast_path_tables_hold_every_real_variable(unpacked, name):
-    module = importlib.import_module(f"sma_fmu.fmi.python_family.slaves.{FMU_SCRIPTS[name][:-3]}")
+    module = importlib.import_module(declaration(name).slave_module)
     slave = getattr(module, name)(instance_name="tables", resources=str(unpacked[name] / "resources"))
     reals = [v for v in read_model_description(str(unpacked[name] / "modelDescription.xml")).modelVariables
              if v.type == "Real"]

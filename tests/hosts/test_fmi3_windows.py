@@ -15,15 +15,16 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from system_needs import needs, wine_command
+from sma_fmu.fmi.c_common import include_flags
+
+from system_needs import need, needs, wine_command
 
 pytestmark = needs("gcc", "mingw-w64")
 TOLERANCE = 1e-12
 HOST = Path(__file__).parents[1] / "support" / "fmi3_walk_host.c"
-FMI3_HEADERS = Path(__file__).parents[2] / "sma_fmu" / "fmi" / "c_family" / "fmi3"
 CASES = {"SmaActuator": ("P_in", ["R", "T", "x", "xi_P", "xi_M", "xi_F", "P"]),
          "SmaPwmDriver": ("P_demand", ["P_in"])}
-FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-O2", "-I", str(FMI3_HEADERS)]
+FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-O2", *include_flags()]
 
 
 @pytest.fixture(scope="module")

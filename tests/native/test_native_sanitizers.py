@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 from fmpy import read_model_description
 
+from sma_fmu.fmi.c_common import include_flags
+
 import test_start_values_files as documents
 from fmi_host import FmiHost, unpack
 from test_state_integrity import DRIVE, _cases
@@ -40,8 +42,8 @@ def sanitized(native_fmus, tmp_path_factory):
                        check=True)
         folders[model] = folder
     host = root / "fmi_host"
-    subprocess.run(["gcc", "-std=c11", *SANITIZE, "-o", str(host), str(HOSTS / "fmi_host.c"),
-                    "-ldl"], check=True)
+    subprocess.run(["gcc", "-std=c11", *SANITIZE, *include_flags(HOSTS), "-o", str(host),
+                    str(HOSTS / "fmi_host.c"), "-ldl"], check=True)
     return host, folders
 
 
@@ -125,7 +127,6 @@ def test_load_unload_cycles_under_sanitizers(sanitized, tmp_path):
 # checks no leaks; the FMI 3.0 walk host (tests/support/fmi3_walk_host.c), a plain C host, runs each
 # sanitized FMI 3.0 FMU with leak detection on.
 SUPPORT = Path(__file__).parents[1] / "support"   # the tests' helpers
-FMI3_HEADERS = Path(__file__).parents[2] / "sma_fmu" / "fmi" / "c_family" / "fmi3"
 MODELS = ["SmaActuator", "SmaFeedforward", "SmaPiController", "SmaPwmDriver", "SmaScenarioSignals"]
 
 
@@ -190,7 +191,7 @@ def test_fuzz_cases_of_both_fronts_under_sanitizers(sanitized3):
 def test_fmi3_walk_host_under_sanitizers_leaks_included(sanitized3, tmp_path, model):
     _, _, unpacked = sanitized3
     host = tmp_path / "walk"
-    subprocess.run(["gcc", "-std=c99", *SANITIZE, "-I", str(FMI3_HEADERS), "-o", str(host),
+    subprocess.run(["gcc", "-std=c99", *SANITIZE, *include_flags(), "-o", str(host),
                     str(SUPPORT / "fmi3_walk_host.c"), "-ldl", "-lm"], check=True)
     description = read_model_description(str(unpacked[model] / "modelDescription.xml"))
     floats = [v for v in description.modelVariables if v.type == "Float64"]

@@ -16,10 +16,11 @@ from pathlib import Path
 
 import sma_fmu.fmi as fmi
 from graph_cycles import find_cycle
+from sma_fmu.fmi.packaging.c_family_build import c_source_folders
 
 FMI = Path(fmi.__file__).parent
 FRONT = FMI / "python_family" / "front"
-C_FAMILY = [FMI / "c_family" / folder for folder in ("runtime", "core", "fmi2", "fmi3", "models")] + [FMI / "c_common"]
+C_FAMILY = c_source_folders()   # runtime, core, both fronts, adapters (models/<Model>/), c_common
 _DEFINITION = re.compile(r"^(?!static\b)[A-Za-z_][^\n;(=]*?\b([A-Za-z_]\w*)\s*\([^;{]*\)\s*\{", re.M)
 
 

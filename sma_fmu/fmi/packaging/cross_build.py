@@ -24,7 +24,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+from sma_fmu.fmi.c_common import include_flags
+from sma_fmu.fmi.hosts import HOSTS, c_compiler, windows_compiler
 
 __all__ = ["FLAGS", "Target", "TARGETS", "target", "fmi2_targets", "zig_command", "toolchain",
            "compile_shared", "compile_host_for", "RUNS_HERE"]
@@ -161,21 +162,16 @@ def compile_host_for(entry, name, output):
     """Cross-build the dlopen C host ``name`` (fmi_host or loop_host, sma_fmu/fmi/hosts/) for
     the Linux target ``entry`` with zig into ``output``; it loads ``binaries/<tuple>/``.
     Returns None or the reason it could not (no zig)."""
-    from importlib import resources
-
     zig = zig_command()
     if zig is None:
         return "no zig cc (pip install ziglang)"
     if not entry.tuple.endswith("-linux"):
         raise ValueError(f"C hosts are cross-built for Linux targets only, not {entry.tuple}")
-    hosts = resources.files("sma_fmu.fmi.hosts")
     output = Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
-    for source in (f"{name}.c", "host_platform.h"):
-        (output.parent / source).write_bytes(hosts.joinpath(source).read_bytes())
     command = [*zig, "-target", entry.zig, "-std=c11", "-O2", "-Wall", "-Wextra", "-Werror",
-               f'-DPLATFORM="{entry.tuple}"', "-o", str(output), str(output.parent / f"{name}.c"),
-               "-ldl"]
+               f'-DPLATFORM="{entry.tuple}"', *include_flags(HOSTS), "-o", str(output),
+               str(HOSTS / f"{name}.c"), "-ldl"]
     result = subprocess.run(command, capture_output=True, text=True, timeout=900)
     if result.returncode != 0:
         raise RuntimeError(f"zig cc could not build {name} for {entry.tuple}: {result.stderr[-3000:]}")

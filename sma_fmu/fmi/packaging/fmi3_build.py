@@ -25,9 +25,9 @@ import warnings
 import zipfile
 from pathlib import Path
 
-from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarning, _c_files,
-                                                  _exact_starts, build_from_twins, compile_binary,
-                                                  model_sources)
+from sma_fmu.fmi.packaging.c_family_build import (NATIVE_MARKER, NativeBuildWarning,
+                                                  build_from_twins, c_source_files, compile_binary,
+                                                  exact_starts, model_sources)
 from sma_fmu.fmi.packaging.c_family_description import (model_starts, native_description,
                                                         variables_header)
 from sma_fmu.fmi.packaging.cross_build import TARGETS
@@ -52,7 +52,7 @@ def _build_one(model_name, python_fmu, folder, work):
     unpacked = work / model_name
     with zipfile.ZipFile(python_fmu) as archive:
         archive.extractall(unpacked)
-    starts, defaults = _exact_starts(model_name, unpacked / "resources")
+    starts, defaults = exact_starts(model_name, unpacked / "resources")
     header_name = f"{model_name}_variables.h"
     names = model_sources(model_name, generated=(header_name, _GENERATED), front="fmi3")
     fmi2_description, _ = native_description((unpacked / "modelDescription.xml").read_bytes(),
@@ -60,7 +60,7 @@ def _build_one(model_name, python_fmu, folder, work):
     description = fmi3_description(fmi2_description)
     sources = work / f"{model_name}.sources"
     sources.mkdir()
-    files = _c_files()
+    files = c_source_files()
     for name in names:
         if name not in (header_name, _GENERATED):
             shutil.copyfile(files[name], sources / name)

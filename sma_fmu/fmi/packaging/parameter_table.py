@@ -10,7 +10,7 @@ defaults). Its order is PARAMETER_SPECS': the layout of ``values[]`` and of
 ``resources/model_starts.json``'s ``wire_defaults``. A new optional parameter is a row of
 PARAMETER_SPECS (and of TERM_DEFAULTS when it is a model term), never a C edit.
 
-Every build of the C family gets it: ``c_family_build._c_files`` lists it beside the shipped
+Every build of the C family gets it: ``c_family_build.c_source_folders`` lists it beside the shipped
 C files (so it lands in every FMU's ``sources/``, where tools and ``buildDescription.xml``
 compile it), from :func:`generated_folder`, which C test programs pass as an include folder.
 """

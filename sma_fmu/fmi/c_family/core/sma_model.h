@@ -1,11 +1,11 @@
 /* The contract between the core (core/, under the fronts fmi2/ and fmi3/) and a model
- * adapter (models/<Model>.c).
+ * adapter (fmi/models/<Model>/<Model>.c).
  *
  * Like the Reference-FMUs' model.h, nothing here is FMI: an adapter declares its variables
  * (a generated table, <Model>_variables.h) and a few functions over its runtime stepper;
  * the core owns the values, the calling sequence, the checks, the log and the saved
  * states, and the fronts translate them to an FMI version. The adapters are as thin as the
- * pythonfmu slaves (fmi/python_family/slaves/) and keep their semantics: a failing start
+ * pythonfmu slaves beside them (fmi/models/<Model>/) and keep their semantics: a failing start
  * refuses ExitInitializationMode, a failing step discards it (slave_support/guards.py). */
 #ifndef SMA_MODEL_H
 #define SMA_MODEL_H
@@ -92,7 +92,7 @@ typedef struct {
 } SmaModel;
 
 
-/* Each adapter defines this one object (models/<Model>.c). */
+/* Each adapter defines this one object (fmi/models/<Model>/<Model>.c). */
 extern const SmaModel SMA_MODEL;
 
 #endif

@@ -1,6 +1,6 @@
 /* SmaPwmDriver: the PWM wire driver (demanded power in, mean power of the wave out), native.
  *
- * A thin adapter over runtime/pwm (PwmDriver), as fmi/python_family/slaves/sma_pwm_driver.py is: a supply
+ * A thin adapter over runtime/pwm (PwmDriver), as the slave beside it (sma_pwm_driver.py) is: a supply
  * switched between peak_W and 0 W at frequency_Hz, periods starting at t = j / f; doStep(t, h)
  * holds P_demand over the step and P_in then holds the exact mean of the wave over
  * [t, t + h). The wave is taken on the step grid start + k h_0: a step that starts within a

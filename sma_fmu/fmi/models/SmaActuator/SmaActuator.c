@@ -1,6 +1,6 @@
 /* SmaActuator: the SMA wire plant (thermal model + resistance hysteresis), native.
  *
- * A thin adapter over runtime/plant (PlantStepper), as fmi/python_family/slaves/sma_actuator.py is:
+ * A thin adapter over runtime/plant (PlantStepper), as the slave beside it (sma_actuator.py) is:
  * doStep(t, h) holds P_in and load over the step (P_in <= 0 is applied as 0 W); the outputs
  * are then the state at t + h. After initialization the outputs reflect T_start and the
  * load. Invalid parameters refuse fmi2ExitInitializationMode; hysteresis_mode is an Integer

@@ -1,7 +1,7 @@
 /* SmaFeedforward: the feedforward hysteresis compensator, native.
  *
  * A thin adapter over runtime/feedforward (FeedforwardStepper), as
- * fmi/python_family/slaves/sma_feedforward.py is: the temperature-sensing inverse of the wire model
+ * the slave beside it (sma_feedforward.py) is: the temperature-sensing inverse of the wire model
  * followed by the phase-lag filter. A sampled block: doStep(t_k, h) samples R_ref and load
  * as set before the call and its outputs then hold u_ff,k for that step. After
  * initialization the outputs are those of the first sample (filter in steady state).

@@ -1,6 +1,6 @@
 /* SmaPiController: the loop's PI block (anti-windup, power clamp at 0 W), native.
  *
- * A thin adapter over runtime/pi_control (PIController), as fmi/python_family/slaves/sma_pi_controller.py
+ * A thin adapter over runtime/pi_control (PIController), as the slave beside it (sma_pi_controller.py)
  * is over runtime/pi_control.py, with the same semantics: a sampled block; doStep(t_k, h)
  * samples R, R_ref and P_ff as set before the call, its outputs then hold
  * u_k = max(0, P_ff + Kp e_k + Ki I_k) with e_k = R - R_ref, and the integrator advances.

@@ -1,7 +1,7 @@
 /* SmaScenarioSignals: a scenario's reference R_ref(t) and load f(t), native.
  *
  * A thin adapter over runtime/scenario_signals (SignalSource), as
- * fmi/python_family/slaves/sma_scenario_signals.py is. Parameters: reference and load_profile, String
+ * the slave beside it (sma_scenario_signals.py) is. Parameters: reference and load_profile, String
  * parameters holding a scenario's [reference] and [load] tables as JSON objects (read with
  * the runtime's JSON reader); their defaults are the build's default scenario, or in an
  * FMU packed by `sma-fmu export` the exported scenario's (resources/start_values.json).
