@@ -12,8 +12,8 @@ sources being packed, so a changed C file, another version (the GUID) or a stale
 never used: the build compiles instead. The Python family's C front is kept there too
 (``front/linux64/front.so``, ``front/win64/front.dll``), taken only where no compiler
 builds it; the prebuilt linux64 front records no build libpython. ``python -m sma_fmu.fmi.packaging.prebuilt_writer``
-fills the folder; ``.ci/run`` runs it before building the wheel, with gcc, mingw-w64 and
-zig present, and fails if any platform is missing.
+fills the folder; the build backend (``build_backend/wheel_backend.py``) runs it when it
+builds the wheel, where gcc, mingw-w64 and zig are, and removes the folder after.
 """
 import hashlib
 import json

@@ -1,4 +1,4 @@
-"""Filling the prebuilt folder of :mod:`.prebuilt` (``.ci/run``, before the wheel is built):
+"""Filling the prebuilt folder of :mod:`.prebuilt` (the build backend, before the wheel is built):
 ``python -m sma_fmu.fmi.packaging.prebuilt_writer [--out DIR]``; without ``--out`` it also
 writes the prebuilt C hosts (:func:`sma_fmu.fmi.hosts.write_prebuilt_hosts`: what
 ``sma-fmu check`` runs where no C compiler is)."""
