@@ -2,10 +2,10 @@
 binaries compiled into the wheel.
 
 ``python -m build`` (or ``pip wheel .``) runs ``python -m sma_fmu.fmi.packaging.prebuilt_writer``
-before setuptools builds the wheel, so the wheel carries the C family's binaries, the Python
-family's fronts and the C hosts (``sma_fmu/fmi/packaging/prebuilt_binaries/``,
-``sma_fmu/fmi/hosts/prebuilt/``): with them ``sma-fmu build [--native]`` and ``sma-fmu check``
-need no compiler. The writer needs gcc, mingw-w64 and zig (``$SMA_FMU_ZIG_CC``, or ``zig`` or
+before setuptools builds the wheel, so the wheel carries the C family's binaries (FMI 2.0 and
+3.0), the Python family's fronts and the C hosts (``sma_fmu/fmi/packaging/prebuilt_binaries/``,
+``sma_fmu/fmi/hosts/prebuilt/``): with them ``sma-fmu build [--native [--fmi 3]]`` and
+``sma-fmu check`` need no compiler. The writer needs gcc, mingw-w64 and zig (``$SMA_FMU_ZIG_CC``, or ``zig`` or
 ziglang's ``python-zig`` on the PATH: an isolated build does not see a venv's ``ziglang``
 module, but it sees that venv's ``bin/`` when the venv is activated). Where one is missing the
 wheel is built without them, and the build says so: ``sma-fmu build --native`` then compiles
@@ -60,9 +60,10 @@ def _sma_fmu():
 
 
 def _targets():
-    """The C family's targets the writer compiles (prebuilt_writer.write_prebuilt)."""
-    from sma_fmu.fmi.packaging.cross_build import fmi2_targets
-    return fmi2_targets()
+    """The C family's targets the writer compiles (prebuilt_writer.write_prebuilt): every
+    target of the cross-build table, FMI 3.0's, of which FMI 2.0 names four."""
+    from sma_fmu.fmi.packaging.cross_build import TARGETS
+    return list(TARGETS.values())
 
 
 def missing_compilers():
@@ -140,8 +141,9 @@ def _write_prebuilt():
             raise RuntimeError(f"{text} ({MODE_VARIABLE}=require)")
         _say(f"{text}; {MODE_VARIABLE}=require makes this an error")
         return
-    platforms = ", ".join(entry.fmi2 or entry.tuple for entry in _targets())
-    _say(f"compiling the prebuilt binaries ({platforms}; the fronts; the C hosts): a few minutes")
+    platforms = ", ".join(entry.tuple for entry in _targets())
+    _say(f"compiling the prebuilt binaries (FMI 2.0 and 3.0: {platforms}; the fronts; the C hosts): "
+         "a few minutes")
     started = time.monotonic()
     result = subprocess.run([sys.executable, "-m", "sma_fmu.fmi.packaging.prebuilt_writer"], cwd=ROOT)
     if result.returncode != 0:

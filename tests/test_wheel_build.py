@@ -14,8 +14,9 @@ from pathlib import Path
 import pytest
 
 from sma_fmu.fmi.hosts import HOST_PROGRAMS
-from sma_fmu.fmi.packaging.cross_build import fmi2_targets
+from sma_fmu.fmi.packaging.cross_build import TARGETS, fmi2_targets
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
+from sma_fmu.fmi.packaging.prebuilt import fmi3_key
 
 REPO = Path(__file__).resolve().parent.parent
 PREBUILT = "sma_fmu/fmi/packaging/prebuilt_binaries"
@@ -52,10 +53,12 @@ def _names(wheel):
 
 
 def expected_binaries():
-    """What the wheel's prebuilt folders hold: every model on every FMI 2.0 platform, the
-    Python family's fronts, the C hosts, and their manifests."""
+    """What the wheel's prebuilt folders hold: every model on every FMI 2.0 platform and on
+    every FMI 3.0 one, the Python family's fronts, the C hosts, and their manifests."""
     names = {f"{PREBUILT}/{model}/{entry.fmi2}/{model}{entry.suffix}"
              for model in FMU_SCRIPTS for entry in fmi2_targets()}
+    names |= {f"{PREBUILT}/{fmi3_key(model)}/{name}/{model}{entry.suffix}"
+              for model in FMU_SCRIPTS for name, entry in TARGETS.items()}
     names |= {f"{PREBUILT}/front/linux64/front.so", f"{PREBUILT}/front/win64/front.dll",
               f"{PREBUILT}/manifest.json", f"{HOSTS}/manifest.json"}
     return names | {f"{HOSTS}/{name}" for name in HOST_PROGRAMS}
