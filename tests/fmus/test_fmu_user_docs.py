@@ -1,5 +1,5 @@
 """documentation/index.html speaks to the FMU's user, in every family and version
-(sma_fmu/fmi/packaging/user_guide.py, user_pages/, documentation.py), and the FMI 3.0 FMUs
+(sma_fmu/fmi/packaging/user_guide.py, fmi/models/<Model>/page.html, documentation.py), and the FMI 3.0 FMUs
 carry their own fmi-ls-ref reference result, which ``sma-fmu check`` verifies (extras.py,
 fmi3_build.py, reference_results.py)."""
 import html

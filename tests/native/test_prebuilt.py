@@ -1,7 +1,8 @@
 """Prebuilt C-family binaries (sma_fmu/fmi/packaging/prebuilt.py, prebuilt_writer.py): with them, and no compiler
 at all (no cc, no mingw-w64, no zig), ``build --native`` writes the five FMUs with every FMI
-2.0 platform's binary, the same bytes as compiled ones; a binary of other sources is never
-taken; ``compile=True`` ignores them."""
+2.0 platform's binary and ``build --native --fmi 3`` with every FMI 3.0 platform's, the
+same bytes as compiled ones; a binary of other sources is never taken; ``compile=True``
+ignores them."""
 import json
 import warnings
 import zipfile
@@ -10,6 +11,8 @@ import pytest
 
 from sma_fmu.fmi.packaging import prebuilt
 from sma_fmu.fmi.packaging.c_family_build import NativeBuildWarning, build_native_fmus
+from sma_fmu.fmi.packaging.cross_build import TARGETS
+from sma_fmu.fmi.packaging.fmi3_build import build_fmi3_fmus
 from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.prebuilt_writer import write_prebuilt
 
@@ -21,6 +24,7 @@ PLATFORMS = ("linux64", "win64", "darwin64", "win32")
 def folder(tmp_path_factory):
     folder = tmp_path_factory.mktemp("prebuilt") / "binaries"
     assert write_prebuilt(folder) == {**{name: sorted(PLATFORMS) for name in FMU_SCRIPTS},
+                                      **{prebuilt.fmi3_key(name): sorted(TARGETS) for name in FMU_SCRIPTS},
                                       "front": ["linux64", "win64"]}
     return folder
 
@@ -32,10 +36,10 @@ def _no_compiler(monkeypatch, folder):
     monkeypatch.setenv("SMA_FMU_ZIG_CC", "none")
 
 
-def _build(path, **options):
+def _build(path, build=build_native_fmus, **options):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        fmus = build_native_fmus(path, **options)
+        fmus = build(path, **options)
     return fmus, [str(w.message) for w in caught if isinstance(w.message, NativeBuildWarning)]
 
 
@@ -52,6 +56,18 @@ def test_without_a_compiler_the_prebuilt_binaries_are_packed(folder, native_fmus
         binaries = _binaries(path)
         assert sorted(b.split("/")[1] for b in binaries) == sorted(PLATFORMS)
         assert binaries == _binaries(native_fmus[name]), name
+
+
+def test_without_a_compiler_the_fmi3_build_packs_every_platform(folder, fmi3_fmus, tmp_path, monkeypatch):
+    """The FMI 3.0 build's own prebuilt binaries (its front differs from FMI 2.0's): every
+    tuple of the cross-build table; its reference result runs the x86_64-linux one."""
+    _no_compiler(monkeypatch, folder)
+    fmus, problems = _build(tmp_path / "fmi3", build=build_fmi3_fmus)
+    assert problems == []
+    for name, path in fmus.items():
+        binaries = _binaries(path)
+        assert sorted(b.split("/")[1] for b in binaries) == sorted(TARGETS)
+        assert binaries == _binaries(fmi3_fmus[name]), name
 
 
 def test_binaries_of_other_sources_are_not_taken(folder, tmp_path, monkeypatch):

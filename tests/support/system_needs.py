@@ -10,12 +10,12 @@ installs everything (``.ci/run``), never silently skips.
 Presence is decided as the build decides: the C compiler is
 :func:`~sma_fmu.fmi.hosts.c_compiler` (``$CC``, else ``cc``, else ``gcc``) found on the
 PATH, mingw-w64 is :func:`~sma_fmu.fmi.hosts.windows_compiler` (``$SMA_FMU_WIN64_CC``, else
-``x86_64-w64-mingw32-gcc``) found on the PATH. ``SMA_FMU_TESTS_WITHOUT`` (names below,
+``x86_64-w64-mingw32-gcc``) found on the PATH, zig is
+:func:`~sma_fmu.fmi.packaging.cross_build.zig_command`. ``SMA_FMU_TESTS_WITHOUT`` (names below,
 separated by spaces or commas) makes needs count as missing that a PATH cannot hide (wine64
 lives in /usr/lib/wine, libpython in /usr/lib, root is who runs): the simulated fresh
 machine of ``tests/project/test_system_needs.py`` uses it.
 """
-import importlib.util
 import os
 import re
 import shutil
@@ -24,6 +24,7 @@ from pathlib import Path
 import pytest
 
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+from sma_fmu.fmi.packaging.cross_build import zig_command
 
 __all__ = ["AARCH64_SYSROOT", "NEEDS", "WITHOUT_VARIABLE", "need", "needs", "missing", "wine_command", "by_hand_executable",
            "system_libpythons"]
@@ -77,7 +78,7 @@ NEEDS = {
                          "apt-get install libpython3.11 (or your release's libpython3.X)"),
     "python3": (Path("/usr/bin/python3").is_file, "Debian's python3 (/usr/bin/python3)",
                 "apt-get install python3"),
-    "zig": (lambda: importlib.util.find_spec("ziglang") is not None,
+    "zig": (lambda: _on_path(zig_command() or [""]),
             "zig cc (PyPI ziglang: the cross-compiler of the C family's targets)", "pip install ziglang"),
     "qemu-user": (lambda: shutil.which("qemu-aarch64") is not None and Path(AARCH64_SYSROOT).is_dir(),
                   f"qemu-aarch64 and the aarch64 C library ({AARCH64_SYSROOT})",

@@ -33,7 +33,7 @@ def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=
         raise ValueError("FMI 3.0 FMUs are built by the C family only (--native): pythonfmu is "
                          "FMI 2.0 only")
     if fmi_version == 3:
-        return build_fmi3_fmus(out_dir, parameter_file, names)
+        return build_fmi3_fmus(out_dir, parameter_file, names, compile)
     if native:
         return build_native_fmus(out_dir, parameter_file, names, compile)
     return build_pythonfmu_fmus(out_dir, parameter_file, names)

@@ -87,13 +87,18 @@ def fmi2_targets():
 
 def zig_command():
     """zig cc as a command list: ``$SMA_FMU_ZIG_CC`` split like a shell would (``none``: no
-    zig), else ``python -m ziglang cc`` when PyPI's ``ziglang`` is installed, else None."""
+    zig), else ``python -m ziglang cc`` when PyPI's ``ziglang`` is installed in this Python,
+    else ``zig cc`` or ``python-zig cc`` (ziglang's script, e.g. of an activated venv: what
+    an isolated wheel build finds) on the PATH, else None."""
     given = os.environ.get("SMA_FMU_ZIG_CC", "").strip()
     if given:
         return None if given.lower() == "none" else shlex.split(given)
-    if importlib.util.find_spec("ziglang") is None:
-        return None
-    return [sys.executable, "-m", "ziglang", "cc"]
+    if importlib.util.find_spec("ziglang") is not None:
+        return [sys.executable, "-m", "ziglang", "cc"]
+    for program in ("zig", "python-zig"):
+        if shutil.which(program):
+            return [program, "cc"]
+    return None
 
 
 def _x86_64_linux():

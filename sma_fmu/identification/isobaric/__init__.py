@@ -10,7 +10,7 @@ The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` w
   and spread), :mod:`~.timebase` (time stamps repeated at their resolution): the pieces of
   reading; :mod:`~.missing`: why a number is missing, named once;
 - :mod:`~.fit`: the joint fit of parameters, temperature profile and lag (:func:`fit_isobaric`),
-  on :mod:`~.terms` (the model with the issue-36 terms, vectorised), :mod:`~.profile` and
+  on :mod:`~.terms` (the model with its optional terms, vectorised), :mod:`~.profile` and
   :mod:`~.lag` (the wire's temperature), :mod:`~.layout` and :mod:`~.starts` (the unknowns,
   their starts and bounds), :mod:`~.jacobian` and :mod:`~.solver` (sparse
   Levenberg-Marquardt), :mod:`~.covariance`, :mod:`~.outliers` (outlier cycles, bounds);

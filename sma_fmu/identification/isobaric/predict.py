@@ -7,7 +7,7 @@ of the parameters with the room temperature 50 K below the file's lowest reading
 convection coefficient 10^6 times larger (a thermal time constant far below one step), and
 each step's power from :func:`sma_fmu.runtime.thermal.power_to_reach`. Everything after the
 temperature, the branch switching, the minor-loop memory and the length with the
-issue-36 terms, is the FMU's own code, in its default ("continuous") hysteresis mode.
+optional model terms, is the FMU's own code, in its default ("continuous") hysteresis mode.
 
 The temperature fed is the file's temperature profile (the piecewise-linear curve the fit
 also starts from, :mod:`~.profile`): thermocouple noise would otherwise make the plant

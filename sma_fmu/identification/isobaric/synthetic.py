@@ -21,7 +21,7 @@ temperature has turned. The file reports:
   (a fresh wire's first cycle).
 
 A header of ``#`` lines states the load, the programme, the noise and the true drift.
-A lab-like file (issue 26): ``IsobaricProgramme(t_low=20, t_high=115, rate=20, cycles=100,
+A lab-like file: ``IsobaricProgramme(t_low=20, t_high=115, rate=20, cycles=100,
 dwell=0, points=26000, noise_K=10, lag_s=20, decay=0.97)`` written without a time column:
 100 cycles of 260 samples, the heating transformation finishing after the measured turn.
 """

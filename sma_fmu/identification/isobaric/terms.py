@@ -1,4 +1,4 @@
-"""The issue-36 model terms (DESIGN-36.md), vectorised for the isobaric fit.
+"""The optional model terms (docs/model.md, 4a), vectorised for the isobaric fit.
 
 Optional wire-file terms, each with a default that gives today's model:
 

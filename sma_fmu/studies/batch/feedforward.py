@@ -113,7 +113,7 @@ class BatchFeedforward:
                        "energy_cooling": table["energy_cooling"][:, runs],
                        "inv_heating": table["inv_centre_heating"][:, runs],
                        "inv_cooling": table["inv_centre_cooling"][:, runs]}
-        for name in STAGE_FIELDS:               # the issue-36 second stage (0: one stage)
+        for name in STAGE_FIELDS:               # the optional second stage (0: one stage)
             self._terms[name] = table[name][:, runs]
         self.two_stage = np.array([q.terms.two_stage for q in p], dtype=bool)
 

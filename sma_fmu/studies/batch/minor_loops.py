@@ -86,7 +86,7 @@ class MinorLoopMemory:
 
     def __init__(self, margins, depths, two_stage=None):
         count = len(margins)
-        # which columns have an issue-36 second stage (their branches: branches.py)
+        # which columns have the optional second stage (their branches: branches.py)
         self.two_stage = np.zeros(count, dtype=bool) if two_stage is None else np.array(
             two_stage, dtype=bool)
         self.any_two_stage = bool(self.two_stage.any())

@@ -29,7 +29,7 @@ caches it; the per-step check for wiping out is a product and a comparison,
 sign(d) T+ >= sign(d) T_B, against a cached bound (+inf below two points). Per step the minor branches then cost
 v = value_B + ratio (L_d(T+) - major_B), the clamp into [0, M] and the selection.
 
-The terms of issue 36 (runtime/model_terms.py): dH/k_B of each run's direction (nu_h, nu_c)
+The optional model terms (runtime/model_terms.py): dH/k_B of each run's direction (nu_h, nu_c)
 is selected with the direction masks; when some run has a second stage, every run's major
 branch is the two-stage sum of :mod:`.branches` (exact for one-stage runs: M2 = 0); when
 some run has strain terms, every run's length is the expanded, stress-scaled one (exact for
@@ -195,7 +195,7 @@ class BatchPlant(PlantTerms):
         np.maximum(e, numerators, out=numerators)
         mul(self.M, numerators, fractions)
         div(fractions, denominator, fractions)
-        if self.two_stage:                             # the issue-36 second stage
+        if self.two_stage:                             # the optional second stage
             fractions[0], fractions[1] = two_stage_fractions(after, self._stages(slice(None)))
         if self.any_continuous:
             self._minor_branches(before, after, turned if changed else None, fractions)
