@@ -26,10 +26,11 @@ from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.sensing import temperature_of_fractions
 
-__all__ = ["SCENARIO", "SECOND_STAGE", "TARGETS", "inverse_targets", "python_inverse_ns",
+__all__ = ["SCENARIO", "FMUS", "SECOND_STAGE", "default_two_stage", "TARGETS", "inverse_targets", "python_inverse_ns",
            "c_inverse_ns", "inverse_costs", "fmu_walls", "run_inverse_bench", "inverse_lines"]
 
 SCENARIO = "heavy-pi+ff-adaptive"
+FMUS = ("SmaActuator", "SmaFeedforward")   # the FMUs its fmpy master runs (PI: the master's)
 LOAD_KG = 0.25          # the scenario's load: every inversion of the micro-benchmark is there
 TARGETS = 1000          # targets per pass, spread over the transformation
 C_PASSES = 40
@@ -112,8 +113,11 @@ def inverse_costs(wires, runs, folder):
 
 
 def fmu_walls(scenarios, fmu_folders, runs):
-    """{wire: [wall s per run]} of each wire's scenario through its FMUs, alternating."""
+    """{wire: [wall s per run]} of each wire's scenario through its FMUs, alternating, after
+    an untimed 0.1-s run of each (the first run in a process loads the FMU's Python)."""
     from sma_fmu.cosim.master import run_fmus
+    for name, scenario in scenarios.items():
+        run_fmus(dataclasses.replace(scenario, stop_time_s=0.1), fmu_folders[name])
     walls = {name: [] for name in scenarios}
     for _ in range(runs):
         for name, scenario in scenarios.items():
@@ -121,9 +125,10 @@ def fmu_walls(scenarios, fmu_folders, runs):
     return walls
 
 
-def run_inverse_bench(out_dir, runs=5, model=None, progress=print):
+def run_inverse_bench(out_dir, runs=5, model=None, stop_time_s=None, progress=print):
     """The section (see the module docstring); returns the results (also written to
-    ``out_dir``/benchmark.json, the FMUs built into ``out_dir``/fmus-*)."""
+    ``out_dir``/benchmark.json, the FMUs the scenario needs built into ``out_dir``/fmus-*).
+    ``stop_time_s`` [s] shortens the scenario (a quick look)."""
     from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
     from sma_fmu.files.json_output import json_text
     from sma_fmu.files.output_folder import staged_folder
@@ -134,6 +139,7 @@ def run_inverse_bench(out_dir, runs=5, model=None, progress=print):
     if model is not None and not load_parameter_set(model).params.terms.two_stage:
         raise ValueError(f"--model {model}: second_stage.w2 = 0, a one-stage wire; the "
                          f"section measures a two-stage one")
+    model = None if model is None else Path(model)
     with staged_folder(out_dir) as stage, tempfile.TemporaryDirectory() as folder:
         if model is None:
             model = write_parameter_file(
@@ -145,18 +151,20 @@ def run_inverse_bench(out_dir, runs=5, model=None, progress=print):
         progress("one inversion, Python and C ...")
         costs = inverse_costs({k: v.params for k, v in wires.items()}, runs, folder)
         scenario = load_scenario(resolve_scenarios([SCENARIO])[0])
+        if stop_time_s:
+            scenario = dataclasses.replace(scenario, stop_time_s=stop_time_s)
         scenarios, fmus = {}, {}
         for name, parameter_set in wires.items():
             progress(f"building the FMUs of the {name} wire ...")
             fmus[name] = stage / f"fmus-{name}"
-            build_fmus(fmus[name], parameter_set.path)
+            build_fmus(fmus[name], parameter_set.path, names=FMUS)
             scenarios[name] = dataclasses.replace(scenario, parameter_set=parameter_set)
         progress(f"{SCENARIO} through the FMUs ({runs} alternating runs per wire) ...")
         walls = fmu_walls(scenarios, fmus, runs)
         ratios = [a / b for a, b in zip(walls["two-stage"], walls["reference"])]
         results = {"inverse": {
-            "model": str(model), "load_kg": LOAD_KG, "per_inversion": costs,
-            "scenario": SCENARIO, "runs": runs,
+            "model": str(Path(out_dir) / model.name if model.parent == stage else model), "load_kg": LOAD_KG, "per_inversion": costs,
+            "scenario": SCENARIO, "stop_time_s": scenario.stop_time_s, "runs": runs,
             "walls_s": {k: [round(w, 4) for w in v] for k, v in walls.items()},
             "wall_s": {k: round(statistics.median(v), 4) for k, v in walls.items()},
             "ratio": {"median": round(statistics.median(ratios), 3),
@@ -172,8 +180,8 @@ def inverse_lines(results):
              *(f"{name:<38}{cost['python_ns']:>10.1f}{cost['c_ns']:>10.2f}"
                for name, cost in section["per_inversion"].items()),
              f"  two-stage wire: {section['model']}", "",
-             f"{section['scenario']} through the pythonfmu FMUs, wall [s] "
-             f"(median of {section['runs']} alternating runs)"]
+             f"{section['scenario']} ({section['stop_time_s']:g} s) through the pythonfmu "
+             f"FMUs, wall [s] (median of {section['runs']} alternating runs)"]
     lines += [f"{name:<38}{wall:>10.3f}" for name, wall in section["wall_s"].items()]
     ratio = section["ratio"]
     lines.append(f"two-stage / reference{'':<17}{ratio['median']:>10.2f} x  "

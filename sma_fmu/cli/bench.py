@@ -23,7 +23,7 @@ def _bench(args):
     if args.only == "inverse":
         from sma_fmu.bench.inverse import inverse_lines, run_inverse_bench
         say = lambda text: print(text, flush=True)  # noqa: E731
-        results = run_inverse_bench(args.out, args.runs, args.model, progress=say)
+        results = run_inverse_bench(args.out, args.runs, args.model, args.stop_time, say)
         print("\n".join(inverse_lines(results)))
         print(f"written: {args.out / 'benchmark.json'}")
         return 0
@@ -61,7 +61,7 @@ def register(commands):
                        help="with --only hosts: a scenario (repeatable; default: the paper's six "
                             "and the two PWM set-point ones)")
     bench.add_argument("--stop-time", type=positive_number, metavar="S",
-                       help="with --only hosts: shorten every scenario to S s")
+                       help="with --only hosts or inverse: shorten every scenario to S s")
     bench.add_argument("--omsimulator", metavar="EXE",
                        help="with --only hosts: OMSimulator's executable (default: "
                             "$SMA_FMU_OMSIMULATOR, else OMSimulator is left out)")
