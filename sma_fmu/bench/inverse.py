@@ -26,8 +26,9 @@ from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.sensing import temperature_of_fractions
 
-__all__ = ["SCENARIO", "FMUS", "SECOND_STAGE", "default_two_stage", "TARGETS", "inverse_targets", "python_inverse_ns",
-           "c_inverse_ns", "inverse_costs", "fmu_walls", "run_inverse_bench", "inverse_lines"]
+__all__ = ["SCENARIO", "FMUS", "SECOND_STAGE", "default_two_stage", "TARGETS", "inverse_targets",
+           "python_inverse_ns", "c_inverse_ns", "inverse_costs", "fmu_walls", "run_inverse_bench",
+           "inverse_lines"]
 
 SCENARIO = "heavy-pi+ff-adaptive"
 FMUS = ("SmaActuator", "SmaFeedforward")   # the FMUs its fmpy master runs (PI: the master's)
@@ -163,7 +164,8 @@ def run_inverse_bench(out_dir, runs=5, model=None, stop_time_s=None, progress=pr
         walls = fmu_walls(scenarios, fmus, runs)
         ratios = [a / b for a, b in zip(walls["two-stage"], walls["reference"])]
         results = {"inverse": {
-            "model": str(Path(out_dir) / model.name if model.parent == stage else model), "load_kg": LOAD_KG, "per_inversion": costs,
+            "model": str(Path(out_dir) / model.name if model.parent == stage else model),
+            "load_kg": LOAD_KG, "per_inversion": costs,
             "scenario": SCENARIO, "stop_time_s": scenario.stop_time_s, "runs": runs,
             "walls_s": {k: [round(w, 4) for w in v] for k, v in walls.items()},
             "wall_s": {k: round(statistics.median(v), 4) for k, v in walls.items()},

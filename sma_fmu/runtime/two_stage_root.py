@@ -13,40 +13,13 @@ order, so the two agree bit for bit.
 """
 import math
 
-from .constant_load import logistic_split, two_stage_fractions
+from .constant_load import two_stage_fractions
 
-__all__ = ["ROOT_CAP", "ROOT_TOLERANCE_K", "two_stage_inverse", "newton_start"]
+__all__ = ["ROOT_CAP", "ROOT_TOLERANCE_K", "two_stage_inverse"]
 
 ROOT_CAP = 200   # rounds of the search (Newton steps or halvings); 1-6 in practice
 ROOT_TOLERANCE_K = 1e-14   # K: bound on the error a last Newton step leaves in T (1e-12 promised)
 _log, _exp = math.log, math.exp
-
-
-def newton_start(xi_mf, xi_p, steep, broad, inverse_steep, low, high):
-    """The first u [1/K]: the steeper stage's closed-form inverse of what the broader stage
-    leaves at the steeper stage's own closed form ``inverse_steep``.
-
-    ``steep`` and ``broad`` are (E, 1/tau_K, M_k) [K, 1/K, 1] of the stage with the larger
-    and the smaller dH/k_B. If the broad stage alone holds more than the target there
-    (a half <= 0 left), the steep stage is taken as saturated, all P or all MF, and the broad
-    stage's inverse of the rest is used. Outside (low, high), or with nothing left, the
-    bracket's midpoint. Exact where the broad stage is flat or the steep one saturated.
-    """
-    energy, inverse_centre, total = steep
-    energy_b, inverse_centre_b, total_b = broad
-    mf_b, p_b = logistic_split(total_b, energy_b * (inverse_centre_b - inverse_steep))
-    left_mf, left_p = xi_mf - mf_b, xi_p - p_b
-    u = math.nan
-    if left_mf > 0.0 and left_p > 0.0:
-        u = inverse_centre - _log(left_p / left_mf) / energy
-    elif left_mf > 0.0:   # the broad stage alone holds more P: the steep one is all MF
-        if xi_mf > total:
-            u = inverse_centre_b - _log(xi_p / (xi_mf - total)) / energy_b
-    elif xi_p > total:    # the broad stage alone holds more MF: the steep one is all P
-        u = inverse_centre_b - _log((xi_p - total) / xi_mf) / energy_b
-    if not low < u < high:   # also NaN
-        u = 0.5 * (low + high)
-    return u
 
 
 def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants):
@@ -56,15 +29,24 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants):
     stage 2's is the other end of the bracket. Where a closed form is <= 0 (that stage alone
     never falls to the target), the low end is 1/T_K = 0: the root exists if the branch is
     below the target there, infinitely hot; else the inverse diverges (ValueError, as the
-    one-stage inverse). From :func:`newton_start`, each round evaluates both stages
-    (a logistic split each, inlined: the halves and the first half's derivative), the
-    residual r = Lambda(u) - exponent and Lambda'(u) = -(E1 q1 + E2 q2)(1/xi_P + 1/xi_MF)
-    (q_k = M_k e^z/(1 + e^z)^2); r narrows the bracket, then u - r/Lambda' is the next u
-    unless it leaves the bracket (or there is no slope: a fraction underflowed), when the
-    bracket is halved. It returns when r = 0, when the bracket is two neighbouring doubles,
-    or after a Newton step dx with E_max dx^2 <= :data:`ROOT_TOLERANCE_K` u^2: since
-    |Lambda''| <= 2 E_max |Lambda'|, the step leaves an error of about E_max dx^2 in u,
-    that many kelvin in T. At most :data:`ROOT_CAP` rounds.
+    one-stage inverse).
+
+    The start: at the steep stage's closed form u_s (the stage of larger dH/k_B = E), the
+    broad stage holds (mf_b, p_b); the steep stage's closed-form inverse of what is left,
+    u', damped by the broad stage's slope there: u_s + (u' - u_s)/(1 + (E_b q_b/E_s)(1/left_P
+    + 1/left_MF)), one Newton step on u - u'(u). If the broad stage alone holds more than the
+    target (nothing left on one side), the steep stage is taken as saturated (all P or all
+    MF) and the broad stage's inverse of the rest is the start. Outside the bracket: its
+    midpoint.
+
+    Each round evaluates both stages (logistic_split's operations, inlined, and the first
+    half's derivative q_k = M_k e^z/(1 + e^z)^2), the residual r = Lambda(u) - exponent and
+    -Lambda'(u) = (E1 q1 + E2 q2)(1/xi_MF + 1/xi_P); r narrows the bracket, then u - r/Lambda'
+    is the next u unless it leaves the bracket (or there is no slope: a fraction
+    underflowed), when the bracket is halved. It returns when r = 0, when the bracket is two
+    neighbouring doubles, or after a Newton step dx with dx^2 <= (:data:`ROOT_TOLERANCE_K` /
+    E_max) u^2: since |Lambda''| <= 2 E_max |Lambda'|, the step leaves an error of about
+    E_max dx^2 in u, that many kelvin in T. At most :data:`ROOT_CAP` rounds.
     """
     energy1, energy2 = constants.energy_over_kB, constants.energy2_over_kB
     centre1, centre2 = constants.inv_centre_K, constants.inv_centre2_K
@@ -80,13 +62,33 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants):
                 f"branch does not reach the target at any temperature (dH(f)/k_B = "
                 f"{energy1!r} K, second stage {energy2!r} K)")
     if energy1 >= energy2:
-        steepest = energy1
-        u = newton_start(xi_mf, xi_p, (energy1, centre1, total1), (energy2, centre2, total2),
-                         inverse_kelvin, low, high)
+        steepest, centre_s, total_s, energy_b, centre_b, total_b, u = (
+            energy1, centre1, total1, energy2, centre2, total2, inverse_kelvin)
     else:
-        steepest = energy2
-        u = newton_start(xi_mf, xi_p, (energy2, centre2, total2), (energy1, centre1, total1),
-                         other, low, high)
+        steepest, centre_s, total_s, energy_b, centre_b, total_b, u = (
+            energy2, centre2, total2, energy1, centre1, total1, other)
+    z = energy_b * (centre_b - u)   # the broad stage at u_s, split as logistic_split does
+    if z > 0.0:
+        e = _exp(-z)
+        d = 1.0 + e
+        half = total_b * e / d      # the smaller half, MF
+        left_mf, left_p = xi_mf - half, xi_p - total_b / d
+    else:
+        e = _exp(z)
+        d = 1.0 + e
+        half = total_b * e / d      # the smaller half, P
+        left_mf, left_p = xi_mf - total_b / d, xi_p - half
+    if left_mf > 0.0 and left_p > 0.0:
+        target = centre_s - _log(left_p / left_mf) / steepest
+        u = u + (target - u) / (1.0 + energy_b * (half / d) / steepest * (
+            1.0 / left_p + 1.0 / left_mf))
+    elif left_mf > 0.0:   # the broad stage alone holds more P: the steep one is all MF
+        u = centre_b - _log(xi_p / (xi_mf - total_s)) / energy_b if xi_mf > total_s else low
+    else:                 # it holds more MF: the steep one is all P
+        u = centre_b - _log((xi_p - total_s) / xi_mf) / energy_b if xi_p > total_s else low
+    if not low < u < high:
+        u = 0.5 * (low + high)
+    limit = ROOT_TOLERANCE_K / steepest
     for _ in range(ROOT_CAP):
         z = energy1 * (centre1 - u)   # stage 1 split as logistic_split does
         if z > 0.0:
@@ -126,7 +128,7 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants):
             step = residual / slope
             new = u + step
             if low <= new <= high:   # new == u: the step is below u's last bit
-                if steepest * step * step <= ROOT_TOLERANCE_K * new * new:
+                if step * step <= limit * new * new:
                     return new
                 if new != u:
                     u = new

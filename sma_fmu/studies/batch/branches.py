@@ -63,24 +63,27 @@ def split_with_slope(inverse_kelvin, M, minus_energy, inv_centre):
 
 
 def _newton_start(xi_mf, xi_p, u1, u2, c, low, high):
-    """(start u [1/K], the steep stage's dH/k_B [K]) per element, as
-    :func:`sma_fmu.runtime.two_stage_root.newton_start`: the steep stage is the one of larger
-    dH/k_B (stage 1 on a tie), ``u1`` and ``u2`` the two closed forms [1/K]."""
+    """(start u [1/K], the steep stage's dH/k_B [K]) per element, as the runtime's
+    :func:`~sma_fmu.runtime.two_stage_root.two_stage_inverse` starts: the steep stage is the
+    one of larger dH/k_B (stage 1 on a tie), ``u1`` and ``u2`` the two closed forms [1/K]."""
     first = -c["minus_energy"] >= -c["minus_energy2"]
     pick = lambda one, two: np.where(first, one, two)  # noqa: E731
-    energy, centre, total = (pick(-c["minus_energy"], -c["minus_energy2"]),
-                             pick(c["inverse"], c["inverse2"]), pick(c["M1"], c["M2"]))
-    energy_b, centre_b, total_b = (pick(-c["minus_energy2"], -c["minus_energy"]),
-                                   pick(c["inverse2"], c["inverse"]), pick(c["M2"], c["M1"]))
-    mf_b, p_b = split_at_inverse(pick(u1, u2), total_b, -energy_b, centre_b)
+    energy, total = pick(-c["minus_energy"], -c["minus_energy2"]), pick(c["M1"], c["M2"])
+    centre = pick(c["inverse"], c["inverse2"])
+    energy_b = pick(-c["minus_energy2"], -c["minus_energy"])
+    centre_b = pick(c["inverse2"], c["inverse"])
+    u = pick(u1, u2)
+    mf_b, p_b, slope_b = split_with_slope(u, pick(c["M2"], c["M1"]), -energy_b, centre_b)
     left_mf, left_p = xi_mf - mf_b, xi_p - p_b
     both = (left_mf > 0.0) & (left_p > 0.0)
-    all_mf = ~both & (left_mf > 0.0) & (xi_mf > total)
-    all_p = ~both & ~(left_mf > 0.0) & (xi_p > total)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        u = np.where(both, centre - np.log(left_p / left_mf) / energy, np.nan)
-        u = np.where(all_mf, centre_b - np.log(xi_p / (xi_mf - total)) / energy_b, u)
-        u = np.where(all_p, centre_b - np.log((xi_p - total) / xi_mf) / energy_b, u)
+        target = centre - np.log(left_p / left_mf) / energy
+        damped = u + (target - u) / (1.0 + energy_b * slope_b / energy * (1.0 / left_p
+                                                                          + 1.0 / left_mf))
+        all_mf = np.where(xi_mf > total,
+                          centre_b - np.log(xi_p / (xi_mf - total)) / energy_b, low)
+        all_p = np.where(xi_p > total, centre_b - np.log((xi_p - total) / xi_mf) / energy_b, low)
+    u = np.where(both, damped, np.where(left_mf > 0.0, all_mf, all_p))
     return np.where((low < u) & (u < high), u, 0.5 * (low + high)), energy
 
 
@@ -99,6 +102,7 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, c):
         reaches = (high > 0.0) & np.where(xi_mf <= xi_p, mf < xi_mf, p > xi_p)
         bad = open_end & ~reaches
     u, steepest = _newton_start(xi_mf, xi_p, inverse_kelvin, other, c, low, high)
+    limit = ROOT_TOLERANCE_K / steepest
     energy1, energy2 = -c["minus_energy"], -c["minus_energy2"]
     result, active = u.copy(), ~bad
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -117,7 +121,7 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, c):
             step = residual / slope
             new = u + step
             newton = active & ~zero & (slope > 0.0) & (low <= new) & (new <= high)
-            stop = newton & (steepest * step * step <= ROOT_TOLERANCE_K * new * new)
+            stop = newton & (step * step <= limit * new * new)
             moves = newton & ~stop & (new != u)
             middle = 0.5 * (low + high)
             halve = active & ~zero & ~stop & ~moves

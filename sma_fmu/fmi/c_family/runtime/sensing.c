@@ -34,30 +34,40 @@ typedef struct Stage {
     double energy, inverse_centre, total;
 } Stage;
 
-/* two_stage_root.newton_start: the steep stage's closed-form inverse of what the broad stage
- * leaves at the steep stage's own closed form; the midpoint of (low, high) outside it. */
+/* The first u [1/K] of two_stage_root.two_stage_inverse: at the steep stage's closed form
+ * u_s, the steep stage's inverse of what the broad stage leaves, damped by the broad stage's
+ * slope; the broad stage's inverse with the steep one saturated where the broad one alone
+ * holds more than the target; the midpoint of (low, high) outside it. */
 static double newton_start(double xi_mf, double xi_p, const Stage *steep, const Stage *broad,
-                           double inverse_steep, double low, double high)
+                           double u, double low, double high)
 {
-    double mf_b, p_b, left_mf, left_p, u = 0.0;
-    int found = 0;
-    logistic_split(broad->total, broad->energy * (broad->inverse_centre - inverse_steep), &mf_b,
-                   &p_b);
-    left_mf = xi_mf - mf_b;
-    left_p = xi_p - p_b;
-    if (left_mf > 0.0 && left_p > 0.0) {
-        u = steep->inverse_centre - log(left_p / left_mf) / steep->energy;
-        found = 1;
-    } else if (left_mf > 0.0) {   /* the broad stage alone holds more P: the steep one all MF */
-        if (xi_mf > steep->total) {
-            u = broad->inverse_centre - log(xi_p / (xi_mf - steep->total)) / broad->energy;
-            found = 1;
-        }
-    } else if (xi_p > steep->total) {   /* it holds more MF: the steep one is all P */
-        u = broad->inverse_centre - log((xi_p - steep->total) / xi_mf) / broad->energy;
-        found = 1;
+    double z = broad->energy * (broad->inverse_centre - u), e, d, half, left_mf, left_p;
+    double target;
+    if (z > 0.0) {
+        e = exp(-z);
+        d = 1.0 + e;
+        half = broad->total * e / d;   /* the smaller half, MF */
+        left_mf = xi_mf - half;
+        left_p = xi_p - broad->total / d;
+    } else {
+        e = exp(z);
+        d = 1.0 + e;
+        half = broad->total * e / d;   /* the smaller half, P */
+        left_mf = xi_mf - broad->total / d;
+        left_p = xi_p - half;
     }
-    if (!found || !(low < u && u < high)) {
+    if (left_mf > 0.0 && left_p > 0.0) {
+        target = steep->inverse_centre - log(left_p / left_mf) / steep->energy;
+        u = u + (target - u) / (1.0 + broad->energy * (half / d) / steep->energy * (
+            1.0 / left_p + 1.0 / left_mf));
+    } else if (left_mf > 0.0) {   /* the broad stage alone holds more P: the steep one all MF */
+        u = xi_mf > steep->total
+            ? broad->inverse_centre - log(xi_p / (xi_mf - steep->total)) / broad->energy : low;
+    } else {                      /* it holds more MF: the steep one is all P */
+        u = xi_p > steep->total
+            ? broad->inverse_centre - log((xi_p - steep->total) / xi_mf) / broad->energy : low;
+    }
+    if (!(low < u && u < high)) {
         u = 0.5 * (low + high);
     }
     return u;
@@ -87,7 +97,7 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *invers
                       const BranchConstants *constants, SmaMessage *message)
 {
     Stage first, second;
-    double other, low, high, u, steepest, mf, p, mf1, p1, q1, mf2, p2, q2, residual, slope;
+    double other, low, high, u, limit, mf, p, mf1, p1, q1, mf2, p2, q2, residual, slope;
     double step, next;
     int i;
     first.energy = constants->energy_over_kB;
@@ -115,11 +125,11 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *invers
         }
     }
     if (first.energy >= second.energy) {
-        steepest = first.energy;
         u = newton_start(xi_mf, xi_p, &first, &second, *inverse_kelvin, low, high);
+        limit = ROOT_TOLERANCE_K / first.energy;
     } else {
-        steepest = second.energy;
         u = newton_start(xi_mf, xi_p, &second, &first, other, low, high);
+        limit = ROOT_TOLERANCE_K / second.energy;
     }
     for (i = 0; i < ROOT_CAP; i++) {
         split_with_slope(&first, u, &mf1, &p1, &q1);
@@ -144,7 +154,7 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *invers
             step = residual / slope;
             next = u + step;
             if (low <= next && next <= high) {   /* next == u: the step is below u's last bit */
-                if (steepest * step * step <= ROOT_TOLERANCE_K * next * next) {
+                if (step * step <= limit * next * next) {
                     u = next;
                     break;
                 }
