@@ -30,6 +30,9 @@ def test_the_inverse_section_reports_both_wires(tmp_path, capsys):
     assert all((out / f"fmus-{name}" / "SmaFeedforward.fmu").is_file() for name in walls)
     text = capsys.readouterr().out
     assert "two-stage / reference" in text and "one inversion at 0.25 kg" in text
+    cpu = section["cpu_ratio"]
+    assert cpu["min"] <= cpu["median"] <= cpu["max"] and set(section["cpu_s"]) == set(walls)
+    assert len(section["load_average"]) == 2
 
 
 def test_a_one_stage_model_is_refused_by_name(tmp_path, capsys):

@@ -4,10 +4,12 @@ costs with a second stage, and what it does to a closed loop through the FMUs.
 - One inversion (``temperature_of_fractions`` on a major branch, the branch constants built
   once, as a compensator at a steady load) in the Python runtime and in the C runtime
   (``inverse_timing.c`` compiled with the C family's sources), on the reference wire (one
-  stage: a closed form) and on a two-stage wire (a root search): ns per inversion, the
+  stage: a closed form) and on a two-stage wire (a root search): CPU ns per inversion, the
   median of the passes.
 - :data:`SCENARIO` (30 s, 0.25 kg) through the pythonfmu FMUs built from each wire, the
-  two wires alternating run by run: the walls [s] and their ratio, two-stage over reference.
+  two wires alternating run by run: wall and CPU time [s] and their ratios, two-stage over
+  reference, with the load average before and after (other work on the machine inflates
+  the wall; the CPU time counts this process only).
 
 The two-stage wire is a parameter file (``--model``; the Flexinol fit's identified.toml is
 the case this measures), else the reference wire with a broad second stage of the shape the
@@ -15,6 +17,7 @@ Flexinol fit gives (:data:`SECOND_STAGE`).
 """
 import dataclasses
 import math
+import os
 import statistics
 import subprocess
 import tempfile
@@ -58,13 +61,13 @@ def inverse_targets(constants, count=TARGETS):
 
 
 def python_inverse_ns(constants, targets, margin, passes):
-    """Median cost [ns] of one Python inversion over ``passes`` passes of ``targets``."""
+    """Median CPU time [ns] of one Python inversion over ``passes`` passes of ``targets``."""
     costs = []
     for _ in range(passes):
-        start = time.perf_counter()
+        start = time.process_time()
         for xi_mf, xi_p in targets:
             temperature_of_fractions(xi_mf, xi_p, constants, margin)
-        costs.append((time.perf_counter() - start) / len(targets) * 1e9)
+        costs.append((time.process_time() - start) / len(targets) * 1e9)
     return statistics.median(costs)
 
 
@@ -87,7 +90,7 @@ def _timing_program(folder):
 
 
 def c_inverse_ns(program, params, load, direction, targets, passes=C_PASSES):
-    """Median cost [ns] of one C inversion (``program`` from :func:`_timing_program`)."""
+    """Median CPU time [ns] of one C inversion (``program`` from :func:`_timing_program`)."""
     values = [getattr(params, spec.name) for spec in PARAMETER_SPECS]
     numbers = [math.nan if v is None else float(v) for v in values]
     numbers += [load, direction, passes, len(targets)] + [v for pair in targets for v in pair]
@@ -100,7 +103,8 @@ def c_inverse_ns(program, params, load, direction, targets, passes=C_PASSES):
 
 def inverse_costs(wires, runs, folder):
     """{wire: {"python_ns", "c_ns"}} for ``wires`` {name: WireParameters}, at
-    :data:`LOAD_KG` heating; ``runs`` passes of the Python timing (at least 3)."""
+    :data:`LOAD_KG` heating; ``runs`` passes of the Python timing (at least 5). CPU time, not
+    wall: on a shared machine it counts only this process's work."""
     program = _timing_program(folder)
     results = {}
     for name, params in wires.items():
@@ -108,22 +112,33 @@ def inverse_costs(wires, runs, folder):
         targets = inverse_targets(constants)
         results[name] = {
             "python_ns": round(python_inverse_ns(constants, targets, params.saturation_margin,
-                                                 max(runs, 3)), 1),
+                                                 max(runs, 5)), 1),
             "c_ns": round(c_inverse_ns(program, params, LOAD_KG, 1, targets), 2)}
     return results
 
 
 def fmu_walls(scenarios, fmu_folders, runs):
-    """{wire: [wall s per run]} of each wire's scenario through its FMUs, alternating, after
-    an untimed 0.1-s run of each (the first run in a process loads the FMU's Python)."""
+    """({wire: [wall s per run]}, {wire: [CPU s per run]}) of each wire's scenario through its
+    FMUs, alternating, after an untimed 0.1-s run of each (the first run in a process loads the
+    FMU's Python). The pythonfmu FMUs run in this process, so its CPU time is theirs and the
+    master's."""
     from sma_fmu.cosim.master import run_fmus
     for name, scenario in scenarios.items():
         run_fmus(dataclasses.replace(scenario, stop_time_s=0.1), fmu_folders[name])
-    walls = {name: [] for name in scenarios}
+    walls, cpus = {name: [] for name in scenarios}, {name: [] for name in scenarios}
     for _ in range(runs):
         for name, scenario in scenarios.items():
+            start = time.process_time()
             walls[name].append(run_fmus(scenario, fmu_folders[name]).wall_time_s)
-    return walls
+            cpus[name].append(time.process_time() - start)
+    return walls, cpus
+
+
+def _ratio(samples):
+    """{median, min, max} of the run-by-run ratio two-stage / reference."""
+    ratios = [a / b for a, b in zip(samples["two-stage"], samples["reference"])]
+    return {"median": round(statistics.median(ratios), 3), "min": round(min(ratios), 3),
+            "max": round(max(ratios), 3)}
 
 
 def run_inverse_bench(out_dir, runs=5, model=None, stop_time_s=None, progress=print):
@@ -149,6 +164,7 @@ def run_inverse_bench(out_dir, runs=5, model=None, stop_time_s=None, progress=pr
                 "(sma-fmu bench --only inverse)")
         two_stage = load_parameter_set(model)
         wires = {"reference": reference, "two-stage": two_stage}
+        before = os.getloadavg()[0]
         progress("one inversion, Python and C ...")
         costs = inverse_costs({k: v.params for k, v in wires.items()}, runs, folder)
         scenario = load_scenario(resolve_scenarios([SCENARIO])[0])
@@ -161,16 +177,16 @@ def run_inverse_bench(out_dir, runs=5, model=None, stop_time_s=None, progress=pr
             build_fmus(fmus[name], parameter_set.path, names=FMUS)
             scenarios[name] = dataclasses.replace(scenario, parameter_set=parameter_set)
         progress(f"{SCENARIO} through the FMUs ({runs} alternating runs per wire) ...")
-        walls = fmu_walls(scenarios, fmus, runs)
-        ratios = [a / b for a, b in zip(walls["two-stage"], walls["reference"])]
+        walls, cpus = fmu_walls(scenarios, fmus, runs)
         results = {"inverse": {
             "model": str(Path(out_dir) / model.name if model.parent == stage else model),
             "load_kg": LOAD_KG, "per_inversion": costs,
             "scenario": SCENARIO, "stop_time_s": scenario.stop_time_s, "runs": runs,
             "walls_s": {k: [round(w, 4) for w in v] for k, v in walls.items()},
             "wall_s": {k: round(statistics.median(v), 4) for k, v in walls.items()},
-            "ratio": {"median": round(statistics.median(ratios), 3),
-                      "min": round(min(ratios), 3), "max": round(max(ratios), 3)}}}
+            "cpu_s": {k: round(statistics.median(v), 4) for k, v in cpus.items()},
+            "ratio": _ratio(walls), "cpu_ratio": _ratio(cpus),
+            "load_average": [round(before, 2), round(os.getloadavg()[0], 2)]}}
         (stage / "benchmark.json").write_text(json_text(results), encoding="utf-8")
     return results
 
@@ -178,14 +194,18 @@ def run_inverse_bench(out_dir, runs=5, model=None, stop_time_s=None, progress=pr
 def inverse_lines(results):
     """The section as plain-text lines."""
     section = results["inverse"]
-    lines = [f"one inversion at {section['load_kg']} kg, heating [ns]      Python         C",
+    lines = [f"one inversion at {section['load_kg']} kg, heating [CPU ns]  Python         C",
              *(f"{name:<38}{cost['python_ns']:>10.1f}{cost['c_ns']:>10.2f}"
                for name, cost in section["per_inversion"].items()),
              f"  two-stage wire: {section['model']}", "",
              f"{section['scenario']} ({section['stop_time_s']:g} s) through the pythonfmu "
-             f"FMUs, wall [s] (median of {section['runs']} alternating runs)"]
-    lines += [f"{name:<38}{wall:>10.3f}" for name, wall in section["wall_s"].items()]
-    ratio = section["ratio"]
-    lines.append(f"two-stage / reference{'':<17}{ratio['median']:>10.2f} x  "
-                 f"({ratio['min']:.2f} ... {ratio['max']:.2f})")
+             f"FMUs (median of {section['runs']} alternating runs; load average "
+             f"{section['load_average'][0]:g} before, {section['load_average'][1]:g} after)",
+             f"{'':<38}  wall [s]   CPU [s]"]
+    lines += [f"{name:<38}{wall:>10.3f}{section['cpu_s'][name]:>10.3f}"
+              for name, wall in section["wall_s"].items()]
+    wall, cpu = section["ratio"], section["cpu_ratio"]
+    lines.append(f"two-stage / reference{'':<17}{wall['median']:>9.2f}x{cpu['median']:>9.2f}x"
+                 f"  (wall {wall['min']:.2f} ... {wall['max']:.2f}, CPU {cpu['min']:.2f} ... "
+                 f"{cpu['max']:.2f})")
     return lines

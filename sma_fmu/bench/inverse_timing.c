@@ -6,7 +6,7 @@
  * [kg], the direction (+1/-1), the number of passes, the number of targets K and K pairs
  * (xi_MF, xi_P) [1]. Each pass inverts every target with temperature_of_fractions (the
  * branch constants built once, as a compensator at a steady load does) and prints one line:
- * the pass's cost [ns per inversion] and the sum of the sensed temperatures [degC] (which
+ * the pass's CPU time [ns per inversion] and the sum of the sensed temperatures [degC] (which
  * keeps the compiler from dropping the work). A refusal prints it on stderr, exit 1.
  */
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
@@ -18,10 +18,11 @@
 #include "parameters.h"
 #include "sensing.h"
 
+/* This process's CPU time [s] (the machine may be shared). */
 static double seconds_now(void)
 {
     struct timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
     return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
 }
 
