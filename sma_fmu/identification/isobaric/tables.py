@@ -117,9 +117,15 @@ def _text(value, digits=4):
         f"{value:.{digits}g}"
 
 
-def _cell(row, source):
+def _cell(row, source, reasons):
+    """The value, or "n/a [k]" with k the number of its reason in ``reasons`` (appended)."""
     value = row[source]
-    return _text(value) if math.isfinite(value) else f"n/a: {row[source + '_note']}"
+    if math.isfinite(value):
+        return _text(value)
+    note = row[source + "_note"]
+    if note not in reasons:
+        reasons.append(note)
+    return f"n/a [{reasons.index(note) + 1}]"
 
 
 def rows_csv(rows):
@@ -136,20 +142,22 @@ def rows_csv(rows):
 
 
 def rows_markdown(rows):
-    """Markdown tables of :func:`cycle_rows` rows, one per file, data and model side by side."""
+    """Markdown tables of :func:`cycle_rows` rows, one per file, data and model side by side;
+    a value that cannot be had reads "n/a [k]", its reason k listed once under the table."""
     lines = ["# Transformation temperatures per cycle (tangent-line construction)", "",
              "A_s, A_f on heating and M_s, M_f on cooling where the transformation tangent meets "
              "the baselines; thermal hysteresis = heating minus cooling temperature at half the "
              "actuation strain; actuation strain recovered on heating; residual strain left by "
              "the cycle at its lowest temperature. Data: strain against the measured (smoothed) "
              "temperature; data, wire T: against the fitted wire temperature (the thermocouple's "
-             "lag removed), the footing of the model and of model - data. n/a: the construction "
-             "cannot be made, and why."]
+             "lag removed), the footing of the model and of model - data. n/a [k]: the "
+             "construction cannot be made, for reason k under the table."]
     files = []
     for row in rows:
         if (row["file"], row["load_kg"]) not in files:
             files.append((row["file"], row["load_kg"]))
     for name, load in files:
+        reasons = []
         lines += ["", f"## {name} (load {load:g} kg)", "",
                   "| cycle | quantity | unit | data | data, wire T | model | model - data, wire T |",
                   "|---:|---|---|---:|---:|---:|---:|"]
@@ -157,7 +165,10 @@ def rows_markdown(rows):
             if (row["file"], row["load_kg"]) != (name, load):
                 continue
             difference = row["model"] - row["data_wire"]
+            cells = [_cell(row, source, reasons) for source in ("data", "data_wire", "model")]
             lines.append(f"| {row['cycle']} | {row['quantity']} | {row['unit']} | "
-                         f"{_cell(row, 'data')} | {_cell(row, 'data_wire')} | {_cell(row, 'model')} | "
-                         f"{_text(difference, 2) or 'n/a: needs both'} |")
+                         + " | ".join(cells) + f" | {_text(difference, 2) or 'n/a'} |")
+        if reasons:
+            lines += [""] + [f"[{k}] {reason}" + ("  " if k < len(reasons) else "")
+                             for k, reason in enumerate(reasons, start=1)]
     return "\n".join(lines) + "\n"
