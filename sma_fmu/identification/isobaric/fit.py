@@ -43,21 +43,19 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import sparse
 from threadpoolctl import threadpool_limits
 
 from sma_fmu.identification.isobaric.files import noise_level
-from sma_fmu.identification.isobaric.first_fit import first_fit
-from sma_fmu.identification.isobaric.jacobian import file_jacobian, scalar_sensitivities
 from sma_fmu.identification.isobaric.lag import uniform_step
 from sma_fmu.identification.isobaric.layout import Layout
 from sma_fmu.identification.isobaric.outcome import (EXPLAINED_RATIO, IsobaricFit, check_inside,
                                                      outcome, residual_blocks)
-from sma_fmu.identification.isobaric.outliers import OUTLIER_OPTIONS, bound_names, mark_outliers
+from sma_fmu.identification.isobaric.outliers import OUTLIER_OPTIONS, bound_names
 from sma_fmu.identification.isobaric.profile import pointwise_error, temperature_profile
 from sma_fmu.identification.isobaric.sensor import choose_lag, lag_sensitivity
-from sma_fmu.identification.isobaric.solver import levenberg_marquardt
-from sma_fmu.identification.isobaric.starts import PROFILE_BOUND, PROFILE_TOLERANCE_K, starts
+from sma_fmu.identification.isobaric.starts import PROFILE_BOUND, PROFILE_TOLERANCE_K
+from sma_fmu.identification.isobaric.structure import (Clock, Joint, choose, joint, joint_starts,
+                                                       second_look, with_head)
 
 __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "OUTLIER_OPTIONS", "IsobaricFit", "fit_isobaric",
            "prepare", "residual_blocks", "EXPLAINED_RATIO"]
@@ -65,13 +63,7 @@ __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "OUTLIER_OPTIONS", "IsobaricFit", 
 RESIDUAL_OPTIONS = ("per-cycle", "none")
 LAG_OPTIONS = ("fit", "none", "auto")
 WIDTH_OPTIONS = ("auto", "separate", "shared")
-STAGE_SHARE_MIN = 1e-3  # a second stage holding less than this share of M is not kept
-STAGE_GAIN_MIN = 0.01   # nor one that lowers the cost by less than this fraction
-JOINT_FTOL = 1e-7       # the joint fit has converged when 3 steps in a row gain less, relative
-FIRST_FTOL = 1e-6       # the first fit only chooses and starts: a looser tolerance
 _FLOOR = 1e-9           # relative floor of the noise estimates (noise-free data)
-SCAN_EVALUATIONS = 6    # per starting lag before the full first fit
-LAG_STARTS = (1 / 300, 1 / 100, 1 / 50, 1 / 25, 1 / 12, 1 / 6)   # of a cycle
 
 
 @dataclass
@@ -118,225 +110,6 @@ def prepare(data, index, residual="per-cycle"):
                         residual == "per-cycle")
 
 
-class _Clock:
-    """Counts model evaluations and moves a progress bar (``meter(total)``: tqdm-like or None)."""
-
-    def __init__(self, meter):
-        self.began = time.perf_counter()
-        self.evaluations = 0
-        self.bar = meter() if meter is not None else None
-
-    def stage(self, text):
-        if self.bar is not None:
-            self.bar.set_description_str(text)
-
-    def tick(self, cost=None):
-        self.evaluations += 1
-        if self.bar is not None:
-            self.bar.update(1)
-            if cost is not None:
-                self.bar.set_postfix_str(f"cost {cost:.6g}", refresh=False)
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
-
-
-def _joint(prepared, layout, lower, upper, clock):
-    """(residuals, jacobian, solve, order) of the joint fit of one layout."""
-    order = layout.time_order(prepared)
-    loads = [f.data.load for f in prepared]
-
-    def residuals(x):
-        out = np.concatenate(residual_blocks(x, layout, prepared))
-        clock.tick(0.5 * float(out @ out))
-        return out
-
-    def jacobian(x):
-        sensitivities = scalar_sensitivities(x, layout, loads)
-        return sparse.vstack([b for f in prepared
-                              for b in file_jacobian(x, layout, f, sensitivities)]).tocsr()
-
-    def solve(x0, evaluations):
-        return levenberg_marquardt(residuals, jacobian, x0, lower, upper, evaluations,
-                                   ftol=JOINT_FTOL, order=order)
-    return residuals, jacobian, solve, order
-
-
-def _carry(old_layout, old_x, layout, vector):
-    """``vector`` with every unknown the two layouts share taken from ``old_x`` (one width
-    nu gives both nu_h and nu_c)."""
-    out = vector.copy()
-    old = {name: i for i, name in enumerate(old_layout.phys)}
-    if "nu" in old:
-        old["nu_h"] = old["nu_c"] = old["nu"]
-    for i, name in enumerate(layout.phys):
-        if name in old:
-            out[i] = old_x[old[name]]
-    k_old, k = len(old_layout.phys), len(layout.phys)
-    out[k:len(layout.reported)] = old_x[k_old:len(old_layout.reported)]
-    if len(old_x) == old_layout.size:     # a joint solution: its profile's knots too
-        out[len(layout.reported):] = old_x[len(old_layout.reported):]
-    return out
-
-
-@dataclass
-class _Trial:
-    """A layout and its first fit: start vector and bounds (all unknowns), solution, weights."""
-
-    layout: object
-    vector: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    solution: object = None
-    weights: list = None
-
-
-def _first(prepared, trial, clock, evaluations=100, rounds=None):
-    trial.solution, trial.weights = first_fit(prepared, trial.layout, trial.vector, trial.lower,
-                                              trial.upper, evaluations, FIRST_FTOL,
-                                              tick=clock.tick,
-                                              **({"rounds": rounds} if rounds else {}))
-    return trial
-
-
-def _choose(prepared, base, layout_of, kind, widths, stages, lagged, outliers, clock):
-    """The first fit: lag valley, outlier cycles, widths and stages. Returns (trial, stages,
-    width kind, outlier cycles, the richer structures it did not keep: "widths", "stages")."""
-    def trial_of(count, width_kind, fraction=0.01):
-        layout = layout_of(count, width_kind)
-        return _Trial(layout, *starts(prepared, layout, base, fraction))
-
-    clock.stage("first fit")
-    # on the data's own starting model first: a poor first fit can hide an odd cycle
-    left_out = mark_outliers(prepared, layout_of(1, kind), trial_of(1, kind).vector,
-                             outliers == "leave-out")
-    if lagged:    # short fits from lags of 1/300 to 1/6 of a cycle; the best two go on
-        scans = [_first(prepared, trial_of(1, kind, fraction), clock, SCAN_EVALUATIONS, 1)
-                 for fraction in LAG_STARTS]
-        scans.sort(key=lambda t: t.solution.cost)
-        best = [_first(prepared, _Trial(t.layout, _with(t.vector, t.solution.x), t.lower,
-                                        t.upper), clock) for t in scans[:2]]
-    else:
-        best = [_first(prepared, trial_of(1, kind), clock)]
-    trial = min(best, key=lambda t: t.solution.cost)
-
-    def outlying(trial):
-        """``trial`` fitted again when its solution shows outlier cycles not yet left out (a
-        poor fit hides them: a wider model can show more)."""
-        found = mark_outliers(prepared, trial.layout, trial.solution.x, outliers == "leave-out")
-        known = {(c["file"], c["cycle"]) for c in left_out}
-        fresh = [c for c in found if (c["file"], c["cycle"]) not in known]
-        left_out.extend(fresh)
-        if fresh and outliers == "leave-out":
-            trial = _first(prepared, _Trial(trial.layout, _with(trial.vector, trial.solution.x),
-                                            trial.lower, trial.upper), clock)
-        return trial
-
-    trial = outlying(trial)
-
-    def richer(count, width_kind):
-        """The richer layout from the kept one's solution, and from the data's own starts."""
-        fresh = trial_of(count, width_kind)
-        carried = _Trial(fresh.layout, _carry(trial.layout, _with(trial.vector, trial.solution.x),
-                                               fresh.layout, fresh.vector), fresh.lower, fresh.upper)
-        tries = [_first(prepared, carried, clock)]
-        if count == 2:
-            tries.append(_first(prepared, fresh, clock))
-        return min(tries, key=lambda t: t.solution.cost)
-
-    rejected = []
-    if widths == "auto":
-        clock.stage("first fit: widths")
-        wider = richer(1, "separate")
-        if wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
-            trial, kind = outlying(wider), "separate"
-        else:
-            rejected.append("widths")
-    if stages == 2:
-        clock.stage("first fit: stages")
-        wider = richer(2, kind)
-        w2 = wider.solution.x[wider.layout.phys.index("w2")]
-        if w2 > STAGE_SHARE_MIN and \
-                wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
-            trial = outlying(wider)
-        else:
-            rejected.append("stages")
-            stages = 1
-    return trial, stages, kind, left_out, rejected
-
-
-def _lag_starts(prepared, trial, start, solve, lagged):
-    """The joint fit's starts: the first fit's solution, and with a lag the two best of short
-    joint fits from it with the lag at the first fit's value and at 1/300 to 1/6 of a cycle
-    (the first fit holds a smoothed temperature, and can put the lag in another valley)."""
-    start = np.clip(start, trial.lower, trial.upper)
-    if not lagged:
-        return [start]
-    candidates = [start]
-    for fraction in LAG_STARTS:
-        x = start.copy()
-        for f in prepared:
-            column = trial.layout.lags[f.index]
-            period = f.data.splitting.period_samples * f.step if f.data.splitting else 100 * f.step
-            x[column] = min(fraction * period, trial.upper[column])
-        candidates.append(x)
-    scans = sorted((solve(x, SCAN_EVALUATIONS) for x in candidates), key=lambda s: s.cost)
-    return [s.x for s in scans[:2]]
-
-
-def _second_look(prepared, base, layout_of, state, kind, rejected, clock, max_evaluations):
-    """The joint fit's word on each richer structure the first fit did not keep (the first
-    fit holds the temperature, and on filtered files, whose noise estimates are tiny, that
-    can hide what the joint fit sees): tried from the joint solution, kept when it lowers
-    the joint cost by STAGE_GAIN_MIN. Returns (state, width kind, stages, notes)."""
-    notes, stages = [], state.layout.stages
-    for what in rejected:
-        count, width_kind = (stages, "separate") if what == "widths" else (2, kind)
-        layout = layout_of(count, width_kind)
-        vector, lower, upper = starts(prepared, layout, base)
-        start = _carry(state.layout, state.solution.x, layout, vector)
-        residuals, jacobian, solve, order = _joint(prepared, layout, lower, upper, clock)
-        solution = solve(np.clip(start, lower, upper), max_evaluations)
-        if what == "stages":
-            w2 = solution.x[layout.phys.index("w2")]
-            if w2 > STAGE_SHARE_MIN and \
-                    solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
-                state, stages = _Joint(layout, solution, jacobian, order, lower, upper, vector), 2
-            else:
-                notes.append(f"a second stage does not fit these data better (w2 = {w2:.3g}, "
-                             f"cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
-                             f"one stage): one stage kept")
-        elif solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
-            state, kind = _Joint(layout, solution, jacobian, order, lower, upper, vector), \
-                width_kind
-        else:
-            notes.append(f"separate heating and cooling widths do not fit these data better "
-                         f"(cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
-                         f"one): one width kept")
-    return state, kind, stages, notes
-
-
-@dataclass
-class _Joint:
-    """A joint fit: its layout, solution, Jacobian function, order, bounds and start."""
-
-    layout: object
-    solution: object
-    jacobian: object
-    order: np.ndarray
-    lower: np.ndarray
-    upper: np.ndarray
-    vector: np.ndarray
-
-
-def _with(vector, head):
-    """``vector`` with its first entries replaced by ``head``."""
-    out = np.array(vector, dtype=float)
-    out[:len(head)] = head
-    return out
-
-
 def _check_options(residual, lag, widths, stages, outliers):
     for name, value, options in (("residual", residual, RESIDUAL_OPTIONS),
                                  ("lag", lag, LAG_OPTIONS), ("widths", widths, WIDTH_OPTIONS),
@@ -373,24 +146,24 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         return Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
                       any(d.resistance is not None for d in files), lag == "fit", count, loads,
                       kind)
-    clock = _Clock(meter)
+    clock = Clock(meter)
     try:
         # the sparse solves gain nothing from BLAS threads, which only contend for the cores
         with threadpool_limits(limits=1, user_api="blas"):
-            trial, stages, kind, left_out, rejected = _choose(
+            trial, stages, kind, left_out, rejected = choose(
                 prepared, base, layout_of, "separate" if widths == "separate" else "shared",
                 widths, stages, lag == "fit", outliers, clock)
             first_evaluations = clock.evaluations
             clock.stage("joint fit")
-            _, jacobian, solve, order = _joint(prepared, trial.layout, trial.lower, trial.upper,
+            _, jacobian, solve, order = joint(prepared, trial.layout, trial.lower, trial.upper,
                                                clock)
-            start = _with(trial.vector, trial.solution.x)   # knots: the thermocouple's profile
+            start = with_head(trial.vector, trial.solution.x)   # knots: the thermocouple's profile
             solution = min((solve(x, max_evaluations) for x in
-                            _lag_starts(prepared, trial, start, solve, lag == "fit")),
+                            joint_starts(prepared, trial, start, solve, lag == "fit")),
                            key=lambda s: s.cost)
-            state = _Joint(trial.layout, solution, jacobian, order, trial.lower, trial.upper,
+            state = Joint(trial.layout, solution, jacobian, order, trial.lower, trial.upper,
                            trial.vector)
-            state, kind, stages, notes = _second_look(prepared, base, layout_of, state, kind,
+            state, kind, stages, notes = second_look(prepared, base, layout_of, state, kind,
                                                       rejected, clock, max_evaluations)
     finally:
         clock.close()
