@@ -75,15 +75,52 @@ def _temperature_panel(axis, data, wire, measured_profile, lagged):
     axis.plot(sample[rows], wire[rows], "-", lw=1.1, color="k", label="fitted wire temperature")
     which = f"cycles {cycles[0]} to {cycles[min(len(cycles), TEMPERATURE_CYCLES) - 1]}" \
         if len(cycles) > 1 else f"cycle {cycles[0]}"
-    axis.set(title=f"{data.path.name}: temperature, {which}",
+    axis.set(title=f"{data.path.name}: temperature, {which}" if len(cycles) > 1 else
+             f"{data.path.name}: temperature",
              xlabel="time [s]" if data.time is not None else "sample",
              ylabel="temperature [degC]")
     axis.legend(fontsize=7)
     axis.grid(alpha=0.3)
 
 
+def _cycle_panel(axis, data, fit_file, cycle, branches, legend):
+    """One cycle's data against the measured temperature, and the model."""
+    for index, b in branches:
+        colour, label = BRANCH_STYLE[b.direction]
+        of = slice(b.start, b.stop)
+        axis.plot(data.temperature[of], 100 * data.strain[of], ".", ms=2, color=colour,
+                  alpha=0.4, label=f"data, {label}")
+        _model_line(axis, data, fit_file, index, b, "k" if b.direction == HEATING else "0.35",
+                    label=f"model, {label}")
+    axis.set_title(f"{data.path.name}, cycle {cycle}", fontsize=9)
+    axis.set(xlabel="measured temperature [degC]", ylabel="strain [%]")
+    axis.grid(alpha=0.3)
+    if legend:
+        axis.legend(fontsize=6)
+
+
+def _side_by_side(files, fit, per_cycle):
+    """Files of one cycle each: a column per file (four to a row), its cycle above its
+    temperature."""
+    columns = min(4, len(files))
+    rows = math.ceil(len(files) / columns)
+    figure = Figure(figsize=(4.2 * columns, 6.2 * rows))
+    grid = figure.add_gridspec(2 * rows, columns, height_ratios=[3.4, 2.2] * rows)
+    for k, data in enumerate(files):
+        row, column = 2 * (k // columns), k % columns
+        fit_file = (fit.profiles[k], fit.wire_bounds[k], fit.params, fit.offsets[k], per_cycle)
+        (cycle, branches), = _cycles(data).items()
+        _cycle_panel(figure.add_subplot(grid[row, column]), data, fit_file, cycle, branches,
+                     k == 0)
+        _temperature_panel(figure.add_subplot(grid[row + 1, column]), data, fit.profiles[k],
+                           fit.measured_profiles[k], fit.lags[k] is not None)
+    return figure
+
+
 def _grid(files, fit, per_cycle):
     counts = [len(_cycles(d)) for d in files]
+    if max(counts) == 1:
+        return _side_by_side(files, fit, per_cycle)
     columns = min(4, max(counts))
     panel_rows = [math.ceil(c / columns) + 1 for c in counts]   # + the temperature panel
     figure = Figure(figsize=(max(3.8 * columns, 7.0), 3.0 * sum(panel_rows)))
@@ -94,19 +131,8 @@ def _grid(files, fit, per_cycle):
         fit_file = (wire, bounds, fit.params, offsets, per_cycle)
         cycles = sorted(_cycles(data).items())
         for j, (cycle, branches) in enumerate(cycles):
-            axis = figure.add_subplot(grid[first_row + j // columns, j % columns])
-            for index, b in branches:
-                colour, label = BRANCH_STYLE[b.direction]
-                of = slice(b.start, b.stop)
-                axis.plot(data.temperature[of], 100 * data.strain[of], ".", ms=2, color=colour,
-                          alpha=0.4, label=f"data, {label}")
-                _model_line(axis, data, fit_file, index, b,
-                            "k" if b.direction == HEATING else "0.35", label=f"model, {label}")
-            axis.set_title(f"{data.path.name}, cycle {cycle}", fontsize=9)
-            axis.set(xlabel="measured temperature [degC]", ylabel="strain [%]")
-            axis.grid(alpha=0.3)
-            if j == 0:
-                axis.legend(fontsize=6)
+            _cycle_panel(figure.add_subplot(grid[first_row + j // columns, j % columns]), data,
+                         fit_file, cycle, branches, j == 0)
         _temperature_panel(figure.add_subplot(grid[first_row + rows - 1, :]), data, wire,
                            fit.measured_profiles[k], fit.lags[k] is not None)
         first_row += rows
@@ -159,7 +185,7 @@ def _no_values(axis, rows, sources):
 
 
 def _stabilisation(files, rows, outliers=()):
-    figure = Figure(figsize=(9.0, 6.8 * len(files)))
+    figure = Figure(figsize=(9.0, 7.6 * len(files)))
     axes = figure.subplots(2 * len(files), 1, squeeze=False)[:, 0]
     for k, data in enumerate(files):
         top, bottom = axes[2 * k], axes[2 * k + 1]
@@ -171,7 +197,7 @@ def _stabilisation(files, rows, outliers=()):
                 axis.axvspan(cycle - 0.5, cycle + 0.5, color="0.85", zorder=0,
                              label="outlier cycle" if n == 0 else None)
             axis.set_xlim(numbers[0] - 0.6, numbers[-1] + 0.6)
-            axis.xaxis.set_major_locator(MaxNLocator(integer=True))
+            axis.xaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))
             axis.grid(alpha=0.3)
         drawn = False
         for quantity, colour in _QUANTITIES:
@@ -180,8 +206,8 @@ def _stabilisation(files, rows, outliers=()):
             top.plot(cycle, [r["data"] for r in these], "x", ms=4, color=colour, alpha=0.5)
             top.plot(cycle, [r["data_wire"] for r in these], "o", ms=4, color=colour,
                      label=f"{quantity} data")
-            top.plot(cycle, [r["model"] for r in these], "-s", lw=1.2, ms=3, color=colour,
-                     mfc="none", label=f"{quantity} model")
+            top.plot(cycle, [r["model"] for r in these], "-s", lw=1.2, ms=7, color=colour,
+                     mfc="none", zorder=3, label=f"{quantity} model")
             drawn = drawn or any(np.isfinite(r[s]) for r in these for s in ("data", "model"))
         if not drawn:
             _no_values(top, [r for r in mine if r["quantity"] in dict(_QUANTITIES)],
@@ -190,20 +216,31 @@ def _stabilisation(files, rows, outliers=()):
                       f"wire temperature, x: at the measured one, squares: model)", fontsize=10)
         top.set(xlabel="cycle", ylabel="temperature [degC]")
         if drawn:
-            top.legend(fontsize=7, ncol=4)
-        these = [r for r in mine if r["quantity"] == "residual_strain"]
+            top.legend(fontsize=7, ncol=5, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+        these = [r for r in mine if r["quantity"] == "residual_strain" and r["cycle"] not in odd]
         cycle = [r["cycle"] for r in these]
         bottom.plot(cycle, [r["data_wire"] for r in these], "o", ms=4, color="k",
                     label="data (wire temperature)")
-        bottom.plot(cycle, [r["model"] for r in these], "-s", ms=3, mfc="none",
+        bottom.plot(cycle, [r["model"] for r in these], "-s", ms=7, mfc="none", zorder=3,
                     color="tab:green", label="model")
         if any(np.isfinite(r[s]) for r in these for s in ("data_wire", "model")):
             bottom.legend(fontsize=7)
         else:
             _no_values(bottom, these, ("data_wire", "model"))
-        bottom.set(title="residual strain left by each cycle", xlabel="cycle",
-                   ylabel="residual strain [%]")
+        bottom.set(title="residual strain left by each cycle (outlier cycles not drawn)",
+                   xlabel="cycle", ylabel="residual strain [%]")
     return figure
+
+
+def _left_out(data, fit, k):
+    """Per sample of file ``k``: True where its strain was left out (an outlier cycle)."""
+    odd = {c["cycle"] for c in fit.outlier_cycles or () if c["file"] == str(data.path)}
+    bounds = fit.wire_bounds[k]
+    out = np.zeros(data.strain.size, dtype=bool)
+    for index, b in enumerate(data.branches):
+        if b.cycle in odd:
+            out[bounds[index]:bounds[index + 1]] = True
+    return out
 
 
 def _residuals(files, fit):
@@ -215,18 +252,27 @@ def _residuals(files, fit):
         strain, _ = file_model(fit.params, data, wire, offsets, fit.directions[k],
                                fit.row_levels[k], len(offsets) > 1)
         _residual_panel(axes[2 * k], sample, 100 * (strain - data.strain), 100 * sigma["strain"],
-                        "tab:blue", ylabel="model - data [% strain]",
+                        "tab:blue", _left_out(data, fit, k), ylabel="model - data [% strain]",
                         title=f"{data.path.name}: strain residuals (band: the noise estimate)")
         _residual_panel(axes[2 * k + 1], sample, data.temperature - measured, sigma["temperature"],
-                        "tab:orange", xlabel="time [s]" if data.time is not None else "sample",
+                        "tab:orange", None,
+                        xlabel="time [s]" if data.time is not None else "sample",
                         ylabel="measured - fitted [K]",
                         title="thermocouple temperature: measured minus fitted profile")
     return figure
 
 
-def _residual_panel(axis, sample, residual, noise, colour, **labels):
-    """Residuals against sample or time, with a band of +-``noise`` (the noise estimate)."""
-    axis.plot(sample, residual, ".", ms=1, alpha=0.5, color=colour)
+def _residual_panel(axis, sample, residual, noise, colour, left_out, **labels):
+    """Residuals against sample or time, with a band of +-``noise`` (the noise estimate);
+    ``left_out`` samples (outlier cycles) in grey, outside the axis range they would set."""
+    kept = np.ones(residual.size, dtype=bool) if left_out is None else ~left_out
+    axis.plot(sample[kept], residual[kept], ".", ms=1, alpha=0.5, color=colour)
+    if not kept.all():
+        axis.plot(sample[~kept], residual[~kept], ".", ms=1, alpha=0.3, color="0.6",
+                  label="outlier cycles, left out (partly beyond this range)")
+        low, high = np.percentile(residual[kept], [0.05, 99.95]) if kept.any() else (-1, 1)
+        margin = 0.2 * max(high - low, 2 * noise)
+        axis.set_ylim(min(low, -noise) - margin, max(high, noise) + margin)
     axis.axhspan(-noise, noise, color="tab:green", alpha=0.2, label="noise estimate")
     axis.set(**labels)
     axis.legend(fontsize=7)

@@ -134,7 +134,9 @@ def _rms(parts, prepared):
                 kept = f.weight > 0 if sigma_key != "temperature" else slice(None)
                 rms[key].append(parts[i][kept] * f.sigma[sigma_key])
                 noise[key].append(np.full(parts[i][kept].size, f.sigma[sigma_key]))
-                file_rms[-1][key] = float(np.sqrt(np.mean(rms[key][-1] ** 2)))
+                kept_rows = rms[key][-1]    # none when every cycle of the file was left out
+                file_rms[-1][key] = float(np.sqrt(np.mean(kept_rows ** 2))) if kept_rows.size \
+                    else float("nan")
                 i += 1
     rms = {key: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) if v else None
            for key, v in rms.items()}
