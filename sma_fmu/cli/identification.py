@@ -219,8 +219,9 @@ def register(commands):
     fit.add_argument("--lag", choices=("auto", "fit", "none"),
                      help="isobaric: fit the wire's first-order lag behind the thermocouple (in "
                           "seconds, or samples without a time column), assume none, or auto: "
-                          "fit it when every file holds two complete cycles or more "
-                          "(default: auto)")
+                          "fit it when every file holds two complete cycles or more crossing "
+                          "the transformation at rates that differ by 25 %% or more (at one "
+                          "rate a lag cannot be told from a wider hysteresis) (default: auto)")
     fit.add_argument("--stages", type=int, choices=(1, 2),
                      help="isobaric: transformation stages, each a logistic with its own centres "
                           "and widths on heating and cooling; 2 fits the second from the "
