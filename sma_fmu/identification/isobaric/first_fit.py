@@ -21,7 +21,7 @@ import numpy as np
 from scipy import sparse
 
 from sma_fmu.identification.isobaric.jacobian import (file_model, model_columns,
-                                                      scalar_sensitivities)
+                                                      scalar_sensitivities, sparse_rows)
 from sma_fmu.identification.isobaric.lag import lag_derivative, lagged
 from sma_fmu.identification.isobaric.profile import wire_rows
 from sma_fmu.identification.isobaric.solver import levenberg_marquardt
@@ -97,18 +97,11 @@ def first_fit(prepared, layout, x0, lower, upper, max_evaluations=200, ftol=1e-8
             for key in ("strain", "resistance"):
                 if columns[key] is None:
                     continue
-                dense = columns[f"{key}_phys"]
-                rows, cols = np.nonzero(dense)
-                parts = [(rows, cols, dense[rows, cols])]
-                if key == "strain":
-                    parts.append(columns["offsets"])
-                if d_tau is not None:
-                    n = profile.size
-                    parts.append((np.arange(n), np.full(n, lag), columns[f"{key}_T"] * d_tau))
-                block = sparse.csr_matrix(
-                    (np.concatenate([p[2] for p in parts]),
-                     (np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]))),
-                    shape=(profile.size, k))
+                n = profile.size
+                extra = [] if d_tau is None else \
+                    [(np.arange(n), np.full(n, lag), columns[f"{key}_T"] * d_tau)]
+                block = sparse_rows(columns[f"{key}_phys"],
+                                    columns["offsets"] if key == "strain" else None, extra, n, k)
                 blocks.append(sparse.diags(w[key]) @ block)
         return sparse.vstack(blocks).tocsr()
 

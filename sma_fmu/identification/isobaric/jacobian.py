@@ -30,7 +30,7 @@ from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constants import COOLING, HEATING
 
 __all__ = ["file_state", "file_model", "file_jacobian", "scalar_sensitivities",
-           "model_columns"]
+           "model_columns", "sparse_rows"]
 
 _RELATIVE = 1e-6      # relative step of the scalars' central differences
 _Q = [SCALARS.index(name) for name in Q_SCALARS]
@@ -158,7 +158,7 @@ def model_columns(x, layout, f, wire, direction, level, sensitivities):
     return out
 
 
-def _block(dense, offsets, extra, n, size):
+def sparse_rows(dense, offsets, extra, n, size):
     """Sparse (n x size) of dense physical columns, offset entries and (rows, cols, values)."""
     rows, cols = np.nonzero(dense)
     parts = [(rows, cols, dense[rows, cols])] + ([offsets] if offsets else []) + extra
@@ -191,5 +191,5 @@ def file_jacobian(x, layout, f, sensitivities=None):
         extra = [(lag_b.row, knots.start + lag_b.col, slope[lag_b.row] * lag_b.data)]
         if d_wire_d_tau is not None:
             extra.append((np.arange(n), np.full(n, layout.lags[f.index]), slope * d_wire_d_tau))
-        blocks.append(sparse.diags(weight / sigma) @ _block(dense, offs, extra, n, size))
+        blocks.append(sparse.diags(weight / sigma) @ sparse_rows(dense, offs, extra, n, size))
     return blocks

@@ -1,8 +1,9 @@
 """``sma-fmu predict isobaric FILE --model PARAMS [--stress MPA | --load KG] --out DIR``.
 
 Writes into DIR: ``predicted.csv`` (temperature fed [degC], measured and predicted strain
-[1] per sample, offset-matched and from the model's own zero), ``report.json`` (``residual_rms.strain``, the tangent-line and half-strain
-temperatures of both, how the plant was driven) and ``predict_isobaric.png`` (strain against
+[1] per sample, offset-matched and from the model's own zero), ``report.json``
+(``residual_rms``: both strain RMS; the tangent-line and half-strain temperatures of both,
+how the plant was driven) and ``predict_isobaric.png`` (strain against
 temperature, measured and predicted, and the residual against sample). Everything is
 computed first; a failure leaves DIR as it was.
 """
