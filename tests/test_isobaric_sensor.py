@@ -95,3 +95,17 @@ def test_the_fitted_temperature_stays_within_its_bound_of_the_thermocouple(tmp_p
     assert np.all(moved <= allowed + 1e-9)
     assert moved.max() > 0.1      # it moved: the bound is not a freeze
     assert fit.residual_rms["temperature_K"] <= 1.5 * fit.noise["temperature_K"]
+
+
+def test_the_fit_shows_its_evaluations_on_a_progress_bar(tmp_path, params):
+    """The bar the command line shows (tqdm), here written to a string: the stages and the
+    evaluations as they run."""
+    import io
+    from tqdm import tqdm
+    stream = io.StringIO()
+    data, _ = _file(tmp_path, params, rates=(12.0,), lag_s=0.0, cycles=3, points=1200)
+    fit = fit_isobaric([data], params, lag="none", widths="shared",
+                       meter=lambda: tqdm(file=stream, disable=False, mininterval=0))
+    text = stream.getvalue()
+    assert "first fit" in text and "joint fit" in text
+    assert f"{fit.evaluations}it" in text.replace(" ", "")

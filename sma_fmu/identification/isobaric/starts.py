@@ -33,7 +33,7 @@ __all__ = ["starts", "LAG_LIMIT", "BOUNDS", "PROFILE_BOUND", "PROFILE_TOLERANCE_
 
 LAG_LIMIT = 1 / 20       # of a cycle: the largest lag the fit may reach (the lag guard)
 PROFILE_BOUND = 5.0      # standard errors the profile's knots may move from the temperature's fit
-PROFILE_TOLERANCE_K = 2.5   # or this far, where larger: a thermocouple's tolerance (IEC 60584 class 2)
+PROFILE_TOLERANCE_K = 2.5   # or this far where larger: IEC 60584 class-2 thermocouple tolerance
 BOUNDS = {"w2": (0.0, 0.95), "alpha_P": (-2e-3, 2e-3),
           "alpha_MF": (-2e-3, 2e-3), "span_ratio_0": (0.01, 10.0), "span_stress": (1.0, 5000.0)}
 

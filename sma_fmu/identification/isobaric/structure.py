@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from sma_fmu.identification.isobaric.first_fit import first_fit
+from sma_fmu.identification.isobaric.first_fit import ROUNDS, first_fit
 from sma_fmu.identification.isobaric.jacobian import file_jacobian, scalar_sensitivities
 from sma_fmu.identification.isobaric.outcome import residual_blocks
 from sma_fmu.identification.isobaric.outliers import mark_outliers
@@ -32,7 +32,8 @@ LAG_STARTS = (1 / 300, 1 / 100, 1 / 50, 1 / 25, 1 / 12, 1 / 6)   # of a cycle
 
 
 class Clock:
-    """Counts model evaluations and moves a progress bar (``meter(total)``: tqdm-like or None)."""
+    """Counts model evaluations and moves a progress bar (``meter()`` returns a tqdm-like bar;
+    None: no bar)."""
 
     def __init__(self, meter):
         self.began = time.perf_counter()
@@ -105,11 +106,11 @@ class _Trial:
     weights: list = None
 
 
-def _first(prepared, trial, clock, evaluations=100, rounds=None):
+def _first(prepared, trial, clock, evaluations=100, rounds=ROUNDS):
+    """``trial`` with its first fit done (at most ``evaluations`` per run, ``rounds`` runs)."""
     trial.solution, trial.weights = first_fit(prepared, trial.layout, trial.vector, trial.lower,
                                               trial.upper, evaluations, FIRST_FTOL,
-                                              tick=clock.tick,
-                                              **({"rounds": rounds} if rounds else {}))
+                                              tick=clock.tick, rounds=rounds)
     return trial
 
 
@@ -151,8 +152,9 @@ def choose(prepared, base, layout_of, kind, widths, stages, lagged, outliers, cl
     def richer(count, width_kind):
         """The richer layout from the kept one's solution, and from the data's own starts."""
         fresh = trial_of(count, width_kind)
-        carried = _Trial(fresh.layout, _carry(trial.layout, with_head(trial.vector, trial.solution.x),
-                                               fresh.layout, fresh.vector), fresh.lower, fresh.upper)
+        kept = with_head(trial.vector, trial.solution.x)
+        carried = _Trial(fresh.layout, _carry(trial.layout, kept, fresh.layout, fresh.vector),
+                         fresh.lower, fresh.upper)
         tries = [_first(prepared, carried, clock)]
         if count == 2:
             tries.append(_first(prepared, fresh, clock))
