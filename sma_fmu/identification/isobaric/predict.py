@@ -13,9 +13,11 @@ The temperature fed is the file's temperature profile (the piecewise-linear curv
 also starts from, :mod:`~.profile`): thermocouple noise would otherwise make the plant
 reverse at every sample and walk minor loops the wire never saw. ``--lag`` delays it by the
 wire's first-order lag behind the thermocouple (the value ``fit isobaric`` reports; default
-0: the FMU itself has no thermocouple). Strain = length /
-reference length - 1, shifted by one constant, the median difference from the measured
-strain (a lab's strain zero is its own; the fit gives each file its offset too).
+0: the FMU itself has no thermocouple). Two predicted strains are reported, and named:
+from the model's own zero, length / reference length - 1 (the reference length and the
+fitted phase lengths, nothing taken from the measured strain), and offset-matched, that
+shifted by one constant, the median difference from the measured strain (a lab's strain
+zero is its own; the fit gives each file its offset too).
 """
 import math
 import time
@@ -107,6 +109,7 @@ def predict_file(data, params, lag=0.0):
     offset = float(np.median(data.strain - raw))
     predicted = raw + offset
     residual = predicted - data.strain
+    own_rms = float(np.sqrt(np.mean((raw - data.strain) ** 2)))
     seconds = time.perf_counter() - began
     measured_t, measured_why = _tangents(data.smoothed, data.strain, data.branches)
     model_t, model_why = _tangents(data.smoothed, predicted, data.branches)
@@ -117,8 +120,10 @@ def predict_file(data, params, lag=0.0):
         "stress_column_MPa": data.stress_column,
         "columns": {q: list(v) for q, v in data.columns.items()},
         "strain_column_note": data.strain_note,
-        "residual_rms": {"strain": float(np.sqrt(np.mean(residual ** 2)))},
+        "residual_rms": {"strain": float(np.sqrt(np.mean(residual ** 2))),
+                         "strain_own_zero": own_rms},
         "strain_offset": offset,
+        "reference_length_m": data.reference_length,
         "transformation_temperatures": {"measured": measured_t, "predicted": model_t,
                                         "predicted_minus_measured": {
                                             k: model_t[k] - measured_t[k] for k in model_t},
@@ -129,10 +134,13 @@ def predict_file(data, params, lag=0.0):
                   "step_s": step, "largest_temperature_deviation_K": deviation,
                   "lag": {"value": lag, "unit": "s" if data.time is not None else "samples"},
                   "hysteresis_mode": "continuous", "seconds": seconds},
-        "note": "strain = plant length / reference length - 1 + strain_offset (the median "
-                "difference from the measured strain; the plant has no residual-strain drift "
-                "from cycle to cycle); tangent-line and half-strain temperatures of both "
-                "against the measured (smoothed) temperature",
+        "note": "residual_rms.strain: offset-matched, the prediction plant length / "
+                "reference length - 1 shifted by strain_offset (the median difference from the "
+                "measured strain; the plant has no residual-strain drift from cycle to cycle); "
+                "residual_rms.strain_own_zero: the same prediction unshifted, from the model's "
+                "own zero (reference_length_m and the fitted phase lengths); tangent-line and "
+                "half-strain temperatures of the offset-matched prediction and the data against "
+                "the measured (smoothed) temperature",
     }
-    return {"predicted": predicted, "measured": data.strain, "temperature": profile,
-            "report": report}
+    return {"predicted": predicted, "own_zero": raw, "measured": data.strain,
+            "temperature": profile, "report": report}
