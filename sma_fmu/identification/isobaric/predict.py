@@ -4,7 +4,8 @@ lab file's measured temperature history at its stress, against the measured stra
 How the plant is driven: :class:`sma_fmu.runtime.plant.PlantStepper` takes electric power,
 not temperature. Its thermal stage is made to follow the file's temperature exactly: a copy
 of the parameters with the room temperature 50 K below the file's lowest reading and a
-convection coefficient 10^6 times larger (a thermal time constant far below one step), and
+heat capacity 10^6 times smaller (a thermal time constant far below one step; every value
+stays inside its plausible range), and
 each step's power from :func:`sma_fmu.runtime.thermal.power_to_reach`. Everything after the
 temperature, the branch switching, the minor-loop memory and the length with the
 optional model terms, is the FMU's own code, in its default ("continuous") hysteresis mode.
@@ -37,7 +38,7 @@ from sma_fmu.runtime.thermal import power_to_reach, step_decay
 __all__ = ["drive_plant", "predict_file", "TANGENT_KEYS"]
 
 _ROOM_BELOW_K = 50.0
-_CONVECTION_FACTOR = 1e6
+_CAPACITY_FACTOR = 1e6
 TANGENT_KEYS = {HEATING: ("A_s", "A_f"), -HEATING: ("M_s", "M_f")}
 
 
@@ -47,7 +48,7 @@ def drive_plant(params, temperature, load, step_s=1.0):
     the plant's temperature from the one asked for."""
     temperature = np.asarray(temperature, dtype=float)
     driven = params.replace(T_room=float(temperature.min()) - _ROOM_BELOW_K,
-                            h_c=params.h_c * _CONVECTION_FACTOR,
+                            c_p=params.c_p / _CAPACITY_FACTOR,
                             T_max=max(params.T_max, float(temperature.max()) + 1.0))
     plant = PlantStepper(driven, T_start=float(temperature[0]), load=load)
     decay = step_decay(step_s, driven.tau_th)
