@@ -32,12 +32,16 @@ centre in :mod:`~.terms`.
 __all__ = ["LinearCentres"]
 
 
+# [degC] the centres' bounds when no measured range is given
+DEFAULT_TEMPERATURES = (-100.0, 400.0)
+
+
 class LinearCentres:
     """The centres of one stage (1 or 2) as unknowns, for the distinct ``loads`` [kg] of
     the files; ``base`` gives the slopes when one load cannot; ``temperatures`` = (lowest,
     highest) measured temperature [degC] bounds the centres."""
 
-    def __init__(self, loads, base, stage=1, temperatures=(-100.0, 400.0)):
+    def __init__(self, loads, base, stage=1, temperatures=DEFAULT_TEMPERATURES):
         loads = sorted({float(f) for f in loads})
         self.stage = stage
         self.prefix = "" if stage == 1 else "2"

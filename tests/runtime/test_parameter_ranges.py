@@ -12,6 +12,7 @@ import math
 import pytest
 
 from sma_fmu.identification.isobaric.starts import BOUNDS
+from sma_fmu.identification.isobaric.centres import DEFAULT_TEMPERATURES
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.parameters import (PARAMETER_SPECS, RULES, ParameterError, range_text,
@@ -52,14 +53,15 @@ def test_every_parameter_has_a_range_that_agrees_with_its_rule():
 
 
 def test_what_a_fit_or_the_command_line_may_reach_lies_inside_the_ranges():
-    """The isobaric fit's own bounds (identification/isobaric/starts.py) and the fit's
+    """The isobaric fit's own bounds (identification/isobaric/starts.py, centres.py) and the fit's
     --stress (0, 2000] MPa and --load [0, 10] kg: a fitted file is never refused."""
-    inside = {"a_c": ("a_c", BOUNDS["a_c"]), "b_c": ("b_c", BOUNDS["b_c"]),
-              "w2": ("w2", BOUNDS["w2"]), "alpha_P": ("alpha_P", BOUNDS["alpha_P"]),
+    low, high = DEFAULT_TEMPERATURES   # the centres' bounds (the measured range, within these)
+    lead = high - low   # the heating lead over the cooling centre: LinearCentres.bounds("gap0")
+    inside = {"a_c": ("a_c", (low, high)), "w2": ("w2", BOUNDS["w2"]), "alpha_P": ("alpha_P", BOUNDS["alpha_P"]),
               "alpha_MF": ("alpha_MF", BOUNDS["alpha_MF"]),
               "span_ratio_0": ("span_ratio_0", BOUNDS["span_ratio_0"]),
               "span_stress": ("span_stress", BOUNDS["span_stress"]),
-              "a_h": ("a_h", (BOUNDS["a_c"][0], BOUNDS["a_c"][1] + BOUNDS["gap0"][1])),
+              "a_h": ("a_h", (low, high + lead)),
               "R_MF": ("R_M", (1e-3, 1e4)), "stress": ("stress_max", (1e-3, 2000.0)),
               "load": ("model_load", (0.0, 10.0))}
     for what, (name, (low, high)) in inside.items():
