@@ -88,17 +88,37 @@ def fmi2_targets():
 def zig_command():
     """zig cc as a command list: ``$SMA_FMU_ZIG_CC`` split like a shell would (``none``: no
     zig), else ``python -m ziglang cc`` when PyPI's ``ziglang`` is installed in this Python,
-    else ``zig cc`` or ``python-zig cc`` (ziglang's script, e.g. of an activated venv: what
-    an isolated wheel build finds) on the PATH, else None."""
+    else ``zig cc`` on the PATH, else the zig of the ``ziglang`` package whose script
+    ``python-zig`` is on the PATH (e.g. of an activated venv: what an isolated wheel build
+    finds), else None."""
     given = os.environ.get("SMA_FMU_ZIG_CC", "").strip()
     if given:
         return None if given.lower() == "none" else shlex.split(given)
     if importlib.util.find_spec("ziglang") is not None:
         return [sys.executable, "-m", "ziglang", "cc"]
-    for program in ("zig", "python-zig"):
-        if shutil.which(program):
-            return [program, "cc"]
-    return None
+    if shutil.which("zig"):
+        return ["zig", "cc"]
+    script = shutil.which("python-zig")
+    return None if script is None else _ziglang_binary(script)
+
+
+def _ziglang_binary(script):
+    """[zig, "cc"] of the ``ziglang`` package whose script ``python-zig`` is ``script``: its
+    own Python (the script's first line) names the package's folder. That Python is asked
+    without the calling process's PYTHONPATH, which an isolated wheel build points at its own
+    packages only, so that the script itself, run there, cannot import ziglang."""
+    with open(script, "rb") as handle:
+        first = handle.readline().decode("utf-8", "replace").strip()
+    interpreter = shlex.split(first[2:]) if first.startswith("#!") else [sys.executable]
+    clean = {key: value for key, value in os.environ.items()
+             if key not in ("PYTHONPATH", "PYTHONNOUSERSITE", "PYTHONHOME")}
+    try:
+        found = subprocess.run([*interpreter, "-c", "import ziglang, os; print(os.path.dirname(ziglang.__file__))"],
+                               capture_output=True, text=True, env=clean, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    zig = Path(found.stdout.strip()) / ("zig.exe" if os.name == "nt" else "zig")
+    return [str(zig), "cc"] if found.returncode == 0 and zig.is_file() else None
 
 
 def _x86_64_linux():
