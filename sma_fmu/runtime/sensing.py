@@ -31,7 +31,7 @@ from .minor_loops import (DENOMINATOR_FLOOR, fractions_of_value, fractions_on_st
 from .reachable_band import band_of_branch
 
 __all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of_fractions",
-           "temperature_on_stack", "invert_on_stack", "sense_temperature"]
+           "temperature_on_stack", "invert_on_stack", "sense_temperature", "inverse_method"]
 
 SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
 SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
@@ -195,3 +195,13 @@ def sense_temperature(resistance, load, direction, params, reversals=()):
     xi_mf, xi_p = mixed_fractions_of_resistance(resistance, constants, params)
     return temperature_on_stack(xi_mf, xi_p, constants, sign, list(reversals),
                                 params.saturation_margin)[0]
+
+
+def inverse_method(two_stage):
+    """How :func:`temperature_of_fractions` finds T [text]: what the FMUs' pages say, so the
+    words follow the code. ``two_stage``: the branch has a second stage (w2 > 0)."""
+    if not two_stage:
+        return "closed form, T_K = 1/(1/tau_K - k_B Lambda/dH(f))"
+    return (f"bisection on 1/T_K between the two stages' closed-form inverses, which bracket "
+            f"the root; the midpoint halves the bracket until it equals an end (at most "
+            f"{BISECTION_CAP} halvings, about 50 in practice), exact to the last bit of 1/T_K")
