@@ -89,7 +89,7 @@ TERM_PAGES = (
         lambda p: p.terms.span_ratio_0 != 1.0 or p.terms.span_ratio_sat != 1.0,
         ("span_ratio_0", "span_ratio_sat", "span_stress"),
         '<p class="eq">s(σ) = s<sub>sat</sub> + (s<sub>0</sub> − s<sub>sat</sub>) '
-        "e<sup>−σ/σ<sub>s</sub></sup> [1], &nbsp; σ = g f/(π d<sup>2</sup>/4) [MPa]</p>\n"
+        "e<sup>−σ/σ<sub>s</sub></sup> [1], &nbsp; σ = g f/(π d<sup>2</sup>/4) in MPa</p>\n"
         '<p class="eq">ℓ<sub>i</sub>(f) = ℓ<sub>P</sub> + s(σ) (ℓ<sub>i</sub> − ℓ<sub>P</sub>), '
         "i = M, F [m]</p>\n"
         '<p class="eq">s<sub>0</sub> = ${span_ratio_0}, &nbsp; s<sub>sat</sub> = '
