@@ -51,6 +51,7 @@ def _meter():
 
 def _fit_isobaric(args, out):
     import sys
+    from sma_fmu.identification.coverage import coverage_lines
     from sma_fmu.identification.isobaric.runner import format_isobaric_report, run_isobaric_fit
     _check_fit_loads(args)
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
@@ -60,6 +61,7 @@ def _fit_isobaric(args, out):
                               outliers="keep" if args.keep_outliers else "leave-out",
                               widths=args.widths or "auto", meter=_meter)
     print(format_isobaric_report(report))
+    print("\n".join(coverage_lines(report)))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
           f"figures")
     solver = report["solver"]
