@@ -5,8 +5,9 @@ duration they share (metrics only, no time series kept; a run that fails there i
 again on the scalar library path, so its row says ``path = library``). A run that cannot
 be built or fails is a row with ``status = "failed"`` and the reason in ``error``, never
 dropped. With ``fmu_dir`` (``sma-fmu sweep --fmus DIR``) each run goes through the C master
-over the FMUs there instead (:func:`~sma_fmu.systems.c_master.run_c_master`, metrics only,
-streamed; ``path = "fmu"``): FMU-path studies at C speed.
+over the FMUs there instead, in the worker's long-lived C master
+(:func:`~sma_fmu.systems.c_master.process_master`: one host process, the FMUs loaded once,
+reset between runs; metrics only, streamed; ``path = "fmu"``): FMU-path studies at C speed.
 """
 from sma_fmu.studies.batch import run_batches
 from sma_fmu.studies.overrides import StudyError
@@ -45,14 +46,16 @@ class _Outcome:
 
 
 def _c_master_runs(scenarios, fmu_dir):
-    """An outcome per scenario, run in the C master over the FMUs in ``fmu_dir``."""
+    """An outcome per scenario, run in this process's long-lived C master over the FMUs in
+    ``fmu_dir`` (one host and its loaded FMUs for all the tasks a worker runs)."""
     from sma_fmu.cosim.metrics import StreamingMetrics
-    from sma_fmu.systems.c_master import run_c_master
+    from sma_fmu.systems.c_master import process_master
 
+    master = process_master(fmu_dir)
     for scenario in scenarios:
         metrics = StreamingMetrics(scenario)
         try:
-            run_c_master(scenario, fmu_dir, metrics.update)
+            master.run(scenario, metrics.update)
         except (ValueError, RuntimeError) as error:  # a bad FMU or a failed call (FmuError)
             yield _Outcome(None, str(error))
             continue

@@ -9,20 +9,31 @@ outputs after initialization and after every step as raw doubles, in frames of
 rows (:mod:`.c_master_rows`) and go to the sink in the fmpy master's blocks, so the
 recorder, the metrics and the figures are those of the fmpy master, to the bit.
 
+:class:`CMaster` pays the fixed cost once for many runs (the scenarios of one command, the
+points of one study): one host process (:mod:`.c_master_host`), each FMU file unpacked
+once per process (:mod:`~sma_fmu.fmi.driving.unpacked`) and loaded once in the host, each
+instance reset (fmi2Reset) between runs instead of freed. A run after a reset equals a
+run in a fresh host, to the bit. :func:`run_c_master` is one run in a master of its own.
+
 A missing FMU, a model whose variables do not match, or a failed call gets a named error
 (:class:`CMasterError`): a failed step ends the run there, the rows up to it are given to
 the sink (and kept in the error), and the message names the FMU, the call and the time.
-A host that sends nothing for ``timeout_s`` seconds (a hung FMU) is killed and the run
-fails naming the time it reached (:data:`DEFAULT_TIMEOUT_S`; ``sma-fmu run --timeout``).
+**Choice: after a failed call (fmi2Discard, fmi2Error) the host stays** (no restart to
+pay); that run's instances are freed and the next run makes new ones, so nothing of the
+failed run reaches it. After fmi2Fatal, a host that died, or a timeout the next run starts
+a new host. A host that sends nothing for ``timeout_s`` seconds while a run waits for it (a
+hung FMU) is killed and the run fails naming the time it reached
+(:data:`DEFAULT_TIMEOUT_S`; ``sma-fmu run --timeout``).
 
 With a :class:`~sma_fmu.cosim.recording.RunRecorder` writing CSV as the sink, the host
 writes the CSV's rows itself (its "csv" line; the same text as the recorder's, byte for
 byte, about ten times faster than Python's formatting); the recorder still gets every
 row for the metrics and the figure.
 """
+import atexit
 import os
-import re
 import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -32,17 +43,19 @@ from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.unpacked import acquire, release
 from sma_fmu.fmi.hosts import CHostError, compile_host
 from sma_fmu.fmi.loop.system import check_variables
+from sma_fmu.systems.c_master_host import (STATUS_NAMES, HostProcess, failed_call, host_stderr,
+                                           log_entry)
 from sma_fmu.systems.c_master_rows import RowAssembler, csv_columns, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
 
-__all__ = ["MASTERS", "DEFAULT_TIMEOUT_S", "CMasterError", "run_c_master"]
+__all__ = ["MASTERS", "DEFAULT_TIMEOUT_S", "CMasterError", "CMaster", "run_c_master",
+           "process_master", "close_process_masters"]
 
 MASTERS = ("fmpy", "c")   # `sma-fmu run --master`: the fmpy master, or this one
 # [s] the longest the host may send nothing (choice: a frame of 4,096 steps takes about 1 ms,
 # wine's start a few seconds; a minute of silence is a hung FMU, not a slow one)
 DEFAULT_TIMEOUT_S = 60.0
-_STATUS = {2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal"}
 
 
 class CMasterError(FmuError):
@@ -68,178 +81,232 @@ def _loop_host(cache, windows):
     return executable
 
 
-def _widen(pipe):
-    """A 1 MiB pipe (Linux): the host steps on while the rows of two frames wait here."""
-    try:
-        import fcntl
-        fcntl.fcntl(pipe.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), 1 << 20)
-    except (ImportError, OSError):  # another system, or a lower pipe-max-size: the default
-        pass
-
-
-def _read_frames(stream):
-    """(tag, payload) frames from the host's stdout until it closes."""
-    while True:
-        head = stream.read(8)
-        if len(head) < 8:
-            return
-        size = int.from_bytes(head[4:], "little")
-        payload = stream.read(size) if size else b""
-        if len(payload) < size:   # cut short: the host died (or was killed) in a frame
-            return
-        yield head[:4], payload
-
-
-class _Watchdog:
-    """Kills ``host`` when :meth:`alive` was not called for ``seconds`` (checked a few times
-    a second from a thread of its own); ``fired`` says whether it did."""
-
-    def __init__(self, host, seconds):
-        self.host, self.seconds, self.fired = host, seconds, False
-        self.last = time.monotonic()
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._watch, name="c-master-watchdog", daemon=True)
-        self._thread.start()
-
-    def alive(self):
-        self.last = time.monotonic()
-
-    def _watch(self):
-        while not self._stop.wait(min(0.25, self.seconds / 4)):
-            if time.monotonic() - self.last > self.seconds:
-                self.fired = True
-                self.host.kill()
-                return
-
-    def stop(self):
-        self._stop.set()
-        self._thread.join()
-
-
-def _log_entry(payload):
-    """(status, component, text) of a LOG_ frame."""
-    head, _, text = payload.decode("utf-8", "replace").partition("\t")
-    status, name, _category = (head.split(" ") + ["", ""])[:3]
-    return int(status), name, text
-
-
-_FAIL = re.compile(r"(?P<name>[^.]+)\.(?P<call>.+) returned (?P<status>-?\d+) at t = (?P<time>\S+) s")
-
-
-def _failure(scenario, text, logs, rows, windows):
+def _failure(scenario, text, logs, rows, where):
     """The :class:`CMasterError` of a FAIL frame ``text``: "NAME.CALL returned S at t = T s"."""
-    match = _FAIL.fullmatch(text.strip())
-    if match is None:  # not the host's form: say it as it came
-        name, call, status, time_s = "?", text, 3, None
-    else:
-        name, call = match["name"], match["call"]
-        status, time_s = int(match["status"]), float(match["time"])
+    name, call, status, time_s = failed_call(text)
     said = "; ".join(t for s, n, t in logs if n == name and s >= 2) or "no message"
-    where = " (win64, wine)" if windows is not None else ""
     when = "" if time_s is None else f" at t = {time_s:g} s"
     message = (f"scenario {scenario.name}: C master{where}: {name}: {call} failed "
-               f"({_STATUS.get(status, status)}){when}: {said}; the run stopped there "
+               f"({STATUS_NAMES.get(status, status)}){when}: {said}; the run stopped there "
                f"({rows} rows kept)")
     return CMasterError(message, status, time_s=time_s)
 
 
+class CMaster:
+    """The C master over the FMUs in ``fmu_dir`` for many runs (:meth:`run`): one host
+    process and the FMUs it loaded, kept until :meth:`close` (or the end of a ``with``).
+
+    ``windows``: None for the linux64 build, else the environment of a wine64 prefix (the
+    win64 host with the FMUs' win64 binaries). ``cache``: the host's build folder (default:
+    the temporary folder). ``timeout_s``: the longest [s] the host may send nothing while a
+    run waits for it before it is killed. ``startup_s`` [s]: the time spent so far starting
+    hosts, unpacking FMUs and loading them in the host (not part of any run's wall time);
+    ``hosts_started``: how many host processes it started.
+    """
+
+    def __init__(self, fmu_dir, windows=None, cache=None, timeout_s=DEFAULT_TIMEOUT_S):
+        if not (isinstance(timeout_s, (int, float)) and timeout_s > 0):
+            raise ValueError(f"the C master's timeout must be a number of seconds > 0, got {timeout_s!r}")
+        self.fmu_dir, self.windows, self.cache, self.timeout_s = fmu_dir, windows, cache, timeout_s
+        self.where = " (win64, wine)" if windows is not None else ""
+        self.startup_s, self.hosts_started = 0.0, 0
+        self._host, self._loaded = None, set()
+        self._unpacked = {}   # FMU file -> Unpacked, held until close
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *_):
+        self.close()
+
+    def close(self):
+        """Stop the host (it frees its instances) and end the use of the unpacked FMUs."""
+        self._stop_host()
+        for unpacked in self._unpacked.values():
+            release(unpacked)
+        self._unpacked = {}
+
+    def _stop_host(self, kill=False):
+        host, self._host, self._loaded = self._host, None, set()
+        if host is None:
+            return None, ""
+        if kill:
+            host.close(kill=True)
+        return host.finish()
+
+    def _folder(self, path):
+        """The folder (text, as the host sees it) of the FMU file ``path``, unpacked once per
+        file version (a rebuilt file: unpacked again, in a new host)."""
+        key, stat = str(path), os.stat(path)
+        held = self._unpacked.get(key)
+        if held is not None and held.key[1:] != (stat.st_size, stat.st_mtime_ns):
+            self._stop_host()
+            release(self._unpacked.pop(key))
+            held = None
+        if held is None:
+            held = self._unpacked[key] = acquire(path)
+        return wine_path(held.folder) if self.windows is not None else str(held.folder)
+
+    def _start(self, scenario, system):
+        """Unpack the FMUs of ``system``, start a host if none runs and load those it has not
+        loaded yet; {component: folder}. The time goes to :attr:`startup_s`."""
+        started = time.perf_counter()
+        try:
+            folders = {c.name: self._folder(c.fmu) for c in system.components}
+            if self._host is not None and self._host.process.poll() is not None:
+                self._stop_host()   # it died between runs (killed from outside): a new one
+            if self._host is None:
+                try:
+                    executable = _loop_host(self.cache, self.windows is not None)
+                except CHostError as error:   # no compiler: one named error, not an internal one
+                    raise CMasterError(f"scenario {scenario.name}: C master: {error}", 3) from None
+                command = ([str(executable)] if self.windows is None
+                           else [wine_executable(), str(executable)])
+                environment = dict(os.environ if self.windows is None else self.windows)
+                environment.pop("LD_PRELOAD", None)
+                stderr = host_stderr()
+                process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                           stderr=stderr, env=environment)
+                self._host = HostProcess(process, stderr, self.timeout_s)
+                self.hosts_started += 1
+            new = [folder for folder in dict.fromkeys(folders.values()) if folder not in self._loaded]
+            if new and not (self._host.send([f"load {folder}" for folder in new])
+                            and all(self._loaded_one() for _ in new)):
+                self._host_died(scenario, None, 0.0)
+            self._loaded.update(new)
+            return folders
+        finally:
+            self.startup_s += time.perf_counter() - started
+
+    def _loaded_one(self):
+        """Whether the host's next frame is the answer to a load line."""
+        return [tag for tag, _ in self._host.frames(last=(b"LOAD",))][-1:] == [b"LOAD"]
+
+    def _host_died(self, scenario, rows, reached):
+        """Raise the :class:`CMasterError` of a host that died, or that the watchdog killed
+        (``rows``: the rows recorded, or None before the run; ``reached`` [s]: its time)."""
+        timed_out = self._host.timed_out
+        status, said = self._stop_host(kill=True)
+        if timed_out:
+            raise CMasterError(f"scenario {scenario.name}: C master{self.where}: no output for "
+                               f"{self.timeout_s:g} s at t = {reached:g} s: the host was stopped "
+                               f"(an FMU hangs?); {rows or 0} rows were recorded", 3, time_s=reached)
+        raise CMasterError(f"scenario {scenario.name}: C master{self.where}: exit status {status}: "
+                           f"{said.splitlines()[-1] if said else 'no message'}", 3)
+
+    def _lines(self, scenario, system, folders, columns, sink):
+        """The host's lines for one run of ``system`` (the CSV line when ``sink`` hands its
+        CSV file to the host)."""
+        lines = loop_host_lines(system, folders, scenario.steps, columns=columns)
+        lines[-1] += f" binary {ROWS_PER_CHUNK}"
+        text = getattr(sink, "csv_for_host", None)   # a RunRecorder writing CSV: the host writes it
+        text = text() if text is not None else None
+        if text is not None:
+            path, every, last = text
+            name = os.fsencode(path) if self.windows is None else wine_path(path).encode("utf-8")
+            lines.insert(-1, f"csv {name.hex()} {every} {last} {csv_columns(columns)}")
+        return lines
+
+    def run(self, scenario, sink=None):
+        """Run ``scenario``; a :class:`LoopResult` (``path`` "fmu"), its ``data`` None when
+        ``sink`` took the rows (see :func:`~sma_fmu.cosim.loop.run_loop`), its
+        ``wall_time_s`` the run's own (the start-up it needed is in :attr:`startup_s`).
+
+        Raises :class:`~sma_fmu.fmi.loop.system.MissingFmuError` for a missing FMU,
+        ``ValueError`` naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and
+        the variable when its variables do not match, and :class:`CMasterError` when a call
+        fails (the rows up to that step kept), the host died, or it sent nothing for
+        ``timeout_s`` s (killed; the rows so far are not kept).
+        """
+        started, before = time.perf_counter(), self.startup_s
+        system = closed_loop(scenario, self.fmu_dir)
+        newer = sorted((c.model, str(c.fmu)) for c in system.components if c.fmi_version != "2")
+        if newer:  # the loop host is an FMI 2.0 host (fmi2 calls, fmi2 binaries)
+            raise ValueError(f"{newer[0][1]} is an FMI 3.0 FMU: the C master runs FMI 2.0 FMUs "
+                             f"(sma-fmu build --native); run FMI 3.0 FMUs with --master fmpy")
+        check_variables(system)
+        folders = self._start(scenario, system)
+        columns = recorded_columns(system)
+        rows = RowAssembler(scenario, columns, sink)
+        logs, failure, done = [], None, False
+        try:
+            if self._host.send(self._lines(scenario, system, folders, columns, sink)):
+                for tag, payload in self._host.frames():
+                    if tag == b"ROWS":
+                        rows.add(payload)
+                    elif tag == b"LOG_":
+                        entry = log_entry(payload)
+                        if entry[0] >= 2:  # what a failure quotes (warnings are not kept: a
+                            logs.append(entry)  # long run may log one per step)
+                    elif tag == b"FAIL":
+                        failure = payload.decode("utf-8", "replace")
+                    elif tag == b"DONE":
+                        done = True
+        except BaseException:   # the sink failed, or an interrupt: the host is mid-run
+            self._stop_host(kill=True)
+            raise
+        if failure is not None:
+            kept = rows.finish()   # the rows up to the failed step, the last without step outputs
+            error = _failure(scenario, failure, logs, rows.count, self.where)
+            if error.status >= 4:   # fmi2Fatal: the host ended itself
+                self._stop_host(kill=True)
+            error.rows = kept
+            raise error
+        if not done:
+            self._host_died(scenario, rows.count, rows.count * scenario.step_s if rows.started else 0.0)
+        data = rows.finish()
+        wall = time.perf_counter() - started - (self.startup_s - before)
+        return LoopResult(scenario, data, "fmu", wall)
+
+
 def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
                  timeout_s=DEFAULT_TIMEOUT_S):
-    """Run ``scenario`` through the FMUs in ``fmu_dir`` in the C master; a :class:`LoopResult`
-    (``path`` "fmu"), its ``data`` None when ``sink`` took the rows (see
-    :func:`~sma_fmu.cosim.loop.run_loop`). ``windows``: None for the linux64 build, else the
-    environment of a wine64 prefix (the win64 host with the FMUs' win64 binaries).
-    ``timeout_s``: the longest [s] the host may send nothing before it is killed.
-
-    Raises :class:`~sma_fmu.fmi.loop.system.MissingFmuError` for a missing FMU, ``ValueError``
-    naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and the variable when its
-    variables do not match, and
-    :class:`CMasterError` when a call fails (the rows up to that step kept) or the host
-    sends nothing for ``timeout_s`` s (killed; the rows so far are not kept).
-    """
-    if not (isinstance(timeout_s, (int, float)) and timeout_s > 0):
-        raise ValueError(f"the C master's timeout must be a number of seconds > 0, got {timeout_s!r}")
+    """Run ``scenario`` through the FMUs in ``fmu_dir`` in a C master of its own (a new host,
+    stopped at the end; :meth:`CMaster.run` says what it returns and raises). Its
+    ``wall_time_s`` includes that host's start and loading its FMUs."""
     started = time.perf_counter()
-    system = closed_loop(scenario, fmu_dir)
-    newer = sorted((c.model, str(c.fmu)) for c in system.components if c.fmi_version != "2")
-    if newer:  # the loop host is an FMI 2.0 host (fmi2 calls, fmi2 binaries)
-        raise ValueError(f"{newer[0][1]} is an FMI 3.0 FMU: the C master runs FMI 2.0 FMUs "
-                         f"(sma-fmu build --native); run FMI 3.0 FMUs with --master fmpy")
-    check_variables(system)
-    unpacked = []   # each FMU unpacked once per process, removed at its exit (driving.unpacked)
-    try:
-        for component in system.components:
-            unpacked.append(acquire(component.fmu))
-        return _run(scenario, system, [u.folder for u in unpacked], sink, windows, cache,
-                    timeout_s, started)
-    finally:
-        for folder in unpacked:
-            release(folder)
+    with CMaster(fmu_dir, windows, cache, timeout_s) as master:
+        result = master.run(scenario, sink)
+    result.wall_time_s = time.perf_counter() - started
+    return result
 
 
-def _run(scenario, system, unpacked, sink, windows, cache, timeout_s, started):
-    """:func:`run_c_master` with the FMUs of ``system`` unpacked in the folders ``unpacked``."""
-    folders = {c.name: folder for c, folder in zip(system.components, unpacked)}
-    if windows is not None:
-        folders = {name: wine_path(folder) for name, folder in folders.items()}
-    try:
-        executable = _loop_host(cache, windows is not None)
-    except CHostError as error:   # no compiler: one named error, not an internal one
-        raise CMasterError(f"scenario {scenario.name}: C master: {error}", 3) from None
-    columns = recorded_columns(system)
-    lines = loop_host_lines(system, {k: str(v) for k, v in folders.items()}, scenario.steps,
-                            columns=columns)
-    lines[-1] += f" binary {ROWS_PER_CHUNK}"
-    text = getattr(sink, "csv_for_host", None)   # a RunRecorder writing CSV: the host writes it
-    text = text() if text is not None else None
-    if text is not None:
-        path, every, last = text
-        name = os.fsencode(path) if windows is None else wine_path(path).encode("utf-8")
-        lines.insert(-1, f"csv {name.hex()} {every} {last} {csv_columns(columns)}")
-    command = [str(executable)] if windows is None else [wine_executable(), str(executable)]
-    environment = dict(os.environ if windows is None else windows)
-    environment.pop("LD_PRELOAD", None)
-    rows = RowAssembler(scenario, columns, sink)
-    logs, failure, done = [], None, False
-    with subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                          stderr=subprocess.PIPE, env=environment) as host:
-        watchdog = _Watchdog(host, timeout_s)
-        try:
-            _widen(host.stdout)
-            try:
-                host.stdin.write(("\n".join(lines) + "\n").encode())
-                host.stdin.close()
-            except BrokenPipeError:  # the host refused the system early: its stderr says why
-                pass
-            for tag, payload in _read_frames(host.stdout):
-                watchdog.alive()
-                if tag == b"ROWS":
-                    rows.add(payload)
-                elif tag == b"LOG_":
-                    entry = _log_entry(payload)
-                    if entry[0] >= 2:  # what a failure quotes (warnings are not kept: a long
-                        logs.append(entry)  # run may log one per step)
-                elif tag == b"FAIL":
-                    failure = payload.decode("utf-8", "replace")
-                elif tag == b"DONE":
-                    done = True
-        finally:
-            watchdog.stop()
-        said = host.stderr.read().decode("utf-8", "replace").strip()
-        status = host.wait()
-    where = " (win64, wine)" if windows is not None else ""
-    if watchdog.fired:
-        reached = rows.count * scenario.step_s if rows.started else 0.0
-        raise CMasterError(f"scenario {scenario.name}: C master{where}: no output for "
-                           f"{timeout_s:g} s at t = {reached:g} s: the host was stopped (an FMU "
-                           f"hangs?); {rows.count} rows were recorded", 3, time_s=reached)
-    if failure is not None:
-        kept = rows.finish()   # the rows up to the failed step, the last without step outputs
-        error = _failure(scenario, failure, logs, rows.count, windows)
-        error.rows = kept
-        raise error
-    if status != 0 or not done:
-        raise CMasterError(f"scenario {scenario.name}: C master{where}: exit status {status}: "
-                           f"{said.splitlines()[-1] if said else 'no message'}", 3)
-    data = rows.finish()
-    return LoopResult(scenario, data, "fmu", time.perf_counter() - started)
+_PROCESS_MASTERS = {}   # (FMU folder, thread) -> CMaster: each worker's long-lived C master
+_PROCESS_LOCK = threading.Lock()
+
+
+def process_master(fmu_dir):
+    """This process's (and thread's) :class:`CMaster` over ``fmu_dir``, made at the first call
+    and kept for the next ones (a study's points on a Dask worker share it) until the
+    process exits (:func:`close_process_masters`)."""
+    key = (str(Path(fmu_dir).resolve()), threading.get_ident())
+    with _PROCESS_LOCK:
+        master = _PROCESS_MASTERS.get(key)
+        if master is None:
+            master = _PROCESS_MASTERS[key] = CMaster(fmu_dir)
+            _close_at_exit()
+        return master
+
+
+def close_process_masters():
+    """Close the masters :func:`process_master` made (their hosts end)."""
+    with _PROCESS_LOCK:
+        masters = list(_PROCESS_MASTERS.values())
+        _PROCESS_MASTERS.clear()
+    for master in masters:
+        master.close()
+
+
+_EXIT_REGISTERED = set()
+
+
+def _close_at_exit():
+    """At this process's exit: atexit, and multiprocessing's finalizers (its children, as
+    Dask's worker processes, end with os._exit and skip atexit)."""
+    if os.getpid() in _EXIT_REGISTERED:
+        return
+    _EXIT_REGISTERED.add(os.getpid())
+    atexit.register(close_process_masters)
+    util = sys.modules.get("multiprocessing.util")
+    if util is not None:
+        util.Finalize(None, close_process_masters, exitpriority=1)
