@@ -10,7 +10,7 @@ rows (:mod:`.c_master_rows`) and go to the sink in the fmpy master's blocks, so 
 recorder, the metrics and the figures are those of the fmpy master, to the bit.
 
 :class:`CMaster` pays the fixed cost once for many runs (the scenarios of one command, the
-points of one study): one host process (:mod:`.c_master_host`), each FMU file unpacked
+points of one study): one host process (:mod:`.loop_host_process`), each FMU file unpacked
 once per process (:mod:`~sma_fmu.fmi.driving.unpacked`) and loaded once in the host, each
 instance reset (fmi2Reset) between runs instead of freed. A run after a reset equals a
 run in a fresh host, to the bit. :func:`run_c_master` is one run in a master of its own.
@@ -32,6 +32,7 @@ row for the metrics and the figure.
 """
 import atexit
 import os
+import struct
 import subprocess
 import sys
 import threading
@@ -43,8 +44,8 @@ from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.unpacked import acquire, release
 from sma_fmu.fmi.hosts import CHostError, compile_host
 from sma_fmu.fmi.loop.system import check_variables
-from sma_fmu.systems.c_master_host import (STATUS_NAMES, HostProcess, failed_call, host_stderr,
-                                           log_entry)
+from sma_fmu.systems.loop_host_process import (STATUS_NAMES, HostProcess, failed_call,
+                                               host_stderr, log_entry)
 from sma_fmu.systems.c_master_rows import RowAssembler, csv_columns, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
@@ -210,7 +211,8 @@ class CMaster:
     def run(self, scenario, sink=None):
         """Run ``scenario``; a :class:`LoopResult` (``path`` "fmu"), its ``data`` None when
         ``sink`` took the rows (see :func:`~sma_fmu.cosim.loop.run_loop`), its
-        ``wall_time_s`` the run's own (the start-up it needed is in :attr:`startup_s`).
+        ``wall_time_s`` the run's own: the start-up it needed is in :attr:`startup_s`, and
+        the time the host spent writing a CSV (as the recorder's, not the run's) is left out.
 
         Raises :class:`~sma_fmu.fmi.loop.system.MissingFmuError` for a missing FMU,
         ``ValueError`` naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and
@@ -228,7 +230,7 @@ class CMaster:
         folders = self._start(scenario, system)
         columns = recorded_columns(system)
         rows = RowAssembler(scenario, columns, sink)
-        logs, failure, done = [], None, False
+        logs, failure, done, writing = [], None, False, 0.0
         try:
             if self._host.send(self._lines(scenario, system, folders, columns, sink)):
                 for tag, payload in self._host.frames():
@@ -240,8 +242,8 @@ class CMaster:
                             logs.append(entry)  # long run may log one per step)
                     elif tag == b"FAIL":
                         failure = payload.decode("utf-8", "replace")
-                    elif tag == b"DONE":
-                        done = True
+                    elif tag == b"DONE":   # with the seconds the host spent writing the CSV
+                        done, writing = True, struct.unpack("<d", payload)[0]
         except BaseException:   # the sink failed, or an interrupt: the host is mid-run
             self._stop_host(kill=True)
             raise
@@ -255,7 +257,7 @@ class CMaster:
         if not done:
             self._host_died(scenario, rows.count, rows.count * scenario.step_s if rows.started else 0.0)
         data = rows.finish()
-        wall = time.perf_counter() - started - (self.startup_s - before)
+        wall = time.perf_counter() - started - (self.startup_s - before) - writing
         return LoopResult(scenario, data, "fmu", wall)
 
 

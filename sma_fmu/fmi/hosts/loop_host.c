@@ -32,7 +32,8 @@
  *   LOG_  "STATUS NAME CATEGORY\tTEXT" of an FMU log message;
  *   FAIL  "NAME.CALL returned STATUS at t = T s" of a failed call (status > fmi2Warning),
  *         after the rows up to that step: the run ends there (see the session);
- *   DONE  the run ended (after the last rows; its instances terminated);
+ *   DONE  the run ended (after the last rows; its instances terminated): one double, the
+ *         seconds it spent writing the CSV (0 without a csv line);
  *   LOAD  (no payload) the answer to a "load" line: that FMU is loaded.
  * A session (the C master's runs in one process): after a "binary" run the host reads the
  * next system from stdin instead of exiting, until stdin closes (then it frees every
@@ -116,6 +117,7 @@ static FILE* csv_file;
 static char csv_path[PATH_SIZE];
 static long csv_every, csv_last, csv_row;
 static double csv_step, csv_x0, csv_prev[MAX_ITEMS];
+static double csv_seconds;  /* [s] this run spent writing the CSV (DONE's payload) */
 static char* csv_buffer;
 static size_t csv_used;
 #define CSV_BUFFER (1u << 20)
@@ -456,7 +458,11 @@ static void print_row(void)
                 return;
             }
         }
-        if (csv_file) csv_sample(row);
+        if (csv_file) {
+            const double begin = host_now();
+            csv_sample(row);
+            csv_seconds += host_now() - begin;
+        }
         if (++block_rows == frame_size) {
             flush_rows();
             frame_size = block_size;
@@ -541,7 +547,9 @@ static void run(double h, long steps, int timing)
     now = (double)steps * h;
     const double total = host_now() - begin;
     if (binary) {   /* DONE follows when the instances have terminated (end_run) */
+        const double begin = host_now();
         csv_finish();
+        csv_seconds += host_now() - begin;
         flush_rows();
     }
     if (timing) {
@@ -660,7 +668,7 @@ static void end_run(void)
 {
     for (int i = 0; i < components && !failed; ++i)
         check(fmu[i]->Terminate(fmu[i]->c), fmu[i], "fmi2Terminate");
-    if (!failed) frame("DONE", NULL, 0);
+    if (!failed) frame("DONE", &csv_seconds, sizeof csv_seconds);
     for (int i = 0; i < components && failed; ++i) {
         if (fmu[i]->c) fmu[i]->FreeInstance(fmu[i]->c);
         fmu[i]->c = NULL;
@@ -671,6 +679,7 @@ static void end_run(void)
     block = NULL;
     block_rows = 0;
     csv_columns = csv_have_prev = 0;
+    csv_seconds = 0.0;
     csv_row = 0;
 }
 

@@ -1,4 +1,4 @@
-"""The C master's host process: one loop host (``loop_host.c``, binary mode) for many runs.
+"""The loop host as the C master's process: one ``loop_host.c`` (binary mode) for many runs.
 
 The host reads a system and its run line from stdin, answers with frames on stdout (an
 8-byte head: a 4-byte tag, the payload's length; see the source's header) and then waits
