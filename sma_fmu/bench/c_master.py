@@ -73,18 +73,24 @@ def _loop_times(master, runs, folder, scenarios, formats):
     return results
 
 
+# the peak is VmHWM (Linux): ru_maxrss keeps, across exec, the peak of the process that
+# started this one (the bench itself, some 260 MB after its sweep)
 _HOUR_RUN = """
-import json, resource, sys
+import json, re, resource, sys
 from sma_fmu.systems.runner import run_scenarios
 run_scenarios([sys.argv[1]], sys.argv[2], "fmu", sys.argv[3], progress=lambda _: None,
               fmt=sys.argv[4], master="c")
-print(json.dumps(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss))
+try:
+    with open("/proc/self/status") as status:
+        print(json.dumps(int(re.search(r"VmHWM:\\s*(\\d+) kB", status.read()).group(1))))
+except (OSError, AttributeError):
+    print(json.dumps(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss))
 """
 
 
 def hour_run_rss(native_dir, folder, fmt="csv", stop_time_s=3600.0):
     """{"python_mb", "wall_s", "rows", "format"}: peak resident memory [MB] of ``sma-fmu run
-    --master c`` (Linux's ru_maxrss of a fresh Python process) over a one-hour
+    --master c`` (Linux's VmHWM of a fresh Python process) over a one-hour
     (``stop_time_s``) copy of :data:`HOUR_SCENARIO` at 1 ms, recorded as ``fmt``. (The C
     host itself stays near 3 MB: it keeps one frame of rows.)"""
     folder = Path(folder)

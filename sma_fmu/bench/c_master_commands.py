@@ -32,11 +32,13 @@ GAIN_GRID = "gain-grid.toml"   # the shipped example: 75 runs of 30 s
 
 def _command(arguments, out):
     """Run ``sma-fmu ARGUMENTS --out OUT`` in a process of its own: (wall [s], CPU [s] of
-    the process and its children)."""
+    the process and its children). Python may write its bytecode caches (as an installed
+    package has them): PYTHONDONTWRITEBYTECODE would compile every module on every run."""
+    environment = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     before = os.times()
     started = time.perf_counter()
     subprocess.run([sys.executable, "-m", "sma_fmu", *arguments, "--out", str(out)],
-                   check=True, capture_output=True)
+                   check=True, capture_output=True, env=environment)
     wall = time.perf_counter() - started
     after = os.times()
     return wall, (after.children_user - before.children_user

@@ -55,7 +55,7 @@ def _c_master_runs(scenarios, fmu_dir):
     for scenario in scenarios:
         metrics = StreamingMetrics(scenario)
         try:
-            master.run(scenario, metrics.update)
+            master.run(scenario, metrics.update, StreamingMetrics.COLUMNS_READ)
         except (ValueError, RuntimeError) as error:  # a bad FMU or a failed call (FmuError)
             yield _Outcome(None, str(error))
             continue

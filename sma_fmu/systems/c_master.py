@@ -208,11 +208,14 @@ class CMaster:
             lines.insert(-1, f"csv {name.hex()} {every} {last} {csv_columns(columns)}")
         return lines
 
-    def run(self, scenario, sink=None):
+    def run(self, scenario, sink=None, columns=None):
         """Run ``scenario``; a :class:`LoopResult` (``path`` "fmu"), its ``data`` None when
         ``sink`` took the rows (see :func:`~sma_fmu.cosim.loop.run_loop`), its
         ``wall_time_s`` the run's own: the start-up it needed is in :attr:`startup_s`, and
         the time the host spent writing a CSV (as the recorder's, not the run's) is left out.
+        ``columns``: the loop's columns the sink reads (e.g.
+        :attr:`~sma_fmu.cosim.metrics.StreamingMetrics.COLUMNS_READ`); the host records only
+        those, the others are NaN (False) in the rows. None: every column.
 
         Raises :class:`~sma_fmu.fmi.loop.system.MissingFmuError` for a missing FMU,
         ``ValueError`` naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and
@@ -228,11 +231,14 @@ class CMaster:
                              f"(sma-fmu build --native); run FMI 3.0 FMUs with --master fmpy")
         check_variables(system)
         folders = self._start(scenario, system)
-        columns = recorded_columns(system)
-        rows = RowAssembler(scenario, columns, sink)
+        read = columns
+        columns = recorded_columns(system, read)
+        missing = () if read is None else [c for c in system.outputs if c not in columns]
+        rows = RowAssembler(scenario, columns, sink, missing)
         logs, failure, done, writing = [], None, False, 0.0
         try:
-            if self._host.send(self._lines(scenario, system, folders, columns, sink)):
+            lines = self._lines(scenario, system, folders, columns, sink if read is None else None)
+            if self._host.send(lines):
                 for tag, payload in self._host.frames():
                     if tag == b"ROWS":
                         rows.add(payload)
