@@ -24,27 +24,12 @@ from sma_fmu.studies.runs import metrics_record
 from sma_fmu.systems import c_master
 from sma_fmu.systems.c_master import CMaster, CMasterError, run_c_master
 from system_needs import needs
+from test_c_master import DISCARD   # a PI so strong the plant discards the step at t = 0.5 s
+from test_native_windows import wine  # noqa: F401 - the fixture: a wine64 prefix of its own
 
 pytestmark = needs("gcc")
 
 PWM = "setpoints-pwm-pi+ff-adaptive"
-# a PI so strong that the plant discards the step where the reference drops (t = 0.5 s)
-DISCARD = """
-[scenario]
-stop_time_s = 1.0
-step_s = 0.001
-[reference]
-kind = "step"
-initial_ohm = 60.0
-final_ohm = 1.0
-time_s = 0.5
-[load]
-times_s = [0.0]
-values_kg = [0.25]
-[controller]
-kind = "pi"
-Kp_W_per_ohm = 1e306
-"""
 
 
 @pytest.fixture(scope="module")
@@ -109,7 +94,7 @@ def test_runs_after_a_reset_equal_fresh_runs_to_the_bit(native_dir, started):
 def test_a_failed_step_ends_its_run_only(native_dir, started, tmp_path):
     """A discard mid-run: the same named error and rows as in a fresh host; the host stays
     (no new process), and the runs after it, CSV written by the host included, are fresh ones."""
-    (tmp_path / "discard.toml").write_text(DISCARD)
+    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
     discard, after = load_scenario(tmp_path / "discard.toml"), _scenario("heavy-pi+ff-fixed")
     with pytest.raises(CMasterError) as alone:
         run_c_master(discard, native_dir)
@@ -141,7 +126,7 @@ def test_a_failed_step_ends_its_run_only(native_dir, started, tmp_path):
 def test_a_hung_host_is_replaced_and_the_next_run_is_fresh(native_dir, started, tmp_path):
     """The watchdog kills a host stopped mid-run (SIGSTOP); the master's next run starts a
     new host and equals a fresh run. A host killed between runs is replaced as well."""
-    (tmp_path / "long.toml").write_text(DISCARD.replace("1e306", "0.3").replace("1.0\nstep", "600.0\nstep"))
+    (tmp_path / "long.toml").write_text(DISCARD.format(stop=600.0).replace("1e306", "0.3"))
     scenario = _scenario("load-step-pi+ff-adaptive")
     expected = run_c_master(scenario, native_dir).data
     del started[:]
@@ -201,7 +186,7 @@ def test_a_sweep_task_keeps_the_workers_master(native_dir, started, tmp_path):
     from sma_fmu.studies.tasks import run_task
 
     c_master.close_process_masters()
-    (tmp_path / "discard.toml").write_text(DISCARD)
+    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
     bases = [template("load-step-pi+ff-adaptive"), template(tmp_path / "discard.toml")]
     points = [(0, {"scenario.stop_time_s": 2.0, "controller.Kp_W_per_ohm": kp}) for kp in (0.2, 0.9, 0.5)]
     points.insert(2, (1, {}))
@@ -275,25 +260,13 @@ def test_the_study_api_runs_its_points_in_one_c_master(native_dir, started):
         assert c.metrics == f.metrics and c.path == "fmu"
 
 
-@pytest.fixture(scope="module")
-def wine(tmp_path_factory):
-    """The environment of a wine64 prefix of its own."""
-    from system_needs import need, wine_command
-
-    need("wine64", "mingw-w64")
-    root = tmp_path_factory.mktemp("wine")
-    environment = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
-    environment.update(WINEPREFIX=str(root / "prefix"), WINEDEBUG="-all", DISPLAY="")
-    subprocess.run([wine_command(), "wineboot", "--init"], env=environment, capture_output=True,
-                   timeout=600, check=True)
-    return environment
 
 
 @needs("wine64", "mingw-w64")
 def test_the_win64_host_under_wine_keeps_its_session_too(native_dir, wine, started, tmp_path):
     """The win64 loop host under wine: runs of different scenarios and a discard in one
     host process equal the same runs each in a win64 host of its own, to the bit."""
-    (tmp_path / "discard.toml").write_text(DISCARD)
+    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
     short = {"scenario.stop_time_s": 2.0}
     scenarios = [_scenario(PWM, short), _scenario("heavy-pi", short),
                  _scenario("load-step-pi+ff-fixed", {**short, "load.values_kg": 0.1})]

@@ -104,22 +104,28 @@ def run_command_times(native_dir, runs, folder, scenarios=("paper",)):
 
 def _timed_task(templates, runs, fmu_dir):
     """:func:`~sma_fmu.studies.tasks.run_task` on a worker: (process id, time.time() at its
-    start and end, rows); the modules it needs are imported before the clock starts (the
-    worker's C master starts, unpacks and loads its FMUs inside it)."""
+    start and end, rows, CPU [s] of the worker and of its C master's host); the modules it
+    needs are imported before the clock starts (the worker's C master starts, unpacks and
+    loads its FMUs inside it)."""
     from sma_fmu.studies.tasks import run_task
-    import sma_fmu.systems.c_master  # noqa: F401 - imported before the clock starts
-    started = time.time()
+    from sma_fmu.systems.c_master import process_master
+
+    master = process_master(fmu_dir)
+    started, cpu, host = time.time(), time.process_time(), master.host_cpu_s()
     rows = run_task(templates, runs, fmu_dir)
-    return os.getpid(), started, time.time(), rows
+    return (os.getpid(), started, time.time(), rows, time.process_time() - cpu,
+            master.host_cpu_s() - host)
 
 
 def _library_walls(spec):
-    """The scalar library path's run-table wall s [s] of every run of ``spec``."""
+    """The scalar library path on every run of ``spec``: ([its run-table wall s], [CPU [s]
+    of the run with its metrics, as a sweep's task computes them])."""
     from sma_fmu.cosim.loop import run_library
+    from sma_fmu.cosim.metrics import StreamingMetrics
     from sma_fmu.cosim.recording import RunRecorder
     import tempfile
 
-    walls = []
+    walls, cpus = [], []
     with tempfile.TemporaryDirectory() as work:
         for run in spec.runs():
             scenario = spec.templates[run.base].scenario(run.overrides)
@@ -129,7 +135,11 @@ def _library_walls(spec):
             result = run_library(scenario, sink=recorder)
             walls.append(result.wall_time_s - recorder.seconds)   # as the runner's table
             recorder.close()
-    return walls
+            cpu, metrics = time.process_time(), StreamingMetrics(scenario)
+            run_library(scenario, sink=metrics.update)
+            metrics.result()
+            cpus.append(time.process_time() - cpu)
+    return walls, cpus
 
 
 def _one_at_a_time(spec, native_dir):
@@ -152,8 +162,10 @@ def _one_at_a_time(spec, native_dir):
 
 def sweep_throughput(native_dir, folder, workers=2, spec_path=None):
     """{"runs", "workers": {pid: runs per second}, "per_worker" (their median),
-    "library_per_s", "ratio", "sweep_command_s", "equal"} of the gain grid (``spec_path``,
-    default the shipped :data:`GAIN_GRID`) over ``workers`` Dask worker processes."""
+    "library_per_s", "library_wall_s", "ratio", "c_cpu_ms" and "library_cpu_ms" (CPU per
+    run: a worker's and its host's; the library's with its metrics), "sweep_command_s",
+    "equal"} of the gain grid (``spec_path``, default the shipped :data:`GAIN_GRID`) over
+    ``workers`` Dask worker processes."""
     import pandas as pd
 
     from sma_fmu.files.package_data import shipped_file
@@ -169,11 +181,12 @@ def sweep_throughput(native_dir, folder, workers=2, spec_path=None):
         done = client.gather([client.submit(_timed_task, spec.templates, chunk, str(native_dir),
                                             pure=False) for chunk in chunks])
     spans = {}
-    for pid, start, stop, rows in done:
+    for pid, start, stop, rows, _, _ in done:
         first, last, count = spans.get(pid, (start, stop, 0))
         spans[pid] = (min(first, start), max(last, stop), count + len(rows))
     per_worker = {pid: count / (last - first) for pid, (first, last, count) in spans.items()}
-    library = _library_walls(spec)
+    c_cpu = sum(worker + host for *_, worker, host in done) / len(runs)
+    library, library_cpu = _library_walls(spec)
     library_per_s = 1.0 / statistics.mean(library)
     out = Path(folder) / "sweep"
     wall, _ = _command(["sweep", str(spec_path), "--fmus", str(native_dir), "--workers",
@@ -189,6 +202,7 @@ def sweep_throughput(native_dir, folder, workers=2, spec_path=None):
             "per_worker": round(median, 1), "library_per_s": round(library_per_s, 2),
             "library_wall_s": round(statistics.mean(library), 4),
             "ratio": round(median / library_per_s, 2), "sweep_command_s": round(wall, 2),
+            "c_cpu_ms": round(1e3 * c_cpu, 1), "library_cpu_ms": round(1e3 * statistics.mean(library_cpu), 1),
             "equal": equal, "spec": spec_path.name}
 
 
@@ -219,7 +233,9 @@ def command_lines(commands, sweep=None):
                      f"worker process ({', '.join(f'{v:.1f}' for v in sweep['workers'].values())}), "
                      f"scalar library {sweep['library_per_s']:.2f} runs/s "
                      f"(wall s per run {sweep['library_wall_s']:.3f}): {sweep['ratio']:.1f} x: "
-                     f"{_verdict(sweep['ratio'], SWEEP_TARGET, larger=True)}; the whole command "
+                     f"{_verdict(sweep['ratio'], SWEEP_TARGET, larger=True)}; CPU per run "
+                     f"{sweep['c_cpu_ms']:.1f} ms (worker and its host) against the library's "
+                     f"{sweep['library_cpu_ms']:.1f} ms; the whole command "
                      f"{sweep['sweep_command_s']:.1f} s; metrics equal to one-at-a-time C-master "
                      f"runs to the bit: {'yes' if sweep['equal'] else 'NO'}")
     return lines

@@ -37,8 +37,8 @@ def summary_table(rows):
                  "the recorder spent writing")
     startup = [row["startup_s"] for row in rows if "startup_s" in row]
     if startup:
-        lines.append(f"the C master's start-up (host started, FMUs unpacked and loaded), paid "
-                     f"once for all the runs and in no run's wall s: {sum(startup):.2f} s")
+        lines.append(f"the C master's start-up (host started, FMUs read, unpacked and loaded), "
+                     f"paid once for all the runs and in no run's wall s: {sum(startup):.2f} s")
     return "\n".join(lines)
 
 
