@@ -183,9 +183,9 @@ def test_a_sweep_task_keeps_the_workers_master(native_dir, started, tmp_path):
     """Two tasks in one process, a failed run among them: one host for both, each row the
     metrics of its point run one at a time in a C master of its own, to the bit."""
     from sma_fmu.studies.spec import StudyRunSpec
-    from sma_fmu.studies.tasks import run_task
+    from sma_fmu.studies.tasks import close_worker_masters, run_task
 
-    c_master.close_process_masters()
+    close_worker_masters()
     (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
     bases = [template("load-step-pi+ff-adaptive"), template(tmp_path / "discard.toml")]
     points = [(0, {"scenario.stop_time_s": 2.0, "controller.Kp_W_per_ohm": kp}) for kp in (0.2, 0.9, 0.5)]
@@ -204,7 +204,7 @@ def test_a_sweep_task_keeps_the_workers_master(native_dir, started, tmp_path):
         run_c_master(scenario, native_dir, metrics.update)
         expected = metrics_record(metrics.result())
         assert {key: row[key] for key in expected} == expected
-    c_master.close_process_masters()
+    close_worker_masters()
     assert all(host.returncode == 0 for host in started)
 
 
@@ -283,3 +283,39 @@ def test_the_win64_host_under_wine_keeps_its_session_too(native_dir, wine, start
         for scenario, expected in zip(scenarios[::-1], fresh[::-1]):
             _same(master.run(scenario).data, expected)
     assert len(started) == 1
+
+
+def test_runs_given_ahead_equal_runs_one_at_a_time(native_dir, started, tmp_path):
+    """``run_many`` gives the host each run before the master reads the one before: the
+    results (a discard among them) are those of :meth:`CMaster.run`; when the host hangs
+    in a run (stopped, killed by the watchdog), the run given after it is given again to a
+    new host and is a fresh run."""
+    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
+    (tmp_path / "long.toml").write_text(DISCARD.format(stop=600.0).replace("1e306", "0.3"))
+    discard, long = load_scenario(tmp_path / "discard.toml"), load_scenario(tmp_path / "long.toml")
+    scenarios = _varied()[:4]
+    fresh = [run_c_master(s, native_dir).data for s in scenarios]
+    with pytest.raises(CMasterError) as alone:
+        run_c_master(discard, native_dir)
+    del started[:]
+    kept = [[] for _ in range(5)]
+    items = [(s, k.append) for s, k in zip(scenarios[:2] + [discard] + scenarios[2:], kept)]
+    with CMaster(native_dir) as master:
+        results = list(master.run_many(items))
+        assert master.hosts_started == 1
+    assert str(results[2]) == str(alone.value)
+    for index, expected in zip((0, 1, 3, 4), fresh):
+        _same(np.concatenate(kept[index]), expected)
+        assert results[index].data is None and results[index].wall_time_s > 0
+    stopped = []
+
+    def stop_once(block):
+        if not stopped:
+            stopped.append(os.kill(started[-1].pid, signal.SIGSTOP))
+
+    with CMaster(native_dir, timeout_s=1.0) as master:
+        results = list(master.run_many([(scenarios[0], None), (long, stop_once), (scenarios[1], None)]))
+    assert isinstance(results[1], CMasterError) and "no output for 1 s" in str(results[1])
+    _same(results[0].data, fresh[0])
+    _same(results[2].data, fresh[1])
+    assert len(started) == 3   # one for the first batch, two here: the hung one and its successor

@@ -7,9 +7,9 @@
   files compared (the same names, the same time series); and from each run's
   ``summary.json`` the run table's "wall s" of every scenario, C master over library.
 - :func:`sweep_throughput`: the shipped gain grid on two Dask worker processes, each
-  running its tasks in its long-lived C master: runs per second per worker process (runs
-  over the time from the start of the worker's first task to the end of its last, the C
-  master's start-up included, the worker's imports not) against the scalar library path's (one over its run table's wall s per run,
+  running its tasks in its long-lived C master: runs per second per worker process (its
+  runs over the time it spent in its tasks, the C master's start-up included; neither the
+  worker's imports nor Dask's time between tasks) against the scalar library path's (one over its run table's wall s per run,
   the same points); the whole ``sma-fmu sweep`` command; and whether the sweep's metrics
   equal those of each point run alone in a C master of its own, to the bit.
 """
@@ -107,10 +107,9 @@ def _timed_task(templates, runs, fmu_dir):
     start and end, rows, CPU [s] of the worker and of its C master's host); the modules it
     needs are imported before the clock starts (the worker's C master starts, unpacks and
     loads its FMUs inside it)."""
-    from sma_fmu.studies.tasks import run_task
-    from sma_fmu.systems.c_master import process_master
+    from sma_fmu.studies.tasks import run_task, worker_master
 
-    master = process_master(fmu_dir)
+    master = worker_master(fmu_dir)
     started, cpu, host = time.time(), time.process_time(), master.host_cpu_s()
     rows = run_task(templates, runs, fmu_dir)
     return (os.getpid(), started, time.time(), rows, time.process_time() - cpu,
@@ -180,11 +179,11 @@ def sweep_throughput(native_dir, folder, workers=2, spec_path=None):
         chunks = [runs[i:i + size] for i in range(0, len(runs), size)]
         done = client.gather([client.submit(_timed_task, spec.templates, chunk, str(native_dir),
                                             pure=False) for chunk in chunks])
-    spans = {}
+    busy = {}   # pid -> (seconds in its tasks, runs)
     for pid, start, stop, rows, _, _ in done:
-        first, last, count = spans.get(pid, (start, stop, 0))
-        spans[pid] = (min(first, start), max(last, stop), count + len(rows))
-    per_worker = {pid: count / (last - first) for pid, (first, last, count) in spans.items()}
+        seconds, count = busy.get(pid, (0.0, 0))
+        busy[pid] = (seconds + stop - start, count + len(rows))
+    per_worker = {pid: count / seconds for pid, (seconds, count) in busy.items()}
     c_cpu = sum(worker + host for *_, worker, host in done) / len(runs)
     library, library_cpu = _library_walls(spec)
     library_per_s = 1.0 / statistics.mean(library)

@@ -30,12 +30,9 @@ writes the CSV's rows itself (its "csv" line; the same text as the recorder's, b
 byte, about ten times faster than Python's formatting); the recorder still gets every
 row for the metrics and the figure.
 """
-import atexit
 import os
 import struct
 import subprocess
-import sys
-import threading
 import time
 from pathlib import Path
 
@@ -50,8 +47,7 @@ from sma_fmu.systems.c_master_rows import RowAssembler, csv_columns, recorded_co
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
 
-__all__ = ["MASTERS", "DEFAULT_TIMEOUT_S", "CMasterError", "CMaster", "run_c_master",
-           "process_master", "close_process_masters"]
+__all__ = ["MASTERS", "DEFAULT_TIMEOUT_S", "CMasterError", "CMaster", "run_c_master"]
 
 MASTERS = ("fmpy", "c")   # `sma-fmu run --master`: the fmpy master, or this one
 # [s] the longest the host may send nothing (choice: a frame of 4,096 steps takes about 1 ms,
@@ -146,18 +142,32 @@ class CMaster:
             host.close(kill=True)
         return host.finish()
 
+    def _held(self, path):
+        """The :class:`~sma_fmu.fmi.driving.unpacked.Unpacked` this master holds of the FMU
+        file ``path`` if it is of the file's current version, else None."""
+        held, stat = self._unpacked.get(str(path)), os.stat(path)
+        return held if held is not None and held.key[1:] == (stat.st_size, stat.st_mtime_ns) else None
+
+    def _text(self, held):
+        return wine_path(held.folder) if self.windows is not None else str(held.folder)
+
     def _folder(self, path):
         """The folder (text, as the host sees it) of the FMU file ``path``, unpacked once per
         file version (a rebuilt file: unpacked again, in a new host)."""
-        key, stat = str(path), os.stat(path)
-        held = self._unpacked.get(key)
-        if held is not None and held.key[1:] != (stat.st_size, stat.st_mtime_ns):
+        held = self._held(path)
+        if held is None and str(path) in self._unpacked:   # an older version
             self._stop_host()
-            release(self._unpacked.pop(key))
-            held = None
+            release(self._unpacked.pop(str(path)))
         if held is None:
-            held = self._unpacked[key] = acquire(path)
-        return wine_path(held.folder) if self.windows is not None else str(held.folder)
+            held = self._unpacked[str(path)] = acquire(path)
+        return self._text(held)
+
+    def _ready(self, system):
+        """Whether a run of ``system`` needs no start-up: the host runs, its FMUs loaded."""
+        if self._host is None or self._host.process.poll() is not None:
+            return False
+        helds = [self._held(c.fmu) for c in system.components]
+        return all(held is not None and self._text(held) in self._loaded for held in helds)
 
     def _start(self, scenario, system):
         """Unpack the FMUs of ``system``, start a host if none runs and load those it has not
@@ -219,25 +229,13 @@ class CMaster:
             lines.insert(-1, f"csv {name.hex()} {every} {last} {csv_columns(columns)}")
         return lines
 
-    def run(self, scenario, sink=None, columns=None):
-        """Run ``scenario``; a :class:`LoopResult` (``path`` "fmu"), its ``data`` None when
-        ``sink`` took the rows (see :func:`~sma_fmu.cosim.loop.run_loop`), its
-        ``wall_time_s`` the run's own: the start-up it needed is in :attr:`startup_s`, and
-        the time the host spent writing a CSV (as the recorder's, not the run's) is left out.
-        ``columns``: the loop's columns the sink reads (e.g.
-        :attr:`~sma_fmu.cosim.metrics.StreamingMetrics.COLUMNS_READ`); the host records only
-        those, the others are NaN (False) in the rows. None: every column.
-
-        Raises :class:`~sma_fmu.fmi.loop.system.MissingFmuError` for a missing FMU,
-        ``ValueError`` naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and
-        the variable when its variables do not match, and :class:`CMasterError` when a call
-        fails (the rows up to that step kept), the host died, or it sent nothing for
-        ``timeout_s`` s (killed; the rows so far are not kept).
-        """
-        started, before = time.perf_counter(), self.startup_s
+    def _system(self, scenario):
+        """The checked loop system of ``scenario`` (reading model descriptions the master had
+        not read yet is start-up)."""
+        started = time.perf_counter()
         system = closed_loop(scenario, self.fmu_dir)
         files = {str(c.fmu) for c in system.components}
-        if not files <= self._described:   # their model descriptions were read: start-up
+        if not files <= self._described:
             self.startup_s += time.perf_counter() - started
             self._described |= files
         newer = sorted((c.model, str(c.fmu)) for c in system.components if c.fmi_version != "2")
@@ -245,15 +243,29 @@ class CMaster:
             raise ValueError(f"{newer[0][1]} is an FMI 3.0 FMU: the C master runs FMI 2.0 FMUs "
                              f"(sma-fmu build --native); run FMI 3.0 FMUs with --master fmpy")
         check_variables(system)
-        folders = self._start(scenario, system)
-        read = columns
-        columns = recorded_columns(system, read)
-        missing = () if read is None else [c for c in system.outputs if c not in columns]
-        rows = RowAssembler(scenario, columns, sink, missing)
+        return system
+
+    def _send(self, run):
+        """Give the host the lines of ``run`` (a :class:`_Run`), after the start-up it needs."""
+        folders = self._start(run.scenario, run.system)
+        read = run.columns
+        columns = recorded_columns(run.system, read)
+        missing = () if read is None else [c for c in run.system.outputs if c not in columns]
+        run.rows = RowAssembler(run.scenario, columns, run.sink, missing)
+        lines = self._lines(run.scenario, run.system, folders, columns,
+                            run.sink if read is None else None)
+        run.host, run.sent = self._host, self._host.send(lines)
+        return run
+
+    def _finish(self, run):
+        """Read the frames of ``run``, sent before; its :class:`LoopResult`. A run sent to a
+        host that a run before it ended (fmi2Fatal, a timeout) is sent again to a new one."""
+        if run.host is not self._host:
+            self._send(run)
+        scenario, rows = run.scenario, run.rows
         logs, failure, done, writing = [], None, False, 0.0
         try:
-            lines = self._lines(scenario, system, folders, columns, sink if read is None else None)
-            if self._host.send(lines):
+            if run.sent:
                 for tag, payload in self._host.frames():
                     if tag == b"ROWS":
                         rows.add(payload)
@@ -278,8 +290,73 @@ class CMaster:
         if not done:
             self._host_died(scenario, rows.count, rows.count * scenario.step_s if rows.started else 0.0)
         data = rows.finish()
-        wall = time.perf_counter() - started - (self.startup_s - before) - writing
+        wall = time.perf_counter() - run.started - (self.startup_s - run.before) - writing
         return LoopResult(scenario, data, "fmu", wall)
+
+    def run(self, scenario, sink=None, columns=None):
+        """Run ``scenario``; a :class:`LoopResult` (``path`` "fmu"), its ``data`` None when
+        ``sink`` took the rows (see :func:`~sma_fmu.cosim.loop.run_loop`), its
+        ``wall_time_s`` the run's own: the start-up it needed is in :attr:`startup_s`, and
+        the time the host spent writing a CSV (as the recorder's, not the run's) is left out.
+        ``columns``: the loop's columns the sink reads (e.g.
+        :attr:`~sma_fmu.cosim.metrics.StreamingMetrics.COLUMNS_READ`); the host records only
+        those, the others are NaN (False) in the rows. None: every column.
+
+        Raises :class:`~sma_fmu.fmi.loop.system.MissingFmuError` for a missing FMU,
+        ``ValueError`` naming an FMI 3.0 FMU (the host is an FMI 2.0 host) or the FMU and
+        the variable when its variables do not match, and :class:`CMasterError` when a call
+        fails (the rows up to that step kept), the host died, or it sent nothing for
+        ``timeout_s`` s (killed; the rows so far are not kept).
+        """
+        run = _Run(scenario, sink, columns, time.perf_counter(), self.startup_s)
+        run.system = self._system(scenario)
+        return self._finish(self._send(run))
+
+    def run_many(self, items, columns=None):
+        """Run the (scenario, sink) pairs of ``items`` one after another, each given to the
+        host before the rows of the one before it are read, so the host goes on to the next
+        run without waiting for the master (on a busy machine each wait is a wait for a
+        core); yields, in order, each run's :class:`LoopResult` or the ``ValueError`` /
+        :class:`CMasterError` it failed with (as :meth:`run` raises them). ``columns``: as
+        for :meth:`run`. A run that needs a start-up (a new host, an FMU not loaded yet)
+        waits for the one before it."""
+        ahead = None   # a run given to the host, its rows not read yet
+        for scenario, sink in items:
+            run = _Run(scenario, sink, columns, time.perf_counter(), self.startup_s)
+            try:
+                run.system = self._system(scenario)
+                if ahead is not None and not self._ready(run.system):
+                    yield self._outcome(ahead)
+                    ahead = None
+                self._send(run)
+            except (ValueError, RuntimeError) as error:
+                if ahead is not None:
+                    yield self._outcome(ahead)
+                    ahead = None
+                yield error
+                continue
+            if ahead is not None:
+                yield self._outcome(ahead)
+                run.started = max(run.started, time.perf_counter())   # its rows are read now
+            ahead = run
+        if ahead is not None:
+            yield self._outcome(ahead)
+
+    def _outcome(self, run):
+        try:
+            return self._finish(run)
+        except (ValueError, RuntimeError) as error:
+            return error
+
+
+class _Run:
+    """One run of a :class:`CMaster`: what it runs and where its rows go, and its state."""
+
+    def __init__(self, scenario, sink, columns, started, before):
+        self.scenario, self.sink, self.columns = scenario, sink, columns
+        self.started, self.before = started, before   # [s]: perf_counter, startup_s then
+        self.system = self.rows = self.host = None
+        self.sent = False
 
 
 def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
@@ -293,43 +370,3 @@ def run_c_master(scenario, fmu_dir, sink=None, windows=None, cache=None,
     result.wall_time_s = time.perf_counter() - started
     return result
 
-
-_PROCESS_MASTERS = {}   # (FMU folder, thread) -> CMaster: each worker's long-lived C master
-_PROCESS_LOCK = threading.Lock()
-
-
-def process_master(fmu_dir):
-    """This process's (and thread's) :class:`CMaster` over ``fmu_dir``, made at the first call
-    and kept for the next ones (a study's points on a Dask worker share it) until the
-    process exits (:func:`close_process_masters`)."""
-    key = (str(Path(fmu_dir).resolve()), threading.get_ident())
-    with _PROCESS_LOCK:
-        master = _PROCESS_MASTERS.get(key)
-        if master is None:
-            master = _PROCESS_MASTERS[key] = CMaster(fmu_dir)
-            _close_at_exit()
-        return master
-
-
-def close_process_masters():
-    """Close the masters :func:`process_master` made (their hosts end)."""
-    with _PROCESS_LOCK:
-        masters = list(_PROCESS_MASTERS.values())
-        _PROCESS_MASTERS.clear()
-    for master in masters:
-        master.close()
-
-
-_EXIT_REGISTERED = set()
-
-
-def _close_at_exit():
-    """At this process's exit: atexit, and multiprocessing's finalizers (its children, as
-    Dask's worker processes, end with os._exit and skip atexit)."""
-    if os.getpid() in _EXIT_REGISTERED:
-        return
-    _EXIT_REGISTERED.add(os.getpid())
-    atexit.register(close_process_masters)
-    util = sys.modules.get("multiprocessing.util")
-    if util is not None:
-        util.Finalize(None, close_process_masters, exitpriority=1)

@@ -119,7 +119,7 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         raise ValueError(f"--timeout must be a number of seconds > 0, got {timeout_s!r}")
     run = FMU_MASTERS[master] if path == "fmu" else PATHS[path]
     if events:
-        run = lambda scenario, fmu_dir, sink: _fmpy(scenario, fmu_dir, sink, events=True)
+        run = lambda scenario, fmu_dir, sink: _fmpy(scenario, fmu_dir, sink, events=True)  # noqa: E731
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
@@ -134,7 +134,7 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         if path == "fmu" and master == "c":   # one C master for every scenario
             from sma_fmu.systems.c_master import DEFAULT_TIMEOUT_S, CMaster
             c_master = stack.enter_context(CMaster(fmu_dir, timeout_s=timeout_s or DEFAULT_TIMEOUT_S))
-            run = lambda scenario, fmu_dir, sink: c_master.run(scenario, sink)
+            run = lambda scenario, fmu_dir, sink: c_master.run(scenario, sink)  # noqa: E731
         if figures:
             from sma_fmu.cosim.plots import plot_comparison, plot_run
         for index, (scenario, name, label) in enumerate(zip(scenarios, names, labels), start=1):
