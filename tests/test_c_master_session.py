@@ -319,3 +319,17 @@ def test_runs_given_ahead_equal_runs_one_at_a_time(native_dir, started, tmp_path
     _same(results[0].data, fresh[0])
     _same(results[2].data, fresh[1])
     assert len(started) == 3   # one for the first batch, two here: the hung one and its successor
+
+
+def test_the_pythonfmu_family_is_reset_to_a_fresh_run_too(fmus, started):
+    """The default FMUs (pythonfmu slaves behind the C front): fmi2Reset gives a fresh
+    slave, so runs of different scenarios in one host equal runs each in a host of its own."""
+    folder = fmus["SmaActuator"].parent
+    scenarios = [_scenario(name, {"scenario.stop_time_s": 2.0})
+                 for name in (PWM, "heavy-pi", "load-step-pi+ff-adaptive")]
+    fresh = [run_c_master(s, folder).data for s in scenarios]
+    del started[:]
+    with CMaster(folder) as master:
+        for scenario, expected in zip(scenarios + scenarios[::-1], fresh + fresh[::-1]):
+            _same(master.run(scenario).data, expected)
+    assert len(started) == 1

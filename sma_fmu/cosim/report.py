@@ -34,7 +34,7 @@ def summary_table(rows):
                      f"{_number(m['max_abs_ohm'], '>8.3f'):>8}{_number(m['iae_ohm_s'], '>8.2f'):>8}"
                      f"{row['wall_time_s']:>8.2f}{row['real_time_factor']:>8.0f}")
     lines.append("wall s: each run's own time, from its start to its last row, less the time "
-                 "the recorder spent writing")
+                 "spent writing its files")
     startup = [row["startup_s"] for row in rows if "startup_s" in row]
     if startup:
         lines.append(f"the C master's start-up (host started, FMUs read, unpacked and loaded), "

@@ -734,6 +734,7 @@ int main(void)
             if (csv_file && n != 5) bad("a csv line needs", "run ... binary ROWS");
             csv_step = h;
             if (n == 5) start_binary(atol(word[4]));
+            now = 0.0;   /* a failure before the first step is at t = 0 */
             initialize((double)steps * h, &callbacks);
             if (!failed) run(h, steps, n == 4);
             if (binary) {   /* a session: the next system follows on stdin */
