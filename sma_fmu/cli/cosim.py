@@ -10,7 +10,7 @@ def _run(args):
     from sma_fmu.systems.runner import timed_run
     timed_run(scenario_paths(args), args.out, args.path, args.fmus,
               output_interval_s=args.output_interval, fmt=args.format, master=args.master,
-              events=args.events, timeout_s=args.timeout)
+              events=args.events, timeout_s=args.timeout, figures=not args.no_figures)
     return 0
 
 
@@ -40,4 +40,7 @@ def register(commands):
                           "every step); the metrics always use every step")
     run.add_argument("--format", choices=("csv", "parquet"), default="csv",  # recording.FORMATS
                      help="time-series file: timeseries.csv (default) or timeseries.parquet")
+    run.add_argument("--no-figures", action="store_true",
+                     help="write no figures (figure.png, comparison-*.png): the time series, "
+                          "metrics and reports only, without the time figures take")
     run.set_defaults(handler=_run)

@@ -3,13 +3,13 @@ import sys
 import warnings
 from pathlib import Path
 
-from sma_fmu.fmi.packaging import build as fmu_build
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
 
 __all__ = ["register"]
 
 
 def _build(args):
+    from sma_fmu.fmi.packaging import build as fmu_build   # here: every other command skips it
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         paths = fmu_build.build_fmus(args.out, args.model, native=args.native,
@@ -22,6 +22,7 @@ def _build(args):
 
 
 def _validate(args):
+    from sma_fmu.fmi.packaging import build as fmu_build
     paths = args.fmus or list(default_fmu_paths(args.out).values())
     failed = False
     for path, problems in fmu_build.validate_fmus(paths).items():
