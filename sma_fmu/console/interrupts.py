@@ -51,13 +51,15 @@ def _module(frame):
 
 def in_fmu_code(frame):
     """True if ``frame`` (the innermost one) is Python code an FMU call runs: a frame of a
-    pythonfmu FMU's modules or of pythonfmu (not its builder) on the stack, or importlib
+    pythonfmu FMU's modules, of the functions they compile (no module name: the front's
+    fast path calls them) or of pythonfmu (not its builder) on the stack, or importlib
     called from fmpy (pythonfmu importing a slave in fmi2Instantiate)."""
     names = []
     while frame is not None:
         names.append(_module(frame))
         frame = frame.f_back
-    if any(_FMU_MODULE.match(name) or (name.startswith("pythonfmu") and not name.startswith(_BUILD_TIME))
+    if any(not name   # code the slave support compiled (slave_support/compiled.py: no module)
+           or _FMU_MODULE.match(name) or (name.startswith("pythonfmu") and not name.startswith(_BUILD_TIME))
            for name in names):
         return True
     outside = list(itertools.dropwhile(lambda name: name.startswith("importlib"), names))
