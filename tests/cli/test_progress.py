@@ -44,17 +44,32 @@ class Terminal:
         return b"".join(self.chunks).decode("utf-8", "replace")
 
 
+class _OnTerminal:
+    """sys.stderr on a pseudo-terminal while a test's body runs (set in the body: pytest's
+    capture sets sys.stderr again between a fixture and the test)."""
+
+    def __init__(self):
+        self.shown = None
+
+    def __call__(self, work, *arguments):
+        self.shown = Terminal()
+        kept, sys.stderr = sys.stderr, self.shown.stream
+        try:
+            result = work(*arguments)
+        finally:
+            sys.stderr = kept
+        return result, self.shown.text()
+
+
 @pytest.fixture
-def terminal(monkeypatch):
-    """sys.stderr on a pseudo-terminal."""
-    shown = Terminal()
-    monkeypatch.setattr(sys, "stderr", shown.stream)
-    return shown
+def terminal():
+    """``terminal(function, *arguments)``: (its result, what it drew on a pseudo-terminal
+    as stderr)."""
+    return _OnTerminal()
 
 
 def _on_terminal(terminal, argv):
-    status = main(argv)
-    return status, terminal.text()
+    return terminal(main, argv)
 
 
 @pytest.mark.needs("gcc")
@@ -65,15 +80,13 @@ def test_run_shows_each_scenario_s_progress(terminal, fmus, tmp_path):
 
 
 @pytest.mark.needs("gcc")
-def test_run_quiet_or_piped_shows_none(monkeypatch, capsys, fmus, tmp_path):
+def test_run_quiet_or_piped_shows_none(terminal, capsys, fmus, tmp_path):
     assert main(["run", "heavy-pi", "--fmus", str(fmus["SmaActuator"].parent),
                  "--out", str(tmp_path / "piped")]) == 0
     assert BAR not in capsys.readouterr().err
-    shown = Terminal()
-    monkeypatch.setattr(sys, "stderr", shown.stream)
-    assert main(["run", "heavy-pi", "--fmus", str(fmus["SmaActuator"].parent), "--quiet",
-                 "--out", str(tmp_path / "quiet")]) == 0
-    assert BAR not in shown.text()
+    status, text = _on_terminal(terminal, ["run", "heavy-pi", "--fmus", str(fmus["SmaActuator"].parent),
+                                           "--quiet", "--out", str(tmp_path / "quiet")])
+    assert status == 0 and BAR not in text
 
 
 @pytest.mark.needs("gcc")
@@ -85,8 +98,7 @@ def test_build_shows_each_fmu(terminal, tmp_path):
 @pytest.mark.needs("gcc")
 def test_a_native_build_shows_each_platform(terminal, tmp_path):
     from sma_fmu.fmi.packaging.build import build_fmus
-    build_fmus(tmp_path / "native", names=["SmaPwmDriver"], native=True)
-    text = terminal.text()
+    _, text = terminal(build_fmus, tmp_path / "native", None, ["SmaPwmDriver"], True)
     assert "native FMUs (FMI 2.0):" in text and "SmaPwmDriver linux64" in text and BAR in text
 
 
@@ -112,9 +124,12 @@ def test_piped_output_gets_no_bar_at_all(capsys, tmp_path):
     assert BAR not in captured.err + captured.out and "\r" not in captured.err
 
 
-def test_a_line_printed_during_a_bar_keeps_it_whole(terminal):
+def _demo():
     with progress.bar(2, "demo", unit="x", delay=0) as shown:
         progress.echo("a line of the command's own", file=sys.stderr)
         shown.update(2)
-    text = terminal.text()
+
+
+def test_a_line_printed_during_a_bar_keeps_it_whole(terminal):
+    _, text = terminal(_demo)
     assert "a line of the command's own\r\n" in text and "demo:" in text
