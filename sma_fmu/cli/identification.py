@@ -62,8 +62,7 @@ def _fit(args):
         _check_fit_loads(args)
     else:
         _only_for(args, _ISOBARIC_ONLY, "isobaric", "fit")
-    require_inputs(*((path, "measurement file") for path in args.files),
-                   (args.model, "parameter file"))
+    require_inputs(*((path, "file") for path in args.files), (args.model, "parameter file"))
     require("fit", "fit")
     from sma_fmu.console.progress import echo
     from sma_fmu.identification.runner import format_report, run_fit
@@ -179,7 +178,7 @@ def _synth(args):
 
 
 def _predict(args):
-    require_inputs((args.file, "measurement file"), (args.model, "parameter file"))
+    require_inputs((args.file, "file"), (args.model, "parameter file"))
     require("fit", "predict")
     from sma_fmu.identification.isobaric.predict_runner import (format_predict_report,
                                                                 run_isobaric_predict)

@@ -105,4 +105,4 @@ def test_the_command_line_starts_without_the_work_imports():
     """)
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert "heavy: [] status: 2" in result.stdout, result.stdout + result.stderr
-    assert result.stderr.strip() == "sma-fmu: error: no-such-file.csv: measurement file not found"
+    assert result.stderr.strip() == "sma-fmu: error: no-such-file.csv: file not found"
