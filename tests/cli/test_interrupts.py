@@ -87,3 +87,19 @@ def test_a_deferred_section_gets_its_interrupt_at_its_end():
         assert interrupts.seen() and finished
         signal.raise_signal(signal.SIGINT)   # after the first: ignored while ending
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_ctrl_c_inside_fmu_code_comes_when_the_fmu_call_returns():
+    """pythonfmu would turn a KeyboardInterrupt in its slave into fmi2Fatal: the slave's step
+    runs to its end, and the interrupt comes in the caller's next line."""
+    namespace = {"__name__": f"sma_actuator_{code_stamp()}", "signal": signal}
+    exec("def step(log):\n"  # noqa: S102 - a fixed text, a slave step's stand-in module
+         "    signal.raise_signal(signal.SIGINT)\n"
+         "    log.append('the step ran to its end')\n"
+         "    return True\n", namespace)
+    log = []
+    with interrupts.handle_interrupts():
+        with pytest.raises(KeyboardInterrupt):
+            namespace["step"](log)
+            log.append("the master went on")   # never: the interrupt comes here
+    assert log == ["the step ran to its end"] and sys.gettrace() is None
