@@ -21,28 +21,11 @@ from sma_fmu.cosim.recording import RunRecorder, interval_steps, read_timeseries
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios
 from sma_fmu.systems.c_master import CMasterError, run_c_master
 from sma_fmu.systems.runner import run_scenarios
+from discarding import MESSAGE, discarding, discards, valid_path
 from system_needs import needs
 
 pytestmark = needs("gcc")
 PWM = ("setpoints-pwm-pi+ff-adaptive", "setpoints-pwm-continuous-pi+ff-adaptive")
-
-# a PI so strong that the plant discards the step where the reference drops (t = 0.5 s)
-DISCARD = """
-[scenario]
-stop_time_s = {stop}
-step_s = 0.001
-[reference]
-kind = "step"
-initial_ohm = 60.0
-final_ohm = 1.0
-time_s = 0.5
-[load]
-times_s = [0.0]
-values_kg = [0.25]
-[controller]
-kind = "pi"
-Kp_W_per_ohm = 1e306
-"""
 
 
 def _scenario(name):
@@ -107,32 +90,34 @@ def test_an_fmu_whose_variables_do_not_match_is_named(native_dir, tmp_path):
         run_c_master(_scenario("heavy-pi"), tmp_path)
 
 
-def test_a_discard_mid_run_stops_there_keeping_the_rows(native_dir, tmp_path):
+def test_a_discard_mid_run_stops_there_keeping_the_rows(native_dir, tmp_path, monkeypatch):
     """The plant discards the step at t = 0.5 s: the error names it, the FMU's message and
     the time; the sink got the rows up to it, equal to those of a run that ends there."""
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
-    (tmp_path / "short.toml").write_text(DISCARD.format(stop=0.5))
+    discard = discarding(tmp_path, monkeypatch)
     got = []
     with pytest.raises(CMasterError) as caught:
-        run_c_master(load_scenario(tmp_path / "discard.toml"), native_dir, sink=got.append)
+        run_c_master(discard, native_dir, sink=got.append)
     error = caught.value
     assert error.status == 2 and error.time_s == 0.5
     assert "plant: fmi2DoStep failed (fmi2Discard) at t = 0.5 s" in str(error)
-    assert "floating-point range" in str(error) and "501 rows kept" in str(error)
+    assert MESSAGE in str(error) and "501 rows kept" in str(error)
     kept = np.concatenate(got)
-    _same(kept, run_c_master(load_scenario(tmp_path / "short.toml"), native_dir).data)
+    (tmp_path / "short").mkdir()
+    _same(kept, run_c_master(discarding(tmp_path / "short", monkeypatch, 0.5), native_dir).data)
     with pytest.raises(CMasterError) as again:   # without a sink: the rows are in the error
-        run_c_master(load_scenario(tmp_path / "discard.toml"), native_dir)
+        run_c_master(discard, native_dir)
     _same(again.value.rows, kept)
 
 
-def test_the_cli_names_the_failure_and_leaves_the_folder(native_dir, tmp_path, capsys):
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
+def test_the_cli_names_the_failure_and_leaves_the_folder(native_dir, tmp_path, capsys,
+                                                        monkeypatch):
+    discards(monkeypatch)
+    valid_path(tmp_path)
     out = tmp_path / "out"
     out.mkdir()
     (out / "keep.txt").write_text("kept")
     fails(capsys, ["run", str(tmp_path / "discard.toml"), "--fmus", str(native_dir),
-                   "--master", "c", "--out", str(out)], "plant: fmi2DoStep failed", "t = 0.5 s")
+                   "--master", "c", "--out", str(out)], MESSAGE)   # the row at 0.5 s
     fails(capsys, ["run", "heavy-pi", "--path", "library", "--master", "c", "--out", str(out)],
           "--master c", "--path library")
     assert [p.name for p in out.iterdir()] == ["keep.txt"]
@@ -239,22 +224,6 @@ def test_the_csv_the_c_master_writes_is_the_recorders_byte_for_byte(native_dir, 
     assert c_rows == len(range(0, scenario.steps + 1, every)) + (scenario.steps % every != 0)
 
 
-def test_a_discard_mid_run_leaves_the_same_csv_rows(native_dir, tmp_path):
-    """The failed step's rows: the C-written CSV holds those the Python recorder writes."""
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
-    scenario = load_scenario(tmp_path / "discard.toml")
-    texts = []
-    for kind, recorder_class in (("c", RunRecorder), ("python", _PythonCsv)):
-        folder = tmp_path / kind
-        folder.mkdir()
-        recorder = recorder_class(scenario, folder, 3, "csv")
-        with pytest.raises(CMasterError, match="501 rows kept"):
-            run_c_master(scenario, native_dir, recorder)
-        recorder.close()
-        texts.append((folder / "timeseries.csv").read_bytes())
-    assert texts[0] == texts[1] and texts[0].count(b"\n") == 1 + len(range(0, 501, 3))
-
-
 def _g10(values, windows=None):
     """The loop host's "%.10g" of each of ``values`` (its "g10" test line)."""
     import subprocess
@@ -332,7 +301,7 @@ def test_a_host_that_falls_silent_mid_run_is_killed_and_named(native_dir, tmp_pa
     import signal
 
     hosts = _stopping_popen(monkeypatch, "first rows")
-    (tmp_path / "hour.toml").write_text(DISCARD.format(stop=3600.0).replace("1e306", "0.3"))
+    valid_path(tmp_path, 3600.0, "hour")
     got = []
 
     def sink(block):

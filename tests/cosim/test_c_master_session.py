@@ -24,7 +24,7 @@ from sma_fmu.studies.runs import metrics_record
 from sma_fmu.systems import c_master
 from sma_fmu.systems.c_master import CMaster, CMasterError, run_c_master
 from system_needs import needs
-from test_c_master import DISCARD   # a PI so strong the plant discards the step at t = 0.5 s
+from discarding import MESSAGE, discarding, valid_path
 
 pytestmark = needs("gcc")
 
@@ -85,11 +85,10 @@ def test_runs_after_a_reset_equal_fresh_runs_to_the_bit(native_dir, started):
     assert not np.array_equal(fresh[5]["R"], fresh[2]["R"])   # and so did the load
 
 
-def test_a_failed_step_ends_its_run_only(native_dir, started, tmp_path):
+def test_a_failed_step_ends_its_run_only(native_dir, started, tmp_path, monkeypatch):
     """A discard mid-run: the same named error and rows as in a fresh host; the host stays
     (no new process), and the runs after it, CSV written by the host included, are fresh ones."""
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
-    discard, after = load_scenario(tmp_path / "discard.toml"), _scenario("heavy-pi+ff-fixed")
+    discard, after = discarding(tmp_path, monkeypatch), _scenario("heavy-pi+ff-fixed")
     with pytest.raises(CMasterError) as alone:
         run_c_master(discard, native_dir)
     expected = run_c_master(after, native_dir).data
@@ -120,7 +119,7 @@ def test_a_failed_step_ends_its_run_only(native_dir, started, tmp_path):
 def test_a_hung_host_is_replaced_and_the_next_run_is_fresh(native_dir, started, tmp_path):
     """The watchdog kills a host stopped mid-run (SIGSTOP); the master's next run starts a
     new host and equals a fresh run. A host killed between runs is replaced as well."""
-    (tmp_path / "long.toml").write_text(DISCARD.format(stop=600.0).replace("1e306", "0.3"))
+    valid_path(tmp_path, 600.0, "long")
     scenario = _scenario("load-step-pi+ff-adaptive")
     expected = run_c_master(scenario, native_dir).data
     del started[:]
@@ -173,14 +172,14 @@ def test_no_figures_writes_every_other_file_alike(native_dir, tmp_path):
         assert files[False][Path(name)].read_bytes() == files[True][Path(name)].read_bytes()
 
 
-def test_a_sweep_task_keeps_the_workers_master(native_dir, started, tmp_path):
+def test_a_sweep_task_keeps_the_workers_master(native_dir, started, tmp_path, monkeypatch):
     """Two tasks in one process, a failed run among them: one host for both, each row the
     metrics of its point run one at a time in a C master of its own, to the bit."""
     from sma_fmu.studies.spec import StudyRunSpec
     from sma_fmu.studies.tasks import close_worker_masters, run_task
 
     close_worker_masters()
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
+    discarding(tmp_path, monkeypatch)
     bases = [template("load-step-pi+ff-adaptive"), template(tmp_path / "discard.toml")]
     points = [(0, {"scenario.stop_time_s": 2.0, "controller.Kp_W_per_ohm": kp}) for kp in (0.2, 0.9, 0.5)]
     points.insert(2, (1, {}))
@@ -188,7 +187,7 @@ def test_a_sweep_task_keeps_the_workers_master(native_dir, started, tmp_path):
     rows = run_task(bases, runs[:2], native_dir) + run_task(bases, runs[2:], native_dir)
     assert len(started) == 1
     assert [row["status"] for row in rows] == ["ok", "ok", "failed", "ok"]
-    assert "fmi2DoStep failed (fmi2Discard)" in rows[2]["error"]
+    assert MESSAGE in rows[2]["error"]   # the host's rows up to t = 0.5 s, then the metrics
     del started[:]
     for row, (base, point) in zip(rows, points):
         if row["status"] != "ok":
@@ -257,36 +256,34 @@ def test_the_study_api_runs_its_points_in_one_c_master(native_dir, started):
 
 
 @needs("wine64", "mingw-w64")
-def test_the_win64_host_under_wine_keeps_its_session_too(native_dir, wine, started, tmp_path):
+def test_the_win64_host_under_wine_keeps_its_session_too(native_dir, wine, started, tmp_path, monkeypatch):
     """The win64 loop host under wine: runs of different scenarios and a discard in one
     host process equal the same runs each in a win64 host of its own, to the bit."""
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
+    discard = discarding(tmp_path, monkeypatch)
     short = {"scenario.stop_time_s": 2.0}
     scenarios = [_scenario(PWM, short), _scenario("heavy-pi", short),
                  _scenario("load-step-pi+ff-fixed", {**short, "load.values_kg": 0.1})]
     fresh = [run_c_master(s, native_dir, windows=wine).data for s in scenarios]
     with pytest.raises(CMasterError) as alone:
-        run_c_master(load_scenario(tmp_path / "discard.toml"), native_dir, windows=wine)
+        run_c_master(discard, native_dir, windows=wine)
     del started[:]
     with CMaster(native_dir, windows=wine) as master:
         for scenario, expected in zip(scenarios, fresh):
             _same(master.run(scenario).data, expected)
         with pytest.raises(CMasterError) as caught:
-            master.run(load_scenario(tmp_path / "discard.toml"))
+            master.run(discard)
         assert str(caught.value) == str(alone.value) and "(win64, wine)" in str(caught.value)
         for scenario, expected in zip(scenarios[::-1], fresh[::-1]):
             _same(master.run(scenario).data, expected)
     assert len(started) == 1
 
 
-def test_runs_given_ahead_equal_runs_one_at_a_time(native_dir, started, tmp_path):
+def test_runs_given_ahead_equal_runs_one_at_a_time(native_dir, started, tmp_path, monkeypatch):
     """``run_many`` gives the host each run before the master reads the one before: the
     results (a discard among them) are those of :meth:`CMaster.run`; when the host hangs
     in a run (stopped, killed by the watchdog), the run given after it is given again to a
     new host and is a fresh run."""
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
-    (tmp_path / "long.toml").write_text(DISCARD.format(stop=600.0).replace("1e306", "0.3"))
-    discard, long = load_scenario(tmp_path / "discard.toml"), load_scenario(tmp_path / "long.toml")
+    discard, long = discarding(tmp_path, monkeypatch), load_scenario(valid_path(tmp_path, 600.0, "long"))
     scenarios = _varied()[:4]
     fresh = [run_c_master(s, native_dir).data for s in scenarios]
     with pytest.raises(CMasterError) as alone:

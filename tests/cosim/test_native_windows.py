@@ -107,12 +107,12 @@ def test_win64_binaries_under_wine_step_the_loop_as_linux64(linux_runs, wine, na
 
 
 @needs("wine64")
-def test_the_c_master_runs_the_win64_build_under_wine(native_dir, wine, tmp_path):
+def test_the_c_master_runs_the_win64_build_under_wine(native_dir, wine, tmp_path, monkeypatch):
     """``--master c`` with the win64 host and DLLs: every row (binary frames on a Windows
     stdout), equal to the linux64 C master to 1e-12 of each column's scale (mingw-w64's
     libm), and a discard mid-run named with the rows up to it, as on linux64."""
     from sma_fmu.systems.c_master import CMasterError, run_c_master
-    from test_c_master import DISCARD
+    from discarding import discarding
 
     scenario = _scenario(SCENARIOS[0])
     linux = run_c_master(scenario, native_dir).data
@@ -123,10 +123,9 @@ def test_the_c_master_runs_the_win64_build_under_wine(native_dir, wine, tmp_path
         assert np.array_equal(np.isnan(a), np.isnan(b)), name
         a, b = np.nan_to_num(a), np.nan_to_num(b)
         assert np.max(np.abs(a - b)) <= TOLERANCE * max(np.max(np.abs(a)), 1e-300), name
-    (tmp_path / "discard.toml").write_text(DISCARD.format(stop=1.0))
     with pytest.raises(CMasterError, match=r"C master \(win64, wine\): plant: fmi2DoStep failed "
                                            r"\(fmi2Discard\) at t = 0.5 s") as caught:
-        run_c_master(load_scenario(tmp_path / "discard.toml"), native_dir, windows=wine)
+        run_c_master(discarding(tmp_path, monkeypatch), native_dir, windows=wine)
     assert len(caught.value.rows) == 501
 
 
