@@ -26,7 +26,8 @@ ParameterSpec = namedtuple("ParameterSpec", ["name", "section", "unit", "rule", 
 ParameterSpec.__doc__ = "One entry of the parameter schema: where it lives, its unit, its rule."
 
 # rule: "positive" (> 0), "nonnegative" (>= 0), "fraction" (0 <= v < 1), "finite",
-#       "margin" (0 < v < 0.5), "depth" (a whole number in [2, MAX_MEMORY_DEPTH])
+#       "margin" (0 < v < 0.5), "depth" (a whole number in [2, MAX_MEMORY_DEPTH]),
+#       "share" (0 <= v <= 1)
 PARAMETER_SPECS = (
     ParameterSpec("x0", "geometry", "m", "positive", True),
     ParameterSpec("x_min", "geometry", "m", "positive", True),
@@ -42,6 +43,8 @@ PARAMETER_SPECS = (
     ParameterSpec("b_h", "hysteresis", "degC/kg", "finite", True),
     ParameterSpec("a_c", "hysteresis", "degC", "finite", True),
     ParameterSpec("b_c", "hysteresis", "degC/kg", "finite", True),
+    ParameterSpec("cc_share_h", "hysteresis", "1", "share", False),
+    ParameterSpec("cc_share_c", "hysteresis", "1", "share", False),
     ParameterSpec("memory_depth", "hysteresis", "1", "depth", False),
     ParameterSpec("xi_F_inf", "constant_load", "1", "fraction", True),
     ParameterSpec("f_F", "constant_load", "kg", "positive", True),
@@ -87,6 +90,7 @@ RULE_TEXT = {
     "finite": "must be finite",
     "margin": "must be in (0, 0.5)",
     "depth": "must be a whole number in [2, 100000]",
+    "share": "must be in [0, 1]",
 }
 MAX_MEMORY_DEPTH = 100_000
 # choice: Ti-Ni actuator wires are rated for 150-200 MPa over many cycles and yield or lose
@@ -108,6 +112,8 @@ def _rule_holds(rule, value):
         return 0.0 < value < 0.5
     if rule == "depth":
         return value == int(value) and 2 <= value <= MAX_MEMORY_DEPTH
+    if rule == "share":
+        return 0.0 <= value <= 1.0
     return True
 
 
@@ -124,7 +130,8 @@ class WireParameters:
     largest load the model is valid for (``stress_max`` [MPa], optional, default
     :data:`DEFAULT_STRESS_MAX`): the steppers warn above it.
 
-    The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``) are
+    The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``,
+    ``cc_share_h``, ``cc_share_c``) are
     None when not given; ``terms`` (:class:`~.model_terms.ModelTerms`) holds the values in
     use, defaults filled in (nu_h = nu_c = nu, w2 = 0, ...: today's model bit for bit).
     """
@@ -177,6 +184,8 @@ class WireParameters:
     span_ratio_0: float = None
     span_ratio_sat: float = None
     span_stress: float = None
+    cc_share_h: float = None
+    cc_share_c: float = None
     source: str = field(default="<parameters>", compare=False, repr=False)
 
     lattice: tuple = field(init=False, repr=False, compare=False)

@@ -32,6 +32,7 @@ static int rule_holds(ParameterRule rule, double value)
     case RULE_FRACTION: return 0.0 <= value && value < 1.0;
     case RULE_MARGIN: return 0.0 < value && value < 0.5;
     case RULE_DEPTH: return value == trunc(value) && 2 <= value && value <= MAX_MEMORY_DEPTH;
+    case RULE_SHARE: return 0.0 <= value && value <= 1.0;
     default: return 1;
     }
 }
