@@ -238,7 +238,8 @@ def _carry(old_layout, old_x, layout, vector):
 
 
 def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=300,
-                 progress=None, stages=1, outliers="leave-out", widths="auto"):
+                 progress=None, stages=1, outliers="leave-out", widths="auto",
+                 centre_law="linear"):
     """Fit the isobaric files (list of IsobaricData) jointly; returns :class:`IsobaricFit`.
 
     ``stages``: 1, or 2 (a second stage, fitted from the one-stage fit); ``widths``:
@@ -265,7 +266,7 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     def layout_of(count, kind):
         return Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
                       any(d.resistance is not None for d in files), lag == "fit", count, loads,
-                      kind)
+                      kind, centre_law)
     began = time.perf_counter()
     clock = {"last": began, "evaluations": 0, "began": began}
 

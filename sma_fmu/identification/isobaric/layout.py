@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from sma_fmu.identification.isobaric.centre_law import SHARE_STRESSES
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.model_terms import domain_widths
 from sma_fmu.runtime.parameters import ParameterError
@@ -22,11 +23,14 @@ class Layout:
     it, ``gap0`` = a_h - a_c at no load and, with two loads or more, ``gapF`` at the largest
     load, both bounded below by 0: so each stage's heating centre is never below its cooling
     centre anywhere between no load and the largest load. :meth:`physical` maps the vector
-    onto the parameter-file names (a linear map; :meth:`transform` is its matrix).
+    onto the parameter-file names (a linear map; :meth:`transform` is its matrix). With the
+    Clausius-Clapeyron centres (``cc_share_h``, ``cc_share_c``) gapF still sets b_h as below;
+    the heating centre's lead at a load f is then gap0 + b_h f_h - b_c f_c (f_d of
+    :func:`~sma_fmu.runtime.model_terms.centre_load`).
     """
 
     def __init__(self, files, base, fit_slopes, absolute, with_resistance, fit_lag, stages=1,
-                 loads=(), widths="separate"):
+                 loads=(), widths="separate", centre_law="linear"):
         self.stages = stages
         self.top_load = max(loads) if loads else 0.0
         fit_slopes = fit_slopes and self.top_load > 0.0
@@ -41,6 +45,13 @@ class Layout:
         self.phys += ["l_MF"] + (["x_min"] if absolute else []) + ["alpha_P", "alpha_MF"]
         self.phys += (["span_ratio_0"] if stresses >= 2 else []) + \
             (["span_stress"] if stresses >= 3 else [])
+        # the centre law (isobaric/centre_law.py): each direction's share, fitted with three
+        # stresses or more (two centres per direction fix only a_d and b_d)
+        self.phys += ["cc_share_h", "cc_share_c"] if centre_law == "clausius-clapeyron" \
+            and stresses >= SHARE_STRESSES else []
+        # linear centres asked for, over a --model file with the law on: switch it off
+        self.linear_centres = centre_law == "linear" and (base.terms.cc_share_h != 0.0
+                                                          or base.terms.cc_share_c != 0.0)
         self.phys += ["R_P", "R_MF"] if with_resistance else []
         self.offsets = []   # per file: (first column, count, level-0 fixed at zero)
         names = list(self.phys)
@@ -109,6 +120,8 @@ class Layout:
                                    f"({', '.join(bad)}); the data do not determine it")
         changes = {k: v for k, v in values.items() if k not in ("l_MF", "R_MF")}
         changes["l_M"], changes["l_F"] = values["l_MF"] - self.half_l, values["l_MF"] + self.half_l
+        if self.linear_centres:
+            changes["cc_share_h"] = changes["cc_share_c"] = 0.0
         if "R_MF" in values:
             changes["R_M"] = values["R_MF"] - self.half_r
             changes["R_F"] = values["R_MF"] + self.half_r

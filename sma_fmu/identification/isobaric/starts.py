@@ -23,7 +23,8 @@ __all__ = ["starts", "LAG_LIMIT", "BOUNDS"]
 LAG_LIMIT = 1 / 20       # of a cycle: the largest lag the fit may reach (the lag guard)
 BOUNDS = {"a_c": (-100.0, 400.0), "b_c": (-5000.0, 5000.0), "gap0": (0.0, 200.0),
           "gapF": (0.0, 200.0), "w2": (0.0, 0.95), "alpha_P": (-2e-3, 2e-3),
-          "alpha_MF": (-2e-3, 2e-3), "span_ratio_0": (0.01, 10.0), "span_stress": (1.0, 5000.0)}
+          "alpha_MF": (-2e-3, 2e-3), "span_ratio_0": (0.01, 10.0), "span_stress": (1.0, 5000.0),
+          "cc_share_h": (0.0, 1.0), "cc_share_c": (0.0, 1.0)}
 
 
 def _crossings(f, temperature):
@@ -148,6 +149,7 @@ def starts(files, layout, base, lag_fraction=0.01):
         if "span_stress" in layout.phys:
             start["span_stress"] = scale
     start["alpha_P"] = start["alpha_MF"] = 0.0
+    start["cc_share_h"] = start["cc_share_c"] = 0.0     # from linear centres
     start.update({"w2": 0.2, "a2_c": start["a_c"], "b2_c": start.get("b_c", 0.0),
                   "gap2_0": start["gap0"], "gap2_F": start["gapF"],
                   "nu2_h": start["nu_h"] / 3.0, "nu2_c": start["nu_c"] / 3.0})

@@ -1,0 +1,68 @@
+"""The centre law of the isobaric fit: linear centres a_d + b_d f, or centres whose load slope
+follows the transformation strain (Clausius-Clapeyron; the runtime's
+:func:`~sma_fmu.runtime.model_terms.centre_load`, one share c = cc_share_h = cc_share_c).
+
+With three stresses or more the share is an unknown of the fit, bounded to [0, 1]; with fewer,
+two centres per direction fix only a_d and b_d, so the share stays from ``--model`` (0, linear,
+for every shipped file) and :func:`law_note` says so. ``linear`` switches a share of
+``--model`` off. The centres' standard errors come from :func:`centre_gradient`.
+"""
+import numpy as np
+
+from sma_fmu.runtime.constant_load import hysteresis_centre
+from sma_fmu.runtime.parameters import ParameterError
+
+__all__ = ["CENTRE_LAWS", "SHARE_STRESSES", "centre_gradient", "law_note"]
+
+CENTRE_LAWS = ("linear", "clausius-clapeyron")
+SHARE_STRESSES = 3      # stresses needed to fit the share
+# the parameters a stage-1 centre depends on (the runtime's hysteresis_centre)
+CENTRE_INPUTS = ("a_h", "b_h", "a_c", "b_c", "cc_share_h", "cc_share_c", "span_ratio_0",
+                 "span_ratio_sat", "span_stress")
+_STEP = 1e-6            # relative step of the central differences
+
+
+def centre_gradient(load, direction, params, names):
+    """d tau_d / d name [degC per the parameter's unit] of the stage-1 centre at ``load``
+    [kg] in ``direction`` (+1/-1) for each of ``names`` (0 for names it does not depend on):
+    central differences of the runtime's centre, one-sided for a share on its bound (exact
+    for a_d, b_d and cc_share_d, in which the centre is linear)."""
+    terms = params.terms
+    gradient = np.zeros(len(names))
+    centre = hysteresis_centre(load, direction, params)
+    for i, name in enumerate(names):
+        if name not in CENTRE_INPUTS:
+            continue
+        value = getattr(params, name)
+        value = getattr(terms, name) if value is None else value
+        step = _STEP * max(abs(value), 1.0)
+        moved, at = [], []
+        for sign in (1.0, -1.0):
+            try:
+                moved.append(hysteresis_centre(load, direction,
+                                               params.replace(**{name: value + sign * step})))
+                at.append(value + sign * step)
+            except ParameterError:
+                moved.append(centre)
+                at.append(value)
+        gradient[i] = (moved[0] - moved[1]) / (at[0] - at[1])
+    return gradient
+
+
+def law_note(option, params, stresses, fitted):
+    """{"option", "cc_share_h", "cc_share_c", "note"}: the law asked for and what was done.
+
+    ``stresses``: how many distinct stresses the files hold; ``fitted``: whether the share
+    was an unknown of the fit."""
+    terms = params.terms
+    if fitted:
+        note = (f"centres with a load slope b_d [1 - c + c s(sigma)/s_sat]: the share c fitted "
+                f"from {stresses} stresses; b_d is the slope where s has saturated")
+    elif option == "clausius-clapeyron":
+        note = (f"the share c of the centres' slope that follows s(sigma) needs "
+                f"{SHARE_STRESSES} stresses or more to be fitted; with {stresses} it stays from "
+                f"--model (cc_share_h = {terms.cc_share_h!r}, cc_share_c = {terms.cc_share_c!r})")
+    else:
+        note = "centres linear in the load, a_d + b_d f"
+    return {"option": option, "cc_share_h": terms.cc_share_h, "cc_share_c": terms.cc_share_c,
+            "note": note}
