@@ -106,9 +106,9 @@ def test_with_two_stresses_the_share_stays_from_the_model(tmp_path, params):
 def test_the_command_fits_the_law_and_writes_it(tmp_path, params, capsys):
     truth = _truth(params)
     paths = []
-    for index, load in enumerate((0.03, 0.1, 0.22)):
+    for index, load in enumerate((0.01, 0.08, 0.3)):
         columns, _ = isobaric_table(truth, load, IsobaricProgramme(
-            points=900, seed=40 + index, cycles=1, t_low=15.0, t_high=140.0))
+            points=900, seed=40 + index, cycles=1, t_low=15.0, t_high=140.0, noise_K=0.5))
         paths.append(tmp_path / f"cli_{index}.csv")
         paths[-1].write_text(isobaric_text(columns, [f"load: {load} kg"]), encoding="utf-8")
     out = tmp_path / "fit"
@@ -127,3 +127,14 @@ def test_the_command_fits_the_law_and_writes_it(tmp_path, params, capsys):
     assert main(["fit", "constant-load", str(paths[0]), "--centre-law", "linear",
                  "--out", str(tmp_path / "cl")]) == 2
     assert "--centre-law applies to isobaric only" in capsys.readouterr().err
+
+
+def test_a_law_the_data_do_not_ask_for_is_not_kept(tmp_path, params):
+    """Linear centres in the truth: the shares do not lower the cost by 1 %, so the linear
+    centres stay and the stage note says why."""
+    truth = _truth(params).replace(cc_share_h=0.0, cc_share_c=0.0)
+    fit = fit_isobaric(_files(tmp_path, truth, (0.02, 0.1, 0.25)), params, lag="none",
+                       centre_law="clausius-clapeyron")
+    assert fit.converged and "cc_share_h" not in fit.wire_names
+    assert (fit.params.terms.cc_share_h, fit.params.terms.cc_share_c) == (0.0, 0.0)
+    assert "linear centres kept" in fit.stage_note

@@ -2,17 +2,21 @@
 follows the transformation strain (Clausius-Clapeyron; the runtime's
 :func:`~sma_fmu.runtime.model_terms.centre_load`, one share c = cc_share_h = cc_share_c).
 
-With three stresses or more the share is an unknown of the fit, bounded to [0, 1]; with fewer,
-two centres per direction fix only a_d and b_d, so the share stays from ``--model`` (0, linear,
-for every shipped file) and :func:`law_note` says so. ``linear`` switches a share of
-``--model`` off. The centres' standard errors come from :func:`centre_gradient`.
+With three stresses or more each direction's share is an unknown of the fit, bounded to
+[0, 1] and fitted last, from the converged linear fit (as a second stage is), and kept when it
+lowers the cost (:func:`law_attempt`): where the transformation strain hardly changes over
+the stresses (the Flexinol files: s from 0.67 to 0.95) the shares are not determined, and the
+linear centres stay. With fewer stresses, two centres per direction fix only a_d and b_d, so
+the shares stay from ``--model`` (0, linear, for every shipped file) and :func:`law_note`
+says so. ``linear`` switches a share of ``--model`` off. The centres' standard errors come
+from :func:`centre_gradient`.
 """
 import numpy as np
 
 from sma_fmu.runtime.constant_load import hysteresis_centre
 from sma_fmu.runtime.parameters import ParameterError
 
-__all__ = ["CENTRE_LAWS", "SHARE_STRESSES", "centre_gradient", "law_note"]
+__all__ = ["CENTRE_LAWS", "SHARE_STRESSES", "centre_gradient", "law_attempt", "law_note"]
 
 CENTRE_LAWS = ("linear", "clausius-clapeyron")
 SHARE_STRESSES = 3      # stresses needed to fit the share
@@ -49,6 +53,17 @@ def centre_gradient(load, direction, params, names):
     return gradient
 
 
+def law_attempt(linear, richer, gain):
+    """(the state kept, a note or ""): ``richer`` (the fit with the shares, started from the
+    ``linear`` one) when it converged and lowers the cost by the fraction ``gain``."""
+    old, new = linear.solution, richer.solution
+    if new.status > 0 and new.cost <= (1.0 - gain) * old.cost:
+        return richer, ""
+    return linear, (f"centres that follow the transformation strain do not fit these data "
+                    f"better (cost {new.cost:.6g} against {old.cost:.6g} with linear centres"
+                    f"{'' if new.status > 0 else '; ' + new.message}): linear centres kept")
+
+
 def law_note(option, params, stresses, fitted):
     """{"option", "cc_share_h", "cc_share_c", "note"}: the law asked for and what was done.
 
@@ -58,6 +73,9 @@ def law_note(option, params, stresses, fitted):
     if fitted:
         note = (f"centres with a load slope b_d [1 - c + c s(sigma)/s_sat]: the share c fitted "
                 f"from {stresses} stresses; b_d is the slope where s has saturated")
+    elif option == "clausius-clapeyron" and stresses >= SHARE_STRESSES:
+        note = ("centres that follow the transformation strain did not fit these data better "
+                "than linear centres, which were kept (stage_note says by how much)")
     elif option == "clausius-clapeyron":
         note = (f"the share c of the centres' slope that follows s(sigma) needs "
                 f"{SHARE_STRESSES} stresses or more to be fitted; with {stresses} it stays from "

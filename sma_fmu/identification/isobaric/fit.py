@@ -49,6 +49,7 @@ from sma_fmu.identification.isobaric.jacobian import file_jacobian, file_model, 
 from sma_fmu.identification.isobaric.lag import uniform_step
 from sma_fmu.identification.isobaric.covariance import (named, named_values,
                                                         reported_covariance, wire_covariance)
+from sma_fmu.identification.isobaric.centre_law import SHARE_STRESSES, law_attempt
 from sma_fmu.identification.isobaric.layout import Layout
 from sma_fmu.identification.isobaric.outliers import OUTLIER_OPTIONS, bound_names, mark_outliers
 from sma_fmu.identification.isobaric.starts import starts
@@ -263,10 +264,14 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     prepared = [prepare(data, index, residual) for index, data in enumerate(files)]
     loads = sorted({data.load for data in files})
 
+    # the centre law's shares are fitted last, from the linear fit (centre_law.py)
+    fit_law = centre_law == "clausius-clapeyron" and len(loads) >= SHARE_STRESSES
+    law = "linear" if fit_law else centre_law
+
     def layout_of(count, kind):
         return Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
                       any(d.resistance is not None for d in files), lag == "fit", count, loads,
-                      kind, centre_law)
+                      kind, law)
     began = time.perf_counter()
     clock = {"last": began, "evaluations": 0, "began": began}
 
@@ -317,6 +322,10 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
                              f"cost {richer.solution.cost:.6g} against "
                              f"{state.solution.cost:.6g} with one stage): one stage kept")
                 stages = 1
+        if fit_law:
+            law = centre_law
+            state, note = law_attempt(state, attempt(state, stages, kind), STAGE_GAIN_MIN)
+            notes += [note] if note else []
     for note in notes if progress is not None else ():
         progress("  " + note)
     stage_note = "; ".join(notes)
