@@ -2,11 +2,9 @@
 (hysteresis.cc_share_h, cc_share_c beside the stress law): the shares are FMU parameters of
 both families, and the plant and the compensator of the two families agree bit for bit and
 equal the library steppers of that file, also with a share set by the host."""
-import random
-
 import pytest
 
-from native_twins import Instance
+from native_twins import Instance, compensator_walk, plant_walk
 from sma_fmu.files.package_data import default_parameter_file
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
@@ -76,22 +74,8 @@ def test_the_plants_agree_bit_for_bit_and_equal_the_library(families, law_file, 
         start["cc_share_c"] = share_c
     library = PlantStepper(params, mode="continuous", load=0.2)
     py, nat = _pair(families, "SmaActuator", f"law-plant{share_c}", start)
-    rng, time, power, load = random.Random(7), 0.0, 1.0, 0.2
     try:
-        for k in range(5000):
-            if k % rng.randint(40, 300) == 0:
-                power = rng.choice([0.0, rng.uniform(0.0, 4.0)])
-            if rng.random() < 0.004:
-                load = rng.uniform(0.0, 0.4)
-            for side in (py, nat):
-                side.set("P_in", power)
-                side.set("load", load)
-                assert side.step(time, 1e-3) <= 1, side.log[-2:]
-            time += 1e-3
-            expected = library.step(power, load, 1e-3)
-            a, b = py.values(), nat.values()
-            assert a == b, (k, a, b)
-            assert (a["R"], a["T"], a["x"]) == (expected.R, expected.T, expected.x), k
+        plant_walk((py, nat), library, 7, 5000, 0.2, load_rate=0.004)
     finally:
         py.close()
         nat.close()
@@ -104,22 +88,8 @@ def test_the_compensators_agree_bit_for_bit_and_equal_the_library(families, law_
     library.initial_outputs(band.cold, 0.15)
     py, nat = _pair(families, "SmaFeedforward", "law-ff",
                     {"inverse": 2, "memory_depth": 3, "R_ref": band.cold, "load": 0.15})
-    rng, time, reference, target, inside = random.Random(3), 0.0, band.cold, band.cold, 0
     try:
-        for k in range(4000):
-            if k % rng.randint(30, 250) == 0:
-                target = rng.uniform(band.hot, band.cold)
-            reference += 0.02 * (target - reference)
-            for side in (py, nat):
-                side.set("R_ref", reference)
-                assert side.step(time, 1e-3) <= 1, side.log[-2:]
-            time += 1e-3
-            expected = library.step(reference, 0.15, 1e-3)
-            a, b = py.values(), nat.values()
-            assert a == b, (k, a, b)
-            assert (a["P_ff"], a["T_ref"]) == (expected.P_ff, expected.T_ref), k
-            inside += not expected.saturated
-        assert inside > 2000
+        assert compensator_walk((py, nat), library, 3, 4000, band, 0.15) > 2000
     finally:
         py.close()
         nat.close()

@@ -5,8 +5,9 @@ iterative (lsmr) steps need thousands of inner iterations on this ill-conditione
 (the lag trades against the centres and the profile's knots). Here every step solves the
 damped normal equations (J^T J + lambda diag(J^T J)) dx = -J^T r with scipy's sparse LU
 (``splu``), so a 26,000-sample, 100-cycle fit with ~1,000 unknowns takes seconds. Bounds
-are kept by projecting each trial point onto the box (Marquardt's scaling makes the step
-invariant to the unknowns' units). Stops when three steps in a row lower the cost by less
+are kept by projecting each trial point onto the box, with the unknowns on a bound that the
+gradient pushes outward held out of the step (Marquardt's scaling makes the step invariant
+to the unknowns' units). Stops when three steps in a row lower the cost by less
 than ``ftol`` relative, a step moves every unknown by less than ``xtol`` relative, or after
 ``max_evaluations``.
 """
@@ -63,6 +64,24 @@ def _step(jac, gradient, damping, order):
         return None
 
 
+def _bounded_step(jac, gradient, damping, order, x, lower, upper):
+    """The damped step with the unknowns held that sit on a bound the gradient pushes them
+    beyond (an active set): projecting a step that moves them would leave the others a step
+    computed for a move that cannot happen, and the solver would crawl along the bound."""
+    held = ((x <= lower) & (gradient > 0)) | ((x >= upper) & (gradient < 0))
+    if not held.any():
+        return _step(jac, gradient, damping, order)
+    free = ~held
+    column = np.cumsum(free) - 1              # each free unknown's column in the reduced problem
+    reduced = None if order is None else column[order[free[order]]]
+    step = _step(jac[:, np.flatnonzero(free)], gradient[free], damping, reduced)
+    if step is None:
+        return None
+    out = np.zeros(x.size)
+    out[free] = step
+    return out
+
+
 def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e-10,
                         xtol=1e-10, damping=1e-3, order=None):
     """Minimise 0.5 |fun(x)|^2 for ``lower <= x <= upper``; ``jac`` returns a sparse matrix;
@@ -73,7 +92,7 @@ def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e
     j = jac(x)
     while evaluations < max_evaluations:
         gradient = j.T @ r
-        step = _step(j, gradient, damping, order)
+        step = _bounded_step(j, gradient, damping, order, x, lower, upper)
         if step is None or not np.all(np.isfinite(step)):
             damping *= 10.0
             if damping > 1e12:
