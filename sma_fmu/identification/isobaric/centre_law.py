@@ -1,6 +1,6 @@
 """The centre law of the isobaric fit: linear centres a_d + b_d f, or centres whose load slope
 follows the transformation strain (Clausius-Clapeyron; the runtime's
-:func:`~sma_fmu.runtime.model_terms.centre_load`, one share c = cc_share_h = cc_share_c).
+:func:`~sma_fmu.runtime.model_terms.centre_load`: a share c_d = cc_share_d per direction).
 
 With three stresses or more each direction's share is an unknown of the fit, bounded to
 [0, 1] and fitted last, from the converged linear fit (as a second stage is), and kept when it
@@ -67,19 +67,21 @@ def law_attempt(linear, richer, gain):
 def law_note(option, params, stresses, fitted):
     """{"option", "cc_share_h", "cc_share_c", "note"}: the law asked for and what was done.
 
-    ``stresses``: how many distinct stresses the files hold; ``fitted``: whether the share
-    was an unknown of the fit."""
+    ``stresses``: how many distinct stresses the files hold; ``fitted``: whether the shares
+    were unknowns of the fit."""
     terms = params.terms
     if fitted:
-        note = (f"centres with a load slope b_d [1 - c + c s(sigma)/s_sat]: the share c fitted "
-                f"from {stresses} stresses; b_d is the slope where s has saturated")
+        note = (f"centres with a load slope b_d [1 - c_d + c_d s(sigma)/s_sat]: the shares "
+                f"c_h = {terms.cc_share_h:.4g}, c_c = {terms.cc_share_c:.4g} fitted from "
+                f"{stresses} stresses; b_d is the slope where s has saturated")
     elif option == "clausius-clapeyron" and stresses >= SHARE_STRESSES:
         note = ("centres that follow the transformation strain did not fit these data better "
                 "than linear centres, which were kept (stage_note says by how much)")
     elif option == "clausius-clapeyron":
-        note = (f"the share c of the centres' slope that follows s(sigma) needs "
-                f"{SHARE_STRESSES} stresses or more to be fitted; with {stresses} it stays from "
-                f"--model (cc_share_h = {terms.cc_share_h!r}, cc_share_c = {terms.cc_share_c!r})")
+        note = (f"the shares of the centres' slopes that follow s(sigma) need "
+                f"{SHARE_STRESSES} stresses or more to be fitted; with {stresses} they stay "
+                f"from --model (cc_share_h = {terms.cc_share_h!r}, "
+                f"cc_share_c = {terms.cc_share_c!r})")
     else:
         note = "centres linear in the load, a_d + b_d f"
     return {"option": option, "cc_share_h": terms.cc_share_h, "cc_share_c": terms.cc_share_c,

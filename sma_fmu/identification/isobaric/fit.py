@@ -49,7 +49,7 @@ from sma_fmu.identification.isobaric.jacobian import file_jacobian, file_model, 
 from sma_fmu.identification.isobaric.lag import uniform_step
 from sma_fmu.identification.isobaric.covariance import (named, named_values,
                                                         reported_covariance, wire_covariance)
-from sma_fmu.identification.isobaric.centre_law import SHARE_STRESSES, law_attempt
+from sma_fmu.identification.isobaric.centre_law import CENTRE_LAWS, SHARE_STRESSES, law_attempt
 from sma_fmu.identification.isobaric.layout import Layout
 from sma_fmu.identification.isobaric.outliers import OUTLIER_OPTIONS, bound_names, mark_outliers
 from sma_fmu.identification.isobaric.starts import starts
@@ -248,7 +248,9 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     separate kept only when it lowers the cost by STAGE_GAIN_MIN: with a fitted lag, separate
     widths blur the lag against the centres); ``outliers``:
     "leave-out" (cycles whose strain residual RMS exceeds OUTLIER_RATIO times the median
-    cycle's are named and fitted again without their strain) or "keep".
+    cycle's are named and fitted again without their strain) or "keep"; ``centre_law``:
+    "linear" or "clausius-clapeyron" (each direction's share of :mod:`~.centre_law`, fitted
+    last, from the linear fit, with three stresses or more).
     ``progress`` (callable taking a line of text, or None) hears from long fits.
     """
     if residual not in RESIDUAL_OPTIONS:
@@ -259,6 +261,8 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         raise ValueError(f"widths must be one of {', '.join(WIDTH_OPTIONS)}, got {widths!r}")
     if stages not in (1, 2):
         raise ValueError(f"stages must be 1 or 2, got {stages!r}")
+    if centre_law not in CENTRE_LAWS:
+        raise ValueError(f"centre_law must be one of {', '.join(CENTRE_LAWS)}, got {centre_law!r}")
     if outliers not in OUTLIER_OPTIONS:
         raise ValueError(f"outliers must be one of {', '.join(OUTLIER_OPTIONS)}, got {outliers!r}")
     prepared = [prepare(data, index, residual) for index, data in enumerate(files)]
