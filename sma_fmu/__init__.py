@@ -1,7 +1,7 @@
 """sma-fmu: SMA wire actuator model, feedforward hysteresis compensator and FMI co-simulation units.
 
 Subpackages, by concern, lowest layer first (each imports only from those before it;
-tests/test_layout.py checks it):
+tests/project/test_layout.py checks it):
 - :mod:`sma_fmu.runtime`: the physics and steppers (standard library only, shipped in the FMUs);
 - :mod:`sma_fmu.files`: shipped data, TOML and JSON files, output folders never left half-written;
 - :mod:`sma_fmu.wire`: parameter files and the parameters derived from a wire's geometry;

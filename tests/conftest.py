@@ -1,14 +1,18 @@
-"""Shared fixtures: the reference wire's parameters, the FMUs built once per session, the C host;
-the ``needs`` marker of tests/system_needs.py."""
+"""Shared fixtures: the reference wire's parameters, the FMUs built once per session, the C host,
+a wine64 prefix; the ``needs`` marker of tests/support/system_needs.py."""
+import os
+import subprocess
+
 import pytest
 
 from sma_fmu import load_parameter_set
-from system_needs import need
+from system_needs import need, wine_command
 
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "needs(*names): system packages or root the test needs "
-                                       "(tests/system_needs.py): skipped without, failed under CI=true")
+                                       "(tests/support/system_needs.py): skipped without, failed "
+                                       "under CI=true")
 
 
 def pytest_runtest_setup(item):
@@ -68,3 +72,16 @@ def fmi_host_exe(tmp_path_factory):
     need("gcc")
     from sma_fmu.fmi.hosts import compile_host
     return compile_host("fmi_host", tmp_path_factory.mktemp("fmi_host"))
+
+
+@pytest.fixture(scope="module")
+def wine(tmp_path_factory):
+    """The environment of a wine64 prefix of the test module's own (Debian's wine64 runs the
+    win64 binaries; Z: is /)."""
+    need("wine64")
+    root = tmp_path_factory.mktemp("wine")
+    environment = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "SMA_FMU_LIBPYTHON")}
+    environment.update(WINEPREFIX=str(root / "prefix"), WINEDEBUG="-all", DISPLAY="")
+    subprocess.run([wine_command(), "wineboot", "--init"], env=environment, capture_output=True,
+                   timeout=600, check=True)
+    return environment

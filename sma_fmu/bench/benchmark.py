@@ -26,14 +26,14 @@ from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario, resolve_scenarios
 __all__ = ["TARGETS", "run_benchmarks", "run_batch_benchmark", "format_table", "main"]
 
 STEP = 1e-3
-TARGETS = {  # issue 6, on a 2-core machine
+TARGETS = {  # the project's speed targets, on a 2-core machine
     "closed_loop_fmu_s": 0.5,                  # 30 s load-step through both FMUs + PI
     "feedforward_step_us": 15.0,               # SmaFeedforward set + doStep + get
     "library_real_time_factor": 150.0,         # per scenario
     "identification_s": 2.0,                   # the 4-load constant-load fit
-    "c_host_vs_fmpy": 2.0,                     # issue 10: SmaActuator step in a C host / fmpy master
+    "c_host_vs_fmpy": 2.0,                     # SmaActuator step in a C host / fmpy master
 }
-RATIO_TARGETS = {  # issue 28 (issue 22 asked 1.5 for the C host): (target, stretch or None)
+RATIO_TARGETS = {  # (target, stretch or None); an earlier target for the C host was 1.5
     "FMU closed loop / library path": (3.0, 2.0),
     "SmaActuator in the C host / library plant step": (2.0, None),
 }
@@ -313,7 +313,7 @@ def _c_host_lines(results):
 
 
 def _ratio_lines(results):
-    """The ratios of issues 22 and 28, with the spread of the alternating runs and their targets."""
+    """The FMU-path ratios, with the spread of the alternating runs and their targets."""
     lines = [f"Ratios (median of {results['runs']} alternating runs, min ... max)"]
     for name, row in results["ratios"].items():
         target = next((t for key, t in RATIO_TARGETS.items() if name.startswith(key)), None)

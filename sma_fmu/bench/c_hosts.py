@@ -24,11 +24,11 @@ import sys
 import tempfile
 import uuid
 import zipfile
-from importlib import resources
 from pathlib import Path
 
-from sma_fmu.fmi.packaging.front_build import libpython_path, remove_front
+from sma_fmu.fmi.c_common import include_flags
 from sma_fmu.fmi.hosts import c_compiler, compile_host
+from sma_fmu.fmi.packaging.front_build import libpython_path, remove_front
 from sma_fmu.systems.c_host import host_environment
 
 __all__ = ["BENCH_LOAD_KG", "BENCH_P_IN_W", "C_HOST_STEPS", "c_host_step_costs",
@@ -76,18 +76,14 @@ def build_thermal_lag(folder, params):
     (None, why) where it cannot be built (not 64-bit Linux, no working C compiler)."""
     if not (sys.platform.startswith("linux") and sys.maxsize > 2 ** 32):
         return None, f"the native bench FMU is built on 64-bit Linux only (this is {sys.platform})"
-    source = resources.files("sma_fmu.bench") / "thermal_lag.c"
+    source = Path(__file__).parent / "thermal_lag.c"
     values = {"T_room": float(params.T_room), "K_th": float(params.K_th), "tau": float(params.tau_th)}
     with tempfile.TemporaryDirectory(prefix="sma_fmu_lag_") as stage:
-        native = Path(stage) / "bench"
-        native.mkdir()
-        (native / "thermal_lag.c").write_bytes(source.read_bytes())
-        shutil.copytree(Path(str(resources.files("sma_fmu.fmi.python_family") / "front")),
-                        Path(stage) / "front")
         library = Path(stage) / "ThermalLag.so"
         command = [*c_compiler(), "-std=c11", "-O2", "-shared", "-fPIC", "-fvisibility=hidden",
-                   f"-DLAG_T_ROOM={values['T_room']!r}", f"-DLAG_K_TH={values['K_th']!r}",
-                   f"-DLAG_TAU={values['tau']!r}", "-o", str(library), str(native / "thermal_lag.c"), "-lm"]
+                   *include_flags(), f"-DLAG_T_ROOM={values['T_room']!r}",
+                   f"-DLAG_K_TH={values['K_th']!r}", f"-DLAG_TAU={values['tau']!r}",
+                   "-o", str(library), str(source), "-lm"]
         try:
             result = subprocess.run(command, capture_output=True, text=True, timeout=300)
         except (OSError, subprocess.SubprocessError) as error:

@@ -5,7 +5,7 @@ library's steppers in Python, or the native FMUs in the C master, ``--master c``
 its rows into a :class:`~sma_fmu.cosim.recording.RunRecorder` (metrics, the time series
 in Parquet or CSV, the figure's rows), timed from the start of the run to the closed file.
 The two alternate, run i of each next to the other; the ratio is the median of the
-per-pair ratios, against :data:`TARGET` (issue 41). The peak memory of a one-hour run at
+per-pair ratios, against :data:`TARGET`. The peak memory of a one-hour run at
 1 ms (:func:`hour_run_rss`) is measured in a fresh process.
 """
 import json
@@ -25,8 +25,8 @@ __all__ = ["SCENARIOS", "TARGET", "RSS_TARGET_MB", "c_master_times", "hour_run_r
            "c_master_lines"]
 
 SCENARIOS = PAPER_SET + ("setpoints-pwm-pi+ff-adaptive", "setpoints-pwm-continuous-pi+ff-adaptive")
-TARGET = 0.25          # C master / library wall time, recording included (issue 41)
-RSS_TARGET_MB = 200.0  # peak resident memory of a one-hour run at 1 ms (issue 41)
+TARGET = 0.25          # C master / library wall time, recording included
+RSS_TARGET_MB = 200.0  # peak resident memory of a one-hour run at 1 ms
 HOUR_SCENARIO = "setpoints-pwm-pi+ff-adaptive"   # all five FMUs
 
 
@@ -100,7 +100,7 @@ def _verdict(value, limit):
 
 
 def c_master_lines(times, hours=None):
-    """The C-master section of the benchmark table, with the targets of issue 41."""
+    """The C-master section of the benchmark table, with its targets."""
     runs = next(iter(times.values()))["runs"]
     lines = [f"C master (--master c) / library, 30 s at 1 ms, recording included "
              f"(median of {runs} alternating runs, min ... max)",

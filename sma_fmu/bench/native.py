@@ -24,7 +24,7 @@ __all__ = ["LOOP_STEPS", "LOOP_SCENARIO", "NATIVE_TARGETS", "native_costs", "nat
 
 LOOP_STEPS = 1_000_000
 LOOP_SCENARIO = "setpoints-pwm-pi+ff-adaptive"  # all five FMUs
-NATIVE_TARGETS = {  # issue 25: (target, "<=" or ">=")
+NATIVE_TARGETS = {  # the C family's speed targets: (target, "<=" or ">=")
     "native SmaActuator in the C host / library plant step": (0.1, "<="),
     "pythonfmu / native SmaActuator, both in the C host": (20.0, ">="),
     "native closed loop in the C host, p99.9 [us]": (10.0, "<"),
@@ -91,7 +91,7 @@ def _verdict(value, target):
 
 
 def native_lines(native):
-    """The native section of the benchmark table, with the targets of issue 25."""
+    """The native section of the benchmark table, with its targets."""
     lines = [f"Native (C) FMUs (median of {len(native['loop_runs'])} alternating runs, min ... max)"]
     for name, row in native["ratios"].items():
         target = NATIVE_TARGETS.get(name)
@@ -105,7 +105,7 @@ def native_lines(native):
                  f"{native['loop_steps']} steps of 1 ms): per step p50 {loop['p50_us']:.3f} us, "
                  f"p99 {loop['p99_us']:.3f} us, p99.9 {loop['p99_9_us']:.3f} us, max {loop['max_us']:.1f} us: "
                  f"{_verdict(loop['p99_9_us'], NATIVE_TARGETS[name])} us")
-    if "c_master" in native:  # issue 41: the scenario's loop in the C master, recorded
+    if "c_master" in native:  # the scenario's loop in the C master, recorded
         from sma_fmu.bench.c_master import c_master_lines
         lines += [""] + c_master_lines(native["c_master"])
     return lines

@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../front/fmi2_types.h"  /* the C front's FMI 2.0 types, staged beside */
+#include "fmi2FunctionTypes.h"  /* the standard's FMI 2.0 types (fmi/c_common/include/) */
 
 #ifdef _WIN32
 #define EXPORT __declspec(dllexport)

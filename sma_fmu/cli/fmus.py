@@ -44,7 +44,8 @@ def register(commands):
                             "no Python needed (default: pythonfmu)")
     build.add_argument("--fmi", type=int, choices=(2, 3), default=2, metavar="{2,3}",
                        help="FMI version (default: 2); 3 needs --native: FMI 3.0 co-simulation "
-                            "FMUs (x86_64-linux/x86_64-windows binaries, buildDescription.xml)")
+                            "FMUs (x86_64/aarch64 Linux and macOS, x86_64/x86 Windows binaries; "
+                            "buildDescription.xml)")
     build.add_argument("--compile", action="store_true",
                        help="--native: compile every binary here, even where the installed "
                             "package has a prebuilt one of the same sources")

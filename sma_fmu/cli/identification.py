@@ -40,7 +40,17 @@ def _check_fit_loads(args):
                                  f"{'(' if low_open else '['}0, {high:g}] {unit}")
 
 
+NOT_CONVERGED = 3     # exit status of a fit whose solver did not converge
+
+
+def _meter():
+    """A progress bar of the fit's model evaluations on stderr, silent when it is no terminal."""
+    from tqdm import tqdm
+    return tqdm(desc="fit", unit=" evaluations", disable=None, leave=False, dynamic_ncols=True)
+
+
 def _fit_isobaric(args, out):
+    import sys
     from sma_fmu.identification.isobaric.runner import format_isobaric_report, run_isobaric_fit
     _check_fit_loads(args)
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
@@ -48,11 +58,17 @@ def _fit_isobaric(args, out):
                               progress=lambda text: print(text, flush=True), cycles=args.cycles,
                               lag=args.lag or "auto", stages=args.stages or 2,
                               outliers="keep" if args.keep_outliers else "leave-out",
-                              widths=args.widths or "auto",
+                              widths=args.widths or "auto", meter=_meter,
                               centre_law=args.centre_law or "linear")
     print(format_isobaric_report(report))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
           f"figures")
+    solver = report["solver"]
+    if not solver["converged"]:
+        print(f"sma-fmu: the fit did not converge: {solver['message']} after "
+              f"{solver['evaluations']} evaluations; identified.toml is marked 'not converged' "
+              f"(exit {NOT_CONVERGED})", file=sys.stderr)
+        return NOT_CONVERGED
     return 0
 
 
@@ -205,8 +221,9 @@ def register(commands):
     fit.add_argument("--lag", choices=("auto", "fit", "none"),
                      help="isobaric: fit the wire's first-order lag behind the thermocouple (in "
                           "seconds, or samples without a time column), assume none, or auto: "
-                          "fit it when every file holds two complete cycles or more "
-                          "(default: auto)")
+                          "fit it when every file holds two complete cycles or more crossing "
+                          "the transformation at rates that differ by 25 %% or more (at one "
+                          "rate a lag cannot be told from a wider hysteresis) (default: auto)")
     fit.add_argument("--stages", type=int, choices=(1, 2),
                      help="isobaric: transformation stages, each a logistic with its own centres "
                           "and widths on heating and cooling; 2 fits the second from the "

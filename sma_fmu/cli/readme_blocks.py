@@ -6,7 +6,7 @@ every command of the argparse tree (:func:`sma_fmu.cli.build_parser`) with its a
 and its help. ``performance`` (README) and ``benchmark`` (docs/performance.md): the
 tables of one recorded ``sma-fmu bench`` run, docs/benchmark.json, with its date and the
 machine's baseline. ``python -m sma_fmu.cli.readme_blocks [--record FILE]`` rewrites the
-blocks; tests/test_readme.py fails when one differs from what its generator writes now.
+blocks; tests/project/test_readme.py fails when one differs from what its generator writes now.
 """
 import argparse
 import re

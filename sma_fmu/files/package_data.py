@@ -1,9 +1,9 @@
-"""The data files shipped inside the package: parameter files, scenarios, examples, FMU slaves.
+"""The data files shipped inside the package: parameter files, scenarios, examples.
 
-They live in the package (``sma_fmu/models``, ``sma_fmu/scenarios``, ``sma_fmu/examples``,
-``sma_fmu/fmi/slaves``) so that a checkout, an editable install, a wheel and an sdist all
-find them the same way: through :mod:`importlib.resources`, opened as real files with
-``as_file`` (never by turning a resource object's text into a path).
+They live in the package (``sma_fmu/models``, ``sma_fmu/scenarios``, ``sma_fmu/examples``)
+so that a checkout, an editable install, a wheel and an sdist all find them the same way:
+through :mod:`importlib.resources`, opened as real files with ``as_file`` (never by turning
+a resource object's text into a path).
 """
 import atexit
 import contextlib
@@ -17,7 +17,6 @@ FOLDERS = {  # name -> (package, folder inside it)
     "models": ("sma_fmu", "models"),
     "scenarios": ("sma_fmu", "scenarios"),
     "examples": ("sma_fmu", "examples"),
-    "slaves": ("sma_fmu.fmi.python_family", "slaves"),
 }
 
 _kept = contextlib.ExitStack()   # real-file copies (zip installs) live as long as the process

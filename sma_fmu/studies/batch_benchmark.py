@@ -22,7 +22,7 @@ from sma_fmu.studies.random_set import gain_grid_scenarios, random_scenarios
 __all__ = ["SIZES", "TARGET", "batch_throughput", "format_batch"]
 
 SIZES = (1, 100, 1000, 10000)
-TARGET = {"N": 1000, "ratio": 50.0}   # issue 12: at least 50x the scalar path at N = 1,000
+TARGET = {"N": 1000, "ratio": 50.0}   # the target: at least 50x the scalar path at N = 1,000
 SETS = {"mixed": lambda count, seed, stop_time_s: random_scenarios(
             count, seed, stop_time_s, load_step_s=round(0.4 * stop_time_s, 3), references=4),
         "gain grid": gain_grid_scenarios}

@@ -115,7 +115,7 @@ def check_load_range(params, source):
 
 
 def _terms_note(params):
-    """What the issue-36 terms add to the range of the model (empty when they are off)."""
+    """What the optional model terms add to the range of the model (empty when they are off)."""
     terms, parts = params.terms, []
     if terms.nu_h != params.nu or terms.nu_c != params.nu:
         parts.append(f"constant_load.nu_h = {terms.nu_h!r}, nu_c = {terms.nu_c!r} in place of nu")

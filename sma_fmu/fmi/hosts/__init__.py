@@ -5,13 +5,15 @@
 - ``loop_host.c``: a sequential (Gauss-Seidel) loop of FMUs in one process, as an
   embedded master runs them; in its binary mode the C master of ``sma-fmu run --master c``
   (:mod:`sma_fmu.systems.c_master`);
-- ``host_platform.h``: what the dlopen hosts share (loading a binary, the platform shim);
+- ``host_platform.h``: what the dlopen hosts share (loading a binary, the platform shim,
+  the FMI 2.0 types of the standard's headers in ``fmi/c_common/include/``);
 - ``cosim_host.c``: sma-fmu's C host on libcosim's C API (libcosimc, from the libcosimpy
   wheel): runs an FMU or an SSP package (``sma-fmu check``, the tests, the benchmark).
 
 They link no libpython and need no environment variable: what they show is what any C
 host sees. :func:`compile_host` builds either with the system C compiler
-(:func:`c_compiler`), once per source, compiler and library, into a cache folder; with
+(:func:`c_compiler`), where its source is, with this folder and the standard's FMI headers
+on the include path, once per source, compiler and library, into a cache folder; with
 ``windows=True`` it cross-builds ``fmi_host.exe`` with mingw-w64 (:func:`windows_compiler`),
 a Windows host for the win64 front (the tests run it under wine).
 """
@@ -22,14 +24,16 @@ import shlex
 import shutil
 import subprocess
 import tempfile
-from importlib import resources
 from pathlib import Path
+
+from sma_fmu.fmi.c_common import FMI_HEADERS, include_flags
 
 __all__ = ["CHostError", "HOST_PROGRAMS", "SHARED_HEADER", "PREBUILT_HOSTS", "c_compiler",
            "windows_compiler", "compile_host", "prebuilt_host", "write_prebuilt_hosts"]
 
 HOST_PROGRAMS = ("fmi_host", "cosim_host", "loop_host")
 SHARED_HEADER = "host_platform.h"   # loading a binary, the platform shim (fmi_host, loop_host)
+HOSTS = Path(__file__).parent       # the hosts' sources
 _FLAGS = ["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"]
 PREBUILT_HOSTS = Path(__file__).parent / "prebuilt"  # the wheel's (write_prebuilt_hosts)
 # from site-packages/sma_fmu/fmi/hosts/prebuilt/ to site-packages/libcosimpy/libcosimc/
@@ -86,26 +90,22 @@ def compile_host(name, cache=None, windows=False):
     """
     if name not in HOST_PROGRAMS:
         raise ValueError(f"C host must be one of {', '.join(HOST_PROGRAMS)}, got {name!r}")
-    source = resources.files(__name__).joinpath(f"{name}.c").read_bytes()
-    shared = resources.files(__name__).joinpath(SHARED_HEADER).read_bytes()
     compiler = windows_compiler() if windows else c_compiler()
     if not windows and shutil.which(compiler[0]) is None:
         prebuilt = prebuilt_host(name)
         if prebuilt is not None:  # no compiler here: the wheel's host of the same source
             return prebuilt
     link = _link_flags(name, windows)
-    key = hashlib.sha256(source + shared + "\0".join([*compiler, *_FLAGS, *link]).encode()).hexdigest()[:12]
+    key = hashlib.sha256(_inputs(name) + "\0".join([*compiler, *_FLAGS, *link]).encode()).hexdigest()[:12]
     folder = Path(cache or tempfile.gettempdir()) / f"sma-fmu-{name}-{key}"
     executable = folder / (f"{name}.exe" if windows else name)
     if executable.is_file():
         return executable
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=folder) as stage:
-        source_file = Path(stage) / f"{name}.c"
-        source_file.write_bytes(source)
-        (Path(stage) / SHARED_HEADER).write_bytes(shared)
         built = Path(stage) / executable.name
-        command = [*compiler, *_FLAGS, "-o", str(built), str(source_file), *link]
+        command = [*compiler, *_FLAGS, *include_flags(HOSTS), "-o", str(built),
+                   str(HOSTS / f"{name}.c"), *link]
         try:
             result = subprocess.run(command, capture_output=True, text=True, timeout=300)
         except (OSError, subprocess.SubprocessError) as error:
@@ -120,10 +120,15 @@ def compile_host(name, cache=None, windows=False):
     return executable
 
 
+def _inputs(name):
+    """The bytes host ``name`` is compiled from: its source, the shared header and the
+    standard's FMI 2.0 headers."""
+    headers = sorted(FMI_HEADERS.glob("fmi2*.h"))
+    return b"\0".join(path.read_bytes() for path in [HOSTS / f"{name}.c", HOSTS / SHARED_HEADER, *headers])
+
+
 def _source_digest(name):
-    files = resources.files(__name__)
-    data = files.joinpath(f"{name}.c").read_bytes() + b"\0" + files.joinpath(SHARED_HEADER).read_bytes()
-    return hashlib.sha256(data).hexdigest()
+    return hashlib.sha256(_inputs(name)).hexdigest()
 
 
 def prebuilt_host(name, folder=None):
@@ -153,8 +158,8 @@ def write_prebuilt_hosts(folder=None):
         built = compile_host(name, folder / ".cache")
         if name == "cosim_host":  # again, with an rpath that holds where the wheel installs it
             library = _libcosimc_folder()
-            command = [*c_compiler(), *_FLAGS, "-o", str(folder / name),
-                       str(resources.files(__name__).joinpath(f"{name}.c")), f"-L{library}",
+            command = [*c_compiler(), *_FLAGS, *include_flags(HOSTS), "-o", str(folder / name),
+                       str(HOSTS / f"{name}.c"), f"-L{library}",
                        "-lcosimc", f"-Wl,-rpath,{_RELATIVE_LIBCOSIMC}"]
             result = subprocess.run(command, capture_output=True, text=True, timeout=300)
             if result.returncode != 0:

@@ -29,31 +29,11 @@
 #define SLOTS 8
 #define MAXN 64
 static struct {
-    Component (*Instantiate)(const char*, int, const char*, const char*, const Callbacks*, int, int);
-    void (*FreeInstance)(Component);
-    int (*SetupExperiment)(Component, int, double, double, int, double);
-    int (*EnterInitializationMode)(Component), (*ExitInitializationMode)(Component);
-    int (*Terminate)(Component), (*Reset)(Component);
-    int (*SetReal)(Component, const unsigned*, size_t, const double*);
-    int (*GetReal)(Component, const unsigned*, size_t, double*);
-    int (*SetInteger)(Component, const unsigned*, size_t, const int*);
-    int (*GetInteger)(Component, const unsigned*, size_t, int*);
-    int (*SetBoolean)(Component, const unsigned*, size_t, const int*);
-    int (*GetBoolean)(Component, const unsigned*, size_t, int*);
-    int (*SetString)(Component, const unsigned*, size_t, const char* const*);
-    int (*GetString)(Component, const unsigned*, size_t, const char**);
-    int (*DoStep)(Component, double, double, int);
-    int (*GetFMUstate)(Component, void**), (*SetFMUstate)(Component, void*);
-    int (*FreeFMUstate)(Component, void**);
-    int (*SerializedFMUstateSize)(Component, void*, size_t*);
-    int (*SerializeFMUstate)(Component, void*, char*, size_t);
-    int (*DeSerializeFMUstate)(Component, const char*, size_t, void**);
-    int (*GetBooleanStatus)(Component, int, int*), (*GetRealStatus)(Component, int, double*);
-    int (*SetDebugLogging)(Component, int, size_t, const char* const*);
+    HOST_FMI2_FUNCTIONS(HOST_FMI2_POINTER)  /* the FMU's functions (host_platform.h) */
 } F;
 
 static char dir[PATH_SIZE], guid[256], model[256];
-static Component slot[SLOTS], freed[SLOTS];
+static fmi2Component slot[SLOTS], freed[SLOTS];
 static char never_an_instance[64];
 static void* states[SLOTS][4];
 
@@ -64,7 +44,8 @@ static void print_hex(const char* text, size_t n)
     for (size_t i = 0; i < n; ++i) printf("%02x", (unsigned char)text[i]);
 }
 
-static void logger(void* env, const char* name, int status, const char* category, const char* message, ...)
+static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                   fmi2String message, ...)
 {
     (void)env; (void)name;
     char text[8192];
@@ -124,12 +105,7 @@ static void load(void)
     void* library = host_open_library(dir, model, path, sizeof path, why, sizeof why);
     if (!library) { fprintf(stderr, "fmi_host: %s\n", why); exit(3); }
 #define SYM(n) if (!(*(void**)&F.n = host_symbol(library, "fmi2" #n))) { fprintf(stderr, "no fmi2" #n "\n"); exit(3); }
-    SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
-    SYM(ExitInitializationMode) SYM(Terminate) SYM(Reset) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
-    SYM(GetInteger) SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(GetString) SYM(DoStep)
-    SYM(GetFMUstate) SYM(SetFMUstate) SYM(FreeFMUstate) SYM(SerializedFMUstateSize)
-    SYM(SerializeFMUstate) SYM(DeSerializeFMUstate) SYM(GetBooleanStatus) SYM(GetRealStatus)
-    SYM(SetDebugLogging)
+    HOST_FMI2_FUNCTIONS(SYM)
 #undef SYM
 }
 
@@ -140,7 +116,7 @@ static int by_value(const void* a, const void* b)
     return (x > y) - (x < y);
 }
 
-static void bench(Component c, long steps, double h, unsigned in, double value, unsigned out, double t)
+static void bench(fmi2Component c, long steps, double h, unsigned in, double value, unsigned out, double t)
 {
     double* cost = malloc(sizeof(double) * (size_t)steps), result = 0.0;
     int status = 0;
@@ -179,7 +155,7 @@ int main(int argc, char** argv)
     snprintf(dir, sizeof dir, "%s", argv[1]);
     read_model_description();
     load();
-    Callbacks callbacks = {logger, calloc, free, NULL, NULL};
+    fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     static char line[1 << 20];
     while (fgets(line, sizeof line, stdin)) {
         char* word[4 * MAXN + 8];
@@ -189,7 +165,7 @@ int main(int argc, char** argv)
         const char* command = word[0];
         if (!strcmp(command, "end")) break;
         int s = n > 1 ? atoi(word[1]) % SLOTS : 0;
-        Component c = slot[s];
+        fmi2Component c = slot[s];
         unsigned vr[MAXN];
         int count = n > 2 ? atoi(word[2]) : 0;
         if (count < 0 || count > MAXN) count = 0;
@@ -197,7 +173,7 @@ int main(int argc, char** argv)
         if (!strcmp(command, "instantiate") && n == 6) {
             char* name = unhex(word[2], NULL);
             const char* id = !strcmp(word[4], "ok") ? guid : !strcmp(word[4], "wrong") ? "{00000000-0}" : NULL;
-            slot[s] = F.Instantiate(name, 1, id, resource_uri(word[3]), &callbacks, 0, atoi(word[5]));
+            slot[s] = F.Instantiate(name, fmi2CoSimulation, id, resource_uri(word[3]), &callbacks, 0, atoi(word[5]));
             free(name);
             printf("= %d\n", slot[s] ? 0 : 3);
             fflush(stdout);
@@ -205,7 +181,7 @@ int main(int argc, char** argv)
         }
         if (!strcmp(command, "reuse") || !strcmp(command, "bogus") || !strcmp(command, "forget")) {
             slot[s] = !strcmp(command, "reuse") ? freed[s]
-                      : !strcmp(command, "bogus") ? (Component)never_an_instance : NULL;
+                      : !strcmp(command, "bogus") ? (fmi2Component)never_an_instance : NULL;
             printf("= 0\n");
             fflush(stdout);
             continue;

@@ -1,10 +1,12 @@
 /*
  * host_platform.h - what every sma-fmu C host needs to load an FMI 2.0 binary, for Linux
  * (dlopen) and Windows (LoadLibrary, the mingw-w64 build run under wine): the platform's
- * folder and suffix, the callback struct, reading the GUID and model identifier, opening
+ * folder and suffix, the FMI 2.0 types (the standard's fmi2FunctionTypes.h, in
+ * fmi/c_common/include/), reading the GUID and model identifier, opening
  * DIR/binaries/<platform>/<model><suffix>, looking up a function, absolute paths and a
- * monotonic clock. Header-only (static functions): each host is one translation unit, and
- * `compile_host` (hosts/__init__.py) stages this file beside it.
+ * monotonic clock. Header-only (static functions): each host is one translation unit, which
+ * `compile_host` (hosts/__init__.py) compiles with this folder and the standard's headers on
+ * the include path.
  */
 #ifndef SMA_FMU_HOST_PLATFORM_H
 #define SMA_FMU_HOST_PLATFORM_H
@@ -26,16 +28,20 @@
 #define SUFFIX ".so"
 #endif
 
+#include "fmi2FunctionTypes.h"
+
 #define PATH_SIZE 4096
 
-typedef void* Component;
-typedef struct {
-    void (*logger)(void*, const char*, int, const char*, const char*, ...);
-    void* (*allocate)(size_t, size_t);
-    void (*release)(void*);
-    void* step_finished;
-    void* environment;
-} Callbacks;
+/* The FMI 2.0 functions the hosts call, named once: HOST_FMI2_FUNCTIONS(X) applies X to each
+ * name, HOST_FMI2_POINTER declares its pointer, typed fmi2<name>TYPE by the standard. */
+#define HOST_FMI2_FUNCTIONS(X)                                                                  \
+    X(Instantiate) X(FreeInstance) X(SetupExperiment) X(EnterInitializationMode)                \
+    X(ExitInitializationMode) X(Terminate) X(Reset) X(SetReal) X(GetReal) X(SetInteger)         \
+    X(GetInteger) X(SetBoolean) X(GetBoolean) X(SetString) X(GetString) X(DoStep)               \
+    X(GetFMUstate) X(SetFMUstate) X(FreeFMUstate) X(SerializedFMUstateSize)                     \
+    X(SerializeFMUstate) X(DeSerializeFMUstate) X(GetBooleanStatus) X(GetRealStatus)            \
+    X(SetDebugLogging)
+#define HOST_FMI2_POINTER(name) fmi2##name##TYPE* name;
 
 /* Read the GUID and modelIdentifier of DIR/modelDescription.xml (each at most 255 bytes);
  * 0 on success, else 1 with `why` saying what failed. */

@@ -61,19 +61,8 @@
 
 typedef struct {
     char name[64], dir[PATH_SIZE], guid[256], model[256];
-    Component c;
-    Component (*Instantiate)(const char*, int, const char*, const char*, const Callbacks*, int, int);
-    void (*FreeInstance)(Component);
-    int (*SetupExperiment)(Component, int, double, double, int, double);
-    int (*EnterInitializationMode)(Component), (*ExitInitializationMode)(Component);
-    int (*Terminate)(Component);
-    int (*SetReal)(Component, const unsigned*, size_t, const double*);
-    int (*GetReal)(Component, const unsigned*, size_t, double*);
-    int (*SetInteger)(Component, const unsigned*, size_t, const int*);
-    int (*SetBoolean)(Component, const unsigned*, size_t, const int*);
-    int (*GetBoolean)(Component, const unsigned*, size_t, int*);
-    int (*SetString)(Component, const unsigned*, size_t, const char* const*);
-    int (*DoStep)(Component, double, double, int);
+    fmi2Component c;
+    HOST_FMI2_FUNCTIONS(HOST_FMI2_POINTER)  /* its functions (host_platform.h) */
 } Fmu;
 
 typedef struct { int kind, component; unsigned vr; double real; int integer; char* text; } Start;
@@ -317,7 +306,8 @@ static void flush_rows(void)
     block_rows = 0;
 }
 
-static void logger(void* env, const char* name, int status, const char* category, const char* message, ...)
+static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                   fmi2String message, ...)
 {
     (void)env;
     char text[8192];
@@ -371,9 +361,7 @@ static void load(Fmu* f)
     void* library = host_open_library(f->dir, f->model, path, sizeof path, why, sizeof why);
     if (!library) { fprintf(stderr, "loop_host: %s\n", why); exit(1); }
 #define SYM(n) if (!(*(void**)&f->n = host_symbol(library, "fmi2" #n))) bad("no fmi2" #n " in", path);
-    SYM(Instantiate) SYM(FreeInstance) SYM(SetupExperiment) SYM(EnterInitializationMode)
-    SYM(ExitInitializationMode) SYM(Terminate) SYM(SetReal) SYM(GetReal) SYM(SetInteger)
-    SYM(SetBoolean) SYM(GetBoolean) SYM(SetString) SYM(DoStep)
+    HOST_FMI2_FUNCTIONS(SYM)
 #undef SYM
 }
 
@@ -460,13 +448,13 @@ static void print_row(void)
     putchar('\n');
 }
 
-static void initialize(double stop, const Callbacks* callbacks)
+static void initialize(double stop, const fmi2CallbackFunctions* callbacks)
 {
     for (int i = 0; i < components; ++i) {
         Fmu* f = &fmu[i];
         char uri[PATH_SIZE + 64];
         resource_uri(f->dir, uri, sizeof uri);
-        f->c = f->Instantiate(f->name, 1, f->guid, uri, callbacks, 0, 0);
+        f->c = f->Instantiate(f->name, fmi2CoSimulation, f->guid, uri, callbacks, fmi2False, fmi2False);
         if (!f->c) { fprintf(stderr, "loop_host: %s: fmi2Instantiate returned NULL\n", f->name); exit(1); }
         check(f->SetupExperiment(f->c, 0, 0.0, 0.0, 1, stop), f, "fmi2SetupExperiment");
         check(f->EnterInitializationMode(f->c), f, "fmi2EnterInitializationMode");
@@ -597,7 +585,7 @@ int main(void)
 {
     static char line[1 << 20];
     init_tens();
-    Callbacks callbacks = {logger, calloc, free, NULL, NULL};
+    fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     while (fgets(line, sizeof line, stdin)) {
         if (!strncmp(line, "g10 ", 4)) {
             print_g10(line + 4);

@@ -7,8 +7,8 @@ FMI 2.0 has only scalars; in FMI 3.0 SmaActuator shows the stack of its minor-lo
 FMI 2.0 parameter of the same name and value reference (the most reversal points the memory
 keeps: the physics are FMI 2.0's), declared a UInt64 ``structuralParameter``, settable only
 in Configuration Mode within the runtime's bounds. The elements past ``reversal_count`` are
-NaN (:data:`UNUSED`). The C side is the adapter's ``get_array`` (models/SmaActuator.c), whose
-array numbers follow :attr:`Arrays.arrays`' order.
+NaN (:data:`UNUSED`). The C side is the adapter's ``get_array``
+(fmi/models/SmaActuator/SmaActuator.c), whose array numbers follow :attr:`Arrays.arrays`' order.
 """
 from dataclasses import dataclass
 

@@ -18,7 +18,8 @@ __all__ = ["build_fmus", "build_fmu", "validate_fmus"]
 
 def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=False,
                fmi_version=2, compile=False):
-    """Build FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``; return {name: path}.
+    """Build FMUs (default: every registered one, :mod:`sma_fmu.fmi.models`) into ``out_dir``;
+    return {name: path}.
 
     They are built in a temporary folder beside ``out_dir`` and moved there at the end, so
     a failed build leaves ``out_dir`` as it was. ``native``: the C family instead
@@ -32,13 +33,13 @@ def build_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None, native=
         raise ValueError("FMI 3.0 FMUs are built by the C family only (--native): pythonfmu is "
                          "FMI 2.0 only")
     if fmi_version == 3:
-        return build_fmi3_fmus(out_dir, parameter_file, names)
+        return build_fmi3_fmus(out_dir, parameter_file, names, compile)
     if native:
         return build_native_fmus(out_dir, parameter_file, names, compile)
     return build_pythonfmu_fmus(out_dir, parameter_file, names)
 
 def build_fmu(model_name, out_dir=DEFAULT_FMU_DIR, parameter_file=None):
-    """Build one FMU (a key of :data:`FMU_SCRIPTS`) into ``out_dir``; return its path."""
+    """Build one FMU (a registered name, :mod:`sma_fmu.fmi.models`) into ``out_dir``; return its path."""
     return build_fmus(out_dir, parameter_file, [model_name])[model_name]
 
 

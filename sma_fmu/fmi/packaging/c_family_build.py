@@ -3,11 +3,12 @@
 Each native FMU holds:
 - ``modelDescription.xml``: the pythonfmu FMU's, made native (:mod:`.native_description`),
   with ``<SourceFiles>`` listing ``sources/``;
-- ``sources/``: the C files it needs, flat (the FMI 2.0 layer ``fmi2/``, its adapter
-  ``models/<Model>.c``, the runtime modules it includes, transitively, the FMI headers) and
-  the generated ``<Model>_variables.h`` and ``sma_parameters_table.h`` (the wire parameter
-  schema, :mod:`.parameter_table`): what a tool compiles (fmpy's
-  ``build_platform_binary`` does, with sources/ as its include folder);
+- ``sources/``: the C files it needs, flat (:func:`c_source_files`: the FMI 2.0 layer
+  ``fmi2/``, the core, its adapter ``<Model>.c`` from its folder ``fmi/models/<Model>/``, the
+  runtime modules it includes, transitively, the standard's FMI headers from
+  ``fmi/c_common/include/``) and the generated ``<Model>_variables.h`` and
+  ``sma_parameters_table.h`` (the wire parameter schema, :mod:`.parameter_table`): what a tool compiles
+  (fmpy's ``build_platform_binary`` does, with sources/ as its include folder);
 - a binary for each FMI 2.0 platform of :mod:`.cross_build`'s table:
   ``binaries/linux64/<Model>.so`` (gcc), ``binaries/win64/<Model>.dll`` (mingw-w64),
   ``binaries/darwin64/<Model>.dylib`` and ``binaries/win32/<Model>.dll`` (zig cc); zig cc is
@@ -15,10 +16,10 @@ Each native FMU holds:
   (``-Werror``; ``-ffp-contract=off``: no fused multiply-add, so results stay equal to the
   Python runtime's on every machine), export only the fmi2 functions and link no libpython;
 - ``resources/parameters.json``: the wire parameter file of the build, for the record
-  (``sma-fmu check``), and ``resources/model_starts.json``: the start of every variable and
-  the wire parameter file's values, which the binary reads (it holds none of them: one
-  binary serves every parameter file), then ``resources/start_values.json``, which
-  ``sma-fmu export`` packs;
+  (``sma-fmu check``), and ``resources/model_starts.json``: the start of every variable
+  (:func:`exact_starts`, the pythonfmu slave's) and the wire parameter file's values, which
+  the binary reads (it holds none of them: one binary serves every parameter file), then
+  ``resources/start_values.json``, which ``sma-fmu export`` packs;
 - ``extra/``: the pythonfmu twin's, if it has one (its reference result: the same numbers).
 - ``documentation/``: index.html and result.png (:func:`.extras.add_documentation`) for
   this FMU, its figure from that reference result.
@@ -32,11 +33,11 @@ from importlib import util
 from pathlib import Path
 
 from sma_fmu.files.output_folder import staged_folder
-from sma_fmu.files.package_data import shipped_file
+from sma_fmu.fmi.c_common import C_COMMON, FMI_HEADERS
+from sma_fmu.fmi.models import declaration, declarations
 from sma_fmu.fmi.packaging.cross_build import FLAGS, RUNS_HERE, compile_shared, fmi2_targets, target
 from sma_fmu.fmi.packaging.c_family_description import model_starts, native_description, variables_header
 from sma_fmu.fmi.packaging.extras import add_documentation
-from sma_fmu.fmi.packaging.fmu_names import FMU_SCRIPTS
 from sma_fmu.fmi.packaging.parameter_table import generated_folder
 from sma_fmu.fmi.packaging.front_build import FrontWarning
 from sma_fmu.fmi.packaging.platforms import NATIVE_MARKER, PlatformEntry, annotate
@@ -45,11 +46,11 @@ from sma_fmu.fmi.packaging.pythonfmu_build import build_pythonfmu_fmus
 from sma_fmu.fmi.packaging.reference_results import MANIFEST
 from sma_fmu.fmi.packaging.reproducible import fix_timestamps
 
-__all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "model_sources",
-           "build_from_twins", "build_native_fmus", "compile_binary"]
+__all__ = ["FLAGS", "NATIVE_MARKER", "NativeBuildWarning", "C_FAMILY", "c_source_folders",
+           "c_source_files", "model_sources", "exact_starts", "build_from_twins",
+           "build_native_fmus", "compile_binary"]
 
 C_FAMILY = Path(__file__).parents[1] / "c_family"
-C_COMMON = Path(__file__).parents[1] / "c_common"   # C code both families compile
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 
@@ -57,14 +58,21 @@ class NativeBuildWarning(FrontWarning):
     """A native FMU was built without the binary of a platform (no compiler for it)."""
 
 
-def _c_files():
-    """{file name: path} of the C family's shipped files and of those generated from the
-    Python schema (:mod:`.parameter_table`); flat names are unique."""
+def c_source_folders():
+    """The folders of the C files a C-family FMU is compiled from: the two FMI fronts, the
+    core, the runtime, the adapters' shared helpers, the C code both families share, the
+    standard's FMI headers, the tables generated from the Python schema
+    (:mod:`.parameter_table`), and each registered FMU's folder (its adapter ``<Model>.c``)."""
+    return [C_FAMILY / "fmi2", C_FAMILY / "fmi3", C_FAMILY / "core", C_FAMILY / "runtime",
+            C_FAMILY / "adapter_support", C_COMMON, FMI_HEADERS, generated_folder(),
+            *(declared.folder for declared in declarations())]
+
+
+def c_source_files():
+    """{file name: path} of the .c and .h files of :func:`c_source_folders`: the names are
+    unique, as a flat ``sources/`` needs (ValueError naming a file in two folders)."""
     files = {}
-    for folder in (C_FAMILY / "fmi2", C_FAMILY / "fmi3", C_FAMILY / "core", C_FAMILY / "runtime",
-                   C_FAMILY / "models", C_COMMON, generated_folder()):
-        if not folder.is_dir():
-            continue
+    for folder in c_source_folders():
         for path in sorted(folder.iterdir()):
             if path.suffix in (".c", ".h"):
                 if path.name in files:
@@ -77,9 +85,10 @@ def _implementers(files):
     """{header: [.c files implementing it]}: a .c file implements the header it includes
     first (runtime/json_repr.c implements part of json_text.h); adapters implement none."""
 
+    adapters = {declared.c_model.name for declared in declarations()}
     found = {}
     for name, path in files.items():
-        if name.endswith(".c") and name[:-2] not in FMU_SCRIPTS:
+        if name.endswith(".c") and name not in adapters:
             first = _INCLUDE.search(path.read_text(encoding="utf-8"))
             if first:
                 found.setdefault(first.group(1), []).append(name)
@@ -90,7 +99,7 @@ def model_sources(model_name, generated=(), front="fmi2"):
     """The file names sources/ needs for ``model_name``: its adapter, the FMI ``front``
     (``fmi2`` or ``fmi3``), the core, and every header they include, transitively, with the
     .c files implementing it; ``generated`` names files written later."""
-    files = _c_files()
+    files = c_source_files()
     implementers = _implementers(files)
     wanted = [f"{model_name}.c"] + sorted(n for n in files if n.startswith(front) or
                                           n.startswith("layer") or n == "sma_model.c")
@@ -117,10 +126,19 @@ def compile_binary(platform, sources_folder, output):
     return compile_shared(target(platform), sources_folder, output)
 
 
-def _exact_starts(model_name, resources_folder):
-    """{name: value} of every variable of the Python slave as it starts (exact floats)."""
+def exact_starts(model_name, resources_folder):
+    """The derived starts of the C family's FMU ``model_name``: (starts, defaults), where
+    starts is {variable name: value} of every variable of its pythonfmu slave as the slave
+    starts (exact floats) and defaults the wire parameters the slave exposes
+    ({name: value}, or None if it exposes none).
 
-    path = shipped_file("slaves", FMU_SCRIPTS[model_name])
+    The slave (:attr:`~sma_fmu.fmi.models.Declaration.slave_path`) runs in this process over
+    ``resources_folder``, the pythonfmu twin's unpacked ``resources/`` (its
+    ``parameters.json``, and ``signals.json`` where it has one): one interface, one set of
+    start values for both families. The FMI 2.0 and 3.0 builds write them into the C FMU's
+    model description and ``resources/model_starts.json``.
+    """
+    path = declaration(model_name).slave_path
     spec = util.spec_from_file_location(f"_sma_native_{model_name}", path)
     module = util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -135,7 +153,7 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
     unpacked = work / model_name
     with zipfile.ZipFile(python_fmu) as archive:
         archive.extractall(unpacked)
-    starts, defaults = _exact_starts(model_name, unpacked / "resources")
+    starts, defaults = exact_starts(model_name, unpacked / "resources")
     header_name = f"{model_name}_variables.h"
     names = model_sources(model_name, generated=(header_name,))
     python_description = (unpacked / "modelDescription.xml").read_bytes()
@@ -143,7 +161,7 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
                                         [name for name in names if name.endswith(".c")])
     sources = work / f"{model_name}.sources"
     sources.mkdir()
-    files = _c_files()
+    files = c_source_files()
     for name in names:
         if name != header_name:
             shutil.copyfile(files[name], sources / name)
@@ -186,12 +204,12 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
 
 
 def build_from_twins(out_dir, parameter_file, names, build_one):
-    """Build each C-family FMU of ``names`` (default: all five) from its pythonfmu twin (the
-    variables, units and exact starts: one interface for both families) into ``out_dir``;
+    """Build each C-family FMU of ``names`` (default: every registered one) from its pythonfmu
+    twin (the variables, units and exact starts: one interface for both families) into ``out_dir``;
     ``build_one(name, twin path, staging folder, work folder)`` writes one FMU and returns its
     problem texts. Built beside ``out_dir`` and moved there at the end (a failed build leaves
     it as it was); returns (names, the distinct problems without their model names)."""
-    names = list(FMU_SCRIPTS) if names is None else list(names)
+    names = [declared.name for declared in declarations()] if names is None else list(names)
     with tempfile.TemporaryDirectory(prefix="sma_fmu_native_") as work:
         work = Path(work)
         with warnings.catch_warnings():

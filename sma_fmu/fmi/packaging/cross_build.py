@@ -24,7 +24,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from sma_fmu.fmi.hosts import c_compiler, windows_compiler
+from sma_fmu.fmi.c_common import include_flags
+from sma_fmu.fmi.hosts import HOSTS, c_compiler, windows_compiler
 
 __all__ = ["FLAGS", "Target", "TARGETS", "target", "fmi2_targets", "zig_command", "toolchain",
            "compile_shared", "compile_host_for", "RUNS_HERE"]
@@ -86,13 +87,38 @@ def fmi2_targets():
 
 def zig_command():
     """zig cc as a command list: ``$SMA_FMU_ZIG_CC`` split like a shell would (``none``: no
-    zig), else ``python -m ziglang cc`` when PyPI's ``ziglang`` is installed, else None."""
+    zig), else ``python -m ziglang cc`` when PyPI's ``ziglang`` is installed in this Python,
+    else ``zig cc`` on the PATH, else the zig of the ``ziglang`` package whose script
+    ``python-zig`` is on the PATH (e.g. of an activated venv: what an isolated wheel build
+    finds), else None."""
     given = os.environ.get("SMA_FMU_ZIG_CC", "").strip()
     if given:
         return None if given.lower() == "none" else shlex.split(given)
-    if importlib.util.find_spec("ziglang") is None:
+    if importlib.util.find_spec("ziglang") is not None:
+        return [sys.executable, "-m", "ziglang", "cc"]
+    if shutil.which("zig"):
+        return ["zig", "cc"]
+    script = shutil.which("python-zig")
+    return None if script is None else _ziglang_binary(script)
+
+
+def _ziglang_binary(script):
+    """[zig, "cc"] of the ``ziglang`` package whose script ``python-zig`` is ``script``: its
+    own Python (the script's first line) names the package's folder. That Python is asked
+    without the calling process's PYTHONPATH, which an isolated wheel build points at its own
+    packages only, so that the script itself, run there, cannot import ziglang."""
+    with open(script, "rb") as handle:
+        first = handle.readline().decode("utf-8", "replace").strip()
+    interpreter = shlex.split(first[2:]) if first.startswith("#!") else [sys.executable]
+    clean = {key: value for key, value in os.environ.items()
+             if key not in ("PYTHONPATH", "PYTHONNOUSERSITE", "PYTHONHOME")}
+    try:
+        found = subprocess.run([*interpreter, "-c", "import ziglang, os; print(os.path.dirname(ziglang.__file__))"],
+                               capture_output=True, text=True, env=clean, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
         return None
-    return [sys.executable, "-m", "ziglang", "cc"]
+    zig = Path(found.stdout.strip()) / ("zig.exe" if os.name == "nt" else "zig")
+    return [str(zig), "cc"] if found.returncode == 0 and zig.is_file() else None
 
 
 def _x86_64_linux():
@@ -161,21 +187,16 @@ def compile_host_for(entry, name, output):
     """Cross-build the dlopen C host ``name`` (fmi_host or loop_host, sma_fmu/fmi/hosts/) for
     the Linux target ``entry`` with zig into ``output``; it loads ``binaries/<tuple>/``.
     Returns None or the reason it could not (no zig)."""
-    from importlib import resources
-
     zig = zig_command()
     if zig is None:
         return "no zig cc (pip install ziglang)"
     if not entry.tuple.endswith("-linux"):
         raise ValueError(f"C hosts are cross-built for Linux targets only, not {entry.tuple}")
-    hosts = resources.files("sma_fmu.fmi.hosts")
     output = Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
-    for source in (f"{name}.c", "host_platform.h"):
-        (output.parent / source).write_bytes(hosts.joinpath(source).read_bytes())
     command = [*zig, "-target", entry.zig, "-std=c11", "-O2", "-Wall", "-Wextra", "-Werror",
-               f'-DPLATFORM="{entry.tuple}"', "-o", str(output), str(output.parent / f"{name}.c"),
-               "-ldl"]
+               f'-DPLATFORM="{entry.tuple}"', *include_flags(HOSTS), "-o", str(output),
+               str(HOSTS / f"{name}.c"), "-ldl"]
     result = subprocess.run(command, capture_output=True, text=True, timeout=900)
     if result.returncode != 0:
         raise RuntimeError(f"zig cc could not build {name} for {entry.tuple}: {result.stderr[-3000:]}")

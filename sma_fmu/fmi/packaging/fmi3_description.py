@@ -4,9 +4,9 @@ Nothing about the interface is written twice: the FMI 3.0 description is the nat
 one (:mod:`.c_family_description`) in FMI 3.0's terms:
 
 - ``instantiationToken`` for the ``guid``; ``CoSimulation`` with saved and serialized
-  states and event mode; the models with events of their own (:data:`EVENT_MODELS`: the PWM
-  driver's edges, the signals' load and set-point steps) may return early from a step, at
-  the event;
+  states and event mode; the models with events of their own (``events`` in their
+  declaration, :mod:`sma_fmu.fmi.models`: the PWM driver's edges, the signals' load and
+  set-point steps) may return early from a step, at the event;
 - the independent variable ``time`` [s], one value reference past the model's variables (the
   C core keeps the FMI 2.0 numbering);
 - Real -> Float64 (its unit kept), Integer -> Int32, Boolean, String (start as ``<Start>``),
@@ -23,14 +23,13 @@ structural parameter and the arrays).
 """
 import xml.etree.ElementTree as ET
 
+from sma_fmu.fmi.models import declaration
 from sma_fmu.fmi.packaging.cross_build import RUNS_HERE, TARGETS
 from sma_fmu.fmi.packaging.array_outputs import ARRAYS
 from sma_fmu.fmi.python_family.slave_support.choices import CHOICES
 
-__all__ = ["EVENT_MODELS", "fmi3_description", "platforms_document", "build_description",
+__all__ = ["fmi3_description", "platforms_document", "build_description",
            "fmi3_model_header", "time_reference"]
-
-EVENT_MODELS = {"SmaPwmDriver", "SmaScenarioSignals"}  # their C adapter has next_event (models/<Model>.c)
 
 _CO_SIMULATION = {"canHandleVariableCommunicationStepSize": "true",
                   "canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
@@ -98,7 +97,7 @@ def fmi3_description(fmi2_description):
     root.set("instantiationToken", old.get("guid"))
     identifier = old.find("CoSimulation").get("modelIdentifier")
     co_simulation = ET.SubElement(root, "CoSimulation", modelIdentifier=identifier, **_CO_SIMULATION)
-    if old.get("modelName") in EVENT_MODELS:
+    if declaration(old.get("modelName")).events:
         co_simulation.set("mightReturnEarlyFromDoStep", "true")
     if old.find("UnitDefinitions") is not None:
         units = ET.SubElement(root, "UnitDefinitions")

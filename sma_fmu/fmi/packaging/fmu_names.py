@@ -1,13 +1,14 @@
-"""The five models of both FMU families: their names, slave scripts and default folder."""
+"""The FMUs of both families by name (from the registry, :mod:`sma_fmu.fmi.models`) and where
+the build puts them by default."""
 from pathlib import Path
 
-__all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "DEFAULT_SIGNALS_SCENARIO", "default_fmu_paths"]
+from sma_fmu.fmi.models import declarations
 
-FMU_SCRIPTS = {"SmaActuator": "sma_actuator.py", "SmaFeedforward": "sma_feedforward.py",
-               "SmaPiController": "sma_pi_controller.py", "SmaPwmDriver": "sma_pwm_driver.py",
-               "SmaScenarioSignals": "sma_scenario_signals.py"}
+__all__ = ["FMU_SCRIPTS", "DEFAULT_FMU_DIR", "default_fmu_paths"]
+
+# model name -> its pythonfmu slave script, in the registry's order
+FMU_SCRIPTS = {declared.name: declared.slave for declared in declarations()}
 DEFAULT_FMU_DIR = Path("fmus")
-DEFAULT_SIGNALS_SCENARIO = "load-step-pi+ff-adaptive"  # the paper's Fig. 10 signals
 
 
 def default_fmu_paths(out_dir=DEFAULT_FMU_DIR):

@@ -26,9 +26,9 @@ import sys
 import sysconfig
 import tempfile
 import zipfile
-from importlib import resources
 from pathlib import Path
 
+from sma_fmu.fmi.c_common import C_COMMON, FMI_HEADERS, include_flags
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
 from sma_fmu.fmi.packaging.prebuilt import find_prebuilt_front, sources_digest
 from sma_fmu.fmi.packaging.platforms import (DEGRADED, HOW_PYTHON_IS_FOUND, PLATFORMS, PlatformEntry,
@@ -45,6 +45,7 @@ _WINDOWS = {"flags": [*_COMMON, "-s", "-static-libgcc", "-D__USE_MINGW_ANSI_STDI
                        "-Wl,--no-insert-timestamp", "-Wl,--disable-auto-image-base"],
             "libraries": ["-ladvapi32"], "output": "front.dll"}
 _compiled = {}  # (compiler, sources digest, defines) -> FrontBuild
+FRONT = Path(__file__).parents[1] / "python_family" / "front"   # the front's C sources
 
 
 class FrontWarning(UserWarning):
@@ -93,13 +94,17 @@ def libpython_path():
     return (str(path) if path.is_file() else ""), soname
 
 
+def _source_files():
+    """{file name: path} of what the front compiles: its own sources (``python_family/front/``),
+    the C code both families share (``fmi/c_common/``) and the FMI standard's headers
+    (``c_common/include/``, found through the include path)."""
+    return {path.name: path for folder in (FRONT, C_COMMON, FMI_HEADERS)
+            for path in sorted(folder.iterdir()) if path.suffix in (".c", ".h")}
+
+
 def _sources():
-    """{file name: bytes} of the shipped C sources and headers: the front's, and the C code
-    both families share (``fmi/c_common/``)."""
-    folders = [resources.files("sma_fmu.fmi.python_family") / "front",
-               resources.files("sma_fmu.fmi") / "c_common"]
-    return {entry.name: entry.read_bytes() for folder in folders for entry in folder.iterdir()
-            if entry.name.endswith((".c", ".h"))}
+    """{file name: bytes} of :func:`_source_files`: what the compiled front is a function of."""
+    return {name: path.read_bytes() for name, path in _source_files().items()}
 
 
 def _compile_cached(compiler, target, defines):
@@ -107,17 +112,18 @@ def _compile_cached(compiler, target, defines):
     digest = hashlib.sha256(b"".join(name.encode() + data for name, data in sorted(sources.items())))
     key = (tuple(compiler), target["output"], digest.hexdigest(), tuple(defines))
     if key not in _compiled:
-        _compiled[key] = _compile(compiler, target, defines, sources)
+        _compiled[key] = _compile(compiler, target, defines)
     return _compiled[key]
 
 
-def _compile(compiler, target, defines, sources):
+def _compile(compiler, target, defines):
+    """Compile the front's .c files where they are (in file-name order: the link order of
+    every build), the headers found through :func:`~sma_fmu.fmi.c_common.include_flags`."""
     with tempfile.TemporaryDirectory(prefix="sma_fmu_front_") as folder:
-        for name, data in sources.items():
-            (Path(folder) / name).write_bytes(data)
         output = Path(folder) / target["output"]
-        command = [*compiler, *target["flags"], *defines, "-o", str(output),
-                   *sorted(str(Path(folder) / n) for n in sources if n.endswith(".c")),
+        command = [*compiler, *target["flags"], *defines, *include_flags(FRONT, C_COMMON),
+                   "-o", str(output),
+                   *[str(path) for name, path in sorted(_source_files().items()) if name.endswith(".c")],
                    *target["libraries"]]
         try:
             result = subprocess.run(command, capture_output=True, text=True, timeout=300)

@@ -6,21 +6,24 @@ but no parameter file's values: :mod:`.c_family_description`, and the generated 
 parameter table: :mod:`.parameter_table`), so one binary per model and
 platform serves every build. They live in ``sma_fmu/fmi/packaging/prebuilt_binaries/``
 (package data of the wheel, not of the sdist, which builds from source; never committed) with ``manifest.json``: for each model, the SHA-256 of the
-sources they were compiled from, and the file of each FMI 2.0 platform.
+sources they were compiled from, and the file of each FMI 2.0 platform; under
+:func:`fmi3_key` the same for the FMI 3.0 build (other sources: its front), per FMI 3.0
+platform tuple.
 
 :func:`find_prebuilt` gives a binary only when its sources' digest equals that of the
 sources being packed, so a changed C file, another version (the GUID) or a stale folder is
 never used: the build compiles instead. The Python family's C front is kept there too
 (``front/linux64/front.so``, ``front/win64/front.dll``), taken only where no compiler
 builds it; the prebuilt linux64 front records no build libpython. ``python -m sma_fmu.fmi.packaging.prebuilt_writer``
-fills the folder; ``.ci/run`` runs it before building the wheel, with gcc, mingw-w64 and
-zig present, and fails if any platform is missing.
+fills the folder; the build backend (``build_backend/wheel_backend.py``) runs it when it
+builds the wheel, where gcc, mingw-w64 and zig are, and removes the folder after.
 """
 import hashlib
 import json
 from pathlib import Path
 
-__all__ = ["PREBUILT", "MANIFEST", "FRONTS", "sources_digest", "find_prebuilt", "find_prebuilt_front"]
+__all__ = ["PREBUILT", "MANIFEST", "FRONTS", "sources_digest", "fmi3_key", "find_prebuilt",
+           "find_prebuilt_front"]
 
 PREBUILT = Path(__file__).parent / "prebuilt_binaries"
 MANIFEST = "manifest.json"
@@ -41,9 +44,15 @@ def _manifest(folder):
         return {}
 
 
+def fmi3_key(model):
+    """Where ``model``'s FMI 3.0 binaries are kept: its manifest key and folder name."""
+    return f"{model}.fmi3"
+
+
 def find_prebuilt(model, platform, digest, folder=None):
-    """The bytes of ``model``'s prebuilt binary for the FMI 2.0 ``platform``, compiled from
-    sources of ``digest``; None if there is none. ``folder``: default :data:`PREBUILT`."""
+    """The bytes of ``model``'s prebuilt binary for ``platform`` (an FMI 2.0 folder name; an
+    FMI 3.0 tuple under :func:`fmi3_key`), compiled from sources of ``digest``; None if
+    there is none. ``folder``: default :data:`PREBUILT`."""
     folder = PREBUILT if folder is None else folder
     entry = _manifest(folder).get(model, {})
     name = entry.get("binaries", {}).get(platform)

@@ -1,13 +1,14 @@
 """Build the Python family's FMUs with pythonfmu (:func:`build_pythonfmu_fmus`).
 
 Each FMU ships, in resources/:
-- its slave script from ``sma_fmu/fmi/python_family/slaves/``, renamed ``<script>_<stamp>``;
+- its slave script from its folder ``sma_fmu/fmi/models/<Model>/`` (named by its declaration,
+  :mod:`sma_fmu.fmi.models`), renamed ``<script>_<stamp>``;
 - a copy of ``sma_fmu/runtime`` (the physics, standard library only) renamed
   ``<script>_rt_<stamp>``, and a copy of ``sma_fmu/fmi/python_family/slave_support`` (the FMI glue, which
   needs pythonfmu) renamed ``<script>_fmi_<stamp>``, with their imports rewritten to match;
 - ``parameters.json``: the wire parameter file used at build time;
-- SmaScenarioSignals only: ``signals.json``, its default signals (those of the shipped
-  scenario :data:`DEFAULT_SIGNALS_SCENARIO`).
+- an FMU whose declaration names ``default_signals`` (SmaScenarioSignals): ``signals.json``,
+  its default signals (those of that shipped scenario).
 
 Its binaries are the C front (:mod:`sma_fmu.fmi.packaging.front_build`) for linux64 and win64,
 in front of pythonfmu's; without a compiler for a platform the build warns
@@ -33,7 +34,8 @@ from pathlib import Path
 
 from sma_fmu import __version__
 from sma_fmu.fmi.packaging.extras import add_documentation_and_reference
-from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, DEFAULT_SIGNALS_SCENARIO, FMU_SCRIPTS
+from sma_fmu.fmi.models import declaration, declarations
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 from sma_fmu.fmi.packaging.front_build import (FrontWarning, compile_fronts, install_fronts,
                                                stage_slave_module)
 from sma_fmu.files.output_folder import staged_folder
@@ -58,8 +60,9 @@ def _package_sources(package):
 def _shipped_sources():
     sources = [(f"{package}/{name}", data) for package in _SHIPPED_PACKAGES
                for name, data in sorted(_package_sources(package).items())]
-    sources += [(f"slaves/{name}", shipped_file("slaves", name).read_bytes())
-                for name in sorted(FMU_SCRIPTS.values())]
+    # each slave under the label it had when the scripts shared one folder: the same stamp
+    sources += [(f"slaves/{declared.slave}", declared.slave_path.read_bytes())
+                for declared in sorted(declarations(), key=lambda declared: declared.slave)]
     return sources
 
 
@@ -79,24 +82,21 @@ def _renamer(stem, stamp):
     return names, lambda text: pattern.sub(lambda match: names[match.group(0)], text)
 
 
-def _default_signals(stage):
-    """Write SmaScenarioSignals' ``signals.json``; returns [its path]."""
+def _default_signals(stage, scenario):
+    """Write ``signals.json``, the signals of the shipped ``scenario``; returns [its path]."""
     # the shipped scenario's signal tables, read at the runtime's level (fmi is below cosim)
-    document = read_toml(shipped_file("scenarios", f"{DEFAULT_SIGNALS_SCENARIO}.toml"),
-                         ValueError, "scenario file")
+    document = read_toml(shipped_file("scenarios", f"{scenario}.toml"), ValueError, "scenario file")
     reference, load = reference_from_table(document["reference"]), load_from_table(document["load"])
     path = stage / "signals.json"
-    path.write_text(json.dumps({"scenario": DEFAULT_SIGNALS_SCENARIO, "reference": reference.as_table(),
+    path.write_text(json.dumps({"scenario": scenario, "reference": reference.as_table(),
                                 "load": load.as_table()}, indent=2), encoding="utf-8")
     return [path]
 
 
-# model name -> function(stage folder) writing more files for its resources/
-_EXTRA_RESOURCES = {"SmaScenarioSignals": _default_signals}
-
-
-def _stage(script_name, stage, parameter_set, stamp):
-    """Write the renamed packages, the rewritten slave script and parameters.json into ``stage``."""
+def _stage(declared, stage, parameter_set, stamp):
+    """Write the renamed packages, the rewritten slave script of the FMU ``declared`` and
+    parameters.json into ``stage``."""
+    script_name = declared.slave
     stem = Path(script_name).stem
     names, rename = _renamer(stem, stamp)
     project_files = []
@@ -106,7 +106,7 @@ def _stage(script_name, stage, parameter_set, stamp):
         for name, data in _package_sources(package).items():
             (folder / name).write_text(rename(data.decode("utf-8")), encoding="utf-8")
         project_files.append(folder)
-    source = shipped_file("slaves", script_name).read_text(encoding="utf-8")
+    source = declared.slave_path.read_text(encoding="utf-8")
     if "sma_fmu.runtime" not in source:
         raise ValueError(f"{script_name}: slave script does not import sma_fmu.runtime")
     staged_script = stage_slave_module(stage, f"{stem}_{stamp}", names["sma_fmu.fmi.python_family.slave_support"],
@@ -129,9 +129,10 @@ def _build_into(model_name, folder, parameter_set, stamp):
     from pythonfmu.builder import FmuBuilder
 
     with tempfile.TemporaryDirectory(prefix="sma_fmu_stage_") as stage:
-        script, project_files = _stage(FMU_SCRIPTS[model_name], Path(stage), parameter_set, stamp)
-        if model_name in _EXTRA_RESOURCES:
-            project_files += _EXTRA_RESOURCES[model_name](Path(stage))
+        declared = declaration(model_name)
+        script, project_files = _stage(declared, Path(stage), parameter_set, stamp)
+        if declared.default_signals:
+            project_files += _default_signals(Path(stage), declared.default_signals)
         try:
             return Path(FmuBuilder.build_FMU(
                 script, dest=folder / f"{model_name}.fmu", project_files=project_files,
@@ -143,13 +144,12 @@ def _build_into(model_name, folder, parameter_set, stamp):
 
 
 def build_pythonfmu_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None):
-    """Build the Python family's FMUs (default: all of :data:`FMU_SCRIPTS`) into ``out_dir``;
-    return {name: path}. Built in a temporary folder beside ``out_dir`` and moved there at the
-    end, so a failed build leaves ``out_dir`` as it was."""
-    names = list(FMU_SCRIPTS) if names is None else list(names)
-    unknown = [name for name in names if name not in FMU_SCRIPTS]
-    if unknown:
-        raise ValueError(f"unknown FMU {unknown[0]!r}; expected one of {', '.join(FMU_SCRIPTS)}")
+    """Build the Python family's FMUs (default: every registered one, :mod:`sma_fmu.fmi.models`)
+    into ``out_dir``; return {name: path}. Built in a temporary folder beside ``out_dir`` and
+    moved there at the end, so a failed build leaves ``out_dir`` as it was."""
+    names = [declared.name for declared in declarations()] if names is None else list(names)
+    for name in names:
+        declaration(name)   # ValueError for an unknown FMU, before anything is built
     parameter_set = load_parameter_set(parameter_file)
     stamp = code_stamp()
     fronts = compile_fronts()

@@ -8,7 +8,8 @@ FMI-LS-REF, github.com/modelica/fmi-ls-ref):
     extra/org.fmi-standard.fmi-ls-ref/<Model>_out.csv       its result
 
 The experiment is the FMU's DefaultExperiment (start, stop, communication step). Its
-stimuli (:data:`STIMULI`) are piecewise linear (a host interpolates linearly between the
+stimuli (the ``[stimuli]`` of the FMU's declaration, ``fmi/models/<Model>/fmu.toml``) are
+piecewise linear (a host interpolates linearly between the
 rows, as the FMI Cross-Check rules ask); an input they do not name stays at its start
 value. fmpy's ``simulate_fmu`` runs it, one communication step of ``stepSize`` at a time;
 the result keeps every output, Booleans as 0/1, once every :func:`output_stride` steps
@@ -21,7 +22,8 @@ import zipfile
 
 import numpy as np
 
-__all__ = ["LS_REF_FOLDER", "MANIFEST", "LS_REF_VERSION", "STIMULI", "MAX_ROWS", "RTOL", "ATOL",
+from sma_fmu.fmi.models import REGISTRY, declaration
+__all__ = ["LS_REF_FOLDER", "MANIFEST", "LS_REF_VERSION", "MAX_ROWS", "RTOL", "ATOL",
            "Experiment", "experiment_of", "stimuli", "output_stride", "simulate_experiment",
            "csv_bytes", "read_csv_bytes", "manifest_bytes", "read_manifest", "reference_check"]
 
@@ -33,20 +35,6 @@ _LS_DESCRIPTION = "Layered Standard providing reference stimuli and results for 
 MAX_ROWS = 1501       # result rows at most (the stride grows to keep under it)
 RTOL, ATOL = 1e-9, 1e-12   # reference_check's tolerance: |result - ref| <= ATOL + RTOL |ref|
 
-# model name -> {input: ((t [s], value in the input's unit), ...)}, linear in between and
-# held after the last row. Over the 10 s default experiment: the plant heats through its
-# transformation and cools back (a triangle of power at 0.15 kg), the compensator and the PI
-# see the resistance such a wire passes through, the PWM driver a ramp of demand.
-STIMULI = {
-    "SmaActuator": {"P_in": ((0.0, 0.0), (4.0, 4.0), (8.0, 0.0), (10.0, 0.0)),
-                    "load": ((0.0, 0.15), (10.0, 0.15))},
-    "SmaFeedforward": {"R_ref": ((0.0, 48.0), (4.0, 36.0), (8.0, 48.0), (10.0, 48.0)),
-                       "load": ((0.0, 0.15), (10.0, 0.15))},
-    "SmaPiController": {"R": ((0.0, 48.0), (4.0, 36.0), (8.0, 48.0), (10.0, 48.0)),
-                        "R_ref": ((0.0, 42.0), (10.0, 42.0)),
-                        "P_ff": ((0.0, 2.9), (10.0, 2.9))},
-    "SmaPwmDriver": {"P_demand": ((0.0, 0.0), (8.0, 12.0), (10.0, 12.0))},
-}
 
 
 class Experiment:
@@ -77,13 +65,15 @@ def _inputs(description):
 
 
 def stimuli(description, experiment):
-    """The stimuli of the FMU's model (:data:`STIMULI`) as a structured array with ``time``
-    first and one column per input, or None for an FMU without inputs. An input not in the
-    table holds its start value."""
+    """The stimuli of the FMU's model (its declaration's, :mod:`sma_fmu.fmi.models`; none for a
+    model not registered) as a structured array with ``time`` first and one column per
+    input, or None for an FMU without inputs. An input not in the table holds its start
+    value."""
     inputs = _inputs(description)
     if not inputs:
         return None
-    table = STIMULI.get(description.modelName, {})
+    model = description.modelName
+    table = declaration(model).stimuli if model in REGISTRY else {}
     unknown = sorted(set(table) - {v.name for v in inputs})
     if unknown:
         raise ValueError(f"{description.modelName}: the stimuli name {unknown[0]!r}, which is no input")

@@ -1,10 +1,11 @@
 """What ``documentation/index.html`` tells an FMU's user about its model, in either FMI version.
 
 The text of each model (what it is, its equations with units, its validity range) is an HTML
-fragment in ``user_pages/<Model>.html``. Its ``${name}`` fields are the numbers of the wire
-the FMU was built for (:func:`limits`, from its ``resources/parameters.json``), each written
-as ``<span class="limit" data-name="name" data-value="repr">value unit</span>`` so a reader
-sees the value with its unit and a test can read the exact number back.
+fragment, the page in the model's folder (``fmi/models/<Model>/page.html``). Its ``${name}``
+fields are the numbers of the wire the FMU was built for (:func:`limits`, from its
+``resources/parameters.json``), each written as
+``<span class="limit" data-name="name" data-value="repr">value unit</span>`` so a reader sees
+the value with its unit and a test can read the exact number back.
 
 :func:`loop_section` says how to connect the FMU in the closed loop: the connections of
 :func:`sma_fmu.fmi.loop.wiring.loop_connections` that touch the model, and its place in
@@ -12,14 +13,12 @@ the Gauss-Seidel order :data:`~sma_fmu.fmi.loop.wiring.STEP_ORDER`.
 """
 import html
 import math
-from importlib import resources
 from string import Template
 
+from sma_fmu.fmi.models import REGISTRY, declaration
 from sma_fmu.fmi.loop.wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
 
-__all__ = ["PAGES", "limits", "page_template", "model_section", "loop_section"]
-
-PAGES = "user_pages"   # folder of the model fragments, beside this module
+__all__ = ["limits", "page_template", "model_section", "loop_section"]
 
 
 def limits(params):
@@ -52,11 +51,10 @@ def _field(name, value, unit):
 
 
 def page_template(model_name):
-    """The fragment of ``model_name`` (a :class:`string.Template`); None for another model."""
-    page = resources.files(__package__).joinpath(PAGES, f"{model_name}.html")
-    if not page.is_file():
+    """The page of ``model_name`` (a :class:`string.Template`); None for a model not registered."""
+    if model_name not in REGISTRY:
         return None
-    return Template(page.read_text(encoding="utf-8"))
+    return Template(declaration(model_name).page.read_text(encoding="utf-8"))
 
 
 def model_section(model_name, params):

@@ -1,25 +1,26 @@
-"""The centre law of the isobaric fit: linear centres a_d + b_d f, or centres whose load slope
-follows the transformation strain (Clausius-Clapeyron; the runtime's
-:func:`~sma_fmu.runtime.model_terms.centre_load`: a share c_d = cc_share_d per direction).
+"""What the isobaric report says about the centre law (``--centre-law``): the centres'
+standard errors whatever the law (:func:`centre_gradient`) and what was done with the shares
+(:func:`law_note`).
 
-With three stresses or more each direction's share is an unknown of the fit, bounded to
-[0, 1] and fitted last, from the converged linear fit (as a second stage is), and kept when it
-lowers the cost (:func:`law_attempt`): where the transformation strain hardly changes over
-the stresses (the Flexinol files: s from 0.67 to 0.95) the shares are not determined, and the
-linear centres stay. With fewer stresses, two centres per direction fix only a_d and b_d, so
-the shares stay from ``--model`` (0, linear, for every shipped file) and :func:`law_note`
-says so. ``linear`` switches a share of ``--model`` off. The centres' standard errors come
-from :func:`centre_gradient`.
+The laws themselves are in :mod:`~.centres`: linear centres a_d + b_d f, or centres whose load
+slope follows the transformation strain (Clausius-Clapeyron; the runtime's
+:func:`~sma_fmu.runtime.model_terms.centre_load`: a share c_d = cc_share_d per direction).
+With three stresses or more each direction's share is an unknown, bounded to [0, 1] and
+fitted last, from the converged linear fit (:func:`~.structure.law_look`), and kept when it
+lowers the cost by 1 %: where the transformation strain hardly changes over the stresses
+(the Flexinol files: s from 0.67 to 0.95) the shares are not determined, and the linear
+centres stay. With fewer stresses, two centres per direction fix only a_d and b_d, so the
+shares stay from ``--model`` (0, linear, for every shipped file). ``linear`` switches a share
+of ``--model`` off.
 """
 import numpy as np
 
+from sma_fmu.identification.isobaric.centres import SHARE_STRESSES
 from sma_fmu.runtime.constant_load import hysteresis_centre
 from sma_fmu.runtime.parameters import ParameterError
 
-__all__ = ["CENTRE_LAWS", "SHARE_STRESSES", "centre_gradient", "law_attempt", "law_note"]
+__all__ = ["centre_gradient", "law_note"]
 
-CENTRE_LAWS = ("linear", "clausius-clapeyron")
-SHARE_STRESSES = 3      # stresses needed to fit the share
 # the parameters a stage-1 centre depends on (the runtime's hysteresis_centre)
 CENTRE_INPUTS = ("a_h", "b_h", "a_c", "b_c", "cc_share_h", "cc_share_c", "span_ratio_0",
                  "span_ratio_sat", "span_stress")
@@ -53,17 +54,6 @@ def centre_gradient(load, direction, params, names):
     return gradient
 
 
-def law_attempt(linear, richer, gain):
-    """(the state kept, a note or ""): ``richer`` (the fit with the shares, started from the
-    ``linear`` one) when it converged and lowers the cost by the fraction ``gain``."""
-    old, new = linear.solution, richer.solution
-    if new.status > 0 and new.cost <= (1.0 - gain) * old.cost:
-        return richer, ""
-    return linear, (f"centres that follow the transformation strain do not fit these data "
-                    f"better (cost {new.cost:.6g} against {old.cost:.6g} with linear centres"
-                    f"{'' if new.status > 0 else '; ' + new.message}): linear centres kept")
-
-
 def law_note(option, params, stresses, fitted):
     """{"option", "cc_share_h", "cc_share_c", "note"}: the law asked for and what was done.
 
@@ -75,8 +65,8 @@ def law_note(option, params, stresses, fitted):
                 f"c_h = {terms.cc_share_h:.4g}, c_c = {terms.cc_share_c:.4g} fitted from "
                 f"{stresses} stresses; b_d is the slope where s has saturated")
     elif option == "clausius-clapeyron" and stresses >= SHARE_STRESSES:
-        note = ("centres that follow the transformation strain did not fit these data better "
-                "than linear centres, which were kept (stage_note says by how much)")
+        note = ("centres that follow the transformation strain were not kept: linear centres "
+                "(stage_note says why)")
     elif option == "clausius-clapeyron":
         note = (f"the shares of the centres' slopes that follow s(sigma) need "
                 f"{SHARE_STRESSES} stresses or more to be fitted; with {stresses} they stay "

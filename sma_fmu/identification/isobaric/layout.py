@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from sma_fmu.identification.isobaric.centre_law import SHARE_STRESSES
+from sma_fmu.identification.isobaric.centres import SHARES, stage_laws
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.model_terms import domain_widths
 from sma_fmu.runtime.parameters import ParameterError
@@ -19,39 +19,32 @@ __all__ = ["Layout"]
 class Layout:
     """Columns of the unknowns, and their map onto the wire parameters.
 
-    The centres are held as the cooling centre (a_c, b_c) and the heating centre's lead over
-    it, ``gap0`` = a_h - a_c at no load and, with two loads or more, ``gapF`` at the largest
-    load, both bounded below by 0: so each stage's heating centre is never below its cooling
-    centre anywhere between no load and the largest load. :meth:`physical` maps the vector
-    onto the parameter-file names (a linear map; :meth:`transform` is its matrix). With the
-    Clausius-Clapeyron centres (``cc_share_h``, ``cc_share_c``) gapF still sets b_h as below;
-    the heating centre's lead at a load f is then gap0 + b_h f_h - b_c f_c (f_d of
-    :func:`~sma_fmu.runtime.model_terms.centre_load`).
+    The centres of each stage are held by a centre law (``centres``: one per stage, a
+    :class:`~.centres.LinearCentres` or, with ``centre_law="clausius-clapeyron"``, a
+    :class:`~.centres.StrainFollowingCentres`): with one load the two centres at that load,
+    with several the cooling line and the heating centre's lead over it at two loads, the
+    lead bounded below by 0. :meth:`physical` maps the vector onto the parameter-file names
+    (:meth:`transform` is its matrix). ``centre_law="linear"`` over a base file with shares
+    writes them as 0.
     """
 
     def __init__(self, files, base, fit_slopes, absolute, with_resistance, fit_lag, stages=1,
                  loads=(), widths="separate", centre_law="linear"):
         self.stages = stages
-        self.top_load = max(loads) if loads else 0.0
-        fit_slopes = fit_slopes and self.top_load > 0.0
-        self.fit_slopes = fit_slopes
+        loads = list(loads) if fit_slopes else sorted(set(loads))[:1]
+        measured = [f.thermocouple.values for f in files] or [np.array([-100.0, 400.0])]
+        span = (min(float(t.min()) for t in measured), max(float(t.max()) for t in measured))
+        self.centres = stage_laws(centre_law, loads, base, stages, span)
+        self.linear_centres = centre_law == "linear" and any(getattr(base.terms, n) != 0.0
+                                                             for n in SHARES)
+        self.fit_slopes = self.centres[0].fit_slopes
         stresses = len({round(float(v), 9) for v in loads})
-        centres = ["a_c"] + (["b_c"] if fit_slopes else []) + ["gap0"] + \
-            (["gapF"] if fit_slopes else [])
-        self.phys = centres + (["nu_h", "nu_c"] if widths == "separate" else ["nu"])
+        self.phys = self.centres[0].names + (["nu_h", "nu_c"] if widths == "separate" else ["nu"])
         if stages == 2:
-            self.phys += ["w2"] + [n.replace("a_c", "a2_c").replace("b_c", "b2_c")
-                                   .replace("gap", "gap2_") for n in centres] + ["nu2_h", "nu2_c"]
+            self.phys += ["w2"] + self.centres[1].names + ["nu2_h", "nu2_c"]
         self.phys += ["l_MF"] + (["x_min"] if absolute else []) + ["alpha_P", "alpha_MF"]
         self.phys += (["span_ratio_0"] if stresses >= 2 else []) + \
             (["span_stress"] if stresses >= 3 else [])
-        # the centre law (isobaric/centre_law.py): each direction's share, fitted with three
-        # stresses or more (two centres per direction fix only a_d and b_d)
-        self.phys += ["cc_share_h", "cc_share_c"] if centre_law == "clausius-clapeyron" \
-            and stresses >= SHARE_STRESSES else []
-        # linear centres asked for, over a --model file with the law on: switch it off
-        self.linear_centres = centre_law == "linear" and (base.terms.cc_share_h != 0.0
-                                                          or base.terms.cc_share_c != 0.0)
         self.phys += ["R_P", "R_MF"] if with_resistance else []
         self.offsets = []   # per file: (first column, count, level-0 fixed at zero)
         names = list(self.phys)
@@ -80,35 +73,50 @@ class Layout:
         """{parameter-file name: value} that the physical unknowns of ``vector`` set."""
         u = dict(zip(self.phys, np.asarray(vector[:len(self.phys)], dtype=float).tolist()))
         out = {}
-        for stage, (a, b, g) in ((1, ("a", "b", "gap")), (2, ("a2", "b2", "gap2_"))):
-            if f"{a}_c" not in u:
-                continue
-            b_c = u.get(f"{b}_c", getattr(self.base, "b_c"))
-            gap0 = u[f"{g}0"]
-            if self.fit_slopes:
-                b_h = b_c + (u[f"{g}F"] - gap0) / self.top_load
-            else:
-                b_h = getattr(self.base, "b_h") + b_c - getattr(self.base, "b_c")
-            out.update({f"{a}_h": u[f"{a}_c"] + gap0, f"{b}_h": b_h, f"{a}_c": u[f"{a}_c"],
-                        f"{b}_c": b_c})
+        held = set()
+        for law in self.centres:
+            out.update(law.parameters(u))
+            held.update(law.names)
         for name, value in u.items():
-            if not (name.startswith(("a_c", "b_c", "a2_c", "b2_c", "gap"))):
+            if name not in held:
                 out[name] = value
         widths = domain_widths(out)   # one width for both directions, or two and their nu
         out.pop("nu", None)
         out.update(widths)
         return out
 
+    def settle(self, vector, base_name):
+        """Choices made after the fit (the one-load slopes, :meth:`LinearCentres.settle`);
+        returns the notes saying what was chosen and why."""
+        u = dict(zip(self.phys, np.asarray(vector[:len(self.phys)], dtype=float).tolist()))
+        for law in self.centres:
+            law.settle(u, base_name)
+        return [law.slope_note for law in self.centres if law.slope_note]
+
+    def centres_at(self, vector, load):
+        """[(heating, cooling) centre [degC] of each stage] at ``load`` [kg]."""
+        u = dict(zip(self.phys, np.asarray(vector[:len(self.phys)], dtype=float).tolist()))
+        return [law.centre_at(u, load) for law in self.centres]
+
     def transform(self, vector):
-        """(names, matrix): d physical / d unknowns (exact: the map is linear)."""
+        """(names, matrix): d physical / d unknowns; by unit steps where every centre law is
+        linear (exact), else by central differences of relative step 1e-6."""
         names = [n for n in self.physical(vector) if n != "nu"]
         base = self.physical(vector)
+        linear = all(law.linear for law in self.centres)
         matrix = np.zeros((len(names), len(self.phys)))
         for j in range(len(self.phys)):
-            moved = np.array(vector[:len(self.phys)], dtype=float)
-            moved[j] += 1.0
+            x = np.array(vector[:len(self.phys)], dtype=float)
+            step = 1.0 if linear else 1e-6 * max(abs(x[j]), 1.0)
+            moved = x.copy()
+            moved[j] += step
             after = self.physical(moved)
-            matrix[:, j] = [after[n] - base[n] for n in names]
+            if linear:
+                matrix[:, j] = [after[n] - base[n] for n in names]
+                continue
+            moved[j] = x[j] - step
+            before = self.physical(moved)
+            matrix[:, j] = [(after[n] - before[n]) / (2.0 * step) for n in names]
         return names, matrix
 
     def params(self, vector):

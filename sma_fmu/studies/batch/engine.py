@@ -7,8 +7,8 @@ e_k = R_k - R_ref(t_k); u_k = max(0, u_ff,k + Kp e_k + Ki I_k), with the integra
 while clamped with e_k <= 0; the plants step with u_k and f(t_k) held, or, for runs with a
 PWM drive, with the mean of their PWM wave over the step for the demand u_k
 (:mod:`sma_fmu.studies.batch.pwm`; Gauss-Seidel, as the library path's default). The results
-equal the scalar library path's to rounding (tests/test_batch.py, tests/test_pwm.py: <= 1e-10
-on every column).
+equal the scalar library path's to rounding (tests/studies/test_batch.py,
+tests/runtime/test_pwm.py: <= 1e-10 on every column).
 
 Two ways to record: ``"timeseries"`` keeps every run's full series (the rows of
 :data:`~sma_fmu.cosim.loop.COLUMNS`; for a few runs), ``"metrics"`` keeps only the metrics,

@@ -8,7 +8,7 @@ the branch of the compensator's own stack of reversal points, :mod:`.minor_loops
 computed for a whole chunk of steps in a few numpy calls, once per distinct compensator
 (runs that differ only in gains or filter share it), and only the phase-lag filter
 (Tustin, started in steady state) runs step by step, per run. The operations are those of
-the scalar code, in its order; tests/test_batch.py binds the two.
+the scalar code, in its order; tests/studies/test_batch.py binds the two.
 
 The inverses are columns, the major ones first and the minor-loop ones after them; each
 kind is computed in its own contiguous arrays (numpy's loops over strided views are
@@ -113,7 +113,7 @@ class BatchFeedforward:
                        "energy_cooling": table["energy_cooling"][:, runs],
                        "inv_heating": table["inv_centre_heating"][:, runs],
                        "inv_cooling": table["inv_centre_cooling"][:, runs]}
-        for name in STAGE_FIELDS:               # the issue-36 second stage (0: one stage)
+        for name in STAGE_FIELDS:               # the optional second stage (0: one stage)
             self._terms[name] = table[name][:, runs]
         self.two_stage = np.array([q.terms.two_stage for q in p], dtype=bool)
 

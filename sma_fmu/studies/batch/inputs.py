@@ -25,7 +25,7 @@ LOAD_TOLERANCE_S = 1e-9   # LoadProfile.value's: a switching time this close cou
 CONSTANT_FIELDS = ("M", "xi_F_min", "energy_over_kB", "inv_centre_heating", "inv_centre_cooling",
                    "energy_cooling", "M1", "M2", "energy2_heating", "energy2_cooling",
                    "inv2_heating", "inv2_cooling", "length_M", "length_F")
-# energy_over_kB is the heating branch's (nu_h); the rest are the issue-36 terms
+# energy_over_kB is the heating branch's (nu_h); the rest are the optional model terms
 # (runtime/model_terms.py): 0 for the second stage of a one-stage wire (M1 = M, M2 = 0, so
 # the two-stage sum equals the one-stage split exactly) and l_M, l_F without strain terms
 

@@ -5,7 +5,7 @@ The same record as :func:`sma_fmu.cosim.metrics.scenario_metrics`: the windows a
 reachable band comes from :func:`~sma_fmu.runtime.reachable_band.reachable_band` per run
 and load segment; the record (and its warning) from
 :func:`~sma_fmu.cosim.metrics.assemble_metrics`. Sums run over chunks instead of a stored
-series, so they agree to rounding (tests/test_batch.py binds the two).
+series, so they agree to rounding (tests/studies/test_batch.py binds the two).
 """
 import math
 

@@ -21,7 +21,7 @@ rounds: the first over all its samples and compensators, each later one over a w
 sample lies in it; a round finishes, per compensator, the samples before its first event
 and the event itself. Events are rare (d_ref reverses a few times a period), so most
 chunks take one round. The operations are those of :mod:`~sma_fmu.runtime.sensing` and
-:mod:`~sma_fmu.runtime.minor_loops`, in their order; tests/test_batch.py binds the two.
+:mod:`~sma_fmu.runtime.minor_loops`, in their order; tests/studies/test_batch.py binds the two.
 """
 import math
 
@@ -86,7 +86,7 @@ class MinorLoopMemory:
 
     def __init__(self, margins, depths, two_stage=None):
         count = len(margins)
-        # which columns have an issue-36 second stage (their branches: branches.py)
+        # which columns have the optional second stage (their branches: branches.py)
         self.two_stage = np.zeros(count, dtype=bool) if two_stage is None else np.array(
             two_stage, dtype=bool)
         self.any_two_stage = bool(self.two_stage.any())

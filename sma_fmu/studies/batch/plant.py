@@ -1,7 +1,7 @@
 """N plants (:class:`~sma_fmu.runtime.plant.PlantStepper`) advanced in lock-step with numpy.
 
 A second implementation of the scalar plant, operation by operation, so the two agree to
-rounding (tests/test_batch.py binds them): the zero-order-hold thermal step, the direction
+rounding (tests/studies/test_batch.py binds them): the zero-order-hold thermal step, the direction
 sgn(T+ - T), the major branch through the overflow-free logistic split of
 :func:`~sma_fmu.runtime.constant_load.logistic_split`, and in mode "continuous" the minor
 branches of :mod:`~sma_fmu.runtime.minor_loops`: a stack of reversal points per run with
@@ -29,7 +29,7 @@ caches it; the per-step check for wiping out is a product and a comparison,
 sign(d) T+ >= sign(d) T_B, against a cached bound (+inf below two points). Per step the minor branches then cost
 v = value_B + ratio (L_d(T+) - major_B), the clamp into [0, M] and the selection.
 
-The terms of issue 36 (runtime/model_terms.py): dH/k_B of each run's direction (nu_h, nu_c)
+The optional model terms (runtime/model_terms.py): dH/k_B of each run's direction (nu_h, nu_c)
 is selected with the direction masks; when some run has a second stage, every run's major
 branch is the two-stage sum of :mod:`.branches` (exact for one-stage runs: M2 = 0); when
 some run has strain terms, every run's length is the expanded, stress-scaled one (exact for
@@ -195,7 +195,7 @@ class BatchPlant(PlantTerms):
         np.maximum(e, numerators, out=numerators)
         mul(self.M, numerators, fractions)
         div(fractions, denominator, fractions)
-        if self.two_stage:                             # the issue-36 second stage
+        if self.two_stage:                             # the optional second stage
             fractions[0], fractions[1] = two_stage_fractions(after, self._stages(slice(None)))
         if self.any_continuous:
             self._minor_branches(before, after, turned if changed else None, fractions)

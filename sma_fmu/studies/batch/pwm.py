@@ -1,7 +1,7 @@
 """PWM drivers of a batch (:class:`~sma_fmu.runtime.pwm.PwmDriver`), advanced in lock-step.
 
 A second implementation of the scalar driver, operation by operation, so the two agree to
-rounding (tests/test_pwm.py binds them): per run a frequency, a peak power, the index of
+rounding (tests/runtime/test_pwm.py binds them): per run a frequency, a peak power, the index of
 the period in progress and its duty. In step [t, t + h) with the demand u held:
 
     duty      = clip(u / peak, 0, 1)                     (0 for u <= 0, also for NaN)

@@ -1,4 +1,4 @@
-"""The issue-36 terms of the batch plants (runtime/model_terms.py): a base of BatchPlant.
+"""The optional model terms of the batch plants (runtime/model_terms.py): a base of BatchPlant.
 
 Per run: dH/k_B of heating and of cooling (nu_h, nu_c), the second stage's M1, M2, -dH2/k_B
 and 1/tau2_K of either direction (0 for a one-stage run, so the two-stage sum is its
@@ -16,7 +16,7 @@ class PlantTerms:
     ``_energies`` and ``_centres`` ([heating; cooling] rows)."""
 
     def _terms_arrays(self, p, n):
-        """The issue-36 terms: which are on in some run, and their per-run arrays."""
+        """The optional model terms: which are on in some run, and their per-run arrays."""
         self.two_stage = any(params.terms.two_stage for params in p)
         self.strain = any(params.terms.strain for params in p)
         self.M1, self.M2, self.minus_energy2 = np.empty(n), np.empty(n), np.empty(n)

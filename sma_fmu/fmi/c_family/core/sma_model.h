@@ -1,11 +1,11 @@
 /* The contract between the core (core/, under the fronts fmi2/ and fmi3/) and a model
- * adapter (models/<Model>.c).
+ * adapter (fmi/models/<Model>/<Model>.c).
  *
  * Like the Reference-FMUs' model.h, nothing here is FMI: an adapter declares its variables
  * (a generated table, <Model>_variables.h) and a few functions over its runtime stepper;
  * the core owns the values, the calling sequence, the checks, the log and the saved
  * states, and the fronts translate them to an FMI version. The adapters are as thin as the
- * pythonfmu slaves (fmi/python_family/slaves/) and keep their semantics: a failing start
+ * pythonfmu slaves beside them (fmi/models/<Model>/) and keep their semantics: a failing start
  * refuses ExitInitializationMode, a failing step discards it (slave_support/guards.py). */
 #ifndef SMA_MODEL_H
 #define SMA_MODEL_H
@@ -28,6 +28,7 @@ typedef struct {
     double start;               /* Real, Integer, Boolean (0/1) start value */
     const char *start_text;     /* String start value (NULL for the others) */
     int wire;                   /* index in PARAMETER_SPECS of a wire parameter, else -1 */
+    const char *unit;           /* its unit, e.g. "ohm" (NULL: none) */
 } SmaVariable;
 
 /* A variable's present value: Real -> real, Integer and Boolean -> integer, String -> text
@@ -89,10 +90,15 @@ typedef struct {
     int (*get_array)(const void *stepper, const SmaValue *values, size_t array, double values_out[],
                      size_t nValues, size_t *index);
     size_t (*live_count)(const void *stepper);
+    /* The outputs of a started stepper into `values`, every output (the adapter's publish):
+     * a restored state's saved outputs must be these (layer_states.c). NULL: the outputs are
+     * not held by the stepper (the model computes them from its inputs in a step), and a
+     * state's outputs are checked to be finite only. */
+    void (*held_outputs)(const void *stepper, SmaValue *values);
 } SmaModel;
 
 
-/* Each adapter defines this one object (models/<Model>.c). */
+/* Each adapter defines this one object (fmi/models/<Model>/<Model>.c). */
 extern const SmaModel SMA_MODEL;
 
 #endif

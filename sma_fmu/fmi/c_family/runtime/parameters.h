@@ -9,26 +9,30 @@
 #include "sma_parameters_table.h"  /* generated from PARAMETER_SPECS at build time */
 
 /* The index of each parameter in the values[] array: PARAMETER_SPECS order. */
-#define SMA_PARAMETER_INDEX(name, section, unit, rule, required) PARAM_##name,
+#define SMA_PARAMETER_INDEX(name, section, unit, rule, required, low, high, range) PARAM_##name,
 typedef enum {
     SMA_PARAMETER_SPECS(SMA_PARAMETER_INDEX)
     PARAM_COUNT
 } ParameterIndex;
 #undef SMA_PARAMETER_INDEX
 
-#define SMA_RULE_NAME(rule, text) rule,
+#define SMA_RULE_NAME(rule, low_open, high_open) rule,
 typedef enum {
     SMA_PARAMETER_RULES(SMA_RULE_NAME)
     RULE_COUNT
 } ParameterRule;
 #undef SMA_RULE_NAME
 
+/* One parameter: its rule and its plausible range [low, high] in `unit` (the rule says
+ * which end is open), `range` the interval as the refusal prints it, e.g. "(0, 100000]". */
 typedef struct ParameterSpec {
     const char *name;
     const char *section;
     const char *unit;
     ParameterRule rule;
     int required;
+    double low, high;
+    const char *range;
 } ParameterSpec;
 
 extern const ParameterSpec PARAMETER_SPECS[PARAM_COUNT];

@@ -12,7 +12,8 @@
 #ifndef SMA_FMU_FRONT_H
 #define SMA_FMU_FRONT_H
 
-#include "fmi2_types.h"
+#include "fmi2Functions.h"  /* the standard's header (fmi/c_common/include/): the types, and
+                                the prototypes the exports must match */
 #include "platform.h"
 
 /* the oldest Python the FMUs run on (their runtime's syntax and library) */
