@@ -6,10 +6,16 @@ import json
 
 import numpy as np
 import pytest
+from scipy import sparse
 
 from sma_fmu.cli import main
 
 from sma_fmu.identification.isobaric.centre_law import centre_gradient
+from sma_fmu.identification.isobaric.centres import LinearCentres, StrainFollowingCentres
+from sma_fmu.identification.isobaric.fit import prepare, residual_blocks
+from sma_fmu.identification.isobaric.jacobian import file_jacobian, scalar_sensitivities
+from sma_fmu.identification.isobaric.layout import Layout
+from sma_fmu.identification.isobaric.starts import starts
 from sma_fmu.identification.isobaric.files import read_isobaric
 from sma_fmu.identification.isobaric.fit import fit_isobaric
 from sma_fmu.identification.isobaric.predict import drive_plant
@@ -20,7 +26,7 @@ from sma_fmu.runtime.constant_load import hysteresis_centre
 from sma_fmu.runtime.constant_load import slope_load as runtime_slope_load
 from sma_fmu.wire.parameter_file import load_parameters
 
-SIGMAS = 4.0        # as tests/test_isobaric.py: within 4 standard errors of the truth
+SIGMAS = 4.0        # as tests/identification/test_isobaric.py: within 4 standard errors of the truth
 LAW = dict(span_ratio_0=0.3, span_ratio_sat=1.0, span_stress=80.0, cc_share_h=0.9,
            cc_share_c=0.5)
 
@@ -55,6 +61,74 @@ def test_the_fit_model_is_the_plant_runtime_with_the_law_on(params):
         for direction in (1, -1):
             assert slope_load(load, direction, wire) == pytest.approx(
                 runtime_slope_load(load, direction, wire), rel=1e-14)
+
+
+def test_the_law_holds_the_centres_at_its_anchor_loads(params):
+    """The unknowns are the centres at the lowest and highest load (and the heating lead
+    there), whatever the shares: the runtime's centres of the wire parameters they map to
+    give them back; with the shares at 0 the map is the linear law's."""
+    base = params.replace(span_ratio_0=0.3, span_stress=80.0)
+    loads, temperatures = (0.02, 0.1, 0.3), (10.0, 200.0)
+    u = {"tau_c_lo": 51.0, "tau_c_hi": 83.0, "gap_lo": 17.0, "gap_hi": 25.0,
+         "span_ratio_0": 0.3, "span_stress": 80.0}
+    law = StrainFollowingCentres(loads, base, 1, temperatures, fit_shares=True)
+    assert law.names[-2:] == ["cc_share_h", "cc_share_c"]
+    assert law.bounds("cc_share_h") == (0.0, 1.0)
+    linear = LinearCentres(loads, base, 1, temperatures).parameters(u)
+    at_zero = law.parameters(dict(u, cc_share_h=0.0, cc_share_c=0.0))
+    for name, value in linear.items():
+        assert at_zero[name] == pytest.approx(value, rel=1e-12, abs=1e-12), name
+    wire = base.replace(**law.parameters(dict(u, cc_share_h=0.9, cc_share_c=0.4)))
+    assert (wire.cc_share_h, wire.cc_share_c) == (0.9, 0.4)
+    for load, cooling, lead in ((0.02, 51.0, 17.0), (0.3, 83.0, 25.0)):
+        assert hysteresis_centre(load, -1, wire) == pytest.approx(cooling, abs=1e-10)
+        assert hysteresis_centre(load, 1, wire) - hysteresis_centre(load, -1, wire) == \
+            pytest.approx(lead, abs=1e-10)
+
+
+def test_one_load_keeps_the_base_slopes_or_raises_both_centres_alike(params):
+    """One load with shares from --model: the centres at the load are the unknowns; after
+    the fit the base file's slopes stay when heating >= cooling down to no load, else both
+    centres rise by the same amount from no load to the load."""
+    base = params.replace(span_ratio_0=0.3, span_stress=80.0, cc_share_h=1.0, cc_share_c=0.2)
+    for gap, kept in ((30.0, True), (2.0, False)):
+        law = StrainFollowingCentres((0.3,), base, 1, (10.0, 200.0))
+        u = {"tau_c": 60.0, "gap": gap}
+        law.settle(u, "base.toml")
+        wire = base.replace(**law.parameters(u))
+        assert hysteresis_centre(0.3, -1, wire) == pytest.approx(60.0, abs=1e-10)
+        assert hysteresis_centre(0.3, 1, wire) == pytest.approx(60.0 + gap, abs=1e-10)
+        assert (law.slopes == (base.b_h, base.b_c)) is kept, law.slope_note
+        assert wire.a_h >= wire.a_c
+        if not kept:
+            assert "raising both centres by" in law.slope_note
+            assert wire.a_h - wire.a_c == pytest.approx(gap, abs=1e-10)
+
+
+def test_the_analytic_jacobian_follows_the_law(tmp_path, params):
+    """The physical columns (the shares and the stress law among them) of the sparse
+    Jacobian with the strain-following centres, shares inside their bounds, against central
+    differences of the whole residual."""
+    truth = _truth(params)
+    files = [prepare(data, i) for i, data in enumerate(_files(tmp_path, truth, (0.02, 0.1, 0.3)))]
+    layout = Layout(files, params, True, False, False, False, 1, [0.02, 0.1, 0.3], "shared",
+                    "clausius-clapeyron")
+    assert {"cc_share_h", "cc_share_c", "span_stress"} <= set(layout.phys)
+    vector, _, _ = starts(files, layout, params)
+    vector[layout.phys.index("cc_share_h")] = 0.7
+    vector[layout.phys.index("cc_share_c")] = 0.3
+    sensitivities = scalar_sensitivities(vector, layout, [f.data.load for f in files])
+    analytic = sparse.vstack([b for f in files
+                              for b in file_jacobian(vector, layout, f, sensitivities)]).toarray()
+    for column in range(len(layout.phys)):
+        step = 1e-6 * max(abs(vector[column]), 1e-3)
+        up, down = vector.copy(), vector.copy()
+        up[column] += step
+        down[column] -= step
+        numeric = (np.concatenate(residual_blocks(up, layout, files))
+                   - np.concatenate(residual_blocks(down, layout, files))) / (2 * step)
+        scale = max(np.abs(numeric).max(), 1e-12)
+        assert np.abs(analytic[:, column] - numeric).max() < 1e-5 * scale, layout.phys[column]
 
 
 def test_a_known_law_comes_back_within_its_standard_errors(tmp_path, params):

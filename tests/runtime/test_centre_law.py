@@ -170,7 +170,7 @@ def test_a_file_with_the_law_loads_and_round_trips(tmp_path):
 @pytest.mark.parametrize("value, match", [
     ("1.5", r"hysteresis\.cc_share_h = 1\.5 must be in \[0, 1\]"),
     ("-0.1", r"hysteresis\.cc_share_h = -0\.1 must be in \[0, 1\]"),
-    ("nan", r"hysteresis\.cc_share_h = nan must be in \[0, 1\]"),
+    ("nan", r"hysteresis\.cc_share_h = nan must be a finite number in \[0, 1\]"),
 ])
 def test_a_bad_share_is_refused_naming_file_key_and_value(tmp_path, value, match):
     path = _write(tmp_path, SHARES.replace("value = 1.0", f"value = {value}", 1))

@@ -1,8 +1,9 @@
-"""The batch engine equals the scalar library path (<= 1e-10, as tests/test_batch.py) with the
-Clausius-Clapeyron centres on (hysteresis.cc_share_h, cc_share_c beside the stress law and a
-second stage): random sets of every controller in both hysteresis modes, half the runs with
-the law and half without in one batch, and nested minor loops. The batch takes its centres
-from the scalar branch constants, so it equals the library by construction; this checks it."""
+"""The batch engine equals the scalar library path (<= 1e-10, as tests/studies/test_batch.py)
+with the Clausius-Clapeyron centres on (hysteresis.cc_share_h, cc_share_c beside the stress
+law and a second stage): random sets of every controller in both hysteresis modes, half the
+runs with the law and half without in one batch, and nested minor loops. The batch takes its
+centres from the scalar branch constants, so it equals the library by construction; this
+checks it."""
 import pytest
 
 from sma_fmu.cosim.loop import run_library
@@ -31,7 +32,7 @@ def _law_changes_the_run(scenario):
 def test_random_sets_with_the_law_equal_the_library_path(seed):
     scenarios = mixed_set(12, seed, stop_time_s=2.0)
     scenarios = [with_law(s) if i % 2 == 0 else s for i, s in enumerate(scenarios)]
-    check(scenarios)      # batch equals library, run by run (tests/test_batch_terms.py)
+    check(scenarios)      # batch equals library, run by run (tests/studies/test_batch_terms.py)
     assert any(_law_changes_the_run(s) for s in scenarios[::2])   # the law changed them
 
 

@@ -104,6 +104,18 @@ class Instance(Driven):
             return error.status
 
 
+def _step_alike(sides, inputs, time, step):
+    """Set ``inputs`` ({name: value}) on both ``sides``, step them from ``time`` [s] by
+    ``step`` [s]; returns their outputs, asserted equal."""
+    for side in sides:
+        for name, value in inputs.items():
+            side.set(name, value)
+        assert side.step(time, step) <= 1, side.log[-2:]
+    a, b = (side.values() for side in sides)
+    assert a == b, (time, a, b)
+    return a
+
+
 def plant_walk(sides, library, seed, steps, load, load_rate=0.003, step=1e-3):
     """Drive the plant FMUs ``sides`` (a pythonfmu FMU and its native twin, started) and the
     library PlantStepper with random powers [W] and, at ``load_rate`` per step, random loads
@@ -114,14 +126,9 @@ def plant_walk(sides, library, seed, steps, load, load_rate=0.003, step=1e-3):
             power = rng.choice([0.0, rng.uniform(0.0, 4.0)])
         if rng.random() < load_rate:
             load = rng.uniform(0.0, 0.4)
-        for side in sides:
-            side.set("P_in", power)
-            side.set("load", load)
-            assert side.step(time, step) <= 1, side.log[-2:]
+        a = _step_alike(sides, {"P_in": power, "load": load}, time, step)
         time += step
         expected = library.step(power, load, step)
-        a, b = (side.values() for side in sides)
-        assert a == b, (k, a, b)
         assert (a["R"], a["T"], a["x"]) == (expected.R, expected.T, expected.x), k
 
 
@@ -135,13 +142,9 @@ def compensator_walk(sides, library, seed, steps, band, load, step=1e-3):
         if k % rng.randint(30, 250) == 0:
             target = rng.uniform(band.hot, band.cold)
         reference += 0.02 * (target - reference)
-        for side in sides:
-            side.set("R_ref", reference)
-            assert side.step(time, step) <= 1, side.log[-2:]
+        a = _step_alike(sides, {"R_ref": reference}, time, step)
         time += step
         expected = library.step(reference, load, step)
-        a, b = (side.values() for side in sides)
-        assert a == b, (k, a, b)
         assert (a["P_ff"], a["T_ref"]) == (expected.P_ff, expected.T_ref), k
         inside += not expected.saturated
     return inside

@@ -126,20 +126,26 @@ class LinearCentres:
             return
         s = self.prefix
         b_h, b_c = self.base_slopes
-        gap = u[self.names[1]]
-        lead_at_zero = gap - (b_h - b_c) * self.load
         which = f"b{s}_h, b{s}_c"
-        if lead_at_zero >= 0.0:
+        if self._lead_at_zero(u, b_h, b_c) >= 0.0:
             self.slopes = (b_h, b_c)
             self.slope_note = (f"{which} not fitted (one load): {b_h:g} and {b_c:g} degC/kg "
                                f"from {base_name}")
             return
+        self.slopes, why = self._even_slopes(u, b_h, b_c, base_name)
+        self.slope_note = f"{which} not fitted (one load): {why}"
+
+    def _lead_at_zero(self, u, b_h, b_c):
+        """The heating centre's lead [K] over the cooling one at no load with slopes b_h, b_c."""
+        return u[self.names[1]] - (b_h - b_c) * self.load
+
+    def _even_slopes(self, u, b_h, b_c, base_name):
+        """(slopes that keep the lead at the load down to no load, the note's reason)."""
         mean = 0.5 * (b_h + b_c)
-        self.slopes = (mean, mean)
-        self.slope_note = (
-            f"{which} not fitted (one load): both {mean:g} degC/kg, the mean of {base_name}'s "
-            f"{b_h:g} and {b_c:g}, because those would put the heating centre below the cooling "
-            f"one at no load (hysteresis {gap:.3g} K at {self.load:g} kg, less than "
+        return (mean, mean), (
+            f"both {mean:g} degC/kg, the mean of {base_name}'s {b_h:g} and {b_c:g}, because "
+            f"those would put the heating centre below the cooling one at no load (hysteresis "
+            f"{u[self.names[1]]:.3g} K at {self.load:g} kg, less than "
             f"{(b_h - b_c) * self.load:.3g} K)")
 
     def centre_at(self, u, load):
@@ -208,29 +214,25 @@ class StrainFollowingCentres(LinearCentres):
         out.update({name: u[name] for name in SHARES if self.owns_shares})
         return out
 
-    def settle(self, u, base_name):
-        """With one load: the base file's slopes when the heating centre stays at or above
-        the cooling one down to no load, else slopes that raise both centres by the same
-        amount from no load to the load (the linear law's mean slopes when f_h = f_c)."""
-        if self.fit_slopes:
-            self.slope_note = ""
-            return
-        s = self.prefix
-        b_h, b_c = self.base_slopes
-        f_h, f_c = self._loads(u, HEATING)(self.load), self._loads(u, COOLING)(self.load)
-        gap = u[self.names[1]]
-        if gap - (b_h * f_h - b_c * f_c) >= 0.0 or not (f_h > 0.0 and f_c > 0.0):
-            self.slopes = (b_h, b_c)
-            self.slope_note = (f"b{s}_h, b{s}_c not fitted (one load): {b_h:g} and {b_c:g} "
-                               f"degC/kg from {base_name}")
-            return
+    def _rises(self, u):
+        """(f_h, f_c) [kg]: the loads the slopes multiply at the fitted load."""
+        return self._loads(u, HEATING)(self.load), self._loads(u, COOLING)(self.load)
+
+    def _lead_at_zero(self, u, b_h, b_c):
+        f_h, f_c = self._rises(u)
+        return u[self.names[1]] - (b_h * f_h - b_c * f_c)
+
+    def _even_slopes(self, u, b_h, b_c, base_name):
+        """Slopes that raise both centres by the same amount from no load to the load (the
+        linear law's mean slopes when f_h = f_c), and the note's reason."""
+        f_h, f_c = self._rises(u)
         rise = 0.5 * (b_h * f_h + b_c * f_c)
-        self.slopes = (rise / f_h, rise / f_c)
-        self.slope_note = (
-            f"b{s}_h, b{s}_c not fitted (one load): {self.slopes[0]:g} and {self.slopes[1]:g} "
-            f"degC/kg, raising both centres by {rise:.3g} K from no load to {self.load:g} kg, "
-            f"because {base_name}'s {b_h:g} and {b_c:g} would put the heating centre below the "
-            f"cooling one at no load (hysteresis {gap:.3g} K at {self.load:g} kg)")
+        slopes = (rise / f_h, rise / f_c)
+        return slopes, (
+            f"{slopes[0]:g} and {slopes[1]:g} degC/kg, raising both centres by {rise:.3g} K from "
+            f"no load to {self.load:g} kg, because {base_name}'s {b_h:g} and {b_c:g} would put "
+            f"the heating centre below the cooling one at no load (hysteresis "
+            f"{u[self.names[1]]:.3g} K at {self.load:g} kg)")
 
     def centre_at(self, u, load):
         """(heating, cooling) centre [degC] at ``load`` [kg]."""
