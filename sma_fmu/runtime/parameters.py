@@ -15,7 +15,8 @@ from .model_terms import ModelTerms, model_terms
 from .thermal import thermal_gain, thermal_time_constant
 
 __all__ = ["ParameterError", "ParameterSpec", "PARAMETER_SPECS", "RULES", "WireParameters",
-           "DEFAULT_STRESS_MAX", "range_text", "requirement_text", "value_in_range"]
+           "DEFAULT_STRESS_MAX", "DATA_RANGE", "range_text", "requirement_text",
+           "value_in_range"]
 
 
 class ParameterError(ValueError):
@@ -108,7 +109,14 @@ PARAMETER_SPECS = (
     ParameterSpec("Ki", "control", "W/(ohm.s)", "nonnegative", True, GAIN),
     ParameterSpec("T_max", "validity", "degC", "finite", True, TEMPERATURE),
     ParameterSpec("stress_max", "validity", "MPa", "positive", False, STRESS),
+    ParameterSpec("T_data_min", "validity", "degC", "finite", False, TEMPERATURE),
+    ParameterSpec("T_data_max", "validity", "degC", "finite", False, TEMPERATURE),
+    ParameterSpec("stress_data_min", "validity", "MPa", "nonnegative", False, STRESS),
+    ParameterSpec("stress_data_max", "validity", "MPa", "nonnegative", False, STRESS),
 )
+# The data range (T_data_*, stress_data_*: optional, written by the fits) is where the
+# parameters were identified; a stepper warns once when a run leaves it (runtime/validity.py).
+DATA_RANGE = ("T_data_min", "T_data_max", "stress_data_min", "stress_data_max")
 
 SPEC_BY_NAME = {spec.name: spec for spec in PARAMETER_SPECS}
 
@@ -159,7 +167,11 @@ class WireParameters:
     ``memory_depth`` [1] is the most reversal points the minor-loop memory keeps (an int;
     optional in a file, default 64). ``load_max`` [kg] = stress_max pi d^2/4 / g is the
     largest load the model is valid for (``stress_max`` [MPa], optional, default
-    :data:`DEFAULT_STRESS_MAX`): the steppers warn above it.
+    :data:`DEFAULT_STRESS_MAX`): the steppers warn above it. The range the fitted data
+    covered, ``T_data_min``/``T_data_max`` [degC] and ``stress_data_min``/``stress_data_max``
+    [MPa], is optional (None: no bound); ``load_data_min``/``load_data_max`` [kg] are the
+    stress bounds as loads (None when not given), ``data_range`` is True when any bound is
+    given: the steppers then warn once when a run leaves the range.
 
     The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``,
     ``cc_share_h``, ``cc_share_c``) are
@@ -217,6 +229,10 @@ class WireParameters:
     span_stress: float = None
     cc_share_h: float = None
     cc_share_c: float = None
+    T_data_min: float = None
+    T_data_max: float = None
+    stress_data_min: float = None
+    stress_data_max: float = None
     source: str = field(default="<parameters>", compare=False, repr=False)
 
     lattice: tuple = field(init=False, repr=False, compare=False)
@@ -230,6 +246,9 @@ class WireParameters:
     tau_th: float = field(init=False, repr=False, compare=False)
     phase_lag_alpha: float = field(init=False, repr=False, compare=False)
     load_max: float = field(init=False, repr=False, compare=False)
+    load_data_min: float = field(init=False, repr=False, compare=False)
+    load_data_max: float = field(init=False, repr=False, compare=False)
+    data_range: bool = field(init=False, repr=False, compare=False)
     terms: ModelTerms = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -300,7 +319,16 @@ class WireParameters:
                 ("stress_max", "diameter"),
                 lambda: self.stress_max * 1e6 * math.pi * self.diameter ** 2 / 4.0 / STANDARD_GRAVITY),
             terms=model_terms(self, self._fail),
+            load_data_min=self._load_of_stress(self.stress_data_min),
+            load_data_max=self._load_of_stress(self.stress_data_max),
+            data_range=any(getattr(self, name) is not None for name in DATA_RANGE),
         )
+
+    def _load_of_stress(self, stress):
+        """The load [kg] of ``stress`` [MPa] on this wire (None for None), as load_max."""
+        if stress is None:
+            return None
+        return stress * 1e6 * math.pi * self.diameter ** 2 / 4.0 / STANDARD_GRAVITY
 
     def _check_consistency(self):
         if not self.R_MF > self.R_P:
@@ -316,6 +344,12 @@ class WireParameters:
         if not self.T_max > self.T_room:
             self._fail(f"parameter validity.T_max = {self.T_max!r} degC must exceed "
                        f"thermal.T_room = {self.T_room!r} degC")
+        for low, high, unit in (("T_data_min", "T_data_max", "degC"),
+                                ("stress_data_min", "stress_data_max", "MPa")):
+            lowest, highest = getattr(self, low), getattr(self, high)
+            if lowest is not None and highest is not None and not lowest <= highest:
+                self._fail(f"parameter validity.{low} = {lowest!r} {unit} must be <= "
+                           f"validity.{high} = {highest!r} {unit}")
 
     def values(self):
         """Parameter values by name (only the schema's entries; alpha omitted when not given)."""

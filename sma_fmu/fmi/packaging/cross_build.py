@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.fmi.c_common import include_flags
+from sma_fmu.console.interrupts import run_child
 from sma_fmu.fmi.hosts import HOSTS, c_compiler, windows_compiler
 
 __all__ = ["FLAGS", "Target", "TARGETS", "target", "fmi2_targets", "zig_command", "toolchain",
@@ -170,8 +171,7 @@ def compile_shared(entry, sources_folder, output, prefer_zig=False):
                 if path.suffix in (".c", ".h"):
                     shutil.copyfile(path, Path(stage) / path.name)
             try:
-                result = subprocess.run(command, capture_output=True, text=True, timeout=900,
-                                        cwd=stage)
+                result = run_child(command, text=True, timeout=900, cwd=stage)
             except (OSError, subprocess.SubprocessError) as error:
                 return f"C compiler {' '.join(compiler)!r} could not run ({error})"
             if result.returncode != 0 or not (Path(stage) / name).is_file():
@@ -197,7 +197,7 @@ def compile_host_for(entry, name, output):
     command = [*zig, "-target", entry.zig, "-std=c11", "-O2", "-Wall", "-Wextra", "-Werror",
                f'-DPLATFORM="{entry.tuple}"', *include_flags(HOSTS), "-o", str(output),
                str(HOSTS / f"{name}.c"), "-ldl"]
-    result = subprocess.run(command, capture_output=True, text=True, timeout=900)
+    result = run_child(command, text=True, timeout=900)
     if result.returncode != 0:
         raise RuntimeError(f"zig cc could not build {name} for {entry.tuple}: {result.stderr[-3000:]}")
     return None

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
+from sma_fmu.identification.coverage import DATA_RANGE_MEANINGS, coverage_header, with_coverage
 from sma_fmu.identification.isobaric.fit import LAG_OPTIONS, RESIDUAL_OPTIONS, fit_isobaric
 from sma_fmu.identification.isobaric.summary import format_isobaric_report, half_strain_table
 from sma_fmu.identification.isobaric.cycles import parse_cycles, splitting_note
@@ -256,7 +257,12 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         fit.params = fit.params.replace(stress_max=float(np.ceil(top)))
     if hottest > fit.params.T_max:
         fit.params = fit.params.replace(T_max=float(np.ceil(hottest)))
+    fit.params, covered = with_coverage(   # the data range; what the data did not determine
+        fit.params, base_set, fit.wire_names,
+        [t for d in data for t in (d.temperature.min(), d.temperature.max())],
+        [stress_of_load(d.load, base.diameter) for d in data])
     report = isobaric_report(data, fit, base_set, residual, rows, outliers)
+    report["coverage"] = covered
     report["lag_choice"] = {"option": fit.lag_option, "note": fit.lag_note}
     report["hysteresis"] = hysteresis_report(data, fit, rows)
     report["centre_law"] = law_note(centre_law, fit.params, len({d.load for d in data}),
@@ -272,13 +278,14 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
             folder / "identified.toml", fit.params, f"{base_set.name}-isobaric",
             f"isobaric fit of {names}; strain RMS {fit.residual_rms['strain']:.3g}"
             + ("" if fit.converged else " (not converged)"),
-            {**TERM_MEANINGS, **(base_set.meanings or {})},
+            {**TERM_MEANINGS, **(base_set.meanings or {}), **DATA_RANGE_MEANINGS},
             header=verdict + [
                 f"Identified by sma-fmu fit isobaric on {stamp}.",
                 f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}"
                 f" (validity.stress_max and T_max raised to the largest fitted stress and "
                 f"temperature where they were lower).",
                 *fit.slope_notes,
+                coverage_header(covered),
                 f"Data: {', '.join(str(f) for f in files)} at "
                 f"{', '.join(f'{d.load:g}' for d in data)} kg"])
         (folder / "report.json").write_text(json_text(report), encoding="utf-8")

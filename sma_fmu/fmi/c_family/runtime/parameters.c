@@ -226,6 +226,11 @@ int wire_parameters_from_given(WireParameters *out, const double values[],
                         STRESS, 2, &p.load_max, 1, failure, message)) {
         return 1;
     }
+    /* the data range's stress bounds as loads, as load_max (NaN stays NaN: not given) */
+    p.load_data_min = p.stress_data_min * 1e6 * SMA_PI * square / 4.0 / STANDARD_GRAVITY;
+    p.load_data_max = p.stress_data_max * 1e6 * SMA_PI * square / 4.0 / STANDARD_GRAVITY;
+    p.data_range = !isnan(p.T_data_min) || !isnan(p.T_data_max) || !isnan(p.stress_data_min)
+                   || !isnan(p.stress_data_max);
     if (model_terms(&p, v, &p.terms, message)) {
         return 1;
     }
@@ -245,6 +250,16 @@ int wire_parameters_from_given(WireParameters *out, const double values[],
     if (!(p.T_max > p.T_room)) {
         return sma_message_set(message, "%s: parameter validity.T_max = %.17g degC must exceed "
                                "thermal.T_room = %.17g degC", p.source, p.T_max, p.T_room);
+    }
+    if (p.T_data_min > p.T_data_max) {
+        return sma_message_set(message, "%s: parameter validity.T_data_min = %.17g degC must be <= "
+                               "validity.T_data_max = %.17g degC", p.source, p.T_data_min,
+                               p.T_data_max);
+    }
+    if (p.stress_data_min > p.stress_data_max) {
+        return sma_message_set(message, "%s: parameter validity.stress_data_min = %.17g MPa must be "
+                               "<= validity.stress_data_max = %.17g MPa", p.source,
+                               p.stress_data_min, p.stress_data_max);
     }
     *out = p;
     return 0;

@@ -52,8 +52,10 @@ typedef struct ModelTerms {
 
 /* Validated parameters of one SMA wire (units as in PARAMETER_SPECS), with the derived
  * constants of Python's WireParameters: lattice, N [1], line_density [kg/m], l_P [m],
- * x_T [m], x_f [m], R_MF [ohm], K_th [K/W], tau_th [s], phase_lag_alpha [s], load_max [kg].
- * alpha is NaN where Python's is None (not given). */
+ * x_T [m], x_f [m], R_MF [ohm], K_th [K/W], tau_th [s], phase_lag_alpha [s], load_max [kg],
+ * load_data_min, load_data_max [kg] (the data range's stress bounds as loads, NaN when not
+ * given) and data_range (1 when any bound of the data range is given).
+ * alpha and the data range are NaN where Python's are None (not given). */
 #define SMA_WIRE_FIELD(type, name) type name;
 typedef struct WireParameters {
     SMA_WIRE_FIELDS(SMA_WIRE_FIELD)
@@ -61,6 +63,8 @@ typedef struct WireParameters {
 
     Lattice lattice;
     double N, line_density, l_P, x_T, x_f, R_MF, K_th, tau_th, phase_lag_alpha, load_max;
+    double load_data_min, load_data_max;
+    int data_range;
     ModelTerms terms;
 } WireParameters;
 #undef SMA_WIRE_FIELD
