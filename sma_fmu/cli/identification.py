@@ -14,7 +14,7 @@ __all__ = ["register"]
 
 EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
 _ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag",
-                  "stages", "keep_outliers", "widths")
+                  "stages", "keep_outliers", "widths", "centre_law")
 _SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit",
                         "lag_s", "drift_decay", "first_cycle_shift")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
@@ -61,7 +61,8 @@ def _fit_isobaric(args, out):
                               progress=echo, cycles=args.cycles,
                               lag=args.lag or "auto", stages=args.stages or 2,
                               outliers="keep" if args.keep_outliers else "leave-out",
-                              widths=args.widths or "auto", meter=_meter)
+                              widths=args.widths or "auto", meter=_meter,
+                              centre_law=args.centre_law or "linear")
     print(format_isobaric_report(report))
     print("\n".join(coverage_lines(report)))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
@@ -248,6 +249,11 @@ def register(commands):
                      help="isobaric: one transition width (nu) for heating and cooling, one each "
                           "(nu_h, nu_c), or auto: one, then one each kept only when it lowers "
                           "the cost by 1 %% (default: auto)")
+    fit.add_argument("--centre-law", choices=("linear", "clausius-clapeyron"),
+                     help="isobaric: hysteresis centres linear in the load, or with a load slope "
+                          "that follows the transformation strain s(sigma) (Clausius-Clapeyron; "
+                          "the shares cc_share_h, cc_share_c are fitted with three stresses or "
+                          "more, else kept from --model) (default: linear)")
     fit.add_argument("--keep-outliers", action="store_true",
                      help="isobaric: keep cycles whose strain residual RMS exceeds 3x the median "
                           "cycle's (default: they are named and left out)")

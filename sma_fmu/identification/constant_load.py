@@ -18,8 +18,8 @@ import numpy as np
 from sma_fmu.identification.least_squares import FitParameter, fit_parameters, percentage_errors
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.checks import direction_name
-from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
-from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
+from sma_fmu.runtime.constant_load import branch_constants, branch_fractions, hysteresis_centre
+from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET
 from sma_fmu.runtime.sensing import mixed_fractions_of_resistance, sense_temperature
 
 __all__ = ["FITTED", "MIN_LOADS", "model_resistance", "starting_parameters", "fit_constant_load",
@@ -201,8 +201,8 @@ def fit_constant_load(data, base):
         "rmse_ohm": float(np.sqrt(np.mean(result.residuals ** 2))),
         "per_load_and_direction": _group_stats(data, model, groups),
         "transformation_temperatures_degC": {
-            f"{load:g} kg": {"heating": result.params.a_h + result.params.b_h * load,
-                             "cooling": result.params.a_c + result.params.b_c * load}
+            f"{load:g} kg": {"heating": hysteresis_centre(load, HEATING, result.params),
+                             "cooling": hysteresis_centre(load, COOLING, result.params)}
             for load in sorted({k[0] for k in groups})},
         "temperature_sensing": sensing,
         "solver": {"converged": result.converged, "message": result.message,

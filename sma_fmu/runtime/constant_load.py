@@ -1,6 +1,7 @@
 """Constant-load model with a direction-switched hysteresis centre (spec sections 3-4).
 
     tau(f, d)  = a_h + b_h f (heating), a_c + b_c f (cooling)        [degC]
+                 (cc_share_d > 0: f_d of model_terms.centre_load in place of f)
     xi_Fmin(f) = xi_F_inf (1 - exp(-f/f_F))                           residual F when hot
     dH(f)      = nu (eps_T - g f x_T / N)                             [J] per cooperative domain
     Lambda     = ln(xi_P/xi_MF) = (dH/k_B)(1/tau_K - 1/T_K)
@@ -22,11 +23,11 @@ from collections import namedtuple
 
 from .checks import direction_sign, require_finite, require_nonnegative
 from .constants import BOLTZMANN, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
-from .model_terms import stressed_lengths
+from .model_terms import centre_load, stressed_lengths
 from .phases import PhaseFractions, resistance_of
 
 __all__ = [
-    "BranchConstants", "hysteresis_centre", "second_centre", "residual_f_fraction",
+    "BranchConstants", "slope_load", "hysteresis_centre", "second_centre", "residual_f_fraction",
     "domain_energy", "branch_constants", "logistic_split", "branch_fractions",
     "two_stage_fractions", "phase_fractions",
     "constant_load_fractions", "constant_load_resistance", "require_temperature", "BranchCache",
@@ -59,16 +60,28 @@ def require_temperature(name, value):
     return temperature
 
 
+def slope_load(load, direction, params):
+    """The load [kg] the centres' slopes multiply in ``direction``: ``load`` itself, or with
+    cc_share_d > 0 the strain-weighted load of :func:`~.model_terms.centre_load`."""
+    terms = params.terms
+    share = terms.cc_share_h if direction_sign(direction) == HEATING else terms.cc_share_c
+    return load if share == 0.0 else centre_load(load, share, terms)
+
+
 def hysteresis_centre(load, direction, params):
-    """Hysteresis centre tau [degC] for a load [kg] and direction (+1 heating, -1 cooling)."""
+    """Hysteresis centre tau [degC] for a load [kg] and direction (+1 heating, -1 cooling):
+    a_d + b_d f (the strain-weighted load with cc_share_d > 0: :func:`slope_load`)."""
+    load = slope_load(load, direction, params)
     if direction_sign(direction) == HEATING:
         return params.a_h + params.b_h * load
     return params.a_c + params.b_c * load
 
 
 def second_centre(load, direction, params):
-    """Second-stage centre tau2 [degC] = a2_d + b2_d f for a load [kg] and direction."""
+    """Second-stage centre tau2 [degC] = a2_d + b2_d f for a load [kg] and direction (the
+    strain-weighted load with cc_share_d > 0, as :func:`hysteresis_centre`)."""
     terms = params.terms
+    load = slope_load(load, direction, params)
     if direction_sign(direction) == HEATING:
         return terms.a2_h + terms.b2_h * load
     return terms.a2_c + terms.b2_c * load

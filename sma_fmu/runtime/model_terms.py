@@ -8,10 +8,17 @@ law of the transformation strain, and the wire length with thermal expansion.
                          sigma = g f / (pi d^2/4) [MPa]   (Lagoudas' H_cur form)
                          l_P(T)   = l_P (1 + alpha_P (T - T_alpha))
                          l_i(T,f) = [l_P + s (l_i - l_P)] (1 + alpha_MF (T - T_alpha)),  i = M, F
+    cc_share_d           [hysteresis] share c_d of the centre's load slope that follows the
+                         transformation strain (Clausius-Clapeyron): tau_d = a_d + b_d f_d,
+                         f_d = f [1 + c_d (s_0/s_sat - 1) phi(sigma/span_stress)] [kg],
+                         phi(x) = (1 - e^-x)/x, phi(0) = 1, so that
+                         d tau_d/df = b_d [1 - c_d + c_d s(sigma)/s_sat]; the second
+                         stage's a2_d + b2_d f_d too (omitted: 0, linear centres)
 
 Every default reproduces the paper's model bit for bit: the steppers take the old code path
-when ``two_stage`` or ``strain`` is False. :data:`TERM_DEFAULTS` is the one table of the
-defaults: the C family's ModelTerms and its defaults are generated from it at build time
+when ``two_stage`` or ``strain`` is False, and a direction whose ``cc_share_d`` is 0 has
+the linear centres. :data:`TERM_DEFAULTS` is the one table of the defaults: the C family's
+ModelTerms and its defaults are generated from it at build time
 (sma_fmu/fmi/packaging/parameter_table.py); the terms' C physics is in
 c_family/runtime/constant_load.c.
 """
@@ -21,7 +28,7 @@ from collections import namedtuple
 from .constants import STANDARD_GRAVITY
 
 __all__ = ["ModelTerms", "TERM_DEFAULTS", "model_terms", "domain_widths", "stress_of_load",
-           "stress_ratio", "stressed_lengths", "wire_length", "DEFAULT_T_ALPHA",
+           "stress_ratio", "centre_load", "stressed_lengths", "wire_length", "DEFAULT_T_ALPHA",
            "DEFAULT_SPAN_STRESS"]
 
 DEFAULT_T_ALPHA = 20.0        # degC: where l_P, l_M, l_F are the given lengths
@@ -36,6 +43,7 @@ TERM_DEFAULTS = (
     ("nu2_h", "nu_h"), ("nu2_c", "nu_c"),
     ("alpha_P", 0.0), ("alpha_MF", 0.0), ("T_alpha", DEFAULT_T_ALPHA),
     ("span_ratio_0", 1.0), ("span_ratio_sat", 1.0), ("span_stress", DEFAULT_SPAN_STRESS),
+    ("cc_share_h", 0.0), ("cc_share_c", 0.0),
 )
 
 ModelTerms = namedtuple("ModelTerms", [name for name, _ in TERM_DEFAULTS] +
@@ -44,8 +52,10 @@ ModelTerms.__doc__ = """The optional terms' values in use (defaults filled in).
 
 nu_h, nu_c, nu2_h, nu2_c [1]; w2 [1]; a2_h, a2_c [degC] (None when stage 2 is off and they
 are not given); b2_h, b2_c [degC/kg]; alpha_P, alpha_MF [1/K]; T_alpha [degC]; span_ratio_0,
-span_ratio_sat [1]; span_stress [MPa]; two_stage: w2 > 0; strain: a thermal expansion or a
-stress law is on; area: the wire's cross-section pi d^2/4 [m2].
+span_ratio_sat [1]; span_stress [MPa]; cc_share_h, cc_share_c [1]: the share of each
+direction's centre slope that follows s(sigma) (0: linear centres); two_stage: w2 > 0;
+strain: a thermal expansion or a stress law is on; area: the wire's cross-section
+pi d^2/4 [m2].
 """
 
 
@@ -103,6 +113,20 @@ def stress_ratio(load, terms):
     sigma = stress_of_load(load, terms)
     return terms.span_ratio_sat + (terms.span_ratio_0 - terms.span_ratio_sat) * math.exp(
         -sigma / terms.span_stress)
+
+
+def centre_load(load, share, terms):
+    """f_d [kg], the load a centre's slope b_d multiplies when ``share`` c_d [1] of it follows
+    the transformation strain (Clausius-Clapeyron: d tau/d sigma = eps_tr(sigma)/ds):
+
+        f_d = integral_0^f [1 - c_d + c_d s(sigma(u))/s_sat] du
+            = f [1 + c_d (s_0/s_sat - 1) phi(sigma/span_stress)],   phi(x) = (1 - e^-x)/x
+
+    ``load`` f [kg] >= 0; with s_0 = s_sat or c_d = 0, f_d = f."""
+    x = stress_of_load(load, terms) / terms.span_stress
+    phi = -math.expm1(-x) / x if x > 0.0 else 1.0
+    return load * (1.0 + share * ((terms.span_ratio_0 - terms.span_ratio_sat)
+                                  / terms.span_ratio_sat) * phi)
 
 
 def stressed_lengths(load, params):

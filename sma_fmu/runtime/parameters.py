@@ -32,7 +32,8 @@ MAX_MEMORY_DEPTH = 100_000
 # The plausible ranges (low, high) [unit]: wide enough for every Ti-Ni, NiTiHf or NiTiCo wire
 # and rod and for what the fits reach, narrow enough to refuse a unit slip (a length in mm, a
 # resistance in mohm, 1e30). The rule says whether an end is open: positive (low, high],
-# nonnegative [low, high], fraction [0, 1), margin (0, 0.5), finite and depth [low, high].
+# nonnegative [low, high], fraction [0, 1), margin (0, 0.5), finite, depth and share
+# [low, high].
 LENGTH = (0.0, 10.0)               # m: from a few mm (a test coupon) to 10 m of wire
 DIAMETER = (0.0, 0.01)             # m: drawn wire 0.025-0.5 mm, rods up to 10 mm
 MASS = (0.0, 10.0)                 # kg: 10 m of a 10 mm rod is 5 kg
@@ -54,6 +55,7 @@ TIME = (0.0, 1e5)                  # s: a 10 mm rod in still air has tau_th of a
 GAIN = (0.0, 1e6)                  # W/ohm, W/(ohm.s): a milliohm rod needs kW per ohm
 FRACTION = (0.0, 1.0)              # 1
 MARGIN = (0.0, 0.5)                # 1
+SHARE = (0.0, 1.0)                 # 1: a share of a slope, both ends included
 DEPTH = (2, MAX_MEMORY_DEPTH)      # 1: reversal points
 
 PARAMETER_SPECS = (
@@ -71,6 +73,8 @@ PARAMETER_SPECS = (
     ParameterSpec("b_h", "hysteresis", "degC/kg", "finite", True, CENTRE_SLOPE),
     ParameterSpec("a_c", "hysteresis", "degC", "finite", True, TEMPERATURE),
     ParameterSpec("b_c", "hysteresis", "degC/kg", "finite", True, CENTRE_SLOPE),
+    ParameterSpec("cc_share_h", "hysteresis", "1", "share", False, SHARE),
+    ParameterSpec("cc_share_c", "hysteresis", "1", "share", False, SHARE),
     ParameterSpec("memory_depth", "hysteresis", "1", "depth", False, DEPTH),
     ParameterSpec("xi_F_inf", "constant_load", "1", "fraction", True, FRACTION),
     ParameterSpec("f_F", "constant_load", "kg", "positive", True, LOAD),
@@ -118,7 +122,8 @@ SPEC_BY_NAME = {spec.name: spec for spec in PARAMETER_SPECS}
 
 # rule -> (low end open, high end open) of its range
 RULES = {"positive": (True, False), "nonnegative": (False, False), "fraction": (False, True),
-         "finite": (False, False), "margin": (True, True), "depth": (False, False)}
+         "finite": (False, False), "margin": (True, True), "depth": (False, False),
+         "share": (False, False)}
 # choice: Ti-Ni actuator wires are rated for 150-200 MPa over many cycles and yield or lose
 # their memory a little above 300 MPa; the reference wire's parameters come from loads up
 # to 0.25 kg (139 MPa on 0.15 mm). Above 300 MPa the model warns (0.54 kg on 0.15 mm).
@@ -168,7 +173,8 @@ class WireParameters:
     stress bounds as loads (None when not given), ``data_range`` is True when any bound is
     given: the steppers then warn once when a run leaves the range.
 
-    The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``) are
+    The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``,
+    ``cc_share_h``, ``cc_share_c``) are
     None when not given; ``terms`` (:class:`~.model_terms.ModelTerms`) holds the values in
     use, defaults filled in (nu_h = nu_c = nu, w2 = 0, ...: today's model bit for bit).
     """
@@ -221,6 +227,8 @@ class WireParameters:
     span_ratio_0: float = None
     span_ratio_sat: float = None
     span_stress: float = None
+    cc_share_h: float = None
+    cc_share_c: float = None
     T_data_min: float = None
     T_data_max: float = None
     stress_data_min: float = None

@@ -119,6 +119,9 @@ def _terms_note(params):
     terms, parts = params.terms, []
     if terms.nu_h != params.nu or terms.nu_c != params.nu:
         parts.append(f"constant_load.nu_h = {terms.nu_h!r}, nu_c = {terms.nu_c!r} in place of nu")
+    if terms.cc_share_h != 0.0 or terms.cc_share_c != 0.0:
+        parts.append(f"the strain-weighted load f_d in place of f (hysteresis.cc_share_h = "
+                     f"{terms.cc_share_h!r}, cc_share_c = {terms.cc_share_c!r})")
     if terms.two_stage:
         parts.append(f"the second stage's centres second_stage.a2_h + b2_h f, a2_c + b2_c f "
                      f"and nu2_h = {terms.nu2_h!r}, nu2_c = {terms.nu2_c!r}")

@@ -204,7 +204,8 @@ def _bad_parameters(values):
     the consistency checks."""
     bad = {"positive": (0.0, -1.0, math.inf, math.nan), "nonnegative": (-1e-9, math.inf),
            "fraction": (1.0, -0.1, math.nan), "finite": (math.inf, -math.inf, math.nan),
-           "margin": (0.0, 0.5), "depth": (1.0, 2.5, 100001.0, math.inf)}
+           "margin": (0.0, 0.5), "depth": (1.0, 2.5, 100001.0, math.inf),
+           "share": (1.0000001, -1e-9, math.inf, math.nan)}
     for spec in PARAMETER_SPECS:
         for value in bad[spec.rule]:
             if spec.required or not math.isnan(value):   # C: NaN = an optional one not given

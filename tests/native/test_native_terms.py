@@ -3,11 +3,9 @@ second stage, thermal expansion, the stress law): the terms travel into each fam
 (resources/parameters.json, the native FMUs' compiled-in defaults), the plant and the
 compensator of the two families agree bit for bit on walks in both hysteresis modes and both
 inverses, and both equal the library steppers of that file."""
-import random
-
 import pytest
 
-from native_twins import Instance
+from native_twins import Instance, compensator_walk, plant_walk
 from sma_fmu.files.package_data import default_parameter_file
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.plant import PlantStepper
@@ -77,22 +75,8 @@ def test_the_plants_agree_bit_for_bit_and_equal_the_library(families, terms_file
                            mode={1: "continuous", 2: "switch"}[mode], load=0.2)
     py, nat = _pair(families, "SmaActuator", f"terms-plant{mode}",
                     {"hysteresis_mode": mode, "memory_depth": 3, "load": 0.2})
-    rng, time, power, load = random.Random(mode), 0.0, 1.0, 0.2
     try:
-        for k in range(6000):
-            if k % rng.randint(40, 300) == 0:
-                power = rng.choice([0.0, rng.uniform(0.0, 4.0)])
-            if rng.random() < 0.003:
-                load = rng.uniform(0.0, 0.4)
-            for side in (py, nat):
-                side.set("P_in", power)
-                side.set("load", load)
-                assert side.step(time, 1e-3) <= 1, side.log[-2:]
-            time += 1e-3
-            expected = library.step(power, load, 1e-3)
-            a, b = py.values(), nat.values()
-            assert a == b, (k, a, b)
-            assert (a["R"], a["T"], a["x"]) == (expected.R, expected.T, expected.x), k
+        plant_walk((py, nat), library, mode, 6000, 0.2)
     finally:
         py.close()
         nat.close()
@@ -108,22 +92,8 @@ def test_the_compensators_agree_bit_for_bit_and_equal_the_library(families, term
     library.initial_outputs(band.cold, 0.1)
     py, nat = _pair(families, "SmaFeedforward", f"terms-ff{inverse}",
                     {"inverse": inverse, "memory_depth": 3, "R_ref": band.cold, "load": 0.1})
-    rng, time, reference, target, inside = random.Random(inverse), 0.0, band.cold, band.cold, 0
     try:
-        for k in range(5000):
-            if k % rng.randint(30, 250) == 0:
-                target = rng.uniform(band.hot, band.cold)
-            reference += 0.02 * (target - reference)
-            for side in (py, nat):
-                side.set("R_ref", reference)
-                assert side.step(time, 1e-3) <= 1, side.log[-2:]
-            time += 1e-3
-            expected = library.step(reference, 0.1, 1e-3)
-            a, b = py.values(), nat.values()
-            assert a == b, (k, a, b)
-            assert (a["P_ff"], a["T_ref"]) == (expected.P_ff, expected.T_ref), k
-            inside += not expected.saturated
-        assert inside > 2500
+        assert compensator_walk((py, nat), library, inverse, 5000, band, 0.1) > 2500
     finally:
         py.close()
         nat.close()

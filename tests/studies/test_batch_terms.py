@@ -17,10 +17,10 @@ TERMS = dict(nu_h=150.0, nu_c=105.0, w2=0.13, a2_h=95.0, b2_h=80.0, a2_c=70.0, b
              span_ratio_0=0.9, span_ratio_sat=1.12, span_stress=120.0)
 
 
-def with_terms(scenario):
-    """The scenario with the terms on in its wire and in its compensator's model."""
+def with_terms(scenario, changes=TERMS):
+    """The scenario with the terms (``changes``) on in its wire and in its compensator's model."""
     def changed(parameter_set):
-        return dataclasses.replace(parameter_set, params=parameter_set.params.replace(**TERMS))
+        return dataclasses.replace(parameter_set, params=parameter_set.params.replace(**changes))
     model = scenario.compensator_parameter_set
     return dataclasses.replace(scenario, parameter_set=changed(scenario.parameter_set),
                                compensator_parameter_set=None if model is None else changed(model))

@@ -5,6 +5,7 @@ arguments, as a C host does): used side by side on a pythonfmu FMU and its nativ
 fmpy's proxy keeps one Python logger for the process: :data:`LOGS` routes its messages by
 instance name, so the instance names of a test must differ.
 """
+import random
 import shutil
 from ctypes import byref
 
@@ -13,7 +14,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.logging import addLoggerProxy
 
-__all__ = ["LOGS", "Driven", "Instance", "STATUS"]
+__all__ = ["LOGS", "Driven", "Instance", "STATUS", "plant_walk", "compensator_walk"]
 
 STATUS = {"ok": 0, "warning": 1, "discard": 2, "error": 3, "fatal": 4}
 LOGS = {}  # instance name -> [(status, text)]
@@ -102,3 +103,48 @@ class Instance(Driven):
         except FMICallException as error:
             return error.status
 
+
+def _step_alike(sides, inputs, time, step):
+    """Set ``inputs`` ({name: value}) on both ``sides``, step them from ``time`` [s] by
+    ``step`` [s]; returns their outputs, asserted equal."""
+    for side in sides:
+        for name, value in inputs.items():
+            side.set(name, value)
+        assert side.step(time, step) <= 1, side.log[-2:]
+    a, b = (side.values() for side in sides)
+    assert a == b, (time, a, b)
+    return a
+
+
+def plant_walk(sides, library, seed, steps, load, load_rate=0.003, step=1e-3):
+    """Drive the plant FMUs ``sides`` (a pythonfmu FMU and its native twin, started) and the
+    library PlantStepper with random powers [W] and, at ``load_rate`` per step, random loads
+    [kg] in [0, 0.4]: both families' outputs equal at every step, and R, T, x the library's."""
+    rng, time, power = random.Random(seed), 0.0, 1.0
+    for k in range(steps):
+        if k % rng.randint(40, 300) == 0:
+            power = rng.choice([0.0, rng.uniform(0.0, 4.0)])
+        if rng.random() < load_rate:
+            load = rng.uniform(0.0, 0.4)
+        a = _step_alike(sides, {"P_in": power, "load": load}, time, step)
+        time += step
+        expected = library.step(power, load, step)
+        assert (a["R"], a["T"], a["x"]) == (expected.R, expected.T, expected.x), k
+
+
+def compensator_walk(sides, library, seed, steps, band, load, step=1e-3):
+    """Drive the compensator FMUs ``sides`` and the library FeedforwardStepper with a
+    reference [ohm] easing towards random targets in ``band`` at ``load`` [kg]: both
+    families' outputs equal at every step, P_ff and T_ref the library's. Returns how many
+    steps were not saturated."""
+    rng, time, reference, target, inside = random.Random(seed), 0.0, band.cold, band.cold, 0
+    for k in range(steps):
+        if k % rng.randint(30, 250) == 0:
+            target = rng.uniform(band.hot, band.cold)
+        reference += 0.02 * (target - reference)
+        a = _step_alike(sides, {"R_ref": reference}, time, step)
+        time += step
+        expected = library.step(reference, load, step)
+        assert (a["P_ff"], a["T_ref"]) == (expected.P_ff, expected.T_ref), k
+        inside += not expected.saturated
+    return inside

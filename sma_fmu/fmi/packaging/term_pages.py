@@ -98,6 +98,21 @@ TERM_PAGES = (
         "scales with the stress (Lagoudas' H<sub>cur</sub> form).</p>",
         "s<sub>0</sub> = ${span_ratio_0}, s<sub>sat</sub> = ${span_ratio_sat}: ℓ<sub>M</sub>, "
         "ℓ<sub>F</sub> do not depend on the stress"),
+    TermPage(
+        "centre_law", "Centres that follow the transformation strain (Clausius–Clapeyron)",
+        lambda p: p.terms.cc_share_h != 0.0 or p.terms.cc_share_c != 0.0,
+        ("cc_share_h", "cc_share_c"),
+        '<p class="eq">τ = a<sub>d</sub> + b<sub>d</sub> f<sub>d</sub>, &nbsp; f<sub>d</sub> = '
+        "f [1 + c<sub>d</sub> (s<sub>0</sub>/s<sub>sat</sub> − 1) φ(σ/σ<sub>s</sub>)], &nbsp; "
+        "φ(x) = (1 − e<sup>−x</sup>)/x [kg]</p>\n"
+        '<p class="eq">c<sub>h</sub> = ${cc_share_h} (heating), &nbsp; c<sub>c</sub> = '
+        "${cc_share_c} (cooling)</p>\n"
+        "<p>A share c<sub>d</sub> of each centre's load slope follows the transformation "
+        "strain s(σ) of the stress law (dτ/dσ ∝ ε<sub>tr</sub>, Clausius–Clapeyron); the "
+        "rest stays linear in the load f. The inverse and the minor loops use the same "
+        "centres.</p>",
+        "c<sub>h</sub> = ${cc_share_h}, c<sub>c</sub> = ${cc_share_c}: the centres are "
+        "linear in the load (τ = a<sub>d</sub> + b<sub>d</sub> f)"),
 )
 
 

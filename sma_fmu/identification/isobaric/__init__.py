@@ -13,10 +13,13 @@ The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` w
   a first fit at the thermocouple's profile (:mod:`~.first_fit`) that chooses the structure
   (:mod:`~.structure`), then the joint fit; on :mod:`~.terms` (the model with its optional
   terms, vectorised), :mod:`~.profile`, :mod:`~.lag` and :mod:`~.sensor` (the wire's
-  temperature, and when a lag can be fitted), :mod:`~.layout`, :mod:`~.centres` and
-  :mod:`~.starts` (the unknowns, their starts and bounds), :mod:`~.jacobian` and
+  temperature, and when a lag can be fitted), :mod:`~.layout`, :mod:`~.centres` (the
+  centre laws: linear, or following Clausius-Clapeyron) and :mod:`~.starts` (the unknowns,
+  their starts and bounds), :mod:`~.jacobian` and
   :mod:`~.solver` (sparse Levenberg-Marquardt), :mod:`~.covariance`, :mod:`~.outliers`
   (outlier cycles, bounds) and :mod:`~.outcome` (what the fit found, the verdict);
+- :mod:`~.centre_law`: the report's word on the centre law (the centres' standard errors,
+  what was done with the shares);
 - :mod:`~.halfway` and :mod:`~.summary`: half-strain temperatures and transformation strain
   of data and model per stress, and the text summary;
 - :mod:`~.predict` and :mod:`~.predict_runner`: ``sma-fmu predict isobaric``, the plant

@@ -24,12 +24,22 @@ directly, for two reasons:
   but a bend in a baseline (on the NiTiHf set a second stage ran to 400 degC and a domain
   size of 6 without this).
 
-Another centre law (say, one following Clausius-Clapeyron) plugs in as a class with the
-same members: ``names``, ``start``, ``bounds``, ``parameters`` (wire-file names from the
-unknowns, linear in them) and ``settle`` (choices made after the fit), and a vectorised
-centre in :mod:`~.terms`.
+Another centre law plugs in as a class with the same members: ``names``, ``start``,
+``bounds``, ``parameters`` (wire-file names from the unknowns; ``linear`` says whether that
+map is linear in them) and ``settle`` (choices made after the fit), and a vectorised centre
+in :mod:`~.terms`. :class:`StrainFollowingCentres` is the one of the Clausius-Clapeyron
+centres (docs/model.md 4a): the same unknowns, anchored at the same loads, with each
+direction's slope following the transformation strain by its share c_d.
 """
-__all__ = ["LinearCentres"]
+from sma_fmu.runtime.constants import COOLING, HEATING
+from sma_fmu.runtime.model_terms import centre_load
+
+__all__ = ["LinearCentres", "StrainFollowingCentres", "stage_laws", "SHARES", "CENTRE_LAWS",
+           "SHARE_STRESSES"]
+
+SHARES = ("cc_share_h", "cc_share_c")     # [1] the wire file's share of each direction
+CENTRE_LAWS = ("linear", "clausius-clapeyron")
+SHARE_STRESSES = 3      # stresses needed to fit the shares (two fix only a_d and b_d)
 
 
 # [degC] the centres' bounds when no measured range is given
@@ -40,6 +50,8 @@ class LinearCentres:
     """The centres of one stage (1 or 2) as unknowns, for the distinct ``loads`` [kg] of
     the files; ``base`` gives the slopes when one load cannot; ``temperatures`` = (lowest,
     highest) measured temperature [degC] bounds the centres."""
+
+    linear = True       # parameters() is linear in the unknowns
 
     def __init__(self, loads, base, stage=1, temperatures=DEFAULT_TEMPERATURES):
         loads = sorted({float(f) for f in loads})
@@ -114,20 +126,26 @@ class LinearCentres:
             return
         s = self.prefix
         b_h, b_c = self.base_slopes
-        gap = u[self.names[1]]
-        lead_at_zero = gap - (b_h - b_c) * self.load
         which = f"b{s}_h, b{s}_c"
-        if lead_at_zero >= 0.0:
+        if self._lead_at_zero(u, b_h, b_c) >= 0.0:
             self.slopes = (b_h, b_c)
             self.slope_note = (f"{which} not fitted (one load): {b_h:g} and {b_c:g} degC/kg "
                                f"from {base_name}")
             return
+        self.slopes, why = self._even_slopes(u, b_h, b_c, base_name)
+        self.slope_note = f"{which} not fitted (one load): {why}"
+
+    def _lead_at_zero(self, u, b_h, b_c):
+        """The heating centre's lead [K] over the cooling one at no load with slopes b_h, b_c."""
+        return u[self.names[1]] - (b_h - b_c) * self.load
+
+    def _even_slopes(self, u, b_h, b_c, base_name):
+        """(slopes that keep the lead at the load down to no load, the note's reason)."""
         mean = 0.5 * (b_h + b_c)
-        self.slopes = (mean, mean)
-        self.slope_note = (
-            f"{which} not fitted (one load): both {mean:g} degC/kg, the mean of {base_name}'s "
-            f"{b_h:g} and {b_c:g}, because those would put the heating centre below the cooling "
-            f"one at no load (hysteresis {gap:.3g} K at {self.load:g} kg, less than "
+        return (mean, mean), (
+            f"both {mean:g} degC/kg, the mean of {base_name}'s {b_h:g} and {b_c:g}, because "
+            f"those would put the heating centre below the cooling one at no load (hysteresis "
+            f"{u[self.names[1]]:.3g} K at {self.load:g} kg, less than "
             f"{(b_h - b_c) * self.load:.3g} K)")
 
     def centre_at(self, u, load):
@@ -135,3 +153,102 @@ class LinearCentres:
         p = self.parameters(u)
         s = self.prefix
         return (p[f"a{s}_h"] + p[f"b{s}_h"] * load, p[f"a{s}_c"] + p[f"b{s}_c"] * load)
+
+
+class StrainFollowingCentres(LinearCentres):
+    """The centres tau_d(f) = a_d + b_d f_d of one stage, f_d the strain-weighted load of the
+    runtime's :func:`~sma_fmu.runtime.model_terms.centre_load` (Clausius-Clapeyron: the slope
+    b_d [1 - c_d + c_d s(sigma)/s_sat] follows the transformation strain by the share c_d).
+
+    The unknowns are the linear law's: the centres at the anchor loads, so the bounds keep
+    heating at or above cooling at those loads whatever the shares, and the shares at 0 give
+    the linear law's centres. a_d and b_d follow from them through f_d, which depends on the
+    shares and the stress law (span_ratio_0, span_stress: unknowns of the fit or the base
+    file's), so the map is not linear. ``fit_shares``: the shares (:data:`SHARES`) are
+    unknowns of stage 1, bounded to [0, 1] (stage 2 uses the same shares); else they stay
+    the base file's."""
+
+    linear = False
+
+    def __init__(self, loads, base, stage=1, temperatures=DEFAULT_TEMPERATURES, fit_shares=False):
+        super().__init__(loads, base, stage, temperatures)
+        self.terms = base.terms
+        self.owns_shares = fit_shares and stage == 1
+        self.names = self.names + (list(SHARES) if self.owns_shares else [])
+
+    def bounds(self, name):
+        return (0.0, 1.0) if name in SHARES else super().bounds(name)
+
+    def start(self, lines):
+        """The linear law's starts, shares at 0 (the linear centres)."""
+        out = super().start(lines)
+        out.update({name: 0.0 for name in SHARES if name in self.names})
+        return out
+
+    def _loads(self, u, direction):
+        """f -> f_d [kg] in ``direction`` with the shares and stress law of ``u``."""
+        terms = self.terms._replace(**{name: u[name] for name in
+                                       ("span_ratio_0", "span_stress") + SHARES if name in u})
+        share = terms.cc_share_h if direction == HEATING else terms.cc_share_c
+        return lambda f: f if share == 0.0 else centre_load(f, share, terms)
+
+    def parameters(self, u):
+        """{a_h, b_h, a_c, b_c (with the stage's prefix)[, cc_share_h, cc_share_c]: value}
+        from the unknowns ``u`` (a dict of all the physical unknowns)."""
+        s = self.prefix
+        heat, cool = self._loads(u, HEATING), self._loads(u, COOLING)
+        if self.fit_slopes:
+            c_low, c_high, g_a, g_b = (u[n] for n in self.names[:4])
+            (low, high), (g0, g1) = self.anchors, self.gap_anchors
+            b_c = (c_high - c_low) / (cool(high) - cool(low))
+            a_c = c_low - b_c * cool(low)
+            h_a, h_b = a_c + b_c * cool(g0) + g_a, a_c + b_c * cool(g1) + g_b
+            b_h = (h_b - h_a) / (heat(g1) - heat(g0))
+            a_h = h_a - b_h * heat(g0)
+        else:
+            tau_c, gap = (u[n] for n in self.names[:2])
+            b_h, b_c = self.slopes
+            a_c = tau_c - b_c * cool(self.load)
+            a_h = tau_c + gap - b_h * heat(self.load)
+        out = {f"a{s}_h": a_h, f"b{s}_h": b_h, f"a{s}_c": a_c, f"b{s}_c": b_c}
+        out.update({name: u[name] for name in SHARES if self.owns_shares})
+        return out
+
+    def _rises(self, u):
+        """(f_h, f_c) [kg]: the loads the slopes multiply at the fitted load."""
+        return self._loads(u, HEATING)(self.load), self._loads(u, COOLING)(self.load)
+
+    def _lead_at_zero(self, u, b_h, b_c):
+        f_h, f_c = self._rises(u)
+        return u[self.names[1]] - (b_h * f_h - b_c * f_c)
+
+    def _even_slopes(self, u, b_h, b_c, base_name):
+        """Slopes that raise both centres by the same amount from no load to the load (the
+        linear law's mean slopes when f_h = f_c), and the note's reason."""
+        f_h, f_c = self._rises(u)
+        rise = 0.5 * (b_h * f_h + b_c * f_c)
+        slopes = (rise / f_h, rise / f_c)
+        return slopes, (
+            f"{slopes[0]:g} and {slopes[1]:g} degC/kg, raising both centres by {rise:.3g} K from "
+            f"no load to {self.load:g} kg, because {base_name}'s {b_h:g} and {b_c:g} would put "
+            f"the heating centre below the cooling one at no load (hysteresis "
+            f"{u[self.names[1]]:.3g} K at {self.load:g} kg)")
+
+    def centre_at(self, u, load):
+        """(heating, cooling) centre [degC] at ``load`` [kg]."""
+        p = self.parameters(u)
+        s = self.prefix
+        return (p[f"a{s}_h"] + p[f"b{s}_h"] * self._loads(u, HEATING)(load),
+                p[f"a{s}_c"] + p[f"b{s}_c"] * self._loads(u, COOLING)(load))
+
+
+def stage_laws(option, loads, base, stages, temperatures):
+    """One centre law per stage for ``option`` (:data:`CENTRE_LAWS`): linear centres, or the
+    strain-following ones, whose shares are fitted with SHARE_STRESSES distinct ``loads``
+    or more and else stay the base file's (the linear centres when those are 0)."""
+    fit_shares = option == "clausius-clapeyron" and len(set(loads)) >= SHARE_STRESSES
+    kept = option == "clausius-clapeyron" and any(getattr(base.terms, n) != 0.0 for n in SHARES)
+    if fit_shares or kept:
+        return [StrainFollowingCentres(loads, base, stage, temperatures, fit_shares)
+                for stage in range(1, stages + 1)]
+    return [LinearCentres(loads, base, stage, temperatures) for stage in range(1, stages + 1)]

@@ -9,7 +9,9 @@ expansion, the stress law of the transformation strain) plus a strain offset. Fi
 (:mod:`~.layout` lists the unknowns, :mod:`~.starts` their starts and bounds):
 - the hysteresis centres of each stage (:mod:`~.centres`): with one load the two centres at
   that load (the load slopes are not in the cost), with several the cooling line and the
-  heating centre's lead (>= 0) at the lowest and highest load;
+  heating centre's lead (>= 0) at the lowest and highest load; with
+  ``centre_law="clausius-clapeyron"`` and three stresses or more, each direction's share of
+  the slope that follows the transformation strain, fitted last (:mod:`~.centre_law`);
 - the domain sizes: one nu, or nu_h and nu_c (``widths``), and nu2_h, nu2_c, w2 with a
   second stage (``stages=2``); richer models are kept only when they lower the cost by
   STAGE_GAIN_MIN;
@@ -45,6 +47,7 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from sma_fmu.identification.isobaric.centres import CENTRE_LAWS, SHARE_STRESSES
 from sma_fmu.identification.isobaric.files import noise_level
 from sma_fmu.identification.isobaric.lag import uniform_step
 from sma_fmu.identification.isobaric.layout import Layout
@@ -55,7 +58,7 @@ from sma_fmu.identification.isobaric.profile import pointwise_error, temperature
 from sma_fmu.identification.isobaric.sensor import choose_lag, lag_sensitivity
 from sma_fmu.identification.isobaric.starts import PROFILE_BOUND, PROFILE_TOLERANCE_K
 from sma_fmu.identification.isobaric.structure import (Clock, Joint, choose, joint, joint_starts,
-                                                       second_look, with_head)
+                                                       law_look, second_look, with_head)
 
 __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "OUTLIER_OPTIONS", "IsobaricFit", "fit_isobaric",
            "prepare", "residual_blocks", "EXPLAINED_RATIO"]
@@ -110,10 +113,11 @@ def prepare(data, index, residual="per-cycle"):
                         residual == "per-cycle")
 
 
-def _check_options(residual, lag, widths, stages, outliers):
+def _check_options(residual, lag, widths, stages, outliers, centre_law):
     for name, value, options in (("residual", residual, RESIDUAL_OPTIONS),
                                  ("lag", lag, LAG_OPTIONS), ("widths", widths, WIDTH_OPTIONS),
-                                 ("outliers", outliers, OUTLIER_OPTIONS)):
+                                 ("outliers", outliers, OUTLIER_OPTIONS),
+                                 ("centre_law", centre_law, CENTRE_LAWS)):
         if value not in options:
             raise ValueError(f"{name} must be one of {', '.join(options)}, got {value!r}")
     if stages not in (1, 2):
@@ -121,7 +125,8 @@ def _check_options(residual, lag, widths, stages, outliers):
 
 
 def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=300,
-                 progress=None, stages=1, outliers="leave-out", widths="auto", meter=None):
+                 progress=None, stages=1, outliers="leave-out", widths="auto", meter=None,
+                 centre_law="linear"):
     """Fit the isobaric files (list of IsobaricData) jointly; returns :class:`IsobaricFit`.
 
     ``lag``: "fit", "none" or "auto" (:func:`~.sensor.choose_lag`); ``stages``: 1, or 2 (a
@@ -129,12 +134,15 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
     "shared" (one nu) or "auto" (shared, then separate kept only when it lowers the cost
     by STAGE_GAIN_MIN); ``outliers``: "leave-out" (cycles whose strain residual RMS exceeds
     OUTLIER_RATIO times the median cycle's are named and fitted again without their strain)
-    or "keep". ``max_evaluations`` bounds the joint fit. ``progress`` (callable taking a
+    or "keep"; ``centre_law``: "linear" or "clausius-clapeyron" (the shares of
+    :class:`~.centres.StrainFollowingCentres`, tried last from the joint fit with linear
+    centres when the files hold three stresses or more, else kept from ``base``).
+    ``max_evaluations`` bounds the joint fit. ``progress`` (callable taking a
     line of text, or None) hears the notes; ``meter`` (a callable returning a tqdm-like
     bar, or None) shows the evaluations as they run. Raises MeasurementError when the
     fitted transformation leaves a file's temperature range.
     """
-    _check_options(residual, lag, widths, stages, outliers)
+    _check_options(residual, lag, widths, stages, outliers, centre_law)
     prepared = [prepare(data, index, residual) for index, data in enumerate(files)]
     loads = sorted({data.load for data in files})
     lag, lag_note = choose_lag(prepared, lag)
@@ -142,10 +150,13 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
         for f in prepared:     # the turns would let the profile mimic the lag there
             f.profile = f.thermocouple
 
-    def layout_of(count, kind):
+    # the shares are fitted last, from the fit with linear centres
+    fit_law = centre_law == "clausius-clapeyron" and len(loads) >= SHARE_STRESSES
+
+    def layout_of(count, kind, law="linear" if fit_law else centre_law):
         return Layout(prepared, base, len(loads) >= 2, any(d.absolute for d in files),
                       any(d.resistance is not None for d in files), lag == "fit", count, loads,
-                      kind)
+                      kind, law)
     clock = Clock(meter)
     try:
         # the sparse solves gain nothing from BLAS threads, which only contend for the cores
@@ -165,6 +176,11 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
                            trial.vector)
             state, kind, stages, notes = second_look(prepared, base, layout_of, state, kind,
                                                       rejected, clock, max_evaluations)
+            if fit_law:
+                state, note = law_look(prepared, base,
+                                       lambda count, kind: layout_of(count, kind, centre_law),
+                                       state, kind, clock, max_evaluations)
+                notes += [note] if note else []
     finally:
         clock.close()
     layout, solution = state.layout, state.solution

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from sma_fmu.identification.isobaric.centres import LinearCentres
+from sma_fmu.identification.isobaric.centres import SHARES, stage_laws
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.model_terms import domain_widths
 from sma_fmu.runtime.parameters import ParameterError
@@ -19,20 +19,24 @@ __all__ = ["Layout"]
 class Layout:
     """Columns of the unknowns, and their map onto the wire parameters.
 
-    The centres of each stage are held by a :class:`~.centres.LinearCentres` (``centres``:
-    one per stage): with one load the two centres at that load, with several the cooling
-    line and the heating centre's lead over it at two loads, the lead bounded below by 0.
-    :meth:`physical` maps the vector onto the parameter-file names (a linear map;
-    :meth:`transform` is its matrix).
+    The centres of each stage are held by a centre law (``centres``: one per stage, a
+    :class:`~.centres.LinearCentres` or, with ``centre_law="clausius-clapeyron"``, a
+    :class:`~.centres.StrainFollowingCentres`): with one load the two centres at that load,
+    with several the cooling line and the heating centre's lead over it at two loads, the
+    lead bounded below by 0. :meth:`physical` maps the vector onto the parameter-file names
+    (:meth:`transform` is its matrix). ``centre_law="linear"`` over a base file with shares
+    writes them as 0.
     """
 
     def __init__(self, files, base, fit_slopes, absolute, with_resistance, fit_lag, stages=1,
-                 loads=(), widths="separate"):
+                 loads=(), widths="separate", centre_law="linear"):
         self.stages = stages
         loads = list(loads) if fit_slopes else sorted(set(loads))[:1]
         measured = [f.thermocouple.values for f in files] or [np.array([-100.0, 400.0])]
         span = (min(float(t.min()) for t in measured), max(float(t.max()) for t in measured))
-        self.centres = [LinearCentres(loads, base, stage, span) for stage in range(1, stages + 1)]
+        self.centres = stage_laws(centre_law, loads, base, stages, span)
+        self.linear_centres = centre_law == "linear" and any(getattr(base.terms, n) != 0.0
+                                                             for n in SHARES)
         self.fit_slopes = self.centres[0].fit_slopes
         stresses = len({round(float(v), 9) for v in loads})
         self.phys = self.centres[0].names + (["nu_h", "nu_c"] if widths == "separate" else ["nu"])
@@ -95,15 +99,24 @@ class Layout:
         return [law.centre_at(u, load) for law in self.centres]
 
     def transform(self, vector):
-        """(names, matrix): d physical / d unknowns (exact: the map is linear)."""
+        """(names, matrix): d physical / d unknowns; by unit steps where every centre law is
+        linear (exact), else by central differences of relative step 1e-6."""
         names = [n for n in self.physical(vector) if n != "nu"]
         base = self.physical(vector)
+        linear = all(law.linear for law in self.centres)
         matrix = np.zeros((len(names), len(self.phys)))
         for j in range(len(self.phys)):
-            moved = np.array(vector[:len(self.phys)], dtype=float)
-            moved[j] += 1.0
+            x = np.array(vector[:len(self.phys)], dtype=float)
+            step = 1.0 if linear else 1e-6 * max(abs(x[j]), 1.0)
+            moved = x.copy()
+            moved[j] += step
             after = self.physical(moved)
-            matrix[:, j] = [after[n] - base[n] for n in names]
+            if linear:
+                matrix[:, j] = [after[n] - base[n] for n in names]
+                continue
+            moved[j] = x[j] - step
+            before = self.physical(moved)
+            matrix[:, j] = [(after[n] - before[n]) / (2.0 * step) for n in names]
         return names, matrix
 
     def params(self, vector):
@@ -115,6 +128,8 @@ class Layout:
                                    f"({', '.join(bad)}); the data do not determine it")
         changes = {k: v for k, v in values.items() if k not in ("l_MF", "R_MF")}
         changes["l_M"], changes["l_F"] = values["l_MF"] - self.half_l, values["l_MF"] + self.half_l
+        if self.linear_centres:
+            changes["cc_share_h"] = changes["cc_share_c"] = 0.0
         if "R_MF" in values:
             changes["R_M"] = values["R_MF"] - self.half_r
             changes["R_F"] = values["R_MF"] + self.half_r

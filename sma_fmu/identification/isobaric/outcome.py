@@ -10,6 +10,7 @@ from sma_fmu.identification.isobaric.covariance import (named, named_values,
 from sma_fmu.identification.isobaric.jacobian import file_model, file_state
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.identification.measurements import MeasurementError
+from sma_fmu.runtime.constant_load import hysteresis_centre
 from sma_fmu.runtime.constants import COOLING, HEATING
 
 __all__ = ["IsobaricFit", "EXPLAINED_RATIO", "verdict", "residual_blocks", "check_inside",
@@ -111,10 +112,9 @@ def check_inside(params, prepared):
     cooling, is not half done somewhere inside the file's measured temperature range."""
     for f in prepared:
         low, high = float(np.min(f.data.temperature)), float(np.max(f.data.temperature))
-        for direction, word, a, b in ((HEATING, "heating", "a_h", "b_h"),
-                                      (COOLING, "cooling", "a_c", "b_c")):
+        for direction, word in ((HEATING, "heating"), (COOLING, "cooling")):
             if _half_way(params, f.data.load, direction, low, high) is None:
-                centre = getattr(params, a) + getattr(params, b) * f.data.load
+                centre = hysteresis_centre(f.data.load, direction, params)
                 raise MeasurementError(
                     f"{f.data.path}: the fitted model's {word} transformation lies outside the "
                     f"data's temperature range {low:.4g} to {high:.4g} degC (its centre at "

@@ -20,11 +20,12 @@ from sma_fmu.identification.isobaric.figures import isobaric_figures
 from sma_fmu.identification.isobaric.files import read_isobaric
 from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
 from sma_fmu.identification.isobaric.tables import cycle_rows, rows_csv, rows_markdown
+from sma_fmu.identification.isobaric.centre_law import centre_gradient, law_note
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import check_folder, staged_folder
 from sma_fmu.wire.parameter_file import load_parameter_set, write_parameter_file
 from sma_fmu.runtime.constant_load import domain_energy, hysteresis_centre
-from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
+from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET
 
 __all__ = ["file_loads", "isobaric_report", "run_isobaric_fit", "format_isobaric_report",
            "TERM_MEANINGS"]
@@ -39,7 +40,11 @@ TERM_MEANINGS = {
     "alpha_P": "linear thermal expansion of the P phase",
     "alpha_MF": "linear thermal expansion of the M and F phases",
     "span_ratio_0": "transformation-strain factor s at no stress (s = 1 at saturation)",
-    "span_stress": "stress scale of the transformation-strain law s(sigma)"}
+    "span_stress": "stress scale of the transformation-strain law s(sigma)",
+    "cc_share_h": "share of the heating centres' load slope that follows s(sigma) "
+                  "(Clausius-Clapeyron; 0: linear centres)",
+    "cc_share_c": "share of the cooling centres' load slope that follows s(sigma) "
+                  "(Clausius-Clapeyron; 0: linear centres)"}
 
 
 def file_loads(files, loads=None, stresses=None, diameter=None):
@@ -64,16 +69,12 @@ def file_loads(files, loads=None, stresses=None, diameter=None):
 
 def _centres(fit, loads):
     """Hysteresis centres [degC] at each load, with standard errors from the covariance."""
-    index = {name: i for i, name in enumerate(fit.names)}
     out = {}
     for load in loads:
         entry = {}
-        for direction, a, b in (("heating", "a_h", "b_h"), ("cooling", "a_c", "b_c")):
-            gradient = np.zeros(len(fit.names))
-            gradient[index[a]] = 1.0
-            if b in index:
-                gradient[index[b]] = load
-            value = getattr(fit.params, a) + getattr(fit.params, b) * load
+        for direction, sign in (("heating", HEATING), ("cooling", COOLING)):
+            gradient = centre_gradient(load, sign, fit.params, fit.names)
+            value = hysteresis_centre(load, sign, fit.params)
             error = float(np.sqrt(gradient @ fit.covariance @ gradient))
             entry[direction] = {"value": value, "std_error": error}
         out[f"{load:g} kg"] = entry
@@ -104,7 +105,8 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
                 for name, v, e, s in zip(fit.names, fit.values, fit.std_errors, fit.starts)}
     fixed = ["eps_T", "xi_F_inf", "f_F"] + [n for n in ("b_h", "b_c", "x_min", "R_P", "R_M", "R_F",
                                                         "T_alpha", "span_ratio_sat",
-                                                        "span_stress")
+                                                        "span_stress", "cc_share_h",
+                                                        "cc_share_c")
                                           if n not in fit.wire_names]
     per_file = []
     for data, offsets, sigma, lag, knots, rms_of_file in zip(
@@ -210,12 +212,14 @@ def hysteresis_report(data, fit, rows):
 
 def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
                      reference_length=None, progress=lambda text: None, cycles=None, lag="auto",
-                     stages=2, outliers="leave-out", widths="auto", meter=None):
+                     stages=2, outliers="leave-out", widths="auto", meter=None,
+                     centre_law="linear"):
     """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report.
 
     ``cycles``: the text of ``--cycles`` (``5:``, ``3:10``, ``:20``, ``4``) or None for all;
     ``lag``: "auto", "fit" (the wire's lag behind the thermocouple) or "none"; ``meter``: a
-    callable returning a tqdm-like progress bar (or None). A fit that did not converge is
+    callable returning a tqdm-like progress bar (or None); ``centre_law``: "linear" or
+    "clausius-clapeyron" (:func:`~.fit.fit_isobaric`). A fit that did not converge is
     written too, marked so in identified.toml's header and report.json's ``solver``.
     """
     if not files:
@@ -241,7 +245,7 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         progress(f"{d.path.name}: {splitting_note(d.splitting, d.branches, d.time is not None)}")
     progress(f"fitting {len(data)} file(s), {sum(d.strain.size for d in data)} points ...")
     fit = fit_isobaric(data, base, residual, lag, stages=stages, outliers=outliers,
-                       widths=widths, meter=meter)
+                       widths=widths, meter=meter, centre_law=centre_law)
     progress("transformation temperatures and figures ...")
     per_cycle = residual == "per-cycle"
     rows = [row for d, offsets, profile, bounds in zip(data, fit.offsets, fit.profiles,
@@ -261,6 +265,8 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
     report["coverage"] = covered
     report["lag_choice"] = {"option": fit.lag_option, "note": fit.lag_note}
     report["hysteresis"] = hysteresis_report(data, fit, rows)
+    report["centre_law"] = law_note(centre_law, fit.params, len({d.load for d in data}),
+                                    "cc_share_h" in fit.wire_names)
     figures = isobaric_figures(data, fit, per_cycle, rows)
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     names = ", ".join(Path(f).name for f in files)

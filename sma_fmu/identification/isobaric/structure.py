@@ -4,7 +4,7 @@ joint fit's starts, and its second look at a richer structure the first fit did 
 
 Richer models are kept only when they lower the cost by STAGE_GAIN_MIN (a second stage also
 needs w2 > STAGE_SHARE_MIN): with a fitted lag, separate widths blur the lag against the
-centres, so one width comes first.
+centres, so one width comes first. The centre law's shares come last (:func:`law_look`).
 """
 import time
 from dataclasses import dataclass
@@ -18,9 +18,12 @@ from sma_fmu.identification.isobaric.outcome import residual_blocks
 from sma_fmu.identification.isobaric.outliers import mark_outliers
 from sma_fmu.identification.isobaric.solver import levenberg_marquardt
 from sma_fmu.identification.isobaric.starts import starts
+from sma_fmu.runtime.constant_load import hysteresis_centre, second_centre
+from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.model_terms import domain_widths
 
-__all__ = ["Clock", "Joint", "joint", "choose", "joint_starts", "second_look", "with_head",
+__all__ = ["Clock", "Joint", "joint", "choose", "joint_starts", "second_look", "law_look",
+           "with_head",
            "STAGE_SHARE_MIN", "STAGE_GAIN_MIN", "JOINT_FTOL", "FIRST_FTOL", "SCAN_EVALUATIONS",
            "LAG_STARTS"]
 
@@ -230,6 +233,43 @@ def second_look(prepared, base, layout_of, state, kind, rejected, clock, max_eva
                          f"(cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
                          f"one): one width kept")
     return state, kind, stages, notes
+
+
+def _crossed_centres(params, loads):
+    """The files' loads [kg] where a heating centre (either stage) lies below its cooling
+    one, by the runtime's centres, as text ("" where none does)."""
+    bad = [f"{load:g} kg" for load in loads
+           for centre in (hysteresis_centre,) + ((second_centre,) if params.terms.two_stage
+                                                 else ())
+           if centre(load, HEATING, params) < centre(load, COOLING, params)]
+    return ", ".join(dict.fromkeys(bad))
+
+
+def law_look(prepared, base, layout_of, state, kind, clock, max_evaluations):
+    """The joint fit with the strain-following centres (their shares fitted,
+    :class:`~.centres.StrainFollowingCentres` from ``layout_of(stages, kind)``), started
+    from the converged joint fit with linear centres (shares at 0: the same centres). Kept
+    when it converged, lowers the joint cost by STAGE_GAIN_MIN and leaves every heating
+    centre at or above its cooling one at each file's load. Returns (state, note: "" when
+    kept, else why not)."""
+    clock.stage("joint fit: centre law")
+    layout = layout_of(state.layout.stages, kind)
+    vector, lower, upper = starts(prepared, layout, base)
+    start = _carry(state.layout, state.solution.x, layout, vector)
+    _, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
+    solution = solve(np.clip(start, lower, upper), max_evaluations)
+    old = state.solution
+    crossed = _crossed_centres(layout.params(solution.x), sorted({f.data.load for f in prepared}))
+    if solution.status > 0 and solution.cost <= (1.0 - STAGE_GAIN_MIN) * old.cost and not crossed:
+        return Joint(layout, solution, jacobian, order, lower, upper, vector), ""
+    costs = f"cost {solution.cost:.6g} against {old.cost:.6g} with linear centres"
+    if solution.status <= 0:
+        why = f"did not converge ({solution.message}; {costs})"
+    elif crossed and solution.cost <= (1.0 - STAGE_GAIN_MIN) * old.cost:
+        why = f"would put the heating centre below the cooling one at {crossed} ({costs})"
+    else:
+        why = f"do not fit these data better ({costs})"
+    return state, f"centres that follow the transformation strain {why}: linear centres kept"
 
 
 @dataclass

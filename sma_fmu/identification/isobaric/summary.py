@@ -85,8 +85,10 @@ def format_isobaric_report(report):
              + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
                 if rms["resistance_ohm"] else ""),
              report["verdict"]]
+    law = report.get("centre_law") or {"option": "linear"}
     for note in (report.get("lag_choice", {}).get("note"), report.get("stage_note"),
-                 *report.get("slopes_not_fitted", [])):
+                 *report.get("slopes_not_fitted", []),
+                 law.get("note") if law["option"] != "linear" else None):
         if note:
             lines.append(note)
     if report.get("on_bound"):
@@ -109,7 +111,8 @@ def format_isobaric_report(report):
         centres = [f"{name} {report['parameters'][name]['value'] * per_mpa:.4g}"
                    for name in ("b_h", "b_c", "b2_h", "b2_c") if name in report["parameters"]]
         if centres and not report.get("slopes_not_fitted"):
-            lines.append("fitted centre slopes [K/MPa]: " + ", ".join(centres))
+            where = " where s(sigma) has saturated" if "cc_share_h" in report["parameters"] else ""
+            lines.append(f"fitted centre slopes{where} [K/MPa]: " + ", ".join(centres))
         slopes = half["slopes_K_per_MPa"]
         if np.isfinite(slopes["data"]["heating"]):
             lines.append(f"half-strain temperature against stress [K/MPa]: heating "

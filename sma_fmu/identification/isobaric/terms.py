@@ -8,11 +8,14 @@ Optional wire-file terms, each with a default that gives today's model:
   (``w2 = 0``: off);
 - thermal expansion ``alpha_P``, ``alpha_MF`` [1/K] about ``T_alpha`` [degC];
 - the stress law of the transformation strain, s(sigma) = span_ratio_sat +
-  (span_ratio_0 - span_ratio_sat) exp(-sigma/span_stress) [1], sigma [MPa].
+  (span_ratio_0 - span_ratio_sat) exp(-sigma/span_stress) [1], sigma [MPa];
+- centres whose load slope follows it (Clausius-Clapeyron), ``cc_share_h``, ``cc_share_c``
+  [1]: tau_d = a_d + b_d f_d with f_d of :func:`slope_load` (0: f_d = f, linear centres).
 
 On a major branch of direction d at load f [kg] and temperature T [degC]:
 
-    q_k = 1/(1 + e^Lambda_k),  Lambda_k = nu_k,d (eps_T - g f x_T/N)/k_B (1/tau_k,d,K - 1/T_K)
+    q_k = 1/(1 + e^Lambda_k),  Lambda_k = nu_k,d (eps_T - g f x_T/N)/k_B (1/tau_k,d,K - 1/T_K),
+    tau_k,d = a_k,d + b_k,d f_d
     q   = (1 - w2) q1 + w2 q2,   xi_MF = M q,  xi_P = M (1 - q),  M = 1 - xi_Fmin(f)
     x   = l_P(T) xi_P + l_M(T, f) xi_MF/2 + l_F(T, f) (xi_Fmin + xi_MF/2)                  [m]
     l_P(T) = l_P (1 + alpha_P (T - T_alpha)),
@@ -31,7 +34,7 @@ from scipy import special
 
 from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 
-__all__ = ["stress_MPa", "span_ratio", "BranchScalars", "SCALARS", "Q_SCALARS", "branch_scalars",
+__all__ = ["stress_MPa", "span_ratio", "slope_load", "BranchScalars", "SCALARS", "Q_SCALARS", "branch_scalars",
            "curve", "curve_derivatives", "branch_curve"]
 
 
@@ -47,12 +50,26 @@ def span_ratio(load, params):
     return p.span_ratio_sat + (p.span_ratio_0 - p.span_ratio_sat) * np.exp(-sigma / p.span_stress)
 
 
+def slope_load(load, direction, params):
+    """f_d [kg]: the load the centres' slopes multiply in ``direction`` (+1/-1), as
+    :func:`sma_fmu.runtime.constant_load.slope_load`: ``load`` [kg] itself when cc_share_d
+    is 0, else f [1 + c_d (s_0/s_sat - 1) phi(sigma/span_stress)], phi(x) = (1 - e^-x)/x."""
+    p = params.terms
+    share = p.cc_share_h if direction == HEATING else p.cc_share_c
+    if share == 0.0:
+        return load
+    x = np.asarray(stress_MPa(load, params.diameter) / p.span_stress)
+    positive = x > 0.0
+    phi = np.where(positive, -np.expm1(-x) / np.where(positive, x, 1.0), 1.0)
+    return load * (1.0 + share * ((p.span_ratio_0 - p.span_ratio_sat) / p.span_ratio_sat) * phi)
+
+
 BranchScalars = namedtuple("BranchScalars", [
     "energy1", "centre1_K", "energy2", "centre2_K", "w2", "T_alpha", "hot0", "hot1", "span0",
     "span1", "resistance_hot", "resistance_span"])
 BranchScalars.__doc__ = """What one major branch (a load, a direction) of the model rests on.
 
-energy_k = nu_k,d (eps_T - g f x_T/N)/k_B [K] and centre_k = a_k,d + b_k,d f [K] of stage k
+energy_k = nu_k,d (eps_T - g f x_T/N)/k_B [K] and centre_k = a_k,d + b_k,d f_d [K] of stage k
 (stage 2: w2 = 0, energy2 = 0 when off); the length is x = hot(T) + span(T) q with
 hot(T) = hot0 + hot1 (T - T_alpha) and span(T) = span0 + span1 (T - T_alpha) [m, m/K]; the
 resistance resistance_hot + resistance_span q [ohm].
@@ -67,11 +84,12 @@ def branch_scalars(params, load, direction):
     load = np.asarray(load, dtype=float)
     per_nu = (p.eps_T - STANDARD_GRAVITY * load * p.x_T / p.N) / BOLTZMANN
     h = direction == HEATING
-    centre1 = (p.a_h if h else p.a_c) + (p.b_h if h else p.b_c) * load + KELVIN_OFFSET
+    f_d = slope_load(load, direction, p)      # the centres' load (f itself: linear centres)
+    centre1 = (p.a_h if h else p.a_c) + (p.b_h if h else p.b_c) * f_d + KELVIN_OFFSET
     energy1 = (terms.nu_h if h else terms.nu_c) * per_nu
     w2 = terms.w2
     if terms.a2_h is not None and terms.a2_c is not None:   # the second stage, even at w2 = 0
-        centre2 = (terms.a2_h if h else terms.a2_c) + (terms.b2_h if h else terms.b2_c) * load \
+        centre2 = (terms.a2_h if h else terms.a2_c) + (terms.b2_h if h else terms.b2_c) * f_d \
             + KELVIN_OFFSET
         energy2 = (terms.nu2_h if h else terms.nu2_c) * per_nu
     else:

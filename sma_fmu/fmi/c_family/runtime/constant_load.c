@@ -18,8 +18,23 @@ int require_temperature(const char *name, double value, SmaMessage *message)
     return 0;
 }
 
+double centre_load(double load, double share, const ModelTerms *terms)
+{
+    double x = STANDARD_GRAVITY * load / terms->area / 1e6 / terms->span_stress;
+    double phi = x > 0.0 ? -expm1(-x) / x : 1.0;
+    return load * (1.0 + share * ((terms->span_ratio_0 - terms->span_ratio_sat)
+                                  / terms->span_ratio_sat) * phi);
+}
+
+double slope_load(double load, int direction, const WireParameters *params)
+{
+    double share = direction == HEATING ? params->terms.cc_share_h : params->terms.cc_share_c;
+    return share == 0.0 ? load : centre_load(load, share, &params->terms);
+}
+
 double hysteresis_centre(double load, int direction, const WireParameters *params)
 {
+    load = slope_load(load, direction, params);
     if (direction == HEATING) {
         return params->a_h + params->b_h * load;
     }
@@ -33,6 +48,7 @@ double residual_f_fraction(double load, const WireParameters *params)
 
 double second_centre(double load, int direction, const WireParameters *params)
 {
+    load = slope_load(load, direction, params);
     if (direction == HEATING) {
         return params->terms.a2_h + params->terms.b2_h * load;
     }

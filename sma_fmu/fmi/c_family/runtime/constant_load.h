@@ -1,6 +1,7 @@
 /* Constant-load model with a direction-switched hysteresis centre (spec sections 3-4);
  * runtime/constant_load.py.
  *   tau(f, d) = a_h + b_h f (heating), a_c + b_c f (cooling)   [degC]
+ *   (cc_share_d > 0: the strain-weighted load f_d of centre_load in place of f)
  *   xi_Fmin(f) = xi_F_inf (1 - exp(-f/f_F)),  dH(f) = nu (eps_T - g f x_T / N)  [J]
  *   Lambda = (dH/k_B)(1/tau_K - 1/T_K),  xi_MF = M/(1 + e^Lambda),  xi_P = M - xi_MF
  * With the issue-36 terms (runtime/model_terms.py): dH with nu_h / nu_c, a second stage
@@ -30,11 +31,19 @@ typedef struct BranchConstants {
 
 /* `value` [degC] finite and above absolute zero, else refused naming `name`. */
 int require_temperature(const char *name, double value, SmaMessage *message);
-/* Hysteresis centre tau [degC] for a load [kg] and direction (+1 heating, -1 cooling). */
+/* f_d [kg] = f [1 + c (s_0/s_sat - 1) phi(sigma/span_stress)], phi(x) = (1 - e^-x)/x,
+ * phi(0) = 1: the load a centre's slope multiplies when the share `share` [1] of it follows
+ * the transformation strain (model_terms.centre_load). */
+double centre_load(double load, double share, const ModelTerms *terms);
+/* The load [kg] the centres' slopes multiply in `direction`: `load`, or centre_load with
+ * cc_share_d > 0 (constant_load.slope_load). */
+double slope_load(double load, int direction, const WireParameters *params);
+/* Hysteresis centre tau [degC] = a_d + b_d slope_load for a load [kg] and direction
+ * (+1 heating, -1 cooling). */
 double hysteresis_centre(double load, int direction, const WireParameters *params);
 /* Residual F fraction xi_Fmin(f) [1]. */
 double residual_f_fraction(double load, const WireParameters *params);
-/* Second-stage centre tau2 [degC] = a2_d + b2_d f. */
+/* Second-stage centre tau2 [degC] = a2_d + b2_d slope_load. */
 double second_centre(double load, int direction, const WireParameters *params);
 /* dH(f) [J] with domain size `nu` [1] -> *energy; refused when it overflows or is <= 0. */
 int domain_energy(double load, const WireParameters *params, double nu, double *energy,
