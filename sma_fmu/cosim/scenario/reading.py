@@ -148,18 +148,8 @@ def _controller(path, table, params):
         if value < 0 or (positive and value == 0):
             _fail(path, f"[controller] {gain.key} must be {'> 0' if positive else '>= 0'}, got {value!r}")
         values[gain.name] = value
-    inverse = table.get("inverse", "major")
-    if inverse not in INVERSES:
-        _fail(path, f"[controller] inverse must be one of {', '.join(INVERSES)}, got {inverse!r}")
-    if inverse != "major" and kind == "pi":
-        _fail(path, f"[controller] inverse = {inverse!r} needs a feedforward controller "
-                    f"(kind pi+ff-fixed or pi+ff-adaptive), got kind 'pi'")
-    shaping = table.get("shaping", "none")
-    if shaping not in SHAPINGS:
-        _fail(path, f"[controller] shaping must be one of {', '.join(SHAPINGS)}, got {shaping!r}")
-    if shaping != "none" and kind == "pi":
-        _fail(path, f"[controller] shaping = {shaping!r} needs a feedforward controller "
-                    f"(kind pi+ff-fixed or pi+ff-adaptive), got kind 'pi'")
+    inverse = _compensator_choice(path, table, kind, "inverse", INVERSES)
+    shaping = _compensator_choice(path, table, kind, "shaping", SHAPINGS)
     cap = None
     if "power_cap_W" in table:
         cap = _number(path, "controller", table, "power_cap_W", positive=True)
@@ -167,6 +157,18 @@ def _controller(path, table, params):
             _fail(path, f"[controller] power_cap_W = {cap!r} needs shaping = 'reachable', "
                         f"got {shaping!r}")
     return ControllerSettings(kind, inverse=inverse, shaping=shaping, power_cap_W=cap, **values)
+
+
+def _compensator_choice(path, table, kind, key, names):
+    """[controller] ``key``: one of ``names`` (default the first), other than the default
+    only with a feedforward controller."""
+    value = table.get(key, names[0])
+    if value not in names:
+        _fail(path, f"[controller] {key} must be one of {', '.join(names)}, got {value!r}")
+    if value != names[0] and kind == "pi":
+        _fail(path, f"[controller] {key} = {value!r} needs a feedforward controller "
+                    f"(kind pi+ff-fixed or pi+ff-adaptive), got kind 'pi'")
+    return value
 
 
 def _check_filter(path, controller, step):
