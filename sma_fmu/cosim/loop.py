@@ -94,7 +94,8 @@ class LibraryCompensator:
     def __init__(self, scenario):
         c = scenario.controller
         self.stepper = FeedforwardStepper(scenario.compensator_params, c.alpha, c.beta,
-                                          c.model_load, c.adapt_to_load, c.inverse)
+                                          c.model_load, c.adapt_to_load, c.inverse, c.shaping,
+                                          c.power_cap_W)
 
     def initial(self, reference, load):
         """(P_ff [W], T_ref [degC], saturated) before the first step (what a Jacobi host passes on)."""

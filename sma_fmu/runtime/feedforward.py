@@ -24,6 +24,12 @@ In both, a reference outside what the branch can reach at the present load gives
 temperature of the nearest reachable edge (xi_MF clamped to delta or M - delta of the
 section 5 clamp) and ``saturated`` = True.
 
+Shaping (``shaping``): ``"none"`` (default, the paper's) turns T_ref into power through the
+phase-lag filter; ``"reachable"`` shapes the demand into what the wire can reach in a step
+(heating up to ``power_cap``, cooling no faster than convection) over a model of the wire
+whose memory is the plant's, and outputs the thermal model's exact one-step power
+(:mod:`.shaping`; the filter is not used). The inverse is then taken on the model's branch.
+
 No reference yet: R_ref <= 0 ohm before the first R_ref > 0 (a host that steps before its
 inputs are connected, as fmpy's ``simulate_ssp`` gives every input 0.0 at t = 0) is an
 unconnected start, not an error. That step outputs P_ff = 0 W, T_ref = T_room and
@@ -51,6 +57,7 @@ from .constants import COOLING, HEATING
 from .minor_loops import push_reversal, read_points
 from .phase_lag import PhaseLagFilter
 from .sensing import invert_on_stack, mixed_fractions_of_resistance, temperature_of_fractions
+from .shaping import ReachableShaping, require_power_cap, require_shaping
 from .state_entries import (StateError, check_format, read_direction, read_entries,
                             read_optional_number, read_temperature)
 from .validity import data_range_warning, validity_warning
@@ -71,7 +78,8 @@ FeedforwardOutputs.__doc__ = """Compensator outputs for one reference sample.
 P_ff : feedforward power u_ff [W] (may be negative; the loop clamps the sum at 0 W);
 T_ref : temperature the inverse model assigns to R_ref [degC];
 saturated : True when R_ref is outside what the inverted branch reaches at the present
-load (T_ref is then the temperature of the nearest reachable edge).
+load (T_ref is then the temperature of the nearest reachable edge); shaped, also when the
+model wire does not reach the inverse's temperature in the step.
 """
 
 
@@ -97,10 +105,15 @@ class FeedforwardStepper:
     inverse : "major" | "minor-loop"
         Invert the major branches (the paper's) or the minor branches of the plant's
         continuous mode, with a stack of reversals taken from d_ref (see the module docstring).
+    shaping : "none" | "reachable"
+        The paper's phase-lag filter, or the demand shaped into what the wire can reach
+        (:mod:`.shaping`).
+    power_cap : float, optional
+        P_max [W] the driver can deliver, with shaping "reachable"; None: no limit.
     """
 
     def __init__(self, params, alpha=None, beta=None, model_load=None, adapt_to_load=True,
-                 inverse="major"):
+                 inverse="major", shaping="none", power_cap=None):
         self.params = params
         self.filter = PhaseLagFilter(
             params.phase_lag_alpha if alpha is None else alpha,
@@ -110,6 +123,10 @@ class FeedforwardStepper:
         self.adapt_to_load = bool(adapt_to_load)
         self.inverse = require_inverse(inverse)
         self._minor_loops = self.inverse == "minor-loop"
+        self.shaping = require_shaping(shaping)
+        self.power_cap = require_power_cap(power_cap, self.shaping)
+        self._shaper = (ReachableShaping(params, self._minor_loops, self.power_cap,
+                                         self.model_load) if self.shaping == "reachable" else None)
         self.direction = HEATING
         self.previous_reference = None
         self.reversals = []               # minor-loop memory: ReversalPoint(T [degC], xi_MF [1])
@@ -125,20 +142,53 @@ class FeedforwardStepper:
     def _invert(self, reference, load, direction):
         """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
 
-        The stack returned is the compensator's list itself when it is unchanged, else a copy.
+        The memory is the compensator's (the last d_ref, T_ref and xi_MF, its stack) or,
+        shaped, the model wire's (its direction, temperature, xi_MF and stack). The stack
+        returned is that list itself when it is unchanged, else a copy.
         """
         params = self.params
         constants = self._branches.get(load if self.adapt_to_load else self.model_load, direction)
         xi_mf, xi_p = mixed_fractions_of_resistance(reference, constants, params)
-        points = self.reversals
+        if self._shaper is None:
+            points, last = self.reversals, self.direction
+            temperature, fraction = self.previous_temperature, self.previous_fraction
+        else:
+            model = self._shaper.model
+            points, last = model.reversals, model.direction
+            temperature, fraction = model.temperature, model.xi_MF
         if not self._minor_loops:
             return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin), \
                 points, xi_mf
-        if direction != self.direction and self.previous_temperature is not None:
+        if direction != last and temperature is not None:
             points = list(points)
-            push_reversal(points, self.previous_temperature, self.previous_fraction,
-                          params.memory_depth)
+            push_reversal(points, temperature, fraction, params.memory_depth)
         return invert_on_stack(xi_mf, xi_p, constants, direction, points, params.saturation_margin)
+
+    def _shaped_demand(self, reference, load, direction):
+        """(way [+1/-1], SensedTemperature): where the shaped compensator's model wire moves
+        and the inverse it aims at (:mod:`.shaping`); no state change.
+
+        Minor-loop: the way that brings the model's xi_MF towards R_ref's (heating lowers it;
+        equal keeps the model's direction), and where that branch's inverse lies behind the
+        model (a flat branch of its memory), the major branch's. Major: d_ref.
+        """
+        model = self._shaper.model
+        if not self._minor_loops:
+            return direction, self._invert(reference, load, direction)[0]
+        params = self.params
+        used = load if self.adapt_to_load else self.model_load
+        target = mixed_fractions_of_resistance(reference, self._branches.get(used, HEATING),
+                                               params)[0]
+        way = (HEATING if target < model.xi_MF else
+               COOLING if target > model.xi_MF else model.direction)
+        sensed = self._invert(reference, load, way)[0]
+        if not self._shaper.ahead(sensed.temperature, way):
+            constants = self._branches.get(used, way)
+            xi_mf, xi_p = mixed_fractions_of_resistance(reference, constants, params)
+            major = temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin)
+            if self._shaper.ahead(major.temperature, way):
+                sensed = major
+        return way, sensed
 
     def _direction_for(self, reference):
         previous = self.previous_reference
@@ -169,8 +219,13 @@ class FeedforwardStepper:
             return self._unconnected()
         reference = require_positive("R_ref", reference)
         load = require_nonnegative("load", load)
-        sensed = self._invert(reference, load, self._direction_for(reference))[0]
+        direction = self._direction_for(reference)
+        sensed = (self._invert(reference, load, direction)[0] if self._shaper is None
+                  else self._shaped_demand(reference, load, direction)[1])
         temperature, saturated = self._demand(sensed)
+        if self._shaper is not None:   # the model has not moved: its temperature, held
+            power, resting = self._shaper.resting()
+            return FeedforwardOutputs(power, resting, saturated or temperature != resting)
         return FeedforwardOutputs(self._power(temperature), temperature, saturated)
 
     def step(self, reference, load, step_size):
@@ -192,7 +247,10 @@ class FeedforwardStepper:
         load = fast_nonnegative("load", load)
         step_size = fast_positive("step_size", step_size)
         direction = self._direction_for(reference)
-        sensed, points, fraction = self._invert(reference, load, direction)
+        if self._shaper is None:
+            sensed, points, fraction = self._invert(reference, load, direction)
+        else:
+            way, sensed = self._shaped_demand(reference, load, direction)
         warning = (validity_warning(self.params, -math.inf, -math.inf, load, self._load_before)
                    if load > self.params.load_max else None)
         temperature, saturated = self._demand(sensed)
@@ -206,15 +264,20 @@ class FeedforwardStepper:
                    if self._data_unwarned else None)
         if outside is not None:
             warning = outside if warning is None else f"{warning}; {outside}"
-        output = self.filter.step(self._power(temperature), step_size)
+        if self._shaper is None:
+            output = self.filter.step(self._power(temperature), step_size)
+            self.reversals = points
+            self.previous_temperature = sensed.temperature
+            self.previous_fraction = fraction
+        else:
+            output, temperature, moved = self._shaper.step(
+                temperature, way, load if self.adapt_to_load else self.model_load, step_size)
+            saturated = saturated or moved
         self.direction = direction
         self.previous_reference = reference
-        self.reversals = points
         self.warning, self._load_before, self._bounded_before = warning, load, bounded
         if outside is not None:
             self._data_unwarned = False
-        self.previous_temperature = sensed.temperature
-        self.previous_fraction = fraction
         return _new_tuple(FeedforwardOutputs, (output, temperature, saturated))
 
     def _demand(self, sensed):
@@ -229,23 +292,30 @@ class FeedforwardStepper:
         return (temperature - self.params.T_room) / self.params.K_th
 
     def state(self):
-        """JSON-ready hidden state (direction, last reference, reversal stack, filter)."""
-        return {"format": STATE_FORMAT,
-                "direction": self.direction, "previous_reference": self.previous_reference,
-                "reversals": [list(point) for point in self.reversals],
-                "previous_temperature": self.previous_temperature,
-                "previous_fraction": self.previous_fraction,
-                "filter": self.filter.state()}
+        """JSON-ready hidden state (direction, last reference, reversal stack, filter; shaped,
+        also the model wire's state as ``model``)."""
+        state = {"format": STATE_FORMAT,
+                 "direction": self.direction, "previous_reference": self.previous_reference,
+                 "reversals": [list(point) for point in self.reversals],
+                 "previous_temperature": self.previous_temperature,
+                 "previous_fraction": self.previous_fraction,
+                 "filter": self.filter.state()}
+        if self._shaper is not None:
+            state["model"] = self._shaper.state()
+        return state
 
     def restore(self, state):
         """Restore a state saved by :meth:`state`.
 
         Every entry is checked first (direction +1/-1; R_ref > 0; T_ref above absolute
-        zero; xi_MF in [0, 1]; the stack; the filter's memory): a malformed state, or one
-        of an earlier build, raises ``ValueError`` naming the entry and changes nothing.
+        zero; xi_MF in [0, 1]; the stack; the filter's memory; shaped, the model wire's
+        state as a plant's): a malformed state, or one of an earlier build, raises
+        ``ValueError`` naming the entry and changes nothing.
         """
         check_format(state, STATE_FORMAT, "compensator state")
-        read_entries(state, _STATE_ENTRIES, what="compensator state")
+        shaped = self._shaper is not None
+        read_entries(state, _STATE_ENTRIES + (("model",) if shaped else ()),
+                     what="compensator state")
         direction = read_direction(state)
         reference = read_optional_number(state, "previous_reference", 5e-324, unit="ohm")
         temperature = read_temperature(state, "previous_temperature", optional=True)
@@ -254,7 +324,16 @@ class FeedforwardStepper:
             raise StateError("state entries previous_temperature and previous_fraction must "
                              "both be numbers or both be null")
         points = read_points(state["reversals"], self.params.memory_depth, "reversals")
+        if shaped:   # checked on a new model wire, taken only when everything else is good
+            model = ReachableShaping(self.params, self._minor_loops, self.power_cap,
+                                     self.model_load)
+            try:
+                model.restore(state["model"])
+            except ValueError as error:
+                raise StateError(f"state entry model: {error}") from None
         self.filter.restore(state["filter"])          # checks, then changes: the last check
+        if shaped:
+            self._shaper = model
         self.direction, self.previous_reference = direction, reference
         self.previous_temperature, self.previous_fraction = temperature, fraction
         self.reversals = points

@@ -2,7 +2,7 @@
 
 Long random walks (power and load for the plant with nested reversals and a small
 memory_depth that the walk fills, both hysteresis modes; references for the compensator
-with both inverses; the PI's clamp; the PWM on a host's summed time; scenario signals),
+with both inverses, without and with shaping; the PI's clamp; the PWM on a host's summed time; scenario signals),
 saved states restored and deserialized mid-walk, bad inputs and refused calls: every
 output must agree to 1e-12 relative (they agree bit for bit: the C runtime does the same
 operations in the same order), every refusal has the same status and the same message
@@ -171,14 +171,16 @@ def _reference_inputs(rng, count, band):
     return inputs
 
 
-@pytest.mark.parametrize("inverse,adapt", [(1, True), (2, True), (2, False)])
-def test_compensator_walks_agree(families, params, inverse, adapt):
-    rng = random.Random(7 * inverse + adapt)
+@pytest.mark.parametrize("inverse,adapt,shaping,cap", [
+    (1, True, 1, 0.0), (2, True, 1, 0.0), (2, False, 1, 0.0),   # shaping 1 = none
+    (1, True, 2, 3.0), (2, True, 2, 0.0), (2, False, 2, 5.0)])  # 2 = reachable; cap 0: none
+def test_compensator_walks_agree(families, params, inverse, adapt, shaping, cap):
+    rng = random.Random(7 * inverse + adapt + 100 * (shaping - 1))
     band = reachable_band(0.1, params)
-    twins = Twins(families, "SmaFeedforward", f"ff{inverse}{adapt}")
+    twins = Twins(families, "SmaFeedforward", f"ff{inverse}{adapt}{shaping}")
     try:
         start = {"inverse": inverse, "adapt_to_load": adapt, "memory_depth": 3,
-                 "R_ref": band.cold, "load": 0.1}
+                 "shaping": shaping, "power_cap": cap, "R_ref": band.cold, "load": 0.1}
         assert twins.both("start", start) == [0, 0]
         twins.compare()
         inputs = _reference_inputs(rng, 16000, band)

@@ -405,6 +405,8 @@ def test_options_the_engine_lacks_are_refused_never_computed_differently():
         run_batch([minor, noisy])
     with pytest.raises(StudyError, match="path='library'"):
         run_many([noisy], path="batch")
+    shaped = base.scenario({"scenario.stop_time_s": 3.0, "controller.shaping": "reachable"})
+    assert "shaping 'reachable'" in batch_engine.unsupported_reason(shaped)
 
 
 def test_runs_must_share_step_and_duration():

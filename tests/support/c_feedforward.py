@@ -14,10 +14,10 @@ from sma_fmu.runtime.reachable_band import reachable_band
 
 from c_runtime import StateDoubles, load_with_signatures, with_reversals
 
-MINE = ("reachable_band", "sensing", "phase_lag", "feedforward")
+MINE = ("reachable_band", "sensing", "phase_lag", "shaping", "feedforward")
 RUNTIME = ("sma_message", "checks", "state_entries", "lattice", "thermal", "phases",
            "constant_load", "minor_loops", "validity", "parameters", "reachable_band",
-           "sensing", "phase_lag", "feedforward")
+           "sensing", "phase_lag", "plant", "shaping", "feedforward")
 
 # a test-only front over the C API: parameters and steppers on the heap, errors as text
 SHIM = r"""
@@ -37,9 +37,10 @@ void *params_new(const double *values, char *error) {
 void params_free(void *p) { free(p); }
 
 void *ff_new(const void *params, double alpha, double beta, double model_load, int adapt,
-             const char *inverse, char *error) {
+             const char *inverse, const char *shaping, double power_cap, char *error) {
     SmaMessage m; FeedforwardStepper *s = malloc(sizeof *s);
-    if (feedforward_stepper_init(s, params, alpha, beta, model_load, adapt, inverse, &m)) {
+    if (feedforward_stepper_init(s, params, alpha, beta, model_load, adapt, inverse, shaping,
+                                 power_cap, &m)) {
         copy_error(error, &m); feedforward_stepper_free(s); free(s); return NULL;
     }
     return s;
@@ -90,7 +91,7 @@ D, P, I, S, C = (ctypes.c_double, ctypes.c_void_p, ctypes.c_int, ctypes.c_size_t
 DP, IP = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int)
 SIGNATURES = {
     "params_new": (P, [DP, C]), "params_free": (None, [P]),
-    "ff_new": (P, [P, D, D, D, I, C, C]), "ff_free": (None, [P]),
+    "ff_new": (P, [P, D, D, D, I, C, C, D, C]), "ff_free": (None, [P]),
     "ff_step": (I, [P, D, D, D, DP, IP, C, C]), "ff_initial": (I, [P, D, D, DP, IP, C]),
     "ff_state_size": (S, [P]), "ff_state_write": (None, [P, DP]),
     "ff_state_read": (I, [P, DP, S, C]), "band": (I, [P, D, DP, C]),
@@ -119,14 +120,16 @@ class CStepper(StateDoubles):
     STATE_CALLS = ("ff_state_size", "ff_state_write", "ff_state_read")
 
     def __init__(self, lib, cparams, params, alpha=None, beta=None, model_load=None,
-                 adapt_to_load=True, inverse="major"):
+                 adapt_to_load=True, inverse="major", shaping="none", power_cap=None):
         self.lib, self.cparams = lib, cparams   # cparams outlives the stepper
         error = ctypes.create_string_buffer(512)
         self.pointer = lib.ff_new(
             cparams.pointer, params.phase_lag_alpha if alpha is None else alpha,
             params.beta if beta is None else beta,
             params.model_load if model_load is None else model_load, int(adapt_to_load),
-            None if inverse is None else inverse.encode(), error)
+            None if inverse is None else inverse.encode(),
+            None if shaping is None else shaping.encode(),
+            math.nan if power_cap is None else power_cap, error)
         if not self.pointer:
             raise ValueError(error.value.decode())
         self._out, self._saturated = (ctypes.c_double * 2)(), ctypes.c_int()
@@ -156,14 +159,21 @@ class CStepper(StateDoubles):
 
 
 def doubles_of(state):
-    """Python's state() dict in the C layout (feedforward.h): None as NaN."""
+    """Python's state() dict in the C layout (feedforward.h): None as NaN; a shaped
+    compensator's model wire after its own doubles (plant.h's layout)."""
     def number(value):
         return math.nan if value is None else float(value)
-    return with_reversals([
+    own = with_reversals([
         float(state["direction"]), number(state["previous_reference"]),
         number(state["previous_temperature"]), number(state["previous_fraction"]),
         number(state["filter"]["previous_input"]), number(state["filter"]["previous_output"])],
         state["reversals"])
+    if "model" not in state:
+        return own
+    model = state["model"]
+    return own + with_reversals([model[key] for key in ("temperature", "direction", "load",
+                                                         "xi_MF", "xi_P", "power")],
+                                model["reversals"])
 
 
 def same_doubles(a, b):

@@ -24,6 +24,9 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
                                 # Kp_W_per_ohm, Ki_W_per_ohm_s, alpha_s, beta_s, model_load_kg
     # inverse = "minor-loop"    # compensator's inverse: "major" (default, the paper's) or
                                 # "minor-loop" (the plant's continuous-mode branches)
+    # shaping = "reachable"     # "none" (default, the paper's phase-lag filter) or
+                                # "reachable" (the demand shaped into what the wire can reach)
+    # power_cap_W = 10.0        # with shaping "reachable": the driver's P_max (default none)
     [plant]
     hysteresis_mode = "switch"  # default "continuous"; optional T_start_degC (default T_room)
 
@@ -52,6 +55,7 @@ from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.feedforward import INVERSES
+from sma_fmu.runtime.shaping import SHAPINGS
 from sma_fmu.runtime.phase_lag import tustin_coefficients
 from sma_fmu.runtime.pwm import DRIVE_KINDS, PwmDriver
 from sma_fmu.runtime.parameters import ParameterError
@@ -66,7 +70,7 @@ _SECTIONS = {
     "scenario": {"description", "stop_time_s", "step_s", "model", "group", "output_interval_s"},
     "reference": None,  # checked by signals.reference_from_table
     "load": None,       # checked by signals.load_from_table
-    "controller": {"kind", "inverse", *(gain.key for gain in GAINS)},
+    "controller": {"kind", "inverse", "shaping", "power_cap_W", *(gain.key for gain in GAINS)},
     "plant": {"hysteresis_mode", "T_start_degC"},
     "analysis": {"metrics_start_s", "zoom_start_s", "zoom_end_s"},
     "drive": {"kind", "frequency_Hz", "peak_W"},
@@ -144,13 +148,27 @@ def _controller(path, table, params):
         if value < 0 or (positive and value == 0):
             _fail(path, f"[controller] {gain.key} must be {'> 0' if positive else '>= 0'}, got {value!r}")
         values[gain.name] = value
-    inverse = table.get("inverse", "major")
-    if inverse not in INVERSES:
-        _fail(path, f"[controller] inverse must be one of {', '.join(INVERSES)}, got {inverse!r}")
-    if inverse != "major" and kind == "pi":
-        _fail(path, f"[controller] inverse = {inverse!r} needs a feedforward controller "
+    inverse = _compensator_choice(path, table, kind, "inverse", INVERSES)
+    shaping = _compensator_choice(path, table, kind, "shaping", SHAPINGS)
+    cap = None
+    if "power_cap_W" in table:
+        cap = _number(path, "controller", table, "power_cap_W", positive=True)
+        if shaping != "reachable":
+            _fail(path, f"[controller] power_cap_W = {cap!r} needs shaping = 'reachable', "
+                        f"got {shaping!r}")
+    return ControllerSettings(kind, inverse=inverse, shaping=shaping, power_cap_W=cap, **values)
+
+
+def _compensator_choice(path, table, kind, key, names):
+    """[controller] ``key``: one of ``names`` (default the first), other than the default
+    only with a feedforward controller."""
+    value = table.get(key, names[0])
+    if value not in names:
+        _fail(path, f"[controller] {key} must be one of {', '.join(names)}, got {value!r}")
+    if value != names[0] and kind == "pi":
+        _fail(path, f"[controller] {key} = {value!r} needs a feedforward controller "
                     f"(kind pi+ff-fixed or pi+ff-adaptive), got kind 'pi'")
-    return ControllerSettings(kind, inverse=inverse, **values)
+    return value
 
 
 def _check_filter(path, controller, step):

@@ -34,8 +34,9 @@ class ScenarioError(ValueError):
 @dataclass(frozen=True)
 class ControllerSettings:
     """Controller of a scenario: kind and gains (Kp [W/ohm], Ki [W/(ohm.s)], alpha, beta [s],
-    model_load [kg] of the fixed compensator) and the compensator's inverse ("major" or
-    "minor-loop", see :class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`)."""
+    model_load [kg] of the fixed compensator), the compensator's inverse ("major" or
+    "minor-loop") and shaping ("none" or "reachable", with the driver's P_max ``power_cap_W``
+    [W] or None), see :class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`."""
 
     kind: str
     Kp: float
@@ -44,6 +45,8 @@ class ControllerSettings:
     beta: float
     model_load: float
     inverse: str = "major"
+    shaping: str = "none"
+    power_cap_W: float = None
 
     @property
     def feedforward(self):

@@ -3,9 +3,10 @@
 Computed here once for every master and system tool. Each component's parameters are,
 besides the wire parameters its FMU exposes (:data:`WIRES`, filtered by the FMU in
 :mod:`.system`): the signals as JSON tables (SmaScenarioSignals), the compensator's
-filter, model load, adaptation and inverse, the PI's gains (:data:`~.gains.GAINS`), the
-driver's frequency and peak power, the plant's start temperature and hysteresis mode.
-Choices (the hysteresis mode, the inverse) are the Integer codes of
+filter, model load, adaptation, inverse, shaping and power cap (0 W: none), the PI's gains
+(:data:`~.gains.GAINS`), the driver's frequency and peak power, the plant's start
+temperature and hysteresis mode.
+Choices (the hysteresis mode, the inverse, the shaping) are the Integer codes of
 :mod:`sma_fmu.fmi.python_family.slave_support.choices`.
 
 An input the signals feed starts at the signal's value at t = 0 (:func:`input_starts`): what
@@ -37,7 +38,9 @@ def component_settings(scenario, name):
                 "load_profile": table_text(scenario.load.as_table())}
     if name == "compensator":
         return {**_gains(c, name), "adapt_to_load": c.adapt_to_load,
-                "inverse": choice_code("inverse", c.inverse)}
+                "inverse": choice_code("inverse", c.inverse),
+                "shaping": choice_code("shaping", c.shaping),
+                "power_cap": 0.0 if c.power_cap_W is None else c.power_cap_W}
     if name == "pi":
         return _gains(c, name)
     if name == "driver":

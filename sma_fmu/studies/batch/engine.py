@@ -46,7 +46,8 @@ _KNOWN_SCENARIO_FIELDS = {"name", "path", "description", "stop_time_s", "step_s"
                           "analysis_window", "group_name", "compensator_parameter_set", "drive",
                           # what `sma-fmu run` records; metrics use every step here as there
                           "output_interval_s"}
-_KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load", "inverse"}
+_KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load", "inverse",
+                            "shaping", "power_cap_W"}   # shaping: "none" only, checked below
 _KNOWN_DRIVE_FIELDS = {"kind", "frequency_Hz", "peak_W"}
 _DRIVE_KINDS = ("power", "pwm")   # not runtime.pwm.DRIVE_KINDS: a kind added there is refused
 
@@ -97,6 +98,9 @@ def unsupported_reason(scenario):
                 f"{getattr(drive, name)!r} is not implemented in the batch engine")
     if drive.kind not in _DRIVE_KINDS:
         return f"{scenario.name}: drive kind {drive.kind!r} is not implemented in the batch engine"
+    if controller.shaping != "none":
+        return (f"{scenario.name}: controller shaping {controller.shaping!r} is not implemented "
+                f"in the batch engine")
     if controller.kind not in CONTROLLERS:
         return f"{scenario.name}: controller kind {controller.kind!r} is not implemented"
     if scenario.hysteresis_mode not in HYSTERESIS_MODES:

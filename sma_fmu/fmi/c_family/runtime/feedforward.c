@@ -33,22 +33,36 @@ int require_inverse(const char *inverse, FeedforwardInverse *out, SmaMessage *me
 
 int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *params,
                              double alpha, double beta, double model_load, int adapt_to_load,
-                             const char *inverse, SmaMessage *message)
+                             const char *inverse, const char *shaping, double power_cap,
+                             SmaMessage *message)
 {
     FeedforwardInverse kind;
+    FeedforwardShaping shaped;
     self->reversals = NULL;
     self->reversal_count = 0;
+    self->shaping = SHAPING_NONE;
     if (phase_lag_filter_init(&self->filter, alpha, beta, message)
         || require_nonnegative("model_load", model_load, message)
-        || require_inverse(inverse, &kind, message)) {
+        || require_inverse(inverse, &kind, message)
+        || require_shaping(shaping, &shaped, message)
+        || require_power_cap(power_cap, shaped, message)) {
+        return 1;
+    }
+    if (shaped == SHAPING_REACHABLE
+        && reachable_shaping_init(&self->shaper, params, kind == INVERSE_MINOR_LOOP, power_cap,
+                                  model_load, message)) {
         return 1;
     }
     /* one point more than the memory keeps: the slot a tentative push writes into */
     self->reversals = malloc(((size_t)params->memory_depth + 1) * sizeof *self->reversals);
     if (self->reversals == NULL) {
+        if (shaped == SHAPING_REACHABLE) {
+            reachable_shaping_free(&self->shaper);
+        }
         return sma_message_set(message, "no memory for a reversal stack of %d points",
                                params->memory_depth);
     }
+    self->shaping = shaped;
     self->params = *params;
     self->model_load = model_load;
     self->adapt_to_load = adapt_to_load != 0;
@@ -69,7 +83,8 @@ int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *par
 /* One sample's inversion (Python's _invert), no state change: *sensed, the stack after it
  * (*stack = the first of *kept points; a tentative push is written into the free slot past
  * the stack, and where it would hold more than memory_depth points *stack starts two points
- * later, as push_reversal drops the two oldest) and the xi_MF assumed. */
+ * later, as push_reversal drops the two oldest) and the xi_MF assumed. The memory is the
+ * compensator's or, shaped, the model wire's (its stack has the same free slot). */
 static int invert(FeedforwardStepper *self, double reference, double load, int direction,
                   SensedTemperature *sensed, ReversalPoint **stack, size_t *kept,
                   double *fraction, SmaMessage *message)
@@ -78,7 +93,17 @@ static int invert(FeedforwardStepper *self, double reference, double load, int d
     BranchConstants constants;
     ReversalPoint *points = self->reversals;
     size_t count = self->reversal_count;
-    double xi_mf, xi_p;
+    int last = self->direction;
+    double xi_mf, xi_p, temperature = self->previous_temperature;
+    double assumed = self->previous_fraction;
+    if (self->shaping == SHAPING_REACHABLE) {
+        const PlantStepper *model = &self->shaper.model;
+        points = model->reversals;
+        count = model->reversal_count;
+        last = model->direction;
+        temperature = model->temperature;
+        assumed = model->xi_MF;
+    }
     if (branch_cache_get(&self->branches, params, self->adapt_to_load ? load : self->model_load,
                          direction, &constants, message)) {
         return 1;
@@ -91,9 +116,9 @@ static int invert(FeedforwardStepper *self, double reference, double load, int d
         return temperature_of_fractions(xi_mf, xi_p, &constants, params->saturation_margin,
                                         sensed, message);
     }
-    if (direction != self->direction && !sma_state_is_none(self->previous_temperature)) {
-        points[count].temperature = self->previous_temperature;   /* push_reversal */
-        points[count].xi_MF = self->previous_fraction;
+    if (direction != last && !sma_state_is_none(temperature)) {
+        points[count].temperature = temperature;   /* push_reversal */
+        points[count].xi_MF = assumed;
         count += 1;
         if (count > (size_t)params->memory_depth) {
             points += 2;
@@ -103,6 +128,49 @@ static int invert(FeedforwardStepper *self, double reference, double load, int d
     *stack = points;
     return invert_on_stack(xi_mf, xi_p, &constants, direction, points, count,
                            params->saturation_margin, sensed, kept, fraction, message);
+}
+
+/* The shaped compensator's demand (Python's _shaped_demand), no state change: *way, where
+ * its model wire moves, and *sensed, the inverse it aims at. Minor-loop: the way that brings
+ * the model's xi_MF towards R_ref's (equal keeps the model's direction), and where that
+ * branch's inverse lies behind the model, the major branch's when it lies ahead. Major: d_ref. */
+static int shaped_demand(FeedforwardStepper *self, double reference, double load, int direction,
+                         int *way, SensedTemperature *sensed, SmaMessage *message)
+{
+    const WireParameters *params = &self->params;
+    const PlantStepper *model = &self->shaper.model;
+    double used = self->adapt_to_load ? load : self->model_load, target, xi_mf, xi_p, fraction;
+    BranchConstants constants;
+    SensedTemperature major;
+    ReversalPoint *stack;
+    size_t kept;
+    if (self->inverse != INVERSE_MINOR_LOOP) {
+        *way = direction;
+        return invert(self, reference, load, direction, sensed, &stack, &kept, &fraction, message);
+    }
+    if (branch_cache_get(&self->branches, params, used, HEATING, &constants, message)) {
+        return 1;
+    }
+    mixed_fractions_of_resistance(reference, &constants, params, &target, &xi_p);
+    *way = target < model->xi_MF ? HEATING : target > model->xi_MF ? COOLING : model->direction;
+    if (invert(self, reference, load, *way, sensed, &stack, &kept, &fraction, message)) {
+        return 1;
+    }
+    if (reachable_shaping_ahead(&self->shaper, sensed->temperature, *way)) {
+        return 0;
+    }
+    if (branch_cache_get(&self->branches, params, used, *way, &constants, message)) {
+        return 1;
+    }
+    mixed_fractions_of_resistance(reference, &constants, params, &xi_mf, &xi_p);
+    if (temperature_of_fractions(xi_mf, xi_p, &constants, params->saturation_margin, &major,
+                                 message)) {
+        return 1;
+    }
+    if (reachable_shaping_ahead(&self->shaper, major.temperature, *way)) {
+        *sensed = major;
+    }
+    return 0;
 }
 
 static int direction_for(const FeedforwardStepper *self, double reference)
@@ -157,6 +225,7 @@ int feedforward_stepper_initial_outputs(FeedforwardStepper *self, double referen
     ReversalPoint *stack;
     size_t kept;
     double fraction;
+    int way;
     if (phase_lag_filter_started(&self->filter)) {
         return sma_message_set(message, "initial_outputs is only defined before the first step");
     }
@@ -168,12 +237,23 @@ int feedforward_stepper_initial_outputs(FeedforwardStepper *self, double referen
         return 0;
     }
     if (require_positive("R_ref", reference, message)
-        || require_nonnegative("load", load, message)
-        || invert(self, reference, load, direction_for(self, reference), &sensed, &stack, &kept,
-                  &fraction, message)) {
+        || require_nonnegative("load", load, message)) {
+        return 1;
+    }
+    if (self->shaping == SHAPING_REACHABLE
+        ? shaped_demand(self, reference, load, direction_for(self, reference), &way, &sensed,
+                        message)
+        : invert(self, reference, load, direction_for(self, reference), &sensed, &stack, &kept,
+                 &fraction, message)) {
         return 1;
     }
     demand_of(self, &sensed, &outputs->T_ref, &outputs->saturated);
+    if (self->shaping == SHAPING_REACHABLE) {   /* the model has not moved: its temperature */
+        double demand = outputs->T_ref;
+        reachable_shaping_resting(&self->shaper, &outputs->P_ff, &outputs->T_ref);
+        outputs->saturated = outputs->saturated || demand != outputs->T_ref;
+        return 0;
+    }
     outputs->P_ff = power_of(self, outputs->T_ref);
     return 0;
 }
@@ -187,7 +267,7 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     size_t kept;
     double fraction, output, temperature;
     char warning[sizeof self->warning];
-    int direction, saturated, bounded, outside;
+    int direction, way, saturated, bounded, outside, moved;
     if (no_reference_yet(self, reference)) {
         if (fast_nonnegative("load", load, message)
             || fast_positive("step_size", step_size, message)) {
@@ -209,7 +289,9 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
         return 1;
     }
     direction = direction_for(self, reference);
-    if (invert(self, reference, load, direction, &sensed, &stack, &kept, &fraction, message)) {
+    if (self->shaping == SHAPING_REACHABLE
+        ? shaped_demand(self, reference, load, direction, &way, &sensed, message)
+        : invert(self, reference, load, direction, &sensed, &stack, &kept, &fraction, message)) {
         return 1;
     }
     warning[0] = '\0';
@@ -229,24 +311,33 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     outside = self->data_unwarned
               && data_range_warning(&self->params, temperature, load, "T_ref", warning,
                                     sizeof warning);
-    if (phase_lag_filter_step(&self->filter, power_of(self, temperature), step_size, &output,
-                              message)) {
-        return 1;
+    if (self->shaping == SHAPING_REACHABLE) {
+        if (reachable_shaping_step(&self->shaper, temperature, way,
+                                   self->adapt_to_load ? load : self->model_load, step_size,
+                                   &output, &temperature, &moved, message)) {
+            return 1;
+        }
+        saturated = saturated || moved;
+    } else {
+        if (phase_lag_filter_step(&self->filter, power_of(self, temperature), step_size,
+                                  &output, message)) {
+            return 1;
+        }
+        if (stack != self->reversals && kept > 0) {
+            memmove(self->reversals, stack, kept * sizeof *stack);
+        }
+        self->reversal_count = kept;
+        self->previous_temperature = sensed.temperature;
+        self->previous_fraction = fraction;
     }
     self->direction = direction;
     self->previous_reference = reference;
-    if (stack != self->reversals && kept > 0) {
-        memmove(self->reversals, stack, kept * sizeof *stack);
-    }
-    self->reversal_count = kept;
     memcpy(self->warning, warning, sizeof warning);
     self->load_before = load;
     self->bounded_before = bounded;
     if (outside) {
         self->data_unwarned = 0;
     }
-    self->previous_temperature = sensed.temperature;
-    self->previous_fraction = fraction;
     outputs->P_ff = output;
     outputs->T_ref = temperature;
     outputs->saturated = saturated;
@@ -255,7 +346,9 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
 
 size_t feedforward_stepper_state_size(const FeedforwardStepper *self)
 {
-    return FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count;
+    size_t own = FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count;
+    return self->shaping == SHAPING_REACHABLE
+           ? own + plant_stepper_state_size(&self->shaper.model) : own;
 }
 
 void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out)
@@ -271,14 +364,37 @@ void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out
         out[FEEDFORWARD_STATE_FIXED + 2 * i] = self->reversals[i].temperature;
         out[FEEDFORWARD_STATE_FIXED + 2 * i + 1] = self->reversals[i].xi_MF;
     }
+    if (self->shaping == SHAPING_REACHABLE) {
+        plant_stepper_state_write(&self->shaper.model,
+                                  out + FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count);
+    }
+}
+
+/* The model wire of a saved state, `count` doubles at `in`, checked on a new model (*model,
+ * allocated when this returns 0); refused as Python's "state entry model: ..." */
+static int read_model(const FeedforwardStepper *self, const double *in, size_t count,
+                      ReachableShaping *model, SmaMessage *message)
+{
+    SmaMessage reason;
+    if (reachable_shaping_init(model, &self->params, self->inverse == INVERSE_MINOR_LOOP,
+                               self->shaper.power_cap, self->model_load, message)) {
+        return 1;
+    }
+    if (plant_stepper_state_read(&model->model, in, count, &reason)) {
+        reachable_shaping_free(model);
+        return sma_message_set(message, "state entry model: %s", reason.text);
+    }
+    return 0;
 }
 
 int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, size_t count,
                                    SmaMessage *message)
 {
     int direction, reference_present, temperature_present, fraction_present;
+    int shaped = self->shaping == SHAPING_REACHABLE;
     double points_given;
-    size_t depth = (size_t)self->params.memory_depth, points;
+    ReachableShaping model;
+    size_t depth = (size_t)self->params.memory_depth, points, own;
     if (count < FEEDFORWARD_STATE_FIXED) {
         return read_entries(count, FEEDFORWARD_STATE_FIXED, "compensator state", message);
     }
@@ -302,18 +418,30 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
                                "pairs, got a count of %.17g", (unsigned long)depth, points_given);
     }
     points = (size_t)points_given;
-    if (count != FEEDFORWARD_STATE_FIXED + 2 * points) {
+    own = FEEDFORWARD_STATE_FIXED + 2 * points;
+    if (shaped ? count < own : count != own) {
         return sma_message_set(message, "reversals: the compensator state holds %lu numbers, "
-                               "not %d + 2 x %lu for its %lu reversal points",
+                               "not %d + 2 x %lu for its %lu reversal points%s",
                                (unsigned long)count, FEEDFORWARD_STATE_FIXED,
-                               (unsigned long)points, (unsigned long)points);
+                               (unsigned long)points, (unsigned long)points,
+                               shaped ? " and the model wire's state" : "");
     }
     if (read_points(in + FEEDFORWARD_STATE_FIXED, points, depth, "reversals", NULL,
                     message)) {
         return 1;
     }
-    if (phase_lag_filter_state_read(&self->filter, in + 4, message)) {   /* the last check */
+    if (shaped && read_model(self, in + own, count - own, &model, message)) {
         return 1;
+    }
+    if (phase_lag_filter_state_read(&self->filter, in + 4, message)) {   /* the last check */
+        if (shaped) {
+            reachable_shaping_free(&model);
+        }
+        return 1;
+    }
+    if (shaped) {   /* taken only now that everything is good */
+        reachable_shaping_free(&self->shaper);
+        self->shaper = model;
     }
     self->direction = direction;
     self->previous_reference = in[1];
@@ -327,6 +455,10 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
 
 void feedforward_stepper_free(FeedforwardStepper *self)
 {
+    if (self->shaping == SHAPING_REACHABLE) {
+        reachable_shaping_free(&self->shaper);
+        self->shaping = SHAPING_NONE;
+    }
     free(self->reversals);
     self->reversals = NULL;
     self->reversal_count = 0;

@@ -13,6 +13,10 @@
  * changes, inverted by invert_on_stack). In both, a reference outside what the branch reaches
  * at the present load gives the temperature of the nearest reachable edge, saturated = 1.
  *
+ * Two shapings (SHAPINGS, shaping.h): "none" (the paper's phase-lag filter) and "reachable"
+ * (the demand shaped into what a model of the wire can reach in a step, up to power_cap; the
+ * inverse then takes the model's memory; P_ff is the model's power, no filter).
+ *
  * No reference yet: R_ref <= 0 ohm before the first R_ref > 0 (a host that steps before its
  * inputs are connected) is an unconnected start: P_ff = 0 W, T_ref = T_room, saturated = 1,
  * one warning (the first such step only), no state change. After a reference has arrived,
@@ -28,7 +32,9 @@
  *   [4] filter previous_input [W] or None        [5] filter previous_output [W] or None
  *   [6] n, the number of reversal points (0 .. memory_depth)
  *   [7 + 2 i], [8 + 2 i]  reversal i (oldest first): T [degC], xi_MF [1]
- * Python's state() dict has the same entries (its "format" is the FMI layer's header). */
+ *   shaping "reachable": then the model wire's state, PLANT_STATE_FIXED + 2 m doubles (plant.h)
+ * Python's state() dict has the same entries (its "format" is the FMI layer's header; the
+ * model's is its "model" entry). */
 #ifndef SMA_FEEDFORWARD_H
 #define SMA_FEEDFORWARD_H
 
@@ -38,6 +44,7 @@
 #include "minor_loops.h"
 #include "parameters.h"
 #include "phase_lag.h"
+#include "shaping.h"
 #include "sma_message.h"
 
 #define FEEDFORWARD_STATE_FIXED 7   /* doubles before the reversal points */
@@ -73,6 +80,8 @@ typedef struct FeedforwardStepper {
     double model_load;            /* load the inverse assumes when not adapting [kg] */
     int adapt_to_load;            /* 1: the measured load enters the inverse */
     FeedforwardInverse inverse;
+    FeedforwardShaping shaping;
+    ReachableShaping shaper;      /* the model wire, with shaping "reachable" only */
     int direction;                /* d_ref of the last sample, +1 / -1 */
     double previous_reference;    /* R_ref of the last sample [ohm]; NaN = None */
     ReversalPoint *reversals;     /* the minor-loop memory, oldest first */
@@ -87,14 +96,16 @@ typedef struct FeedforwardStepper {
     int data_unwarned;            /* the data-range warning is still to come (not saved) */
 } FeedforwardStepper;
 
-/* Python's FeedforwardStepper(params, alpha, beta, model_load, adapt_to_load, inverse). For
- * Python's defaults pass params->phase_lag_alpha, params->beta and params->model_load.
- * Refuses (in Python's order, naming it) alpha < 0, beta <= 0, model_load < 0, an unknown
- * inverse; allocates the stack (memory_depth + 1 points). On refusal nothing is allocated and
- * feedforward_stepper_free is harmless. */
+/* Python's FeedforwardStepper(params, alpha, beta, model_load, adapt_to_load, inverse,
+ * shaping, power_cap). For Python's defaults pass params->phase_lag_alpha, params->beta,
+ * params->model_load, "none" and NaN (None: no power cap). Refuses (in Python's order, naming
+ * it) alpha < 0, beta <= 0, model_load < 0, an unknown inverse or shaping, a bad power_cap;
+ * allocates the stack (memory_depth + 1 points) and, shaped, the model wire. On refusal
+ * nothing is allocated and feedforward_stepper_free is harmless. */
 int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *params,
                              double alpha, double beta, double model_load, int adapt_to_load,
-                             const char *inverse, SmaMessage *message);
+                             const char *inverse, const char *shaping, double power_cap,
+                             SmaMessage *message);
 /* Outputs before the first step (filter in steady state); the state is unchanged.
  * Refuses after the first step, and a bad `reference` R_ref [ohm] ("R_ref") or `load` [kg]
  * ("load"); R_ref <= 0 gives the unconnected outputs. */
@@ -110,8 +121,8 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
                              SmaMessage *message);
 /* Saved state, layout above. state_read checks every entry as Python's restore() does (the
  * message names the entry: direction, previous_reference, previous_temperature,
- * previous_fraction, reversals / reversals[i], previous_input, previous_output) and changes
- * nothing when it refuses. */
+ * previous_fraction, reversals / reversals[i], previous_input, previous_output; shaped,
+ * "state entry model: " and the plant's) and changes nothing when it refuses. */
 size_t feedforward_stepper_state_size(const FeedforwardStepper *self);
 void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out);
 int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, size_t count,

@@ -6,10 +6,13 @@
  * as set before the call and its outputs then hold u_ff,k for that step. After
  * initialization the outputs are those of the first sample (filter in steady state).
  * Invalid parameters refuse fmi2ExitInitializationMode; inverse is an Integer
- * (1 = major, 2 = minor-loop). */
+ * (1 = major, 2 = minor-loop), shaping too (1 = none, 2 = reachable), power_cap [W] the
+ * driver's P_max (0: no limit). */
 #include "fp_contract.h"
 #include "feedforward.h"
+#include "checks.h"
 #include "sma_choices.h"
+#include "state_entries.h"
 #include "sma_wire.h"
 #include "SmaFeedforward_variables.h"
 
@@ -25,12 +28,15 @@ static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *messa
     FeedforwardStepper *self = (FeedforwardStepper *)stepper;
     WireParameters params;
     FeedforwardOutputs outputs;
-    const char *inverse;
+    const char *inverse, *shaping;
+    double cap = values[VAR_power_cap].real;
     if (sma_wire_parameters(&SMA_MODEL, values, run, &params, message) ||
         choice_name("inverse", values[VAR_inverse].integer, &inverse, message) ||
+        choice_name("shaping", values[VAR_shaping].integer, &shaping, message) ||
+        (cap != cap && require_positive("power_cap", cap, message)) ||   /* NaN is not "none" */
         feedforward_stepper_init(self, &params, params.phase_lag_alpha, params.beta,
                                  params.model_load, values[VAR_adapt_to_load].integer, inverse,
-                                 message))
+                                 shaping, cap == 0.0 ? SMA_STATE_NONE : cap, message))
         return 1;
     if (feedforward_stepper_initial_outputs(self, values[VAR_R_ref].real, values[VAR_load].real,
                                             &outputs, message)) {

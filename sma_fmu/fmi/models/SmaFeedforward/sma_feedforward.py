@@ -10,14 +10,21 @@ initialization the outputs are those of the first sample (filter in steady state
 Initialization Mode they follow R_ref, load and the parameters as they are set.
 Invalid parameters make exitInitializationMode fail with fmi2Error naming the reason;
 the instance stays in Initialization Mode, where they can be corrected. ``inverse`` is an
-Integer: 1 = major, 2 = minor-loop (``slave_support/choices.py``). A step within a
-millionth of the first step's size is taken as that size (the time grid, docs/systems.md).
+Integer: 1 = major, 2 = minor-loop; ``shaping`` too: 1 = none (the phase-lag filter),
+2 = reachable (``slave_support/choices.py``), with ``power_cap`` [W] the driver's P_max
+(0: no limit). A step within a millionth of the first step's size is taken as that size
+(the time grid, docs/systems.md).
 """
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.fmi.python_family.slave_support.choices import choice_name
 from sma_fmu.fmi.python_family.slave_support.interface import SlaveInterface
 from sma_fmu.fmi.python_family.slave_support.stepper_slave import StepperSlave
+
+
+def power_cap_of(value):
+    """The runtime's power_cap [W] of the FMU parameter: 0 means no limit (None)."""
+    return None if value == 0.0 else value
 
 
 def _mid_transformation_resistance(params):
@@ -48,10 +55,17 @@ class SmaFeedforward(StepperSlave):
                              "major: the paper's, major branches; minor-loop: the plant's "
                              "continuous-mode minor branches, reversals taken from R_ref")
         fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin", "stress_max"))
+        fmi.choice_parameter("shaping", "none",
+                             "none: the paper's, T_ref through the phase-lag filter; reachable: "
+                             "the demand shaped into what the wire can reach, over a model of it")
+        fmi.parameter("power_cap", 0.0, "W", "with shaping reachable: the most power the "
+                      "driver delivers, P_max (0: no limit)")
         self.stepper = None
 
     def _start(self):
         stepper = FeedforwardStepper(self.interface.wire_parameters(),
                                      adapt_to_load=self.adapt_to_load,
-                                     inverse=choice_name("inverse", self.inverse))
+                                     inverse=choice_name("inverse", self.inverse),
+                                     shaping=choice_name("shaping", self.shaping),
+                                     power_cap=power_cap_of(self.power_cap))
         return stepper, stepper.initial_outputs(self.R_ref, self.load)
