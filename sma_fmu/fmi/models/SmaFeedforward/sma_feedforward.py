@@ -47,7 +47,7 @@ class SmaFeedforward(StepperSlave):
         fmi.choice_parameter("inverse", "major",
                              "major: the paper's, major branches; minor-loop: the plant's "
                              "continuous-mode minor branches, reversals taken from R_ref")
-        fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin", "stress_max"))
+        fmi.model_parameters()
         self.stepper = None
 
     def _start(self):
