@@ -150,14 +150,14 @@ class SlaveInterface:
         for spec in (spec for name, spec in SPEC_BY_NAME.items() if name in wanted):
             start = getattr(self.defaults, spec.name)
             meaning = entries.get(spec.name, {}).get("meaning") or (
-                "not in the parameter file" if start is None else spec.name)
+                "optional, not in the parameter file" if start is None else spec.name)
             if spec.rule == "depth":  # a count: an Integer (FMI 2.0 Integers have no unit)
                 self.parameter(spec.name, int(start), None, f"{meaning} [{spec.section}, 1]",
                                kind=Integer)
             else:
                 if spec.name in NULLABLE:
                     self.nullable.add(spec.name)
-                    meaning += f"; NaN: not given, then {not_given_text(spec.name)}"
+                    meaning += f"; {not_given_text(spec.name)}"
                 self.parameter(spec.name, math.nan if start is None else start, spec.unit,
                                f"{meaning} [{spec.section}]")
             self.exposed.append(spec.name)

@@ -45,12 +45,13 @@ def wire_names(model):
 
 
 def not_given_text(name):
-    """What the model takes in place of the optional parameter ``name`` when it is not given."""
+    """What NaN means in the optional parameter ``name``: not given, and what the model
+    takes in its place."""
     if name == "alpha":
-        return "the thermal time constant tau_th"
+        return "NaN: not given, the model then takes the thermal time constant tau_th"
     default = _DEFAULTS.get(name)
     if isinstance(default, str):
-        return f"the value of {default}"
+        return f"NaN: not given, the model then takes the value of {default}"
     if default is None:
-        return "none: unused while second_stage.w2 = 0, required when w2 > 0"
-    return repr(float(default))
+        return "NaN: not given (unused while second_stage.w2 = 0, required when w2 > 0)"
+    return f"NaN: not given, the model then takes {float(default)!r}"
