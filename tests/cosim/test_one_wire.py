@@ -163,7 +163,7 @@ def test_every_fmu_states_its_wire_and_the_system_records_the_scenarios(fmus, sc
     for path in fmus.values():
         stated = {v.name: v for v in read_model_description(str(path)).modelVariables}["wire_digest"]
         assert (stated.causality, stated.variability, stated.start) == (
-            "output", "constant", parameter_set.digest)
+            "local", "constant", parameter_set.digest)
         with zipfile.ZipFile(path) as archive:
             assert json.loads(archive.read("resources/parameters.json"))["wire_digest"] == \
                 parameter_set.digest
@@ -173,3 +173,22 @@ def test_every_fmu_states_its_wire_and_the_system_records_the_scenarios(fmus, sc
     assert plant["w2"] == 0.35 and plant["T_alpha"] == 25.0
     # not given in the scenario's wire and not in the FMU's either: nothing to set
     assert "span_ratio_sat" not in plant and "b2_h" not in plant
+
+
+def test_runs_record_the_wire_file_and_digest(scenarios, two_stage, tmp_path):
+    from sma_fmu.runtime.wire_identity import wire_digest
+    from sma_fmu.studies.runs import run as study_run
+    from sma_fmu.systems.runner import run_scenarios
+
+    scenario = scenarios["two-stage"]
+    rows = run_scenarios([scenario.path], tmp_path / "out", "library", progress=lambda _: None)
+    recorded = {"file": str(two_stage.path), "digest": two_stage.digest}
+    metrics = json.loads((tmp_path / "out" / scenario.name / "metrics.json").read_text())
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert metrics["wire"] == recorded == rows[0]["metrics"]["wire"]
+    assert summary[0]["metrics"]["wire"] == recorded
+    # a study's run records the wire it ran: the drawn values' digest, the base file
+    drawn = study_run(scenario, {"wire.a_h": 77.0}, path="library")
+    row = drawn.record()
+    assert row["wire_file"] == str(two_stage.path)
+    assert row["wire_digest"] == wire_digest(two_stage.params.replace(a_h=77.0)) != two_stage.digest

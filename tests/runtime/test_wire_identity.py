@@ -74,3 +74,15 @@ def test_a_written_fit_round_trips_its_digest(tmp_path, parameter_set):
     assert loaded.digest == wire_digest(two_stage) == _by_the_documented_rule(path)
     assert loaded.record() == {"file": str(path), "digest": loaded.digest}
     assert loaded.as_json()["wire_digest"] == loaded.digest
+
+
+def test_sma_fmu_wire_prints_the_digest(tmp_path, capsys, parameter_set):
+    import json
+
+    from sma_fmu.cli import main
+
+    nudged = parameter_set.params.replace(a_h=math.nextafter(68.0, 0.0))
+    path = write_parameter_file(tmp_path / "nudged.toml", nudged, "nudged")
+    assert main(["wire", "--model", str(path), "--json"]) == 0
+    shown = json.loads(capsys.readouterr().out)
+    assert shown["digest"] == wire_digest(nudged) != parameter_set.digest

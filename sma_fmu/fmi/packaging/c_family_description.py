@@ -128,7 +128,7 @@ def variables_header(description):
         name = variable.get("name")
         causality = variable.get("causality")
         variability = variable.get("variability")
-        if causality not in ("parameter", "input", "output") or \
+        if causality not in ("parameter", "input", "output", "local") or \
                 variability not in ("fixed", "tunable", "discrete", "continuous", "constant"):
             raise ValueError(f"{model}: variable {name} is a {variability} {causality}")
         wire = spec_index.get(name, -1) if causality == "parameter" else -1

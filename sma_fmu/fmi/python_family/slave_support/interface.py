@@ -165,7 +165,7 @@ class SlaveInterface:
     def state_wire_digest(self):
         """The String constant ``wire_digest``: the digest of the wire the FMU was built
         from (declared after the slave's own variables, :class:`~.stepper_slave.StepperSlave`)."""
-        self._declare(String(WIRE_DIGEST, causality=Fmi2Causality.output,
+        self._declare(String(WIRE_DIGEST, causality=Fmi2Causality.local,
                              variability=Fmi2Variability.constant, initial=Fmi2Initial.exact,
                              start=self.digest,
                              description="SHA-256 of the canonical values of the wire parameter "
