@@ -171,3 +171,16 @@ def test_the_digest_is_stated_and_read_back(request, family, parameter_set, othe
             assert binaries and all(a.read(n) == b.read(n) for n in binaries)
         tokens = [read_model_description(str(p)) for p in (own, other)]
         assert len({d.guid if family == "native" else d.instantiationToken for d in tokens}) == 2
+
+
+def test_the_page_names_the_wire_file_and_digest(request, other_wire, tmp_path_factory):
+    import html
+    import re
+
+    _, other = _family(request, "python", other_wire, tmp_path_factory)
+    with zipfile.ZipFile(other) as archive:
+        page = archive.read("documentation/index.html").decode("utf-8")
+    file = re.search(r'<code class="wire-file">([^<]*)</code>', page)
+    digest = re.search(r'<code class="wire-digest">([^<]*)</code>', page)
+    assert file and html.unescape(file.group(1)) == str(other_wire.path)
+    assert digest and digest.group(1) == other_wire.digest

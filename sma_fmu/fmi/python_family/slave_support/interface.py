@@ -7,9 +7,10 @@ The build writes the wire's parameter set to ``resources/parameters.json``; a sl
 exposes the wire parameters its model uses as FMI parameters (:mod:`.wire_use`: start
 values from that file, NaN for an optional one the file does not give) and takes the rest
 from the file as they are. Every slave states the digest of that wire
-(:mod:`sma_fmu.runtime.wire_identity`) in the String constant ``wire_digest``. An FMU packed by ``sma-fmu export`` also has
-``resources/start_values.json`` (:mod:`.start_values`): the scenario's values, which
-replace the start values of the parameters it names. Settings that choose among names
+(:mod:`sma_fmu.runtime.wire_identity`) in the String constant ``wire_digest``. An FMU
+packed by ``sma-fmu export`` also has ``resources/start_values.json``
+(:mod:`.start_values`): the scenario's values, which replace the start values of the
+parameters it names. Settings that choose among names
 are Integer parameters holding a code (:mod:`.choices`).
 
 Creating a :class:`SlaveInterface` also puts a :class:`~.guards.CallGuard` over the
