@@ -17,7 +17,15 @@ def _bench(args):
         from sma_fmu.bench.c_master import c_master_lines, run_c_master_bench
         say = lambda text: print(text, flush=True)  # noqa: E731
         results = run_c_master_bench(args.out, args.runs, args.fmus, progress=say)
-        print("\n".join(c_master_lines(results["c_master"], results["one_hour"])))
+        print("\n".join(c_master_lines(results["c_master"], results["one_hour"],
+                                        results["commands"], results["sweep"])))
+        print(f"written: {args.out / 'benchmark.json'}")
+        return 0
+    if args.only == "inverse":
+        from sma_fmu.bench.inverse import inverse_lines, run_inverse_bench
+        say = lambda text: print(text, flush=True)  # noqa: E731
+        results = run_inverse_bench(args.out, args.runs, args.model, args.stop_time, say)
+        print("\n".join(inverse_lines(results)))
         print(f"written: {args.out / 'benchmark.json'}")
         return 0
     if args.only == "pwm":
@@ -35,20 +43,27 @@ def register(commands):
                        help="output folder")
     bench.add_argument("--runs", type=bounded_integer(1, MAX_RUNS), default=5,
                        help=f"repetitions per measurement, 1-{MAX_RUNS}")
-    bench.add_argument("--only", choices=("batch", "hosts", "pwm", "c-master"),
+    bench.add_argument("--only", choices=("batch", "hosts", "pwm", "c-master", "inverse"),
                        help="only this section (batch: the batch engine's throughput table; "
                             "hosts: every scenario in every host against the library loop, "
                             "docs/systems.md's table; pwm: the PWM table of docs/model.md; "
-                            "c-master: the C master against the library per scenario, and the "
-                            "peak memory of a one-hour run)")
+                            "c-master: the C master against the library: the loop per "
+                            "scenario, whole run commands, the run table's wall s, a sweep per "
+                            "worker, the peak memory of a one-hour run; inverse: one inversion "
+                            "of a two-stage wire in Python and C, and heavy-pi+ff-adaptive "
+                            "through its FMUs against the reference wire's)")
     bench.add_argument("--fmus", type=Path, metavar="DIR",
                        help="with --only c-master: the native FMUs (sma-fmu build --native; "
                             "default: built into the output folder)")
+    bench.add_argument("--model", type=Path, metavar="FILE",
+                       help="with --only inverse: the two-stage wire's parameter file (e.g. "
+                            "a fit's identified.toml; default: the reference wire with a "
+                            "broad second stage)")
     bench.add_argument("--scenario", action="append", metavar="NAME",
                        help="with --only hosts: a scenario (repeatable; default: the paper's six "
                             "and the two PWM set-point ones)")
     bench.add_argument("--stop-time", type=positive_number, metavar="S",
-                       help="with --only hosts: shorten every scenario to S s")
+                       help="with --only hosts or inverse: shorten every scenario to S s")
     bench.add_argument("--omsimulator", metavar="EXE",
                        help="with --only hosts: OMSimulator's executable (default: "
                             "$SMA_FMU_OMSIMULATOR, else OMSimulator is left out)")

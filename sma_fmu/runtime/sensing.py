@@ -4,7 +4,8 @@
     Lambda = ln((M - xi_MF)/xi_MF),   T_K = 1 / (1/tau_K - k_B Lambda / dH(f))
 
 With a second stage (w2 > 0, :mod:`.constant_load`) no closed form exists: 1/T_K is found
-by bisection between the two single-stage closed forms (:func:`two_stage_inverse`).
+by a safeguarded Newton iteration on Lambda(1/T_K), bracketed by the two single-stage closed
+forms (:func:`~.two_stage_root.two_stage_inverse`).
 
 Outside the transformation the resistance is saturated and carries no temperature
 information. There xi_MF is clamped into [delta, M - delta], delta = saturation_margin * M,
@@ -23,20 +24,20 @@ import math
 from collections import namedtuple
 
 from .checks import direction_sign, require_positive
-from .constant_load import branch_constants, two_stage_fractions
+from .constant_load import branch_constants
 from .constants import KELVIN_OFFSET
 from .constants import HEATING
 from .minor_loops import (DENOMINATOR_FLOOR, fractions_of_value, fractions_on_stack, major_value,
                           value_of)
 from .reachable_band import band_of_branch
+from .two_stage_root import ROOT_CAP, ROOT_TOLERANCE_K, two_stage_inverse
 
 __all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of_fractions",
-           "temperature_on_stack", "invert_on_stack", "sense_temperature"]
+           "temperature_on_stack", "invert_on_stack", "sense_temperature", "inverse_method"]
 
 SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
 SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
 _new_tuple = tuple.__new__  # builds the namedtuple in C (see plant.py)
-BISECTION_CAP = 200   # halvings of the two-stage inverse's bracket (64 bits need far fewer)
 
 
 def mixed_fractions_of_resistance(resistance, constants, params):
@@ -75,43 +76,6 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin):
             f"temperature-sensing inverse diverges at Lambda = {exponent!r}: dH(f)/k_B = "
             f"{constants.energy_over_kB!r} K is too small for the hysteresis centre")
     return _new_tuple(SensedTemperature, (1.0 / inverse_kelvin - KELVIN_OFFSET, saturated))
-
-
-def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants):
-    """1/T_K [1/K] where a two-stage major branch has (xi_MF, xi_P) [1]: bisection on 1/T_K.
-
-    ``exponent`` = ln(xi_P/xi_MF) and ``inverse_kelvin`` is stage 1's closed-form inverse;
-    stage 2's is the other end of the bracket (the branch is a weighted mean of the two
-    stages, each monotone in 1/T_K, so the root lies between them). Where a closed form is
-    <= 0 (that stage alone never falls to the target), the low end is 1/T_K = 0: the root
-    exists if the branch is below the target there, infinitely hot; else the inverse
-    diverges (ValueError, as the one-stage inverse). The midpoint halves the bracket until it
-    equals an end (at most :data:`BISECTION_CAP` times); the fraction compared is the smaller
-    one, for digits. The C family runs the same operations.
-    """
-    other = constants.inv_centre2_K - exponent / constants.energy2_over_kB
-    low, high = (inverse_kelvin, other) if inverse_kelvin <= other else (other, inverse_kelvin)
-    by_mf = xi_mf <= xi_p
-    if not low > 0.0:
-        low = 0.0
-        mf, p = two_stage_fractions(0.0, constants)
-        if not (high > 0.0 and ((mf < xi_mf) if by_mf else (p > xi_p))):
-            raise ValueError(
-                f"temperature-sensing inverse diverges at Lambda = {exponent!r}: the two-stage "
-                f"branch does not reach the target at any temperature (dH(f)/k_B = "
-                f"{constants.energy_over_kB!r} K, second stage {constants.energy2_over_kB!r} K)")
-    middle = 0.5 * (low + high)
-    for _ in range(BISECTION_CAP):
-        if middle <= low or middle >= high:
-            break
-        mf, p = two_stage_fractions(middle, constants)
-        # xi_MF rises and xi_P falls with 1/T_K: below the target, the root is colder
-        if (mf < xi_mf) if by_mf else (p > xi_p):
-            low = middle
-        else:
-            high = middle
-        middle = 0.5 * (low + high)
-    return middle
 
 
 def temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin, count=None):
@@ -195,3 +159,14 @@ def sense_temperature(resistance, load, direction, params, reversals=()):
     xi_mf, xi_p = mixed_fractions_of_resistance(resistance, constants, params)
     return temperature_on_stack(xi_mf, xi_p, constants, sign, list(reversals),
                                 params.saturation_margin)[0]
+
+
+def inverse_method(two_stage):
+    """How :func:`temperature_of_fractions` finds T [text]: what the FMUs' pages say, so the
+    words follow the code. ``two_stage``: the branch has a second stage (w2 > 0)."""
+    if not two_stage:
+        return "closed form, T_K = 1/(1/tau_K - k_B Lambda/dH(f))"
+    return (f"Newton's method on 1/T_K, safeguarded: started from the steeper stage's "
+            f"closed-form inverse, kept inside the bracket of the two stages' closed forms "
+            f"(a step that would leave it halves it instead), stopped when the error left in "
+            f"T is below {ROOT_TOLERANCE_K:g} K (about 3 evaluations; at most {ROOT_CAP} rounds)")

@@ -50,7 +50,7 @@ def _help_texts(parser, name="sma-fmu"):
 
 def user_docs():
     """{name: text} of the user docs: README, docs/, the shipped texts, the CLI's help."""
-    files = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+    files = [REPO / "README.md", REPO / "CONTRIBUTING.md", *sorted((REPO / "docs").glob("*.md"))]
     files += sorted(p for folder in ("models", "scenarios", "examples") for p in (PACKAGE / folder).rglob("*")
                     if p.suffix in SHIPPED_TEXT)
     files += sorted(PACKAGE.rglob("*.html"))   # the FMUs' model pages

@@ -9,10 +9,10 @@ so the sum is the one-stage split bit for bit, and the batch needs no per-run br
 import numpy as np
 
 from sma_fmu.runtime.constants import KELVIN_OFFSET
-from sma_fmu.runtime.sensing import BISECTION_CAP
+from sma_fmu.runtime.two_stage_root import ROOT_CAP, ROOT_TOLERANCE_K
 
-__all__ = ["major_fractions", "split_at_inverse", "two_stage_at_inverse", "two_stage_temperatures",
-           "two_stage_fractions", "two_stage_inverse", "wire_lengths"]
+__all__ = ["major_fractions", "split_at_inverse", "split_with_slope", "two_stage_at_inverse",
+           "two_stage_temperatures", "two_stage_fractions", "two_stage_inverse", "wire_lengths"]
 
 
 def major_fractions(temperature, M, minus_energy, inv_centre):
@@ -50,32 +50,86 @@ def two_stage_fractions(temperature, c):
     return two_stage_at_inverse(1.0 / (temperature + KELVIN_OFFSET), c)
 
 
+def split_with_slope(inverse_kelvin, M, minus_energy, inv_centre):
+    """:func:`split_at_inverse` (the same operations) and the first half's derivative by
+    -z, M e/(1 + e)^2 [1]: the smaller half over 1 + e, as the runtime's inlined split."""
+    x = inv_centre - inverse_kelvin
+    positive = (x > 0.0).astype(float)
+    e = np.exp(minus_energy * np.abs(x))
+    denominator = 1.0 + e
+    mf = M * np.maximum(e, 1.0 - positive) / denominator
+    p = M * np.maximum(e, positive) / denominator
+    return mf, p, np.minimum(mf, p) / denominator
+
+
+def _newton_start(xi_mf, xi_p, u1, u2, c, low, high):
+    """(start u [1/K], the steep stage's dH/k_B [K]) per element, as the runtime's
+    :func:`~sma_fmu.runtime.two_stage_root.two_stage_inverse` starts: the steep stage is the
+    one of larger dH/k_B (stage 1 on a tie), ``u1`` and ``u2`` the two closed forms [1/K]."""
+    first = -c["minus_energy"] >= -c["minus_energy2"]
+    pick = lambda one, two: np.where(first, one, two)  # noqa: E731
+    energy, total = pick(-c["minus_energy"], -c["minus_energy2"]), pick(c["M1"], c["M2"])
+    centre = pick(c["inverse"], c["inverse2"])
+    energy_b = pick(-c["minus_energy2"], -c["minus_energy"])
+    centre_b = pick(c["inverse2"], c["inverse"])
+    u = pick(u1, u2)
+    mf_b, p_b, slope_b = split_with_slope(u, pick(c["M2"], c["M1"]), -energy_b, centre_b)
+    left_mf, left_p = xi_mf - mf_b, xi_p - p_b
+    both = (left_mf > 0.0) & (left_p > 0.0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        target = centre - np.log(left_p / left_mf) / energy
+        damped = u + (target - u) / (1.0 + energy_b * slope_b / energy * (1.0 / left_p
+                                                                          + 1.0 / left_mf))
+        all_mf = np.where(xi_mf > total,
+                          centre_b - np.log(xi_p / (xi_mf - total)) / energy_b, low)
+        all_p = np.where(xi_p > total, centre_b - np.log((xi_p - total) / xi_mf) / energy_b, low)
+    u = np.where(both, damped, np.where(left_mf > 0.0, all_mf, all_p))
+    return np.where((low < u) & (u < high), u, 0.5 * (low + high)), energy
+
+
 def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, c):
     """1/T_K [1/K] of two-stage branches and ``bad`` (the branch does not reach the target
-    at any temperature), as :func:`sma_fmu.runtime.sensing.two_stage_inverse`: bisection
-    between the two closed forms (from 0 where one is <= 0), per element until its midpoint
-    equals an end (at most BISECTION_CAP rounds)."""
+    at any temperature), as :func:`sma_fmu.runtime.two_stage_root.two_stage_inverse`: the
+    same start, Newton steps, halvings and stops per element, each element leaving the
+    rounds where the runtime returns (at most ROOT_CAP rounds)."""
     other = c["inverse2"] - exponent / -c["minus_energy2"]
     low, high = np.minimum(inverse_kelvin, other), np.maximum(inverse_kelvin, other)
-    by_mf = xi_mf <= xi_p
     open_end = ~(low > 0.0)              # a stage alone never falls to the target: from 0
     bad = np.zeros(low.shape, dtype=bool)
     if open_end.any():
         low = np.where(open_end, 0.0, low)
         mf, p = two_stage_at_inverse(np.zeros(low.shape), c)
-        reaches = (high > 0.0) & np.where(by_mf, mf < xi_mf, p > xi_p)
+        reaches = (high > 0.0) & np.where(xi_mf <= xi_p, mf < xi_mf, p > xi_p)
         bad = open_end & ~reaches
-    middle = 0.5 * (low + high)
-    for _ in range(BISECTION_CAP):
-        active = (middle > low) & (middle < high)
-        if not active.any():
-            break
-        mf, p = two_stage_at_inverse(middle, c)
-        colder = np.where(by_mf, mf < xi_mf, p > xi_p)
-        low = np.where(active & colder, middle, low)
-        high = np.where(active & ~colder, middle, high)
-        middle = 0.5 * (low + high)
-    return middle, bad
+    u, steepest = _newton_start(xi_mf, xi_p, inverse_kelvin, other, c, low, high)
+    limit = ROOT_TOLERANCE_K / steepest
+    energy1, energy2 = -c["minus_energy"], -c["minus_energy2"]
+    result, active = u.copy(), ~bad
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for _ in range(ROOT_CAP):
+            if not active.any():
+                break
+            mf1, p1, q1 = split_with_slope(u, c["M1"], c["minus_energy"], c["inverse"])
+            mf2, p2, q2 = split_with_slope(u, c["M2"], c["minus_energy2"], c["inverse2"])
+            mf, p = mf1 + mf2, p1 + p2
+            ok = (mf > 0.0) & (p > 0.0)
+            residual = np.where(ok, np.log(p / mf) - exponent, p - mf)
+            slope = np.where(ok, (energy1 * q1 + energy2 * q2) * (1.0 / mf + 1.0 / p), 0.0)
+            low = np.where(active & (residual > 0.0), u, low)
+            high = np.where(active & (residual < 0.0), u, high)
+            zero = active & ~(residual > 0.0) & ~(residual < 0.0)
+            step = residual / slope
+            new = u + step
+            newton = active & ~zero & (slope > 0.0) & (low <= new) & (new <= high)
+            stop = newton & (step * step <= limit * new * new)
+            moves = newton & ~stop & (new != u)
+            middle = 0.5 * (low + high)
+            halve = active & ~zero & ~stop & ~moves
+            collapsed = halve & ~((low < middle) & (middle < high))
+            result = np.where(zero | collapsed, u, np.where(stop, new, result))
+            active = active & ~(zero | stop | collapsed)
+            u = np.where(moves, new, np.where(halve, middle, u))
+    return np.where(active, u, result), bad
 
 
 def wire_lengths(temperature, xi_p, xi_m, xi_f, l_P, length_M, length_F, terms):

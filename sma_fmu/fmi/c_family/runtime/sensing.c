@@ -29,12 +29,84 @@ static void clamped(double *xi_mf, double *xi_p, double total, double delta)
     *xi_p = delta;
 }
 
+/* A stage of a two-stage branch: (dH/k_B [K], 1/tau_K [1/K], its share M_k of M [1]). */
+typedef struct Stage {
+    double energy, inverse_centre, total;
+} Stage;
+
+/* The first u [1/K] of two_stage_root.two_stage_inverse: at the steep stage's closed form
+ * u_s, the steep stage's inverse of what the broad stage leaves, damped by the broad stage's
+ * slope; the broad stage's inverse with the steep one saturated where the broad one alone
+ * holds more than the target; the midpoint of (low, high) outside it. */
+static double newton_start(double xi_mf, double xi_p, const Stage *steep, const Stage *broad,
+                           double u, double low, double high)
+{
+    double z = broad->energy * (broad->inverse_centre - u), e, d, half, left_mf, left_p;
+    double target;
+    if (z > 0.0) {
+        e = exp(-z);
+        d = 1.0 + e;
+        half = broad->total * e / d;   /* the smaller half, MF */
+        left_mf = xi_mf - half;
+        left_p = xi_p - broad->total / d;
+    } else {
+        e = exp(z);
+        d = 1.0 + e;
+        half = broad->total * e / d;   /* the smaller half, P */
+        left_mf = xi_mf - broad->total / d;
+        left_p = xi_p - half;
+    }
+    if (left_mf > 0.0 && left_p > 0.0) {
+        target = steep->inverse_centre - log(left_p / left_mf) / steep->energy;
+        u = u + (target - u) / (1.0 + broad->energy * (half / d) / steep->energy * (
+            1.0 / left_p + 1.0 / left_mf));
+    } else if (left_mf > 0.0) {   /* the broad stage alone holds more P: the steep one all MF */
+        u = xi_mf > steep->total
+            ? broad->inverse_centre - log(xi_p / (xi_mf - steep->total)) / broad->energy : low;
+    } else {                      /* it holds more MF: the steep one is all P */
+        u = xi_p > steep->total
+            ? broad->inverse_centre - log((xi_p - steep->total) / xi_mf) / broad->energy : low;
+    }
+    if (!(low < u && u < high)) {
+        u = 0.5 * (low + high);
+    }
+    return u;
+}
+
+/* One stage at u: logistic_split's halves (the same operations) and the first half's
+ * derivative by -z, total e^z/(1 + e^z)^2 (two_stage_root.two_stage_inverse inlines it). */
+static void split_with_slope(const Stage *stage, double u, double *mf, double *p, double *q)
+{
+    double z = stage->energy * (stage->inverse_centre - u), e, d;
+    if (z > 0.0) {
+        e = exp(-z);
+        d = 1.0 + e;
+        *mf = stage->total * e / d;
+        *p = stage->total / d;
+        *q = *mf / d;
+        return;
+    }
+    e = exp(z);
+    d = 1.0 + e;
+    *mf = stage->total / d;
+    *p = stage->total * e / d;
+    *q = *p / d;
+}
+
 int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *inverse_kelvin,
                       const BranchConstants *constants, SmaMessage *message)
 {
-    double other = constants->inv_centre2_K - exponent / constants->energy2_over_kB;
-    double low, high, middle, mf, p;
-    int by_mf = xi_mf <= xi_p, i;
+    Stage first, second;
+    double other, low, high, u, limit, mf, p, mf1, p1, q1, mf2, p2, q2, residual, slope;
+    double step, next;
+    int i;
+    first.energy = constants->energy_over_kB;
+    first.inverse_centre = constants->inv_centre_K;
+    first.total = constants->M1;
+    second.energy = constants->energy2_over_kB;
+    second.inverse_centre = constants->inv_centre2_K;
+    second.total = constants->M2;
+    other = second.inverse_centre - exponent / second.energy;
     if (*inverse_kelvin <= other) {
         low = *inverse_kelvin;
         high = other;
@@ -45,29 +117,60 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *invers
     if (!(low > 0.0)) {   /* a stage alone never falls to the target: from 1/T_K = 0 */
         low = 0.0;
         two_stage_fractions(0.0, constants, &mf, &p);
-        if (!(high > 0.0 && (by_mf ? (mf < xi_mf) : (p > xi_p)))) {
+        if (!(high > 0.0 && (xi_mf <= xi_p ? (mf < xi_mf) : (p > xi_p)))) {
             return sma_message_set(message, "temperature-sensing inverse diverges at Lambda = "
                                    "%.17g: the two-stage branch does not reach the target at "
                                    "any temperature (dH(f)/k_B = %.17g K, second stage %.17g K)",
-                                   exponent, constants->energy_over_kB,
-                                   constants->energy2_over_kB);
+                                   exponent, first.energy, second.energy);
         }
     }
-    middle = 0.5 * (low + high);
-    for (i = 0; i < BISECTION_CAP; i++) {
-        if (middle <= low || middle >= high) {
+    if (first.energy >= second.energy) {
+        u = newton_start(xi_mf, xi_p, &first, &second, *inverse_kelvin, low, high);
+        limit = ROOT_TOLERANCE_K / first.energy;
+    } else {
+        u = newton_start(xi_mf, xi_p, &second, &first, other, low, high);
+        limit = ROOT_TOLERANCE_K / second.energy;
+    }
+    for (i = 0; i < ROOT_CAP; i++) {
+        split_with_slope(&first, u, &mf1, &p1, &q1);
+        split_with_slope(&second, u, &mf2, &p2, &q2);
+        mf = mf1 + mf2;
+        p = p1 + p2;
+        if (mf > 0.0 && p > 0.0) {
+            residual = log(p / mf) - exponent;
+            slope = (first.energy * q1 + second.energy * q2) * (1.0 / mf + 1.0 / p);
+        } else {   /* a fraction underflowed (extreme values): its sign only, then halve */
+            residual = p - mf;
+            slope = 0.0;
+        }
+        if (residual > 0.0) {   /* Lambda above the target: the root is colder */
+            low = u;
+        } else if (residual < 0.0) {
+            high = u;
+        } else {
             break;
         }
-        two_stage_fractions(middle, constants, &mf, &p);
-        /* xi_MF rises and xi_P falls with 1/T_K: below the target, the root is colder */
-        if (by_mf ? (mf < xi_mf) : (p > xi_p)) {
-            low = middle;
-        } else {
-            high = middle;
+        if (slope > 0.0) {
+            step = residual / slope;
+            next = u + step;
+            if (low <= next && next <= high) {   /* next == u: the step is below u's last bit */
+                if (step * step <= limit * next * next) {
+                    u = next;
+                    break;
+                }
+                if (next != u) {
+                    u = next;
+                    continue;
+                }
+            }
         }
-        middle = 0.5 * (low + high);
+        next = 0.5 * (low + high);
+        if (!(low < next && next < high)) {   /* the bracket is two neighbouring doubles */
+            break;
+        }
+        u = next;
     }
-    *inverse_kelvin = middle;
+    *inverse_kelvin = u;
     return 0;
 }
 

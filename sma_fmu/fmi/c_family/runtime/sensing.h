@@ -33,12 +33,14 @@ typedef struct SensedTemperature {
  * difference from its own saturated end. */
 void mixed_fractions_of_resistance(double resistance, const BranchConstants *constants,
                                    const WireParameters *params, double *xi_mf, double *xi_p);
-#define BISECTION_CAP 200   /* sensing.BISECTION_CAP */
+#define ROOT_CAP 200              /* two_stage_root.ROOT_CAP */
+#define ROOT_TOLERANCE_K 1e-14    /* two_stage_root.ROOT_TOLERANCE_K [K] */
 
-/* 1/T_K [1/K] where a two-stage branch has (xi_MF, xi_P): bisection between stage 1's
- * closed form (*inverse_kelvin on entry) and stage 2's (from 0 where one is <= 0; refused
- * when the branch does not reach the target at any temperature), `exponent` =
- * ln(xi_P/xi_MF); sensing.two_stage_inverse, the same operations. */
+/* 1/T_K [1/K] where a two-stage branch has (xi_MF, xi_P): a safeguarded Newton iteration on
+ * Lambda(1/T_K) = ln(xi_P/xi_MF) inside the bracket of stage 1's closed form
+ * (*inverse_kelvin on entry) and stage 2's (from 0 where one is <= 0; refused when the
+ * branch does not reach the target at any temperature), `exponent` = ln(xi_P/xi_MF);
+ * runtime/two_stage_root.py's two_stage_inverse, the same operations. */
 int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *inverse_kelvin,
                       const BranchConstants *constants, SmaMessage *message);
 /* Invert a major branch: (xi_MF, xi_P) [1] -> *sensed; `margin` is delta/M [1]. Refuses

@@ -11,13 +11,13 @@ to the schema is exposed, never silently left out). The loop's masters read the 
 An optional parameter that the parameter file does not give (None in Python) is exposed
 with the value NaN, "not given": the FMU then takes the value the model defines in its
 place (:data:`~sma_fmu.runtime.model_terms.TERM_DEFAULTS`; alpha: the thermal time
-constant), as the library does. A host may set NaN to take a given value back. A required
-parameter is never NaN.
+constant; a bound of the data range: none), as the library does. A host may set NaN to
+take a given value back. A required parameter is never NaN.
 """
 from dataclasses import fields
 
 from sma_fmu.runtime.model_terms import TERM_DEFAULTS
-from sma_fmu.runtime.parameters import PARAMETER_SPECS, WireParameters
+from sma_fmu.runtime.parameters import DATA_RANGE, PARAMETER_SPECS, WireParameters
 
 __all__ = ["WIRE_DIGEST", "UNUSED_SECTIONS", "NULLABLE", "wire_names", "not_given_text"]
 
@@ -49,6 +49,8 @@ def not_given_text(name):
     takes in its place."""
     if name == "alpha":
         return "NaN: not given, the model then takes the thermal time constant tau_th"
+    if name in DATA_RANGE:
+        return "NaN: not given, the data range has no bound on this side"
     default = _DEFAULTS.get(name)
     if isinstance(default, str):
         return f"NaN: not given, the model then takes the value of {default}"

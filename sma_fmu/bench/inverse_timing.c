@@ -1,0 +1,85 @@
+/*
+ * inverse_timing.c - what one temperature-sensing inversion costs in the C runtime, for
+ * `sma-fmu bench --only inverse` (sma_fmu/bench/inverse.py).
+ *
+ * Reads from stdin: the wire's values in PARAMETER_SPECS order ("nan" = not given), the load
+ * [kg], the direction (+1/-1), the number of passes, the number of targets K and K pairs
+ * (xi_MF, xi_P) [1]. Each pass inverts every target with temperature_of_fractions (the
+ * branch constants built once, as a compensator at a steady load does) and prints one line:
+ * the pass's CPU time [ns per inversion] and the sum of the sensed temperatures [degC] (which
+ * keeps the compiler from dropping the work). A refusal prints it on stderr, exit 1.
+ */
+#define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "constant_load.h"
+#include "parameters.h"
+#include "sensing.h"
+
+/* This process's CPU time [s] (the machine may be shared). */
+static double seconds_now(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+}
+
+static int read_double(double *value)
+{
+    if (scanf("%lf", value) != 1) {
+        fprintf(stderr, "inverse_timing: input ends early\n");
+        return 1;
+    }
+    return 0;
+}
+
+int main(void)
+{
+    static double values[PARAM_COUNT];
+    WireParameters params;
+    BranchConstants constants;
+    SensedTemperature sensed;
+    SmaMessage message;
+    double load, direction, passes, count, *targets, start, sum;
+    long i, pass, k;
+    for (i = 0; i < PARAM_COUNT; i++) {
+        if (read_double(&values[i])) {
+            return 1;
+        }
+    }
+    if (read_double(&load) || read_double(&direction) || read_double(&passes)
+        || read_double(&count) || count < 1.0 || count > 1e7) {
+        return 1;
+    }
+    targets = malloc(2 * (size_t)count * sizeof *targets);
+    if (targets == NULL) {
+        return 1;
+    }
+    for (k = 0; k < 2 * (long)count; k++) {
+        if (read_double(&targets[k])) {
+            return 1;
+        }
+    }
+    if (wire_parameters_from_values(&params, values, &message)
+        || branch_constants(load, direction > 0.0 ? 1 : -1, &params, &constants, &message)) {
+        fprintf(stderr, "%s\n", message.text);
+        return 1;
+    }
+    for (pass = 0; pass < (long)passes; pass++) {
+        sum = 0.0;
+        start = seconds_now();
+        for (k = 0; k < (long)count; k++) {
+            if (temperature_of_fractions(targets[2 * k], targets[2 * k + 1], &constants,
+                                         params.saturation_margin, &sensed, &message)) {
+                fprintf(stderr, "%s\n", message.text);
+                return 1;
+            }
+            sum += sensed.temperature;
+        }
+        printf("%.6f %.17g\n", (seconds_now() - start) / count * 1e9, sum);
+    }
+    free(targets);
+    return 0;
+}
