@@ -33,7 +33,8 @@ def _wire(args, parameter_set):
     from sma_fmu.runtime.parameters import PARAMETER_SPECS
 
     params = parameter_set.params
-    rows = [("name", parameter_set.name, ""), ("file", str(parameter_set.path), "")]
+    rows = [("name", parameter_set.name, ""), ("file", str(parameter_set.path), ""),
+            ("digest", parameter_set.digest, "")]
     for spec in PARAMETER_SPECS:
         value = getattr(params, spec.name)
         if value is not None:

@@ -125,15 +125,20 @@ def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped
     ``overall``, ``reachable`` and each of ``segments`` (one per load segment, in order) are
     :func:`error_metrics` dicts; the fractions [1] are shares of the metrics window;
     ``intervals`` are the :func:`unreachable_intervals` of the whole run. Adds the header
-    (scenario, controller, window), each segment's times and load, and the warning.
+    (scenario, controller, the wire: its parameter file and digest, and the compensator's
+    model where a study gives it other values, window), each segment's times and load, and
+    the warning.
     """
     metrics_start = scenario.analysis.metrics_start_s
     warning = reachability_warning(intervals, unreachable_fraction)
+    model = scenario.compensator_parameter_set
     return {
         "scenario": scenario.name,
         "controller": scenario.controller.kind,
         "inverse": scenario.controller.inverse if scenario.controller.feedforward else None,
         "hysteresis_mode": scenario.hysteresis_mode,
+        "wire": scenario.parameter_set.record(),
+        **({} if model is None else {"compensator_wire": model.record()}),
         "window": f"t >= {metrics_start:g} s",
         "metrics_start_s": metrics_start,
         "overall": overall,

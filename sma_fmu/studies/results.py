@@ -47,12 +47,15 @@ def _statistics(values):
 
 
 def summary(spec, table):
-    """Counts, and per base scenario the RMSE statistics [ohm] and the best run's inputs."""
+    """Counts, and per base scenario its wire (parameter file and digest: the runs' rows
+    give each run's own, drawn values included), the RMSE statistics [ohm] and the best
+    run's inputs."""
     counts = {status: int((table["status"] == status).sum()) for status in ("ok", "failed", "error")}
     scenarios = {}
+    wires = {t.name: t.parameter_set.record() for t in spec.templates}
     for name, rows in table.groupby("scenario", sort=False):
         ok = rows[rows["status"] == "ok"]
-        entry = {"runs": int(len(rows)), "ok": int(len(ok)),
+        entry = {"runs": int(len(rows)), "ok": int(len(ok)), "wire": wires.get(name),
                  "rmse_ohm": _statistics(ok["rmse_ohm"].to_numpy(dtype=float)) if len(ok) else None}
         if len(ok):
             best = ok.loc[ok["rmse_ohm"].idxmin()]

@@ -37,11 +37,14 @@ def timeseries_frame(data):
 
 
 def metrics_record(metrics):
-    """A :func:`scenario_metrics` record flattened to one row: overall metrics, the saturated,
+    """A :func:`scenario_metrics` record flattened to one row: the wire the run ran
+    (``wire_file``, "" for none, and ``wire_digest``), overall metrics, the saturated,
     clamped and unreachable fractions, and per load segment ``segment{i}_load_kg`` and
     ``segment{i}_rmse_ohm``."""
-    row = {f"{name}": metrics["overall"][name]
-           for name in ("rmse_ohm", "max_abs_ohm", "iae_ohm_s", "samples")}
+    wire = metrics["wire"]
+    row = {"wire_file": wire["file"] or "", "wire_digest": wire["digest"]}
+    row.update({f"{name}": metrics["overall"][name]
+                for name in ("rmse_ohm", "max_abs_ohm", "iae_ohm_s", "samples")})
     for name in ("saturated_fraction", "clamped_fraction", "unreachable_fraction"):
         row[name] = metrics.get(name)
     for index, segment in enumerate(metrics["segments"]):

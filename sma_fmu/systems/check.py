@@ -11,6 +11,10 @@ Per FMU (a container is an FMU; the FMUs inside an SSP are checked one by one):
 - ``default experiment``: the FMU's default experiment run again in fmpy gives the
   reference result it carries (:mod:`sma_fmu.fmi.packaging.reference_results`, the fmi-ls-ref layout);
   "n/a" without one, or for an FMU an export packed with a scenario's values.
+- ``wire``: the digest of the wire the FMU was built from, as its model description states
+  it (the String constant ``wire_digest``) and as its resources hold it (parameters.json's
+  values; a C-family FMU's model_starts.json too): FAIL where they differ, "n/a" for an FMU
+  without a wire (a container).
 Per SSP also ``SSD schema``: SystemStructure.ssd against the SSP 1.0 schemas (fmpy's
 copy); ``packed defaults``: the FMUs' packed start values agree with their model
 descriptions and the SSD's bindings; one ``host ...`` line per known host
@@ -35,6 +39,7 @@ from pathlib import Path
 
 from sma_fmu.files.archives import inspect_archive
 from sma_fmu.fmi.packaging.reference_results import reference_check
+from sma_fmu.fmi.python_family.slave_support.wire_use import WIRE_DIGEST
 from sma_fmu.systems.c_host import run_c_host
 from sma_fmu.systems.host_needs import KNOWN_HOSTS, host_check, packed_defaults_check, read_ssp
 from sma_fmu.systems.packed import START_VALUES_ENTRY
@@ -45,6 +50,7 @@ __all__ = ["CheckResult", "SHORT_RUN_STEPS", "archive_results", "check_file", "c
            "format_result"]
 
 SHORT_RUN_STEPS = 100   # steps of the C-host run
+_MODEL_STARTS = "resources/model_starts.json"   # a C-family FMU's build starts
 STATE_STEPS = 20        # steps before and after saving the state
 _DEFAULT_STEP_S = 1e-3  # when the file names no step size
 
@@ -187,6 +193,30 @@ def _state_round_trip3(path, description):
             else ("FAIL", f"{STATE_STEPS} steps after restoring the state differ from the first run"))
 
 
+def _wire(path, description):
+    """The FMU's wire digest, stated by its model description and held by its resources."""
+    import json
+
+    from sma_fmu.fmi.loop.wire_values import built_wire
+
+    stated = next((v.start for v in description.modelVariables if v.name == WIRE_DIGEST), None)
+    built = built_wire(path)
+    with zipfile.ZipFile(path) as archive:
+        starts = json.loads(archive.read(_MODEL_STARTS)) if _MODEL_STARTS in archive.namelist() \
+            else {}
+    if stated is None and built.params is None:
+        return "n/a", "the FMU states no wire and holds no resources/parameters.json"
+    held = {"resources/parameters.json": built.digest}
+    if "wire_digest" in starts:
+        held[_MODEL_STARTS] = starts["wire_digest"]
+    if stated is not None:
+        held["modelDescription.xml"] = stated
+    if len(set(held.values())) != 1:
+        return "FAIL", "; ".join(f"{where} says {digest}" for where, digest in held.items())
+    how = "" if stated is not None else " (the model description states none: an older build)"
+    return "ok", f"{built.digest} of {built.source}{how}"
+
+
 def _c_host_run(path, description):
     """The C host's short run; n/a for FMI 3.0 (libcosim runs FMI 1.0 and 2.0 only)."""
     if description.fmiVersion.startswith("3"):
@@ -201,7 +231,8 @@ def _fmu_checks(path, label, c_host=True):
     # would have alone (exceptions are not cached)
     description = functools.cache(lambda: read_model_description(str(path)))
     results = [_run(label, "fmpy validation", lambda: _fmpy_validation(path)),
-               _run(label, "FMI checker", lambda: _toolbox_checker(path))]
+               _run(label, "FMI checker", lambda: _toolbox_checker(path)),
+               _run(label, "wire", lambda: _wire(path, description()))]
     if c_host:
         results.append(_run(label, "C host (libcosim)", lambda: _c_host_run(path, description())))
     results.append(_run(label, "state round trip", lambda: _state_round_trip(path, description())))

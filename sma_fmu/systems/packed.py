@@ -16,6 +16,7 @@ host runs the scenario whatever it binds. :func:`fmu_defaults` reads both places
 """
 import io
 import json
+import math
 import zipfile
 import xml.etree.ElementTree as ET
 
@@ -48,6 +49,12 @@ def _set_starts(root, values, label):
         if variable is None or variable.get("causality") != "parameter":
             raise ValueError(f"{label}: has no parameter {name!r}")
         element, kind = _typed(variable)
+        if kind == "Real" and isinstance(value, float) and math.isnan(value):
+            raise ValueError(
+                f"{label}: the scenario's wire does not give {name}, which the FMU was built "
+                f"with (start {element.get('start')}): an export packs no \"not given\" (NaN) "
+                f"for hosts to bind; build the FMUs from the scenario's parameter file "
+                f"(sma-fmu build --model FILE) and export again")
         value = start_value(kind, value, f"{label}: {name}")
         element.set("start", start_value_text(kind, value))
         packed[name] = value

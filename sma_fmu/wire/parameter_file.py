@@ -21,6 +21,7 @@ from sma_fmu.files.package_data import default_parameter_file
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError, WireParameters
+from sma_fmu.runtime.wire_identity import wire_digest
 from sma_fmu.files.toml_files import read_toml
 from sma_fmu.wire.geometry import DERIVABLE, GEOMETRY_INPUTS, complete_from_geometry
 
@@ -43,11 +44,24 @@ class ParameterSet:
     path: Path = None
     derived: dict = field(default_factory=dict)  # {name: how it was derived} (wire_geometry)
 
+    @property
+    def digest(self):
+        """The wire's identity, ``"sha256:..."`` of its canonical values
+        (:func:`~sma_fmu.runtime.wire_identity.wire_digest`)."""
+        return wire_digest(self.params)
+
+    def record(self):
+        """{"file": the parameter file's path (or None), "digest": :attr:`digest`}: how a run
+        names the wire it ran."""
+        return {"file": None if self.path is None else str(self.path), "digest": self.digest}
+
     def as_json(self):
-        """JSON-ready dict {name, description, parameters: {key: {value, unit, meaning}}}."""
+        """JSON-ready dict {name, description, wire_digest, parameters: {key: {value, unit,
+        meaning}}}."""
         return {
             "name": self.name,
             "description": self.description,
+            "wire_digest": self.digest,
             "parameters": {
                 spec.name: {"value": getattr(self.params, spec.name), "unit": spec.unit,
                             "meaning": self.meanings.get(spec.name, "")}

@@ -47,10 +47,11 @@ def _text(body, at):
 
 def c_offsets(blob, variables):
     """{variable name or stepper entry index: byte offset of its value in ``blob``}, a C-family
-    state (c_family/core/layer_state_bytes.c: header, model, GUID, format, calling state,
-    four times, three flags, initial_error, the variables, the stepper's doubles)."""
+    state (c_family/core/layer_state_bytes.c: header, model, wire digest, GUID, format,
+    calling state, four times, three flags, initial_error, the variables, the stepper's
+    doubles)."""
     body, at, where = blob[HEADER:], 16, {}
-    for _ in range(3):
+    for _ in range(4):
         at = _text(body, at)
     at = _text(body, at + 4 + 4 * 8 + 3)
     assert struct.unpack_from("<I", body, at)[0] == len(variables)

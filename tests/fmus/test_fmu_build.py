@@ -1,4 +1,5 @@
 """The built FMUs: fmpy validation, declared interface, shipped code, CLI build/validate."""
+import math
 import zipfile
 
 import pytest
@@ -73,7 +74,10 @@ def test_feedforward_interface(fmus, parameter_set):
     assert variables["saturated"].type == "Boolean"
     assert variables["adapt_to_load"].start == "true"
     params = parameter_set.params
-    assert float(variables["alpha"].start) == params.tau_th
+    # alpha is not in the reference file: NaN, "not given", the thermal time constant
+    assert math.isnan(float(variables["alpha"].start)) and params.alpha is None
+    assert "the thermal time constant" in variables["alpha"].description
+    assert float(variables["T_max"].start) == params.T_max   # the compensator bounds T_ref by it
     assert (float(variables["beta"].start), variables["beta"].unit) == (params.beta, "s")
     assert float(variables["model_load"].start) == 0.05 == params.model_load
     band = reachable_band(params.model_load, params)

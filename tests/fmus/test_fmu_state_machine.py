@@ -157,7 +157,7 @@ def test_states_of_another_build_or_corrupt_ones_are_refused(fmus, tmp_path, par
     own = bytes(plant.fmu.serializeFMUstate(plant.fmu.getFMUstate()))
     before = plant.get("R", "T", "R_P")
     state = plant.fmu.deSerializeFMUstate(foreign)  # a well-formed state ...
-    plant.refused(plant.fmu.setFMUstate, state, words=["another FMU build"])  # ... of another build
+    plant.refused(plant.fmu.setFMUstate, state, words=["another wire"])  # ... of another wire
     document = json.loads(own[20:])
     for corrupt in ({**document, "__stepper__": {**document["__stepper__"], "temperature": "hot"}},
                     {k: v for k, v in document.items() if k != "T_start"},

@@ -1,13 +1,15 @@
 """Reproducible builds (sma_fmu/fmi/packaging/reproducible.py): two builds of the same inputs
-give byte-identical FMU files, in both families; the C family's GUID is the model's
-structure's (start values do not count), the Python family's its content's."""
+give byte-identical FMU files, in both families; the C family's binary holds the model's
+structure's GUID (start values do not count) and its model description the token of that
+structure and the wire's digest, the Python family's GUID is its content's."""
+import json
 import tempfile
 import zipfile
 
 import pytest
 
 from sma_fmu import __version__
-from sma_fmu.fmi.packaging.reproducible import fixed_date_time, structural_guid
+from sma_fmu.fmi.packaging.reproducible import fixed_date_time, structural_guid, wire_token
 
 DESCRIPTION = b"""<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="2.0" modelName="M" guid="{x}" generationDateAndTime="2026-01-01">
@@ -60,7 +62,10 @@ def test_two_builds_give_the_same_bytes(fmus, native_fmus, tmp_path, native, mon
             description = archive.read("modelDescription.xml")
         assert b"generationDateAndTime" not in description
         if native:
-            assert structural_guid(description, __version__).encode() in description
+            with zipfile.ZipFile(path) as archive:
+                digest = json.loads(archive.read("resources/parameters.json"))["wire_digest"]
+            token = wire_token(structural_guid(description, __version__), digest)
+            assert f'guid="{token}"'.encode() in description
 
 
 @pytest.mark.needs("gcc")
@@ -80,5 +85,6 @@ def test_another_parameter_file_gives_the_same_c_family_binaries(native_fmus, tm
             assert first.read(name) == second.read(name), name
         assert first.read("resources/model_starts.json") != second.read("resources/model_starts.json")
         assert b'"R_P"' in first.read("resources/parameters.json")
+    # the model description's GUID names the wire: another parameter file, another GUID
     from fmpy import read_model_description
-    assert read_model_description(str(built)).guid == read_model_description(str(native_fmus["SmaActuator"])).guid
+    assert read_model_description(str(built)).guid != read_model_description(str(native_fmus["SmaActuator"])).guid

@@ -2,6 +2,7 @@
 and the compensator FMUs of both families and both FMI versions log one warning per instance
 when a run leaves that range (naming the bound and its value, the same text everywhere), and
 run on; a run that stays inside it logs none."""
+import math
 import re
 
 import pytest
@@ -119,3 +120,38 @@ def test_the_compensator_warns_once_per_instance_about_a_load_outside_the_data(f
         f"load = 0.5 kg is above {params.load_data_max:.4g} kg (validity.stress_data_max = "
         f"200 MPa on a 0.15 mm wire): {DATA_RANGE_NOTE}"), first
     assert texts["nat"] == first and texts["fmi3"] == first
+
+
+def test_the_data_range_is_a_wire_parameter_every_family_takes(families, fmus, native_fmus,
+                                                               fmi3_fmus, range_file):
+    """FMUs built from a wire without a data range expose its bounds as NaN (not given) and,
+    given the range as parameters, warn as those built from the ranged wire do: the range is
+    part of the wire a master sets whole."""
+    params = load_parameters(range_file)
+    bounds = {name: getattr(params, name) for name in
+              ("T_data_min", "T_data_max", "stress_data_min", "stress_data_max")}
+    heavy = 0.5
+    band = reachable_band(0.15, params)
+    built = {"py": fmus, "nat": native_fmus, "fmi3": fmi3_fmus}
+    texts = {}
+    for kind in KINDS:
+        for source, paths, values in (("ranged", families[kind], {}), ("set", built[kind], bounds)):
+            path = paths["SmaFeedforward"]
+            side = (Instance3 if kind == "fmi3" else Instance)(path, f"range-set-{kind}-{source}")
+            try:
+                if source == "set":
+                    assert all(math.isnan(float(side.variables[name].start)) for name in bounds), kind
+                start = {"R_ref": 0.5 * (band.hot + band.cold), "load": 0.15, **values}
+                assert side.start(start) == 0, side.log[-2:]
+                time = 0.0
+                for load in (0.15, heavy):
+                    side.set("load", load)
+                    for _ in range(20):
+                        assert side.step(time, 1e-3) <= 1, side.log[-2:]
+                        time += 1e-3
+                texts[kind, source] = _data_warnings(side.log)
+            finally:
+                side.close()
+    first = texts["py", "ranged"]
+    assert len(first) == 1 and "validity.stress_data_max = 200 MPa" in first[0], first
+    assert all(found == first for found in texts.values()), texts

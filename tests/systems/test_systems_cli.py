@@ -13,6 +13,7 @@ from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.ssp import write_ssp
 from sma_fmu.files.output_folder import MARKER
+from sma_fmu.wire.parameter_file import load_parameter_set
 from system_needs import needs
 
 
@@ -70,11 +71,14 @@ def test_check_passes_on_everything_built(fmus, exported, capsys):
     assert main(["check", *map(str, files)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert not [line for line in lines if line.startswith("FAIL")]
-    for path in fmus.values():  # five checks and two platforms per FMU, each passed
+    for path in fmus.values():  # six checks and two platforms per FMU, each passed
         assert [line.split(": ")[1] for line in lines if line.startswith(f"ok    {path}:")] == [
-            "fmpy validation", "FMI checker", "C host (libcosim)", "state round trip",
+            "fmpy validation", "FMI checker", "wire", "C host (libcosim)", "state round trip",
             "default experiment", "platform linux64", "platform win64"]
+        digest = load_parameter_set().digest   # each FMU's wire, printed
+        assert f"ok    {path}: wire: {digest} of " in "\n".join(lines)
     container = exported / "heavy-pi.fmu"
+    assert f"n/a   {container}: wire: the FMU states no wire and holds no resources/parameters.json" in lines
     assert f"n/a   {container}: state round trip: the FMU does not declare canGetAndSetFMUstate" in lines
     assert any(line.startswith(f"n/a   {container}: default experiment: no ") for line in lines)
     assert any(line.startswith("ok") and "SSD schema" in line for line in lines)

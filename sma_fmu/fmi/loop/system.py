@@ -2,11 +2,12 @@
 
 :func:`loop_system` puts it together once: the components (which FMUs the scenario needs,
 :func:`~.wiring.loop_components`), each with its FMU file, its model variables and its
-parameter values (the wire parameters the FMU exposes, then the scenario's settings,
-:mod:`.values`), the connections and outputs (:mod:`.wiring`) and the wire the values come
-from. The fmpy master (:mod:`sma_fmu.cosim.master`), the C master, the SSP package and the
-container FMU (:mod:`sma_fmu.systems`) all run or write what it says, so they wire and
-parameterise the loop alike; :func:`check_variables` says whether the FMUs fit it.
+parameter values (the scenario's whole wire as the FMU takes it, :mod:`.wire_values`, then
+the scenario's settings, :mod:`.values`), the connections and outputs (:mod:`.wiring`) and
+the wire the values come from (its file and digest). The fmpy master
+(:mod:`sma_fmu.cosim.master`), the C master, the SSP package and the container FMU
+(:mod:`sma_fmu.systems`) all run or write what it says, so they wire and parameterise the
+loop alike; :func:`check_variables` says whether the FMUs fit it.
 """
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -14,8 +15,10 @@ from pathlib import Path
 
 from sma_fmu.fmi.driving.description import read_description
 from sma_fmu.fmi.loop.values import component_settings, input_starts, wire_of
+from sma_fmu.fmi.loop.wire_values import built_wire, mismatch_error, wire_values
 from sma_fmu.fmi.loop.wiring import (COMPONENT_MODELS, STEP_ORDER, loop_components,
                                      loop_connections, loop_outputs)
+from sma_fmu.runtime.wire_identity import wire_digest
 
 __all__ = ["MissingFmuError", "Component", "WireSource", "LoopSystem", "loop_system",
            "built_fmus", "check_variables"]
@@ -45,11 +48,16 @@ class Component:
 @dataclass(frozen=True)
 class WireSource:
     """Where a loop's wire parameter values come from: the ``parameter_file`` (a study may
-    change values of it), and ``digest``, the place for a digest of the values themselves
-    (not computed yet: None)."""
+    change values of it), and ``digest``, the digest of the values themselves
+    (:func:`~sma_fmu.runtime.wire_identity.wire_digest`)."""
 
     parameter_file: object
     digest: str = None
+
+    def record(self):
+        """{"file", "digest"}, as a run records its wire."""
+        return {"file": None if self.parameter_file is None else str(self.parameter_file),
+                "digest": self.digest}
 
 
 @dataclass(frozen=True)
@@ -104,18 +112,22 @@ def _read_fmu(version):
     return {v.name: v for v in description.modelVariables}, description.fmiVersion.split(".")[0]
 
 
-def _wire_values(variables, params):
-    """{name: value} of every wire parameter in ``params`` the FMU exposes as a parameter
-    (``variables``: its model variables, in their order)."""
-    values = params.values()
-    return {v.name: values[v.name] for v in variables.values()
-            if v.causality == "parameter" and v.name in values}
+@lru_cache(maxsize=64)
+def _built_wire(version):
+    """The :class:`~.wire_values.BuiltWire` of the FMU file ``version`` (:func:`_version`)."""
+    return built_wire(version[0])
 
 
-def _component(scenario, name, path, starts):
+def _component(scenario, name, path, starts, sources):
     variables, version = _read_fmu(_version(path))
     wire = wire_of(scenario, name)
-    values = {} if wire is None else _wire_values(variables, wire)
+    values = {}
+    if wire is not None:
+        model = COMPONENT_MODELS[name]
+        values, refused = wire_values(model, variables, wire, lambda: _built_wire(_version(path)))
+        if refused:
+            raise mismatch_error(path, model, refused, sources[name].record(),
+                                 _built_wire(_version(path)))
     values.update(component_settings(scenario, name))
     return Component(name, COMPONENT_MODELS[name], path, values, dict(variables), version,
                      starts.get(name, {}))
@@ -131,14 +143,17 @@ def loop_system(scenario, fmu_files, only=None):
     paths = built_fmus(fmu_files, [COMPONENT_MODELS[name] for name in names])
     connections = loop_connections(feedforward, pwm)
     starts = input_starts(scenario, connections)
-    components = tuple(_component(scenario, name, paths[COMPONENT_MODELS[name]], starts)
+    wire = WireSource(scenario.parameter_set.path, wire_digest(scenario.params))
+    model = WireSource((scenario.compensator_parameter_set or scenario.parameter_set).path,
+                       wire_digest(scenario.compensator_params))
+    sources = {"plant": wire, "compensator": model}
+    components = tuple(_component(scenario, name, paths[COMPONENT_MODELS[name]], starts, sources)
                        for name in names)
     outputs = {column: source for column, source in loop_outputs(feedforward).items()
                if source[0] in names}
     return LoopSystem(scenario, components,
                       tuple(c for c in connections if c.source in names and c.target in names),
-                      outputs, WireSource(scenario.parameter_set.path),
-                      WireSource((scenario.compensator_parameter_set or scenario.parameter_set).path))
+                      outputs, wire, model)
 
 
 def _need(component, name, causality, types, why):

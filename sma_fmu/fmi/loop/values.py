@@ -1,8 +1,8 @@
 """What a scenario sets in each component of its loop: parameter values and input starts.
 
 Computed here once for every master and system tool. Each component's parameters are,
-besides the wire parameters its FMU exposes (:data:`WIRES`, filtered by the FMU in
-:mod:`.system`): the signals as JSON tables (SmaScenarioSignals), the compensator's
+besides the scenario's wire in the FMUs that model it (:data:`WIRES`, set whole by
+:mod:`.wire_values`): the signals as JSON tables (SmaScenarioSignals), the compensator's
 filter, model load, adaptation, inverse, shaping and power cap (0 W: none), the PI's gains
 (:data:`~.gains.GAINS`), the driver's frequency and peak power, the plant's start
 temperature and hysteresis mode.

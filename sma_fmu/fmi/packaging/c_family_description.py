@@ -4,28 +4,33 @@ A native FMU must drop in for its pythonfmu twin (an SSP or a container made wit
 family runs with the other), so nothing about its interface is written twice: the model
 description is the one ``sma-fmu build`` writes, with only what makes it native changed:
 
-- ``guid`` (:func:`~.reproducible.structural_guid`: the same for every parameter file),
-  ``generationTool``, no ``generationDateAndTime``;
+- ``guid``: :func:`~.reproducible.wire_token` of the structure and the wire's digest (the
+  binary holds only the structure's :func:`~.reproducible.structural_guid`, the same for
+  every parameter file), ``generationTool``, no ``generationDateAndTime``;
 - the ``CoSimulation`` element: ``needsExecutionTool="false"``, saved and serialized states,
   and ``<SourceFiles>``;
 - the ``start`` of every Real as the exact value the Python slave starts with (``repr``:
-  pythonfmu writes 15 digits, so ``41.4726014989086`` becomes ``41.47260149890864``);
+  pythonfmu writes 15 digits, so ``41.4726014989086`` becomes ``41.47260149890864``; NaN,
+  an optional wire parameter not given, as ``NaN``);
 - the platforms annotation (:mod:`sma_fmu.fmi.packaging.platforms`): native binaries, no Python.
 
 The C header ``<Model>_variables.h`` (:func:`variables_header`) holds the same variables
 (value reference, name, type, causality, variability, unit) as an enum ``VAR_<name>`` and a table
 the layer uses: the structure only, so one binary serves every parameter file. The start
-values travel in ``resources/model_starts.json`` (:func:`model_starts`): the exact start of
-every variable, and the wire parameter file the FMU was built with, in PARAMETER_SPECS order
-(null where Python's value is None), for the parameters the FMU does not expose. An adapter
-that names a variable the FMU does not have does not compile.
+values travel in ``resources/model_starts.json`` (:func:`model_starts`): the build's identity
+(the structure, the token, the wire's digest), the exact start of every variable (null: NaN),
+and the wire parameter file the FMU was built with, in PARAMETER_SPECS order (null where
+Python's value is None), for the parameters the FMU does not expose. An adapter that names
+a variable the FMU does not have does not compile.
 """
 import json
 import math
 import xml.etree.ElementTree as ET
 
 from sma_fmu import __version__
-from sma_fmu.fmi.packaging.reproducible import structural_guid
+from sma_fmu.fmi.packaging.reproducible import structural_guid, wire_token
+from sma_fmu.fmi.python_family.slave_support.start_values import start_value_text
+from sma_fmu.fmi.python_family.slave_support.wire_use import WIRE_DIGEST
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 
 __all__ = ["LOG_CATEGORIES", "native_description", "variables_header", "model_starts", "c_string"]
@@ -54,7 +59,8 @@ def native_description(python_description, starts, source_files):
     (bytes); ``starts`` {name: exact start value}; ``source_files`` the names in sources/.
     Returns (bytes, guid)."""
     root = ET.fromstring(python_description)
-    guid = structural_guid(root, __version__)  # one per structure: reproducible builds
+    # one per structure and wire: reproducible builds, a binary for every wire
+    guid = wire_token(structural_guid(root, __version__), starts[WIRE_DIGEST])
     root.set("guid", guid)
     root.attrib.pop("generationDateAndTime", None)
     root.set("generationTool", f"sma-fmu {__version__} (build --native: C99, no Python)")
@@ -74,7 +80,7 @@ def native_description(python_description, starts, source_files):
                          f"layer's {list(LOG_CATEGORIES)}")
     for variable, typed in _variables(root):
         if typed.tag == "Real" and typed.get("start") is not None:
-            typed.set("start", repr(float(starts[variable.get("name")])))
+            typed.set("start", start_value_text("Real", float(starts[variable.get("name")])))
     vendor = root.find("VendorAnnotations")
     if vendor is not None:
         root.remove(vendor)  # the front's platforms: annotated again for the native binaries
@@ -115,15 +121,15 @@ def variables_header(description):
     structure only (no start value: those are in :func:`model_starts`), so the binary is
     the same for every parameter file."""
     root = ET.fromstring(description)
-    model, guid = root.get("modelName"), root.get("guid")
+    model, guid = root.get("modelName"), structural_guid(root, __version__)
     spec_index = {spec.name: i for i, spec in enumerate(PARAMETER_SPECS)}
     rows, names = [], []
     for variable, typed in _variables(root):
         name = variable.get("name")
         causality = variable.get("causality")
         variability = variable.get("variability")
-        if causality not in ("parameter", "input", "output") or \
-                variability not in ("fixed", "tunable", "discrete", "continuous"):
+        if causality not in ("parameter", "input", "output", "local") or \
+                variability not in ("fixed", "tunable", "discrete", "continuous", "constant"):
             raise ValueError(f"{model}: variable {name} is a {variability} {causality}")
         wire = spec_index.get(name, -1) if causality == "parameter" else -1
         unit = typed.get("unit")
@@ -144,9 +150,11 @@ def variables_header(description):
 
 
 def model_starts(description, starts, wire_defaults):
-    """Text of ``resources/model_starts.json``: the exact start of every variable of the
-    native model ``description`` (bytes), and ``wire_defaults`` (the WireParameters of the
-    build's parameter file, or None) in PARAMETER_SPECS order, null where Python's is None."""
+    """Text of ``resources/model_starts.json``: the build's identity (``structure``, the
+    binary's GUID; ``token``, the model description's; ``wire_digest``), the exact start of
+    every variable of the native model ``description`` (bytes; null for a NaN, an optional
+    wire parameter not given), and ``wire_defaults`` (the WireParameters of the build's
+    parameter file, or None) in PARAMETER_SPECS order, null where Python's is None."""
     root = ET.fromstring(description)
     values = {}
     for variable, typed in _variables(root):
@@ -158,11 +166,15 @@ def model_starts(description, starts, wire_defaults):
             values[name] = bool(start)
         elif typed.tag == "Integer":
             values[name] = int(start or 0)
+        elif start is not None and math.isnan(start):
+            values[name] = None
         else:
             values[name] = float(_number(0.0 if start is None else start))
     wire = [] if wire_defaults is None else \
         [None if getattr(wire_defaults, spec.name) is None else float(_number(getattr(wire_defaults, spec.name)))
          for spec in PARAMETER_SPECS]
-    document = {"format": "sma-fmu C-family start values 1", "model": root.get("modelName"),
-                "values": values, "wire_defaults": wire}
+    document = {"format": "sma-fmu C-family start values 2", "model": root.get("modelName"),
+                "structure": structural_guid(root, __version__),
+                "token": root.get("guid") or root.get("instantiationToken"),
+                "wire_digest": starts[WIRE_DIGEST], "values": values, "wire_defaults": wire}
     return json.dumps(document, indent=1, allow_nan=False) + "\n"

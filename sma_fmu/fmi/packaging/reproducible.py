@@ -3,10 +3,13 @@
 Three things made builds differ, and each is fixed here:
 
 - the GUID: pythonfmu draws one at random (uuid1), the C family drew one too. The C family's
-  is :func:`structural_guid`: a name-based UUID (uuid5) of the model's structure (name,
-  identifier, and each variable's value reference, name, type, causality, variability,
-  initial) and the layer's version, so it is the same for every parameter file, and a
-  state saved by one build is taken by another of the same structure. The Python family's
+  binary holds :func:`structural_guid`: a name-based UUID (uuid5) of the model's structure
+  (name, identifier, and each variable's value reference, name, type, causality,
+  variability, initial) and the layer's version, the same for every parameter file, so one
+  binary serves them all; its model description's GUID (instantiation token) is
+  :func:`wire_token`, a uuid5 of that structure and the wire's digest, which its resources
+  record too: a host that pairs a model description with another build's resources folder
+  is refused (docs/fmus.md, "One wire"). The Python family's
   is :func:`content_guid`: a uuid5 of everything the FMU holds, its parameter file
   included, because its saved states refuse another parameter file by the GUID;
 - ``generationDateAndTime``, dropped (optional in FMI 2.0 and 3.0);
@@ -24,7 +27,7 @@ import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
-__all__ = ["GUID_NAMESPACE", "structural_guid", "content_guid", "stable_description",
+__all__ = ["GUID_NAMESPACE", "structural_guid", "wire_token", "content_guid", "stable_description",
            "fixed_date_time", "fix_timestamps"]
 
 GUID_NAMESPACE = uuid.UUID("5b6c3e0e-7d0c-5f43-9a51-736d612d666d")  # sma-fmu's, fixed once
@@ -51,6 +54,12 @@ def structural_guid(description, layer_version):
                               ("valueReference", "name", "causality", "variability", "initial"))
                      + f" type={typed}")
     return "{" + str(uuid.uuid5(GUID_NAMESPACE, "\n".join(parts))) + "}"
+
+
+def wire_token(structure, digest):
+    """``{uuid}`` of a C-family build: its ``structure`` (:func:`structural_guid`) and its
+    wire's ``digest`` (:func:`~sma_fmu.runtime.wire_identity.wire_digest`)."""
+    return "{" + str(uuid.uuid5(GUID_NAMESPACE, f"{structure}\nwire {digest}")) + "}"
 
 
 def content_guid(fmu_path):

@@ -11,6 +11,9 @@ with its equations and numbers when the wire switches it on, named as off when n
 ``${inverse}``, how the compensator inverts this wire's branch; ``${data_range}``, the range
 the wire's data covered.
 
+:func:`wire_section` names the wire the FMU was built from: its parameter file and the
+digest of its values, which the model description states too (``wire_digest``).
+
 :func:`loop_section` says how to connect the FMU in the closed loop: the connections of
 :func:`sma_fmu.fmi.loop.wiring.loop_connections` that touch the model, and its place in
 the Gauss-Seidel order :data:`~sma_fmu.fmi.loop.wiring.STEP_ORDER`.
@@ -22,7 +25,7 @@ from sma_fmu.fmi.models import REGISTRY, declaration
 from sma_fmu.fmi.packaging.term_pages import field, page_blocks
 from sma_fmu.fmi.loop.wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
 
-__all__ = ["limits", "page_template", "model_section", "loop_section"]
+__all__ = ["limits", "page_template", "model_section", "wire_section", "loop_section"]
 
 
 def limits(params):
@@ -64,6 +67,24 @@ def model_section(model_name, params):
     fields = {name: field(name, value, unit) for name, (value, unit) in limits(params).items()}
     fields.update(page_blocks(params))   # the model terms, the inverse, the data range
     return template.substitute(fields)   # a field the page names and limits() lacks: KeyError
+
+
+def wire_section(document):
+    """The HTML naming the wire of a parameters.json ``document`` (the FMU's): its name, its
+    parameter file and its digest; "" without one."""
+    if document is None:
+        return ""
+    from sma_fmu.runtime.parameters import WireParameters
+    from sma_fmu.runtime.wire_identity import wire_digest
+
+    e = html.escape
+    params = WireParameters.from_values({name: entry["value"] for name, entry
+                                         in document["parameters"].items()})
+    return (f'<p class="wire">Wire: {e(str(document.get("name", "")))}, from the parameter file '
+            f'<code class="wire-file">{e(str(document.get("source", "")))}</code>; digest '
+            f'<code class="wire-digest">{e(wire_digest(params))}</code> (SHA-256 of its values, '
+            "as the String constant <code>wire_digest</code> states it). A master sets a "
+            "scenario's whole wire in the FMU: an optional parameter at NaN is not given.</p>")
 
 
 def _connection_rows(model_name):

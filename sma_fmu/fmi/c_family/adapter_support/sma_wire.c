@@ -5,6 +5,18 @@
 
 #include "sma_wire.h"
 
+/* May the parameter `index` be not given (NaN in its variable)? The optional ones without a
+ * number as default (alpha and the model terms; wire_use.NULLABLE): memory_depth and
+ * stress_max have one, so a NaN there is a value, refused by its rule. */
+static int nullable(int index)
+{
+    if (PARAMETER_SPECS[index].required) return 0;
+#define SMA_HAS_DEFAULT(name, number) if (index == PARAM_##name) return 0;
+    SMA_PARAMETER_DEFAULTS(SMA_HAS_DEFAULT)
+#undef SMA_HAS_DEFAULT
+    return 1;
+}
+
 int sma_wire_parameters(const SmaModel *model, const SmaValue *values, const SmaRun *run,
                         WireParameters *out, SmaMessage *message)
 {
@@ -19,11 +31,12 @@ int sma_wire_parameters(const SmaModel *model, const SmaValue *values, const Sma
         merged[i] = run->wire_defaults[i];
         given[i] = !isnan(merged[i]);
     }
-    for (i = 0; i < model->count; ++i) {  /* a variable is always given, NaN too */
+    for (i = 0; i < model->count; ++i) {  /* a variable is given, NaN too, but where NaN
+                                             * means "not given" (SlaveInterface.wire_parameters) */
         const SmaVariable *v = &model->variables[i];
         if (v->wire >= 0 && v->wire < PARAM_COUNT) {
             merged[v->wire] = v->kind == SMA_REAL ? values[i].real : (double)values[i].integer;
-            given[v->wire] = 1;
+            given[v->wire] = !(isnan(merged[v->wire]) && nullable(v->wire));
         }
     }
     snprintf(source, sizeof source, "%s instance '%s'", run->model_name, run->instance_name);

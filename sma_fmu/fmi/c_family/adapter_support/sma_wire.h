@@ -1,6 +1,7 @@
 /* The wire parameters of an instance: the parameter file the FMU was built with (read from
  * resources/model_starts.json into run->wire_defaults) with the present values of the
- * parameters the FMU exposes (SlaveInterface.wire_parameters). */
+ * parameters the FMU exposes (SlaveInterface.wire_parameters): NaN in an optional one
+ * without a number as default is "not given". */
 #ifndef SMA_WIRE_H
 #define SMA_WIRE_H
 

@@ -73,6 +73,11 @@ typedef struct Instance {
     double discard_time, discard_step;
     SavedState *states;              /* states handed out and not freed */
     double *wire_defaults;           /* run.wire_defaults (malloc'd; layer_start_values.c) */
+    /* the build's identity, from resources/model_starts.json (layer_start_values.c): the
+     * wire's digest ("sha256:" + 64 hex digits) and the GUID/instantiation token of the
+     * model description it belongs to, which the host must pass */
+    char wire_digest[80];
+    char build_token[80];
     /* FMI 3.0 only (its front sets and reads them; not in saved states): */
     int event_mode_used, early_return;  /* fmi3InstantiateCoSimulation's flags */
     int event_mode;                  /* in Event Mode (the core's state is then stepComplete) */
@@ -200,7 +205,8 @@ int layer_resource_folder(const char *uri, char **folder, int *plain, char *why,
 char *layer_start_file(const char *path, int *missing, char *why, size_t size);
 int layer_packed_start_values(Instance *in, char *why, size_t size);
 /* The build's start values of every variable and its wire parameter file
- * (resources/model_starts.json, which every C-family FMU holds). */
+ * (resources/model_starts.json, which every C-family FMU holds), and its identity: the
+ * structure it was built for must be this binary's (model->guid). */
 int layer_build_starts(Instance *in, char *why, size_t size);
 
 #endif

@@ -154,11 +154,6 @@ int layer_instantiate(Instance *in, const char *function, const char *token,
         layer_reject(in, SMA_ERROR, function, why);
         goto fail;
     }
-    if (strcmp(token, in->model->guid) != 0) {
-        layer_plain(in, SMA_ERROR, "%s: %s '%s' does not match the %s '%s' of this FMU", function,
-                    token_name, token, fmi2 ? "guid" : "instantiationToken", in->model->guid);
-        goto fail;
-    }
     in->guid = copy_text(token);
     if (!in->guid) goto fail;
     if (!layer_resource_folder(resource_location, &in->resources, &plain, why, sizeof why)) {
@@ -174,6 +169,16 @@ int layer_instantiate(Instance *in, const char *function, const char *token,
                     "section 2.3.1); accepted", function, resource_location);
     if (!layer_initial_state(in, why, sizeof why)) {
         layer_log(in, SMA_ERROR, "%s: %s", function, why);
+        goto fail;
+    }
+    /* the host's token is its model description's: it must be the one the resources were
+     * built for (the binary is the same for every wire: docs/fmus.md, "One wire") */
+    if (strcmp(token, in->build_token) != 0) {
+        layer_plain(in, SMA_ERROR, "%s: %s '%s' does not match the %s '%s' of this FMU's "
+                    "resources folder '%s' (wire %s): the model description and the resources "
+                    "are of different builds (another parameter file, version or model)",
+                    function, token_name, token, fmi2 ? "guid" : "instantiationToken",
+                    in->build_token, in->resources, in->wire_digest);
         goto fail;
     }
     layer_log(in, SMA_OK, "%s: %s (%s)", function, NATIVE_MARKER, in->resources);

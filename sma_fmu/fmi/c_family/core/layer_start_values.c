@@ -106,8 +106,9 @@ int layer_packed_start_values(Instance *in, char *why, size_t size)
     return failed;
 }
 
-/* The build's starts: {"values": {every variable: its start}, "wire_defaults": [numbers or
- * null, PARAMETER_SPECS order]}, written by `sma-fmu build --native` beside parameters.json
+/* The build's starts: {"structure", "token", "wire_digest": the build's identity, "values":
+ * {every variable: its start; null: an optional wire parameter not given, NaN},
+ * "wire_defaults": [numbers or null, PARAMETER_SPECS order]}, written by `sma-fmu build --native` beside parameters.json
  * (packaging/c_family_build.py). Choice: the binary holds none of a parameter file's values,
  * so one binary serves every parameter file and can be built once (reproducible.py); the
  * model description's start attributes are written from the same numbers. */
@@ -137,6 +138,43 @@ static int build_wire_defaults(Instance *in, const JsonValue *wire, const char *
     return 0;
 }
 
+/* The text member `key` of the build's starts into `out` (at most size - 1 bytes); 0 with why
+ * when it is missing, not a string or too long. */
+static int identity_text(const JsonValue *document, const char *key, const char *path, char *out,
+                         size_t out_size, char *why, size_t size)
+{
+    const JsonValue *value = json_object_get(document, key);
+    if (!value || value->kind != JSON_STRING || value->length >= out_size ||
+        strlen(value->text) != value->length) {
+        snprintf(why, size, "%.300s: must hold a string '%s' (the build's identity)", path, key);
+        return 0;
+    }
+    memcpy(out, value->text, value->length + 1);
+    return 1;
+}
+
+/* The build's identity: the structure it was built for must be this binary's, then its
+ * token and wire digest are kept (layer_instantiate checks the host's token against them).
+ * Choice: the binary holds no wire (one binary serves every parameter file), so the token of
+ * a build is {structure + wire} and the resources say which wire they hold. */
+static int build_identity(Instance *in, const JsonValue *document, const char *path, char *why,
+                          size_t size)
+{
+    char structure[80];
+    if (!identity_text(document, "structure", path, structure, sizeof structure, why, size) ||
+        !identity_text(document, "token", path, in->build_token, sizeof in->build_token, why, size) ||
+        !identity_text(document, "wire_digest", path, in->wire_digest, sizeof in->wire_digest,
+                       why, size))
+        return 1;
+    if (strcmp(structure, in->model->guid) != 0) {
+        snprintf(why, size, "%.300s: the resources were built for another model or version "
+                 "(structure %s; this binary is %s): point the resource location at this FMU's "
+                 "own resources folder", path, structure, in->model->guid);
+        return 1;
+    }
+    return 0;
+}
+
 int layer_build_starts(Instance *in, char *why, size_t size)
 {
     char path[4200];
@@ -149,6 +187,7 @@ int layer_build_starts(Instance *in, char *why, size_t size)
                                  why, size);
     if (found == 0) snprintf(why, size, "%.300s: missing (the FMU's start values)", path);
     if (found <= 0) return 1;
+    failed = build_identity(in, &document, path, why, size);
     for (index = 0; index < in->model->count && !failed; ++index) {
         const SmaVariable *v = &in->model->variables[index];
         for (i = 0; i < values->count; ++i)
@@ -156,6 +195,8 @@ int layer_build_starts(Instance *in, char *why, size_t size)
         if (i == values->count) {
             snprintf(why, size, "%.300s: no start value of %s", path, v->name);
             failed = 1;
+        } else if (v->kind == SMA_REAL && v->wire >= 0 && values->items[i].kind == JSON_NULL) {
+            in->values[index].real = NAN;   /* an optional wire parameter not given */
         } else {
             failed = start_value(BUILD_STARTS_FILE, v, &values->items[i], &in->values[index], why,
                                  size);

@@ -3,15 +3,16 @@
  * The body goes inside the frame of c_common/state_frame.c (header with length and CRC-32),
  * which is checked first: a changed, truncated or extended state is refused whole.
  * The body (native byte order, declared by the header):
- *   "SMAFMU2S" | u32 format version | u32 byte-order mark | str model name | str GUID |
- *   str the stepper's state format (e.g. PLANT_STATE_FORMAT) |
+ *   "SMAFMU2S" | u32 format version (2) | u32 byte-order mark | str model name |
+ *   str wire digest | str GUID | str the stepper's state format (e.g. PLANT_STATE_FORMAT) |
  *   u32 calling-sequence state | f64 start_time, stop_time, time, first_step |
  *   u8 stop_defined, time_defined, outputs_current | str initial_error |
  *   u32 variable count | each variable: f64 (Real), i32 (Integer, Boolean), str (String) |
  *   u8 has stepper | u32 count | f64 x count (the stepper's <x>_state_write layout)
  * where str = u32 length + UTF-8 bytes. Reading refuses, with the reason, bytes of another
- * model, build (GUID: another build carries other compiled-in parameters) or stepper
- * format, truncated bytes, an entry out of range, and anything that follows the state. */
+ * model, wire (the digest of the build's parameter file: saved_state.py says the same),
+ * structure (GUID: another version) or stepper format, truncated bytes, an entry out of
+ * range, and anything that follows the state. */
 #include "fp_contract.h"
 #include <math.h>
 #include <stdint.h>
@@ -23,7 +24,7 @@
 #include "state_frame.h"  /* the frame both families put around a state */
 
 #define MAGIC "SMAFMU2S"
-#define FORMAT_VERSION 1u
+#define FORMAT_VERSION 2u
 #define BYTE_ORDER_MARK 0x01020304u
 #define MAX_TEXT 16000000u
 
@@ -56,6 +57,7 @@ static void write_state(const Instance *in, Writer *w)
     put_u32(w, FORMAT_VERSION);
     put_u32(w, BYTE_ORDER_MARK);
     put_text(w, model->name);
+    put_text(w, in->wire_digest);
     put_text(w, model->guid);
     put_text(w, model->state_format);
     put_u32(w, (uint32_t)in->state);
@@ -179,6 +181,23 @@ static int expect_text(Reader *r, const char *what, const char *expected, const 
     return same;
 }
 
+/* The wire the state was saved with must be this FMU's: the same sentence as the pythonfmu
+ * family's (saved_state.py), naming both digests. Beside the frame's checks, before any
+ * entry is read. */
+static int expect_wire(Reader *r, const char *digest)
+{
+    char *text = take_text(r, "the wire digest");
+    int same;
+    if (!text) return 0;
+    same = strcmp(text, digest) == 0;
+    if (!same)
+        snprintf(r->why, r->why_size, "the state was saved by an FMU of another wire (%.80s); "
+                 "this FMU's wire is %.80s: restore it into an FMU built from the same parameter "
+                 "file", text, digest);
+    free(text);
+    return same;
+}
+
 static int parse(const Instance *in, Reader *r, Parsed *p)
 {
     const SmaModel *model = in->model;
@@ -200,9 +219,8 @@ static int parse(const Instance *in, Reader *r, Parsed *p)
         snprintf(r->why, r->why_size, "the state was saved on a machine of another byte order");
         return 0;
     }
-    if (!expect_text(r, "model", model->name, "") ||
-        !expect_text(r, "the FMU build (GUID)", model->guid,
-                     ": another parameter file, version or model") ||
+    if (!expect_text(r, "model", model->name, "") || !expect_wire(r, in->wire_digest) ||
+        !expect_text(r, "the FMU build (GUID)", model->guid, ": another version or model") ||
         !expect_text(r, "stepper state format", model->state_format, ""))
         return 0;
     if (!take_u32(r, &p->state, "the calling-sequence state")) return 0;

@@ -15,7 +15,7 @@
 
 static const char *const KIND_NAMES[] = {"Real", "Integer", "Boolean", "String"};
 static const char *const FMI3_KIND_NAMES[] = {"Float64", "Int32", "Boolean", "String"};
-static const char *const CAUSALITY_NAMES[] = {"parameter", "input", "output"};
+static const char *const CAUSALITY_NAMES[] = {"parameter", "input", "output", "local"};
 
 const SmaVariable *layer_variable(const SmaModel *model, unsigned int vr, size_t *index)
 {

@@ -15,8 +15,8 @@
 #include "sma_message.h"
 
 typedef enum { SMA_REAL, SMA_INTEGER, SMA_BOOLEAN, SMA_STRING } SmaKind;
-typedef enum { SMA_PARAMETER, SMA_INPUT, SMA_OUTPUT } SmaCausality;
-typedef enum { SMA_FIXED, SMA_TUNABLE, SMA_DISCRETE, SMA_CONTINUOUS } SmaVariability;
+typedef enum { SMA_PARAMETER, SMA_INPUT, SMA_OUTPUT, SMA_LOCAL } SmaCausality;
+typedef enum { SMA_FIXED, SMA_TUNABLE, SMA_DISCRETE, SMA_CONTINUOUS, SMA_CONSTANT } SmaVariability;
 
 /* One variable, as the pythonfmu FMU declares it (generated from its model description). */
 typedef struct {

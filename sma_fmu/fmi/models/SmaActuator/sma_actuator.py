@@ -48,7 +48,7 @@ class SmaActuator(StepperSlave):
         fmi.choice_parameter("hysteresis_mode", "continuous",
                              "continuous: minor loops, holds a set-point; switch: the paper's, "
                              "branch follows sgn dT/dt, limit-cycles at a set-point")
-        fmi.model_parameters(extra=("T_max", "stress_max"))
+        fmi.model_parameters()
         self.stepper = None
 
     def _start(self):

@@ -54,7 +54,7 @@ class SmaFeedforward(StepperSlave):
         fmi.choice_parameter("inverse", "major",
                              "major: the paper's, major branches; minor-loop: the plant's "
                              "continuous-mode minor branches, reversals taken from R_ref")
-        fmi.model_parameters(extra=("alpha", "beta", "model_load", "saturation_margin", "stress_max"))
+        fmi.model_parameters()
         fmi.choice_parameter("shaping", "none",
                              "none: the paper's, T_ref through the phase-lag filter; reachable: "
                              "the demand shaped into what the wire can reach, over a model of it")

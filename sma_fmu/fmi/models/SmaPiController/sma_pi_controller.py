@@ -34,7 +34,7 @@ class SmaPiController(StepperSlave):
         fmi.input("P_ff", 0.0, "W", "feedforward power u_ff (0 W without a compensator)")
         fmi.output("P", "W", "power command u = max(0, P_ff + Kp e + Ki I) for this step")
         fmi.output("P_fb", "W", "feedback part Kp e + Ki I (before the clamp)")
-        fmi.model_parameters(sections=(), extra=("Kp", "Ki"))
+        fmi.model_parameters(("Kp", "Ki"))
         self.stepper = None
 
     def _start(self):

@@ -88,6 +88,26 @@ char* resource_uri_for_pythonfmu(const char* uri, char* err, size_t errlen, char
     return forwarded;
 }
 
+/* The wire digest parameters.json in `resources` records ("sha256:..."), into `out`; "unknown"
+ * if it cannot be read (the build writes it as  "wire_digest": "sha256:<64 hex>"). */
+static void resources_wire(const char* resources, char* out, size_t size)
+{
+    char file[PATH_SIZE + 64], text[1024];
+    snprintf(out, size, "unknown");
+    snprintf(file, sizeof file, "%s/parameters.json", resources);
+    FILE* stream = file_open(file, "r");
+    if (!stream) return;
+    size_t n = fread(text, 1, sizeof text - 1, stream);
+    fclose(stream);
+    text[n] = '\0';
+    const char* start = strstr(text, "\"wire_digest\": \"");
+    if (!start) return;
+    start += 16;
+    const char* end = strchr(start, '"');
+    if (end && end - start < (long)size && end - start <= 80)
+        snprintf(out, size, "%.*s", (int)(end - start), start);
+}
+
 int guid_matches(const char* resources, const char* guid, char* err, size_t errlen)
 {
     char file[PATH_SIZE + 64];
@@ -105,7 +125,11 @@ int guid_matches(const char* resources, const char* guid, char* err, size_t errl
     if (!end) return 1;
     if (strlen(guid) == (size_t)(end - start) && strncmp(start, guid, (size_t)(end - start)) == 0)
         return 1;
-    snprintf(err, errlen, "fmuGUID '%s' does not match the guid '%.*s' of %s", guid,
-             (int)(end - start), start, file);
+    char wire[96];
+    resources_wire(resources, wire, sizeof wire);
+    snprintf(err, errlen, "fmuGUID '%s' does not match the guid '%.*s' of %s (its resources "
+             "hold the wire %s): the model description and the resources are of different "
+             "builds (another parameter file, version or model)", guid, (int)(end - start), start,
+             file, wire);
     return 0;
 }

@@ -4,10 +4,13 @@ It imports pythonfmu: it runs only inside an FMU (or while one is built), and ev
 pythonfmu FMU ships pythonfmu in its resources/. The library path never imports it.
 
 The build writes the wire's parameter set to ``resources/parameters.json``; a slave
-exposes some of those parameters as FMI parameters (start values from that file) and
-takes the rest from the file as they are. An FMU packed by ``sma-fmu export`` also has
-``resources/start_values.json`` (:mod:`.start_values`): the scenario's values, which
-replace the start values of the parameters it names. Settings that choose among names
+exposes the wire parameters its model uses as FMI parameters (:mod:`.wire_use`: start
+values from that file, NaN for an optional one the file does not give) and takes the rest
+from the file as they are. Every slave states the digest of that wire
+(:mod:`sma_fmu.runtime.wire_identity`) in the String constant ``wire_digest``. An FMU
+packed by ``sma-fmu export`` also has ``resources/start_values.json``
+(:mod:`.start_values`): the scenario's values, which replace the start values of the
+parameters it names. Settings that choose among names
 are Integer parameters holding a code (:mod:`.choices`).
 
 Creating a :class:`SlaveInterface` also puts a :class:`~.guards.CallGuard` over the
@@ -15,6 +18,7 @@ slave's pythonfmu callbacks: the FMI state machine, checked arguments and saved 
 and no exception ever reaching pythonfmu (which would make it fmi2Fatal).
 """
 import json
+import math
 import os
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Variability, Integer, Real, String
@@ -26,13 +30,15 @@ from sma_fmu.fmi.python_family.slave_support.lifecycle import setting_refusal
 from sma_fmu.fmi.python_family.slave_support.model_description import decorate_model_description
 from sma_fmu.fmi.python_family.slave_support.saved_state import state_from_bytes, state_to_bytes
 from sma_fmu.fmi.python_family.slave_support.start_values import START_VALUES_FILE, read_start_values, start_value
-from sma_fmu.runtime.parameters import PARAMETER_SPECS, WireParameters
+from sma_fmu.fmi.python_family.slave_support.wire_use import (NULLABLE, WIRE_DIGEST, not_given_text,
+                                                               wire_names)
+from sma_fmu.runtime.parameters import SPEC_BY_NAME, WireParameters
+from sma_fmu.runtime.wire_identity import wire_digest
 from sma_fmu.runtime.scenario_signals import GRID_TOLERANCE
 
-__all__ = ["PARAMETERS_FILE", "MODEL_SECTIONS", "SlaveInterface"]
+__all__ = ["PARAMETERS_FILE", "SlaveInterface"]
 
 PARAMETERS_FILE = "parameters.json"
-MODEL_SECTIONS = ("geometry", "phases", "hysteresis", "constant_load", "thermal")
 _KIND_OF = ((Real, "Real"), (Boolean, "Boolean"), (String, "String"), (Integer, "Integer"))
 
 
@@ -58,6 +64,8 @@ class SlaveInterface:
         self.defaults = WireParameters.from_values(
             {name: entry["value"] for name, entry in entries.items()},
             source=self.parameter_file.get("source", PARAMETERS_FILE))
+        self.digest = wire_digest(self.defaults)   # of the values themselves, not of a claim
+        self.nullable = set()   # the exposed wire parameters that may be NaN: not given
         # the scenario's values packed at export: they replace the parameters' start values
         self.packed = read_start_values(slave.resources)
         self.first_step = None  # h0 [s]: the size of the first step (see nominal_step)
@@ -134,23 +142,36 @@ class SlaveInterface:
                            variability=Fmi2Variability.fixed, description=description),
                       start, unit)
 
-    def model_parameters(self, sections=MODEL_SECTIONS, extra=()):
-        """Expose the wire parameters of ``sections`` (plus names in ``extra``) as parameters."""
+    def model_parameters(self, names=None):
+        """Expose the wire parameters ``names`` (default: those the model uses,
+        :func:`~.wire_use.wire_names`) as fixed parameters, in PARAMETER_SPECS order; an
+        optional one the file does not give starts at NaN, "not given"."""
         entries = self.parameter_file["parameters"]
-        for spec in PARAMETER_SPECS:
-            if spec.section in sections or spec.name in extra:
-                entry = entries.get(spec.name, {})
-                start = getattr(self.defaults, "phase_lag_alpha" if spec.name == "alpha" else spec.name)
-                if start is None:   # an optional term the file omits (nu_h, nu_c): not exposed
-                    continue
-                meaning = entry.get("meaning") or (
-                    "phase-lag lead time (default: thermal time constant)" if spec.name == "alpha" else spec.name)
-                if spec.rule == "depth":  # a count: an Integer (FMI 2.0 Integers have no unit)
-                    self.parameter(spec.name, int(start), None, f"{meaning} [{spec.section}, 1]",
-                                   kind=Integer)
-                else:
-                    self.parameter(spec.name, start, spec.unit, f"{meaning} [{spec.section}]")
-                self.exposed.append(spec.name)
+        wanted = set(wire_names(self.slave.modelName) if names is None else names)
+        for spec in (spec for name, spec in SPEC_BY_NAME.items() if name in wanted):
+            start = getattr(self.defaults, spec.name)
+            meaning = entries.get(spec.name, {}).get("meaning") or (
+                "optional, not in the parameter file" if start is None else spec.name)
+            if spec.rule == "depth":  # a count: an Integer (FMI 2.0 Integers have no unit)
+                self.parameter(spec.name, int(start), None, f"{meaning} [{spec.section}, 1]",
+                               kind=Integer)
+            else:
+                if spec.name in NULLABLE:
+                    self.nullable.add(spec.name)
+                    meaning += f"; {not_given_text(spec.name)}"
+                self.parameter(spec.name, math.nan if start is None else start, spec.unit,
+                               f"{meaning} [{spec.section}]")
+            self.exposed.append(spec.name)
+
+    def state_wire_digest(self):
+        """The String constant ``wire_digest``: the digest of the wire the FMU was built
+        from (declared after the slave's own variables, :class:`~.stepper_slave.StepperSlave`)."""
+        self._declare(String(WIRE_DIGEST, causality=Fmi2Causality.local,
+                             variability=Fmi2Variability.constant, initial=Fmi2Initial.exact,
+                             start=self.digest,
+                             description="SHA-256 of the canonical values of the wire parameter "
+                                         "file the FMU was built from (resources/parameters.json)"),
+                      self.digest, None)
 
     def string_parameter(self, name, start, description):
         """A fixed String parameter (no unit)."""
@@ -197,10 +218,15 @@ class SlaveInterface:
         return first if abs(step_size - first) <= GRID_TOLERANCE * first else step_size
 
     def wire_parameters(self):
-        """WireParameters from the file, with the exposed parameters' present values."""
+        """WireParameters from the file, with the exposed parameters' present values (NaN in
+        an optional one: not given)."""
         values = self.defaults.values()
         for name in self.exposed:
-            values[name] = getattr(self.slave, name)
+            value = getattr(self.slave, name)
+            if name in self.nullable and value != value:  # NaN
+                values.pop(name, None)
+            else:
+                values[name] = value
         return WireParameters.from_values(
             values, source=f"{self.slave.modelName} instance '{self.slave.instance_name}'")
 

@@ -2,10 +2,13 @@
 
 A state is a JSON-ready dict: every variable's value (pythonfmu's part), the stepper's
 hidden state under ``__stepper__`` (the slave's ``_get_fmu_state``) and, under
-``__fmi__``, the FMU's GUID, the calling-sequence state and the communication point.
+``__fmi__``, the FMU's model name, its wire's digest, its GUID, the calling-sequence state
+and the communication point.
 
-Restoring checks everything before it changes anything: the GUID must be this FMU's (a
-state of another build, that is another parameter file or code, is refused), every
+Restoring checks everything before it changes anything: the model and the wire must be
+this FMU's (a state saved with another parameter file is refused naming both digests, in
+the words of the C family, c_family/core/layer_state_bytes.c), then the GUID (another
+build: another version or code), every
 variable must be present with its type, nothing unknown may be there, a state after
 initialization (stepComplete, terminated) must hold the stepper's hidden state, and the
 stepper must take it back unchanged (it is saved again and compared). If a check or the
@@ -104,7 +107,8 @@ class SavedStates:
         except Exception as error:  # noqa: BLE001
             guard.refuse("fmi2GetFMUstate", f"{type(error).__name__}: {error}")
             return {_INVALID: "the state could not be saved"}
-        state[_META] = {"guid": self.guid, "state": guard.state, "time": guard.time,
+        state[_META] = {"model": guard.slave.modelName, "wire": guard.interface.digest,
+                        "guid": self.guid, "state": guard.state, "time": guard.time,
                         "start_time": guard.start_time, "stop_time": guard.stop_time,
                         "outputs_current": guard.outputs_current,
                         "initial_error": guard.initial_error}
@@ -119,9 +123,17 @@ class SavedStates:
         meta = state.get(_META)
         if not isinstance(meta, dict) or meta.get("state") not in STATES:
             return "not a state saved by this FMU (no valid __fmi__ entry)"
+        model = self.guard.slave.modelName
+        if meta.get("model") != model:
+            return f"the state was saved by model '{meta.get('model')}', this FMU is '{model}'"
+        digest = self.guard.interface.digest
+        if meta.get("wire") != digest:
+            return (f"the state was saved by an FMU of another wire ({meta.get('wire')}); this "
+                    f"FMU's wire is {digest}: restore it into an FMU built from the same "
+                    f"parameter file")
         if self.guid is not None and meta.get("guid") != self.guid:
             return (f"the state was saved by another FMU build (GUID {meta.get('guid')!r}, this FMU "
-                    f"is {self.guid!r}): another parameter file, version or model")
+                    f"is {self.guid!r}): another version or model")
         for key in ("time", "start_time", "stop_time"):
             value = meta.get(key)
             if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value)):

@@ -61,11 +61,12 @@ def start_value(kind, value, name="value"):
 
 
 def start_value_text(kind, value):
-    """The modelDescription.xml / SSP attribute text of a ``kind`` value."""
+    """The modelDescription.xml / SSP attribute text of a ``kind`` value (a Real NaN, an
+    optional wire parameter not given, as XML Schema spells it: ``NaN``)."""
     if kind == "Boolean":
         return "true" if value else "false"
     if kind == "Real":
-        return repr(float(value))
+        return "NaN" if math.isnan(value) else repr(float(value))
     if kind == "Integer":
         return str(int(value))
     return str(value)

@@ -15,10 +15,13 @@ stepper's outputs go to, in order) and ``step_inputs`` (the variables passed to
 
 ``_start`` and ``_advance`` may raise (``ValueError`` naming the parameter or input): the
 guard (:class:`~.guards.CallGuard`) turns that into a refused fmi2ExitInitializationMode
-or a discarded step. Initialization, guarded steps, the model description's additions and
-the saved state (the pythonfmu variables plus the stepper's hidden state) are the same for
+or a discarded step. Initialization, guarded steps, the model description's additions, the
+String constant ``wire_digest`` after a slave's own variables (its wire's identity) and the
+saved state (the pythonfmu variables plus the stepper's hidden state) are the same for
 every slave, here.
 """
+import functools
+
 from pythonfmu import Fmi2Slave
 from pythonfmu.default_experiment import DefaultExperiment
 
@@ -26,6 +29,17 @@ from sma_fmu.fmi.python_family.slave_support.compiled import attribute_writer, s
 from sma_fmu.fmi.python_family.slave_support.saved_state import split_state, state_with
 
 __all__ = ["StepperSlave"]
+
+
+def _stating_the_wire(cls, declare):
+    """``cls``'s ``__init__`` ``declare``, then the ``wire_digest`` constant (last: the
+    slave's own variables keep their value references)."""
+    @functools.wraps(declare)
+    def __init__(self, **kwargs):
+        declare(self, **kwargs)
+        if type(self) is cls:
+            self.interface.state_wire_digest()
+    return __init__
 
 
 class StepperSlave(Fmi2Slave):
@@ -48,6 +62,8 @@ class StepperSlave(Fmi2Slave):
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
+        if "__init__" in cls.__dict__:
+            cls.__init__ = _stating_the_wire(cls, cls.__dict__["__init__"])
         if "published" in cls.__dict__ and cls.published is not None:
             cls._publish = attribute_writer(cls.published)
             cls._publish.declared = tuple(cls.published)
