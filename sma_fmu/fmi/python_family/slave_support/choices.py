@@ -16,6 +16,7 @@ __all__ = ["CHOICES", "choice_code", "choice_name", "choice_text"]
 CHOICES = {
     "hysteresis_mode": {1: "continuous", 2: "switch"},
     "inverse": {1: "major", 2: "minor-loop"},
+    "modulation": {1: "pwm", 2: "linear"},   # the driver: switched, or the demand itself
 }
 
 
