@@ -34,7 +34,7 @@ def test_the_ssp_binds_the_sensor_and_the_limit(bench, fmu_dir, tmp_path):
 
 
 def test_the_system_tools_run_the_bench_loop(bench, fmu_dir):
-    rows = compare_hosts(bench, fmu_dir, hosts=("libcosim", "ecos"))
+    rows = compare_hosts(bench, fmu_dir)
     runs = {row["run"]: row for row in rows}
     assert {"libcosim (ssp)", "ecos (ssp)", "fmpy (container)", "libcosim-container (container)"} \
         <= set(runs)

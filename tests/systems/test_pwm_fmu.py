@@ -64,7 +64,10 @@ def test_driver_fmu_is_valid_and_declares_its_variables_with_units(fmus):
     variables = {v.name: v for v in read_model_description(str(path)).modelVariables}
     declared = {name: (v.causality, v.unit) for name, v in variables.items()}
     assert declared == {"P_demand": ("input", "W"), "P_in": ("output", "W"),
-                        "frequency_Hz": ("parameter", "Hz"), "peak_W": ("parameter", "W")}
+                        "frequency_Hz": ("parameter", "Hz"), "peak_W": ("parameter", "W"),
+                        # the drive limit (docs/scenarios.md, the bench)
+                        "R": ("input", "ohm"), "modulation": ("parameter", None),
+                        "I_max_A": ("parameter", "A"), "V_max_V": ("parameter", "V")}
     assert all(v.description for v in variables.values())
     with FmuInstance(path, "driver") as fmu:
         assert fmu.get_real(("P_in",)) == [0.0]  # after initialization: no wave yet

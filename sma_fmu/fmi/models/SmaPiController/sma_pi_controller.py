@@ -36,8 +36,8 @@ class SmaPiController(StepperSlave):
         super().__init__(**kwargs)
         self.interface = fmi = SlaveInterface(self)
         defaults = fmi.defaults
-        fmi.input("R", defaults.R_P, "ohm", "measured wire resistance")
-        fmi.input("R_ref", defaults.R_P, "ohm", "reference resistance; error e = R - R_ref")
+        fmi.input("R", defaults.R_P, "ohm", "the wire's resistance, read through the sensor")
+        fmi.input("R_ref", defaults.R_P, "ohm", "reference resistance; error e = R_measured - R_ref")
         fmi.input("P_ff", 0.0, "W", "feedforward power u_ff (0 W without a compensator)")
         fmi.output("P", "W", "power command u = max(0, P_ff + Kp e + Ki I) for this step")
         fmi.output("P_fb", "W", "feedback part Kp e + Ki I (before the clamp)")
