@@ -26,7 +26,7 @@ def _scenarios():
     bench = load_scenario(resolve_scenarios(["load-step-bench-pi+ff-adaptive"])[0])
     bench = dataclasses.replace(bench, stop_time_s=1.5)
     limited = dataclasses.replace(bench, drive=dataclasses.replace(bench.drive, I_max_A=0.3))
-    pwm = dataclasses.replace(bench, drive=DriveSettings("pwm", 50.0, 8.0, 0.3, 24.0))
+    pwm = dataclasses.replace(bench, drive=DriveSettings("pwm", 50.0, 8.0, I_max_A=0.3, V_max_V=24.0))
     return {"linear": limited, "pwm": pwm}
 
 

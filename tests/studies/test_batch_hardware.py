@@ -36,7 +36,7 @@ def _bench_variants():
         _scenario("heavy-continuous-bench-pi"),
         _scenario("load-step-continuous-bench-pi+ff-adaptive-minor-loop"),
         dataclasses.replace(bench, drive=dataclasses.replace(drive, I_max_A=0.3)),  # binding
-        dataclasses.replace(bench, drive=DriveSettings("pwm", 50.0, 8.0, 0.3, 24.0)),
+        dataclasses.replace(bench, drive=DriveSettings("pwm", 50.0, 8.0, I_max_A=0.3, V_max_V=24.0)),
         dataclasses.replace(bench, sensor=SensorSettings(0.5, 20.0, 6, 9)),   # clips at 20 ohm
         _scenario("load-step-pi+ff-adaptive"),                               # no hardware
         _scenario("setpoints-pwm-pi+ff-adaptive"),

@@ -1,7 +1,7 @@
 """What a validated scenario holds: the :class:`Scenario` record, its controller, drive and
 analysis settings, and :class:`ScenarioError`, the error of every scenario problem."""
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "SensorSettings",
@@ -65,8 +65,9 @@ class DriveSettings:
     kind: str = "power"
     frequency_Hz: float = None
     peak_W: float = None
-    I_max_A: float = 0.0     # current limit [A] (0: none), :class:`~sma_fmu.runtime.drive_limit.DriveLimit`
-    V_max_V: float = 0.0     # voltage limit [V] (0: none)
+    # the limits are keyword-only: DriveSettings(kind, frequency_Hz, peak_W) keeps its meaning
+    I_max_A: float = field(default=0.0, kw_only=True)   # current limit [A] (0: none), DriveLimit
+    V_max_V: float = field(default=0.0, kw_only=True)   # voltage limit [V] (0: none)
 
     @property
     def pwm(self):
