@@ -91,10 +91,14 @@ def _requirement_name(requirement):
 
 
 def writer_requirements():
-    """The project's dependencies the writer imports (WRITER_IMPORTS), as pyproject.toml states them."""
+    """The project's dependencies the writer imports (WRITER_IMPORTS), as pyproject.toml states
+    them: in its dependencies or one of its extras (libcosimpy is the systems extra's)."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
-    dependencies = project["dependencies"]
-    chosen = [r for r in dependencies if _requirement_name(r) in WRITER_IMPORTS]
+    extras = project.get("optional-dependencies", {})
+    dependencies = project["dependencies"] + [r for name, listed in extras.items()
+                                              if name not in ("all", "test") for r in listed]
+    chosen = list({_requirement_name(r): r for r in reversed(dependencies)
+                   if _requirement_name(r) in WRITER_IMPORTS}.values())[::-1]
     unknown = set(WRITER_IMPORTS) - {_requirement_name(r) for r in chosen}
     if unknown:
         raise RuntimeError(f"wheel_backend.WRITER_IMPORTS names {', '.join(sorted(unknown))}, "

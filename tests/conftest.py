@@ -50,6 +50,12 @@ def native_fmus(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def native_dir(native_fmus):
+    """The folder of :func:`native_fmus` (what ``--fmus`` takes)."""
+    return native_fmus["SmaActuator"].parent
+
+
+@pytest.fixture(scope="session")
 def fmi3_fmus(tmp_path_factory):
     """The native FMUs as FMI 3.0, built once per session (sma-fmu build --native --fmi 3):
     {name: path}."""

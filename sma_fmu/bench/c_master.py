@@ -1,12 +1,14 @@
 """The C master in ``sma-fmu bench``: its closed loop against the library's, per scenario.
 
-Each run is what ``sma-fmu run`` does for one scenario, recording included: the loop (the
-library's steppers in Python, or the native FMUs in the C master, ``--master c``) streams
-its rows into a :class:`~sma_fmu.cosim.recording.RunRecorder` (metrics, the time series
-in Parquet or CSV, the figure's rows), timed from the start of the run to the closed file.
-The two alternate, run i of each next to the other; the ratio is the median of the
-per-pair ratios, against :data:`TARGET`. The peak memory of a one-hour run at
-1 ms (:func:`hour_run_rss`) is measured in a fresh process.
+The loop only (:func:`c_master_times`): each run is what ``sma-fmu run`` does for one
+scenario once its master has started, recording included: the loop (the library's
+steppers in Python, or the native FMUs in a long-lived C master, ``--master c``, started
+and loaded before) streams its rows into a :class:`~sma_fmu.cosim.recording.RunRecorder`
+(metrics, the time series in Parquet or CSV, the figure's rows), timed from the start of
+the run to the closed file. The two alternate, run i of each next to the other; the ratio
+is the median of the per-pair ratios, against :data:`TARGET`. What the user waits for,
+whole commands and a sweep, is :mod:`.c_master_commands`'s. The peak memory of a
+one-hour run at 1 ms (:func:`hour_run_rss`) is measured in a fresh process.
 """
 import json
 import statistics
@@ -19,7 +21,7 @@ from pathlib import Path
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.recording import RunRecorder
 from sma_fmu.cosim.scenario import PAPER_SET, load_scenario, resolve_scenarios
-from sma_fmu.systems.c_master import run_c_master
+from sma_fmu.systems.c_master import CMaster
 
 __all__ = ["SCENARIOS", "TARGET", "RSS_TARGET_MB", "c_master_times", "hour_run_rss",
            "c_master_lines"]
@@ -43,14 +45,19 @@ def _recorded_wall_s(run, scenario, folder, fmt):
 
 def c_master_times(native_dir, runs, folder, scenarios=SCENARIOS, formats=("parquet", "csv")):
     """{"SCENARIO (FORMAT)": {library_s, c_s (medians), ratio, min, max, runs}} over ``runs``
-    alternating runs of each (the C master warmed up first: host built, FMUs unpacked)."""
-    folder = Path(folder)
+    alternating runs of each, in one C master (started, its FMUs unpacked and loaded by a
+    first run of each scenario)."""
+    with CMaster(native_dir) as master:
+        return _loop_times(master, runs, Path(folder), scenarios, formats)
+
+
+def _loop_times(master, runs, folder, scenarios, formats):
     paths = {"library": lambda scenario, sink: run_library(scenario, sink=sink),
-             "c": lambda scenario, sink: run_c_master(scenario, native_dir, sink)}
+             "c": master.run}
     results = {}
     for name in scenarios:
         scenario = load_scenario(resolve_scenarios([name])[0])
-        run_c_master(scenario, native_dir)
+        master.run(scenario)
         for fmt in formats:
             walls = {path: [] for path in paths}
             for index in range(runs):
@@ -66,18 +73,24 @@ def c_master_times(native_dir, runs, folder, scenarios=SCENARIOS, formats=("parq
     return results
 
 
+# the peak is VmHWM (Linux): ru_maxrss keeps, across exec, the peak of the process that
+# started this one (the bench itself, some 260 MB after its sweep)
 _HOUR_RUN = """
-import json, resource, sys
+import json, re, resource, sys
 from sma_fmu.systems.runner import run_scenarios
 run_scenarios([sys.argv[1]], sys.argv[2], "fmu", sys.argv[3], progress=lambda _: None,
               fmt=sys.argv[4], master="c")
-print(json.dumps(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss))
+try:
+    with open("/proc/self/status") as status:
+        print(json.dumps(int(re.search(r"VmHWM:\\s*(\\d+) kB", status.read()).group(1))))
+except (OSError, AttributeError):
+    print(json.dumps(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss))
 """
 
 
 def hour_run_rss(native_dir, folder, fmt="csv", stop_time_s=3600.0):
     """{"python_mb", "wall_s", "rows", "format"}: peak resident memory [MB] of ``sma-fmu run
-    --master c`` (Linux's ru_maxrss of a fresh Python process) over a one-hour
+    --master c`` (Linux's VmHWM of a fresh Python process) over a one-hour
     (``stop_time_s``) copy of :data:`HOUR_SCENARIO` at 1 ms, recorded as ``fmt``. (The C
     host itself stays near 3 MB: it keeps one frame of rows.)"""
     folder = Path(folder)
@@ -99,11 +112,14 @@ def _verdict(value, limit):
     return f"{'meets' if value <= limit else 'MISSES'} target <= {limit:g}"
 
 
-def c_master_lines(times, hours=None):
-    """The C-master section of the benchmark table, with its targets."""
+def c_master_lines(times, hours=None, commands=None, sweep=None):
+    """The C-master section of the benchmark table, with its targets: the loop only, then
+    (when measured) whole commands and a sweep (:mod:`.c_master_commands`)."""
+    from sma_fmu.bench.c_master_commands import command_lines
+
     runs = next(iter(times.values()))["runs"]
-    lines = [f"C master (--master c) / library, 30 s at 1 ms, recording included "
-             f"(median of {runs} alternating runs, min ... max)",
+    lines = [f"C master (--master c) / library, the loop only: 30 s at 1 ms, recording "
+             f"included (median of {runs} alternating runs, min ... max)",
              f"{'scenario (format)':<58}{'library s':>10}{'C s':>8}{'ratio':>8}"]
     for name, row in times.items():
         lines.append(f"{name:<58}{row['library_s']:>10.3f}{row['c_s']:>8.3f}{row['ratio']:>8.3f}"
@@ -111,6 +127,9 @@ def c_master_lines(times, hours=None):
     for hour in hours or ():
         lines.append(f"one hour at 1 ms ({hour['rows']} rows, {hour['format']}) through the C master: "
                      f"peak RSS {hour['python_mb']:.1f} MB, {hour['wall_s']:.1f} s: {_verdict(hour['python_mb'], RSS_TARGET_MB)} MB")
+    if commands or sweep:
+        lines += ["", "what the user waits for: whole commands, the run table, a sweep"]
+        lines += command_lines(commands or {}, sweep)
     return lines
 
 
@@ -125,11 +144,22 @@ def run_c_master_bench(out_dir, runs, native_dir=None, progress=print):
             from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
             progress("building the native FMUs ...")
             native_dir = Path(build_native_fmus(stage / "native-fmus")["SmaActuator"]).parent
-        progress(f"C master against the library ({runs} alternating runs per scenario and format) ...")
+        from sma_fmu.bench import c_master_commands as commands
+
+        progress(f"C master against the library, the loop only ({runs} alternating runs per "
+                 f"scenario and format) ...")
         times = c_master_times(native_dir, runs, Path(work) / "runs")
+        progress(f"whole `sma-fmu run paper` commands ({runs} alternating, with and without figures) ...")
+        whole = commands.run_command_times(native_dir, runs, Path(work) / "commands")
+        progress(f"sweep {commands.GAIN_GRID} --fmus on 2 workers, the library on its points ...")
+        sweep = commands.sweep_throughput(native_dir, Path(work) / "sweep")
         progress("one hour at 1 ms through the C master ...")
         hour = [hour_run_rss(native_dir, Path(work) / f"hour-{fmt}", fmt) for fmt in ("csv", "parquet")]
-        results = {"runs": runs, "c_master": times, "one_hour": hour,
-                   "targets": {"ratio": TARGET, "rss_mb": RSS_TARGET_MB}}
+        results = {"runs": runs, "c_master": times, "one_hour": hour, "commands": whole,
+                   "sweep": sweep,
+                   "targets": {"ratio": TARGET, "rss_mb": RSS_TARGET_MB,
+                               "command_ratio": commands.COMMAND_TARGET,
+                               "wall_ratio": commands.WALL_TARGET,
+                               "sweep_ratio": commands.SWEEP_TARGET}}
         (stage / "benchmark.json").write_text(json_text(results), encoding="utf-8")
     return results

@@ -3,8 +3,13 @@
 One module per group of commands (model, fmus, cosim, analysis, loops, export, check,
 identification, studies, bench, examples);
 each has ``register(commands)``. Every failure is one line ``sma-fmu: error: ...`` on stderr
-with exit status 2 (``validate`` and ``check`` exit 1 when a file fails); no traceback, ever.
+with exit status 2 (``validate`` and ``check`` exit 1 when a file fails); a Ctrl-C is one
+line ``sma-fmu: interrupted``, exit status 130; no traceback, ever. The modules import what a
+command's work needs inside its handler, after its input files were found: ``--version``
+and a wrong path answer at once.
 """
+
+import sys
 
 from sma_fmu import __version__
 
@@ -12,7 +17,9 @@ from . import (analysis, bench, check, cosim, examples, export, fmus, identifica
                model, studies)
 from .arguments import Parser, fail
 
-__all__ = ["main", "build_parser", "COMMAND_GROUPS"]
+__all__ = ["main", "build_parser", "COMMAND_GROUPS", "INTERRUPTED"]
+
+INTERRUPTED = 130   # the exit status after a Ctrl-C (128 + SIGINT), as shells report it
 
 COMMAND_GROUPS = (model, fmus, cosim, analysis, loops, export, check, identification, studies,
                   bench, examples)
@@ -28,10 +35,16 @@ def build_parser():
     return parser
 
 
-def _message(error):
-    from sma_fmu.fmi.driving.instance import FmuError
-    if isinstance(error, (ValueError, FmuError)):
+def _message(error, command):
+    instance = sys.modules.get("sma_fmu.fmi.driving.instance")   # imported if an FMU ran
+    if isinstance(error, ValueError) or (instance and isinstance(error, instance.FmuError)):
         return str(error)
+    if isinstance(error, ModuleNotFoundError) and error.name:
+        from sma_fmu.console.extras import extra_of_module
+        module = error.name.partition(".")[0]
+        extra = extra_of_module(module)
+        if extra:
+            return f'{command} needs {module}, which is not installed: pip install "sma-fmu[{extra}]"'
     if isinstance(error, OSError):
         where = f"{error.filename}: " if error.filename else ""
         return f"{where}{error.strerror or error}"
@@ -43,11 +56,19 @@ def _message(error):
 
 
 def main(argv=None):
-    """Run the command line; returns the exit status."""
+    """Run the command line; returns the exit status (130 after a Ctrl-C)."""
     args = build_parser().parse_args(argv)
+    from sma_fmu.console import interrupts, progress
+
+    previous = progress.configure(quiet=getattr(args, "quiet", False), notes=True)
     try:
-        return args.handler(args)
-    except KeyboardInterrupt:
-        return fail("interrupted")
-    except Exception as error:  # noqa: BLE001 - the command line never prints a traceback
-        return fail(_message(error))
+        with interrupts.handle_interrupts():
+            try:
+                return args.handler(args)
+            except (Exception, KeyboardInterrupt) as error:  # noqa: BLE001 - never a traceback
+                if interrupts.seen():   # whatever the Ctrl-C caused on its way out
+                    print("sma-fmu: interrupted", file=sys.stderr)
+                    return INTERRUPTED
+                return fail(_message(error, args.command))
+    finally:
+        progress.configure(*previous)

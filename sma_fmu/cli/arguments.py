@@ -9,7 +9,16 @@ from sma_fmu.runtime.checks import direction_sign
 
 __all__ = ["Parser", "HelpFormatter", "finite_number", "positive_number", "nonnegative_number",
            "positive_integer", "bounded_integer", "bounded_number", "number_list", "direction", "fail", "add_scenario_arguments",
-           "scenario_paths", "add_fmus_argument"]
+           "scenario_paths", "add_fmus_argument", "add_quiet_argument", "require_inputs"]
+
+
+def require_inputs(*inputs):
+    """Raise ValueError ``PATH: WHAT not found`` for the first (path, what) of ``inputs``
+    whose path is given (not None) and does not exist: a command checks its input files
+    before it imports what its work needs, so a wrong path is told at once."""
+    for path, what in inputs:
+        if path is not None and not Path(path).exists():
+            raise ValueError(f"{path}: {what} not found")
 
 
 def fail(message):
@@ -24,7 +33,8 @@ class HelpFormatter(argparse.HelpFormatter):
 
     def _get_help_string(self, action):
         text = action.help or ""
-        if ("%(default)" not in text and action.default not in (None, False, argparse.SUPPRESS)
+        if ("%(default)" not in text and "(default" not in text and "default:" not in text
+                and action.default not in (None, False, argparse.SUPPRESS)
                 and action.option_strings):
             text += " (default: %(default)s)"
         return text
@@ -144,3 +154,9 @@ def add_fmus_argument(parser, help_text="folder of the built FMUs"):
     from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 
     parser.add_argument("--fmus", type=Path, default=DEFAULT_FMU_DIR, metavar="DIR", help=help_text)
+
+
+def add_quiet_argument(parser):
+    """Add ``--quiet``: no progress bars (they show only on a terminal anyway)."""
+    parser.add_argument("--quiet", action="store_true",
+                        help="no progress bars (shown only when stderr is a terminal)")

@@ -17,7 +17,8 @@ def _bench(args):
         from sma_fmu.bench.c_master import c_master_lines, run_c_master_bench
         say = lambda text: print(text, flush=True)  # noqa: E731
         results = run_c_master_bench(args.out, args.runs, args.fmus, progress=say)
-        print("\n".join(c_master_lines(results["c_master"], results["one_hour"])))
+        print("\n".join(c_master_lines(results["c_master"], results["one_hour"],
+                                        results["commands"], results["sweep"])))
         print(f"written: {args.out / 'benchmark.json'}")
         return 0
     if args.only == "inverse":
@@ -54,12 +55,13 @@ def register(commands):
                        help="only this section (batch: the batch engine's throughput table; "
                             "hosts: every scenario in every host against the library loop, "
                             "docs/systems.md's table; pwm: the PWM table of docs/model.md; "
-                            "c-master: the C master against the library per scenario, and the "
-                            "peak memory of a one-hour run; inverse: one inversion of a "
-                            "two-stage wire in Python and C, and heavy-pi+ff-adaptive through "
-                            "its FMUs against the reference wire's; hardware: the sensor's and "
-                            "the drive limit's cost per step in Python and C, and the C master "
-                            "against the library on the bench scenarios)")
+                            "c-master: the C master against the library: the loop per "
+                            "scenario, whole run commands, the run table's wall s, a sweep per "
+                            "worker, the peak memory of a one-hour run; inverse: one inversion "
+                            "of a two-stage wire in Python and C, and heavy-pi+ff-adaptive "
+                            "through its FMUs against the reference wire's; hardware: the "
+                            "sensor's and the drive limit's cost per step in Python and C, and "
+                            "the C master against the library on the bench scenarios)")
     bench.add_argument("--fmus", type=Path, metavar="DIR",
                        help="with --only c-master or hardware: the native FMUs (sma-fmu build "
                             "--native; default: built into the output folder)")

@@ -1,16 +1,24 @@
 """Co-simulation command: run scenarios and write their results."""
 from pathlib import Path
 
-from .arguments import add_fmus_argument, add_scenario_arguments, positive_number, scenario_paths
+from .arguments import (add_fmus_argument, add_quiet_argument, add_scenario_arguments,
+                        positive_number, scenario_paths)
 
 __all__ = ["register"]
 
 
 def _run(args):
+    from sma_fmu.console.extras import require
+    paths = scenario_paths(args)
+    if args.format == "parquet":
+        require("parquet", "--format parquet")
+    if args.path in ("ssp", "container"):
+        require("systems", f"--path {args.path}")
+    from sma_fmu.console.progress import echo
     from sma_fmu.systems.runner import timed_run
-    timed_run(scenario_paths(args), args.out, args.path, args.fmus,
+    timed_run(paths, args.out, args.path, args.fmus, progress=echo,
               output_interval_s=args.output_interval, fmt=args.format, master=args.master,
-              events=args.events, timeout_s=args.timeout)
+              events=args.events, timeout_s=args.timeout, figures=not args.no_figures)
     return 0
 
 
@@ -40,4 +48,8 @@ def register(commands):
                           "every step); the metrics always use every step")
     run.add_argument("--format", choices=("csv", "parquet"), default="csv",  # recording.FORMATS
                      help="time-series file: timeseries.csv (default) or timeseries.parquet")
+    run.add_argument("--no-figures", action="store_true",
+                     help="write no figures (figure.png, comparison-*.png): the time series, "
+                          "metrics and reports only, without the time figures take")
+    add_quiet_argument(run)
     run.set_defaults(handler=_run)

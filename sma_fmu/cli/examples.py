@@ -1,31 +1,44 @@
-"""Examples command: list the shipped example files, or copy them into a folder."""
-import shutil
+"""Examples command: list the shipped scenarios and example files, or copy them into a folder."""
 from pathlib import Path
-
-from sma_fmu.files.package_data import shipped_file, shipped_files
 
 __all__ = ["register"]
 
 
 def _examples(args):
+    from sma_fmu.files.package_data import shipped_file, shipped_files
+
     names = shipped_files("examples")
+    scenarios = shipped_files("scenarios", ".toml")
     if args.out is None:
+        print("scenarios (sma-fmu run NAME; copy one with --out and edit it):")
+        for name in scenarios:
+            print(f"  {name[:-len('.toml')]:<48} {shipped_file('scenarios', name)}")
+        print("examples (measurements, study specs, scripts):")
         for name in names:
-            print(shipped_file("examples", name))
+            print(f"  {shipped_file('examples', name)}")
         return 0
+    import shutil
+
     from sma_fmu.files.output_folder import staged_folder
     with staged_folder(args.out, "--out") as folder:
         for name in names:
             shutil.copyfile(shipped_file("examples", name), folder / name)
+        (folder / "scenarios").mkdir()
+        for name in scenarios:
+            shutil.copyfile(shipped_file("scenarios", name), folder / "scenarios" / name)
     for name in names:
         print(Path(args.out) / name)
+    print(f"{Path(args.out) / 'scenarios'}/: the {len(scenarios)} shipped scenarios "
+          "(sma-fmu run FILE.toml runs an edited copy)")
     return 0
 
 
 def register(commands):
     """Add ``examples`` to the ``commands`` subparsers."""
     examples = commands.add_parser(
-        "examples", help="list the shipped example files (measurements, scripts), or copy them")
+        "examples", help="list the shipped scenarios and example files (measurements, study "
+                         "specs, scripts), or copy them")
     examples.add_argument("--out", type=Path, metavar="DIR",
-                          help="copy the examples into this folder (default: only list them)")
+                          help="copy the examples, and the scenarios into DIR/scenarios/ "
+                               "(default: only list them)")
     examples.set_defaults(handler=_examples)

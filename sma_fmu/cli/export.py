@@ -1,7 +1,5 @@
 """Export commands: the closed loop for system-level tools (SSP package, container FMU), and
 the FMI Cross-Check tree of the built FMUs."""
-import re
-import zipfile
 from pathlib import Path
 
 from .arguments import add_fmus_argument, add_scenario_arguments, scenario_paths
@@ -24,6 +22,9 @@ class Fmi3ExportError(ValueError):
 
 def _refuse_fmi3(folder, kind):
     """Raise :class:`Fmi3ExportError` if ``folder`` holds an FMI 3.0 FMU."""
+    import re
+    import zipfile
+
     for path in sorted(Path(folder).glob("*.fmu")):
         try:
             with zipfile.ZipFile(path) as archive:
@@ -37,15 +38,17 @@ def _refuse_fmi3(folder, kind):
 
 
 def _ssp(args):
+    paths = scenario_paths(args)
     from sma_fmu.systems.ssp import export_ssp
 
     _refuse_fmi3(args.fmus, "ssp")
-    for path in export_ssp(scenario_paths(args), args.out, args.fmus):
+    for path in export_ssp(paths, args.out, args.fmus):
         print(path)
     return 0
 
 
 def _container(args):
+    from sma_fmu.console.extras import require
     from sma_fmu.cosim.scenario import resolve_scenarios
     from sma_fmu.systems.container import export_container
 
@@ -54,6 +57,7 @@ def _container(args):
     if len(paths) != 1:
         raise ValueError(f"SCENARIO {args.scenario!r}: names {len(paths)} scenarios; a container "
                          "holds one (export each into its own file)")
+    require("systems", "export container")
     print(export_container(paths[0], args.out, args.fmus))
     return 0
 

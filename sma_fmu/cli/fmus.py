@@ -3,13 +3,17 @@ import sys
 import warnings
 from pathlib import Path
 
-from sma_fmu.fmi.packaging import build as fmu_build
-from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
+from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
+
+from .arguments import add_quiet_argument, require_inputs
 
 __all__ = ["register"]
 
 
 def _build(args):
+    require_inputs((args.model, "parameter file"))
+    from sma_fmu.fmi.packaging import build as fmu_build   # here: every other command skips it
+
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         paths = fmu_build.build_fmus(args.out, args.model, native=args.native,
@@ -22,6 +26,10 @@ def _build(args):
 
 
 def _validate(args):
+    from sma_fmu.fmi.packaging import build as fmu_build
+    from sma_fmu.fmi.packaging.fmu_names import default_fmu_paths
+
+    require_inputs(*((path, "FMU file") for path in args.fmus))
     paths = args.fmus or list(default_fmu_paths(args.out).values())
     failed = False
     for path, problems in fmu_build.validate_fmus(paths).items():
@@ -49,6 +57,7 @@ def register(commands):
     build.add_argument("--compile", action="store_true",
                        help="--native: compile every binary here, even where the installed "
                             "package has a prebuilt one of the same sources")
+    add_quiet_argument(build)
     build.set_defaults(handler=_build)
 
     validate = commands.add_parser("validate", help="validate FMUs with fmpy (exit 1 on problems)")

@@ -2,12 +2,13 @@
 
 Experiments: constant-load, constant-temperature (resistance, the paper's two) and isobaric
 (strain under constant load through thermal cycles, ASTM E3097-style lab data)."""
-import dataclasses
 from pathlib import Path
 
+from sma_fmu.console.extras import require
 from sma_fmu.identification.limits import MAX_LOAD_KG, MAX_STRESS_MPA
 
-from .arguments import bounded_integer, bounded_number, finite_number, number_list
+from .arguments import (add_quiet_argument, bounded_integer, bounded_number, finite_number,
+                        number_list, require_inputs)
 
 __all__ = ["register"]
 
@@ -40,35 +41,62 @@ def _check_fit_loads(args):
                                  f"{'(' if low_open else '['}0, {high:g}] {unit}")
 
 
+NOT_CONVERGED = 3     # exit status of a fit whose solver did not converge
+
+
+def _meter():
+    """A progress bar of the fit's model evaluations on stderr, silent when it is no terminal."""
+    from tqdm import tqdm
+    return tqdm(desc="fit", unit=" evaluations", disable=None, leave=False, dynamic_ncols=True)
+
+
 def _fit_isobaric(args, out):
+    import sys
+    from sma_fmu.identification.coverage import coverage_lines
     from sma_fmu.identification.isobaric.runner import format_isobaric_report, run_isobaric_fit
+    from sma_fmu.console.progress import echo
     _check_fit_loads(args)
     report = run_isobaric_fit(args.files, out, args.load, args.stress, args.model,
                               args.residual_strain or "per-cycle", args.reference_length,
-                              progress=lambda text: print(text, flush=True), cycles=args.cycles,
+                              progress=echo, cycles=args.cycles,
                               lag=args.lag or "auto", stages=args.stages or 2,
                               outliers="keep" if args.keep_outliers else "leave-out",
-                              widths=args.widths or "auto")
+                              widths=args.widths or "auto", meter=_meter)
     print(format_isobaric_report(report))
+    print("\n".join(coverage_lines(report)))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
           f"figures")
+    solver = report["solver"]
+    if not solver["converged"]:
+        print(f"sma-fmu: the fit did not converge: {solver['message']} after "
+              f"{solver['evaluations']} evaluations; identified.toml is marked 'not converged' "
+              f"(exit {NOT_CONVERGED})", file=sys.stderr)
+        return NOT_CONVERGED
     return 0
 
 
 def _fit(args):
+    if args.experiment == "isobaric":
+        _check_fit_loads(args)
+    else:
+        _only_for(args, _ISOBARIC_ONLY, "isobaric", "fit")
+    require_inputs(*((path, "file") for path in args.files), (args.model, "parameter file"))
+    require("fit", "fit")
+    from sma_fmu.console.progress import echo
     from sma_fmu.identification.runner import format_report, run_fit
     out = args.out or Path("results") / f"fit-{args.experiment}"
     if args.experiment == "isobaric":
         return _fit_isobaric(args, out)
     _only_for(args, _ISOBARIC_ONLY, "isobaric", "fit")
-    report = run_fit(args.experiment, args.files, out, args.model,
-                     progress=lambda text: print(text, flush=True))
+    report = run_fit(args.experiment, args.files, out, args.model, progress=echo)
     print(format_report(report))
     print(f"written: {out}/identified.toml, report.json, figures")
     return 0
 
 
 def _synth_isobaric(args, params, t_min, t_max):
+    import dataclasses
+
     from sma_fmu.identification.isobaric.synthetic import (IsobaricProgramme, isobaric_table,
                                                            isobaric_text, stress_of_load)
     from sma_fmu.files.output_folder import staged_folder, write_file
@@ -138,6 +166,9 @@ def _check_synth_size(args, params, t_min, t_max):
 
 
 def _synth(args):
+    require_inputs((args.model, "parameter file"))
+    if args.experiment == "isobaric":
+        require("fit", "synth isobaric")
     from sma_fmu.identification.synthetic import (constant_load_rows, constant_temperature_rows,
                                                   write_rows)
     from sma_fmu.wire.parameter_file import load_parameter_set
@@ -165,6 +196,8 @@ def _synth(args):
 
 
 def _predict(args):
+    require_inputs((args.file, "file"), (args.model, "parameter file"))
+    require("fit", "predict")
     from sma_fmu.identification.isobaric.predict_runner import (format_predict_report,
                                                                 run_isobaric_predict)
     for name, value, high, unit in (("--load", args.load, MAX_LOAD_KG, "kg"),
@@ -204,8 +237,9 @@ def register(commands):
     fit.add_argument("--lag", choices=("auto", "fit", "none"),
                      help="isobaric: fit the wire's first-order lag behind the thermocouple (in "
                           "seconds, or samples without a time column), assume none, or auto: "
-                          "fit it when every file holds two complete cycles or more "
-                          "(default: auto)")
+                          "fit it when every file holds two complete cycles or more crossing "
+                          "the transformation at rates that differ by 25 %% or more (at one "
+                          "rate a lag cannot be told from a wider hysteresis) (default: auto)")
     fit.add_argument("--stages", type=int, choices=(1, 2),
                      help="isobaric: transformation stages, each a logistic with its own centres "
                           "and widths on heating and cooling; 2 fits the second from the "
@@ -220,6 +254,7 @@ def register(commands):
     fit.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
                      help="isobaric: length the strain is measured from [m] (default: the base "
                           "file's x0)")
+    add_quiet_argument(fit)
     fit.set_defaults(handler=_fit)
 
     predict = commands.add_parser(
@@ -242,6 +277,7 @@ def register(commands):
                               "without a time column], as fit isobaric reports it")
     predict.add_argument("--out", type=Path, metavar="DIR",
                          help="output folder (default: results/predict-isobaric)")
+    add_quiet_argument(predict)
     predict.set_defaults(handler=_predict)
 
     synth = commands.add_parser("synth", help="synthetic measurement CSV from a parameter file")

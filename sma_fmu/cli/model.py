@@ -1,18 +1,8 @@
 """Model commands: lattice, wire, resistance, sense, constant-length (``name = value unit`` or JSON)."""
-import json
 import math
 import sys
 
-from sma_fmu.wire.parameter_file import load_parameter_set
-from sma_fmu.runtime.checks import direction_name
-from sma_fmu.runtime.constant_length import load_temperature_slope
-from sma_fmu.runtime.constant_load import constant_load_fractions
-from sma_fmu.runtime.parameters import PARAMETER_SPECS
-from sma_fmu.runtime.phases import length_of, resistance_of
-from sma_fmu.runtime.sensing import sense_temperature
-from sma_fmu.runtime.validity import validity_warning
-
-from .arguments import Parser, direction, finite_number
+from .arguments import Parser, direction, finite_number, require_inputs
 
 __all__ = ["register"]
 
@@ -20,6 +10,7 @@ __all__ = ["register"]
 def _report(rows, as_json):
     """Print rows of (name, value, unit) as text lines or one JSON object."""
     if as_json:
+        import json
         print(json.dumps({name: value for name, value, _ in rows}, allow_nan=False))
         return
     for name, value, unit in rows:
@@ -39,6 +30,8 @@ def _derived_notes(parameter_set):
 
 
 def _wire(args, parameter_set):
+    from sma_fmu.runtime.parameters import PARAMETER_SPECS
+
     params = parameter_set.params
     rows = [("name", parameter_set.name, ""), ("file", str(parameter_set.path), "")]
     for spec in PARAMETER_SPECS:
@@ -58,6 +51,10 @@ def _wire(args, parameter_set):
 
 
 def _resistance(args, parameter_set):
+    from sma_fmu.runtime.checks import direction_name
+    from sma_fmu.runtime.constant_load import constant_load_fractions
+    from sma_fmu.runtime.phases import length_of, resistance_of
+
     params = parameter_set.params
     fractions = constant_load_fractions(args.temperature, args.load, args.direction, params)
     return [("temperature", args.temperature, "degC"), ("load", args.load, "kg"),
@@ -68,6 +65,9 @@ def _resistance(args, parameter_set):
 
 
 def _sense(args, parameter_set):
+    from sma_fmu.runtime.checks import direction_name
+    from sma_fmu.runtime.sensing import sense_temperature
+
     sensed = sense_temperature(args.resistance, args.load, args.direction, parameter_set.params)
     return [("resistance", args.resistance, "ohm"), ("load", args.load, "kg"),
             ("direction", direction_name(args.direction), ""),
@@ -75,6 +75,8 @@ def _sense(args, parameter_set):
 
 
 def _constant_length(args, parameter_set):
+    from sma_fmu.runtime.constant_length import load_temperature_slope
+
     slope = load_temperature_slope(args.xi_p, args.xi_m, args.xi_f, parameter_set.params)
     return [("xi_P", args.xi_p, ""), ("xi_M", args.xi_m, ""), ("xi_F", args.xi_f, ""),
             ("df_dT", slope, "kg/K")]
@@ -83,6 +85,8 @@ def _constant_length(args, parameter_set):
 def _warn_load(args, params):
     """One ``sma-fmu: warning:`` line on stderr for a --load above the validity limit, as the
     FMUs warn (runtime/validity.py)."""
+    from sma_fmu.runtime.validity import validity_warning
+
     load = getattr(args, "load", None)
     message = None if load is None else validity_warning(params, -math.inf, -math.inf, load, -math.inf)
     if message:
@@ -92,6 +96,9 @@ def _warn_load(args, params):
 def _handler(compute):
     """Handler that loads the parameter file, computes rows and prints them."""
     def handler(args):
+        require_inputs((args.model, "parameter file"))
+        from sma_fmu.wire.parameter_file import load_parameter_set
+
         parameter_set = load_parameter_set(args.model)
         rows = compute(args, parameter_set)
         _warn_load(args, parameter_set.params)

@@ -1,7 +1,10 @@
 """Study commands: sweep (a study spec on Dask) and tune (PI and compensator gains)."""
 from pathlib import Path
 
-from .arguments import add_scenario_arguments, bounded_integer, bounded_number, scenario_paths
+from sma_fmu.console.extras import require
+
+from .arguments import (add_quiet_argument, add_scenario_arguments, bounded_integer,
+                        bounded_number, require_inputs, scenario_paths)
 
 # choice: ranges wide enough for any real study, narrow enough that a typo cannot start a
 # run that would never end or exhaust memory (checked before any work starts)
@@ -14,6 +17,8 @@ __all__ = ["register"]
 
 
 def _sweep(args):
+    require_inputs((args.spec, "study spec"))
+    require("studies", "sweep")
     from sma_fmu.studies.sweep import run_sweep
     out = args.out or Path("results") / f"sweep-{Path(args.spec).stem}"
     summary = run_sweep(args.spec, out, args.scheduler, args.workers, progress=not args.quiet,
@@ -32,14 +37,18 @@ def _sweep(args):
 
 
 def _tune(args):
+    paths = scenario_paths(args)
+    require("studies", "tune")
+    from sma_fmu.console.progress import echo
     from sma_fmu.studies.robust import RobustCriterion
     from sma_fmu.studies.tuning import run_tuning
     out = args.out or Path("results") / "tune"
     robust = None
     if args.robust:
         robust = RobustCriterion(args.draws, args.spread, args.quantile, args.seed)
-    run_tuning(scenario_paths(args), out, seed=args.seed, generations=args.generations,
-               population=args.population, stop_time_s=args.stop_time, robust=robust)
+    run_tuning(paths, out, seed=args.seed, generations=args.generations,
+               population=args.population, stop_time_s=args.stop_time, progress=echo,
+               robust=robust)
     print(f"written: {out}/report.md, report.json, NAME/controller.toml")
     return 0
 
@@ -56,7 +65,7 @@ def register(commands):
                             "(default: one per core)")
     sweep.add_argument("--out", type=Path, metavar="DIR",
                        help="output folder (default: results/sweep-SPEC); rerun to resume")
-    sweep.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_quiet_argument(sweep)
     sweep.add_argument("--fmus", type=Path, metavar="DIR",
                        help="run every run through the C master over the FMUs in DIR (sma-fmu "
                             "build --native: FMU-path studies at C speed); default: the batch engine")
@@ -87,4 +96,5 @@ def register(commands):
     tune.add_argument("--quantile", type=bounded_number(0.0, 1.0, closed=True), default=0.5,
                       help="with --robust: the quantile of the draws' RMSEs minimised, 0-1 "
                            "(default 0.5: the median)")
+    add_quiet_argument(tune)
     tune.set_defaults(handler=_tune)

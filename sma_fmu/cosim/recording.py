@@ -291,11 +291,10 @@ def read_timeseries(path):
 
 
 def progress_bar(total_rows, label, stream=None):
-    """A tqdm bar over ``total_rows`` rows that shows only on a terminal and after 2 s, or None."""
-    stream = sys.stderr if stream is None else stream
-    if not getattr(stream, "isatty", lambda: False)():
-        return None
-    from tqdm import tqdm
+    """A bar over ``total_rows`` rows (:func:`sma_fmu.console.progress.bar`: on a terminal
+    only, not with ``--quiet``), or None where none shows."""
+    from sma_fmu.console import progress
 
-    return tqdm(total=total_rows, desc=label, unit="step", unit_scale=True, delay=2.0,
-                file=stream, leave=False)
+    if not progress.enabled(stream):
+        return None
+    return progress.bar(total_rows, label, unit="step", stream=stream, unit_scale=True)

@@ -33,6 +33,12 @@ def summary_table(rows):
                      f"{row['metrics']['hysteresis_mode']:<12}{_number(m['rmse_ohm'], '>8.3f'):>8}"
                      f"{_number(m['max_abs_ohm'], '>8.3f'):>8}{_number(m['iae_ohm_s'], '>8.2f'):>8}"
                      f"{row['wall_time_s']:>8.2f}{row['real_time_factor']:>8.0f}")
+    lines.append("wall s: each run's own time, from its start to its last row, less the time "
+                 "spent writing its files")
+    startup = [row["startup_s"] for row in rows if "startup_s" in row]
+    if startup:
+        lines.append(f"the C master's start-up (host started, FMUs read, unpacked and loaded), "
+                     f"paid once for all the runs and in no run's wall s: {sum(startup):.2f} s")
     return "\n".join(lines)
 
 

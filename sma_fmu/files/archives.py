@@ -141,12 +141,14 @@ def require_safe_archive(path):
     return Path(path)
 
 
-def safe_extract(path, folder):
-    """Inspect ``path``, then unpack it into ``folder`` [a new, empty folder]; returns ``folder``."""
+def safe_extract(path, folder, wanted=None):
+    """Inspect ``path``, then unpack it into ``folder`` [a new, empty folder]; returns ``folder``.
+    ``wanted``: a function of a member's name, whether to unpack it (None: every member)."""
     require_safe_archive(path)
     folder = Path(folder)
     with zipfile.ZipFile(path) as archive:
-        archive.extractall(folder)
+        names = None if wanted is None else [n for n in archive.namelist() if wanted(n)]
+        archive.extractall(folder, names)
     return folder
 
 

@@ -1,16 +1,29 @@
 """Write a command's outputs so that a failure leaves nothing half-written.
 
 A command writes into a temporary folder beside its output folder and, only when all
-of it succeeded, moves the results into place (a rename). A failure removes the
+of it succeeded, moves the results into place (a rename). A failure, or a Ctrl-C
+(:mod:`sma_fmu.console.interrupts`: moving and cleaning up are not cut), removes the
 temporary folder and leaves the output folder as it was.
+
+A rerun into the same folder replaces the previous results whole: the folder records
+what sma-fmu wrote into it (:data:`MARKER`), and those entries go, so no stale result
+(a scenario not run this time) stays beside the new ones. Entries sma-fmu did not write
+(your notes) are kept, and said so (:func:`~sma_fmu.console.progress.note`: the command
+line prints it).
 """
 import contextlib
+import json
 import os
 import shutil
 import tempfile
 from pathlib import Path
 
-__all__ = ["OutputError", "check_folder", "staged_folder", "write_file"]
+from sma_fmu.console.interrupts import deferred
+from sma_fmu.console.progress import note
+
+__all__ = ["OutputError", "MARKER", "check_folder", "staged_folder", "write_file"]
+
+MARKER = ".sma-fmu-output.json"   # {"written_by": "sma-fmu", "entries": [names]} in each folder
 
 
 def _umask():
@@ -47,34 +60,57 @@ def _writable_parent(path, argument):
 
 
 @contextlib.contextmanager
-def staged_folder(out, argument="--out"):
+def staged_folder(out, argument="--out", report=True):
     """Yield an empty temporary folder beside ``out``; on success move its contents into ``out``.
 
-    Entries of ``out`` with the same names as new ones are replaced; other entries stay.
-    Raises :class:`OutputError` when ``out`` is an existing file or cannot be written.
+    What sma-fmu wrote into ``out`` before (its :data:`MARKER`) is replaced whole; other
+    entries stay (``report``: said so, and that it replaced, by a note). Raises :class:`OutputError`
+    when ``out`` is an existing file or cannot be written.
     """
     out = Path(out)
     check_folder(out, argument)
     parent = _writable_parent(out, argument)
+    stage = None
     try:
-        stage = Path(tempfile.mkdtemp(prefix=f".{out.absolute().name or 'out'}.", suffix=".partial",
-                                      dir=parent))
-    except OSError as error:
-        raise OutputError(f"{argument} {out}: cannot write in {parent}: "
-                          f"{error.strerror or error}") from None
-    stage.chmod(0o777 & ~_umask())  # mkdtemp makes it private (0700); results are for sharing
-    try:
+        with deferred():   # a Ctrl-C here: the folder is made and known, then removed below
+            try:
+                stage = Path(tempfile.mkdtemp(prefix=f".{out.absolute().name or 'out'}.",
+                                              suffix=".partial", dir=parent))
+            except OSError as error:
+                raise OutputError(f"{argument} {out}: cannot write in {parent}: "
+                                  f"{error.strerror or error}") from None
+            stage.chmod(0o777 & ~_umask())  # mkdtemp makes it private (0700); results are for sharing
         yield stage
-        _commit(stage, out, argument)
+        with deferred():
+            _commit(stage, out, argument, report)
     finally:
-        shutil.rmtree(stage, ignore_errors=True)
+        if stage is not None:
+            with deferred():
+                shutil.rmtree(stage, ignore_errors=True)
 
 
-def _commit(stage, out, argument):
+def _written_before(out):
+    """The entries of ``out`` sma-fmu wrote there last (its marker), or () when none."""
+    try:
+        document = json.loads((out / MARKER).read_text(encoding="utf-8"))
+        return tuple(str(name) for name in document["entries"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return ()
+
+
+def _commit(stage, out, argument, report):
+    entries = sorted(entry.name for entry in stage.iterdir())
+    (stage / MARKER).write_text(json.dumps({"written_by": "sma-fmu", "entries": entries}),
+                                encoding="utf-8")
     try:
         if not out.exists():
             os.replace(stage, out)
             return
+        previous = [name for name in _written_before(out)   # names only, never a path
+                    if name not in ("", ".", "..", MARKER) and Path(name).name == name
+                    and os.path.lexists(out / name)]
+        for name in previous:
+            _remove(out / name)
         for entry in sorted(stage.iterdir()):
             target = out / entry.name
             if target.is_dir() and not target.is_symlink():
@@ -83,6 +119,21 @@ def _commit(stage, out, argument):
     except OSError as error:
         raise OutputError(f"{argument} {out}: cannot move the results into place: "
                           f"{error.strerror or error}") from None
+    others = sorted(entry.name for entry in out.iterdir() if entry.name not in entries
+                    and entry.name != MARKER)
+    if report and previous:
+        note(f"{out}: replaced the results written there before")
+    if report and others:
+        shown = ", ".join(others[:5]) + (f" and {len(others) - 5} more" if len(others) > 5 else "")
+        note(f"{out}: kept {len(others)} entr{'y' if len(others) == 1 else 'ies'} sma-fmu "
+                  f"did not write: {shown}")
+
+
+def _remove(path):
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    else:
+        path.unlink()
 
 
 def write_file(path, data, argument="--out"):
@@ -91,17 +142,19 @@ def write_file(path, data, argument="--out"):
     if path.is_dir():
         raise OutputError(f"{argument} {path}: is a folder; expected a file name")
     parent = _writable_parent(path, argument)
-    try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=parent)
-    except OSError as error:
-        raise OutputError(f"{argument} {path}: cannot write in {parent}: "
-                          f"{error.strerror or error}") from None
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data.encode("utf-8") if isinstance(data, str) else data)
-        os.chmod(temporary, 0o666 & ~_umask())  # mkstemp makes it private (0600)
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
-        raise
+    with deferred():   # small: written whole, or not at all
+        try:
+            handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial",
+                                                 dir=parent)
+        except OSError as error:
+            raise OutputError(f"{argument} {path}: cannot write in {parent}: "
+                              f"{error.strerror or error}") from None
+        try:
+            with os.fdopen(handle, "wb") as stream:
+                stream.write(data.encode("utf-8") if isinstance(data, str) else data)
+            os.chmod(temporary, 0o666 & ~_umask())  # mkstemp makes it private (0600)
+            os.replace(temporary, path)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.unlink(temporary)
+            raise

@@ -5,14 +5,22 @@ switch); the callers write the bytes where they belong (results folders, FMU arc
 """
 import io
 
-__all__ = ["png_bytes"]
+__all__ = ["png_bytes", "tight_layout"]
+
+
+def tight_layout(figure):
+    """``figure.tight_layout()``, leaving no layout engine behind: matplotlib leaves a
+    placeholder one, and savefig then draws the whole figure once more before it renders
+    it (a third of a figure's time)."""
+    figure.tight_layout()
+    figure.set_layout_engine(None)
 
 
 def png_bytes(figure, dpi=None, tight=False):
     """The PNG bytes of ``figure``: at ``dpi`` (None: matplotlib's savefig default), after
-    ``tight_layout()`` if ``tight``."""
+    :func:`tight_layout` if ``tight``."""
     if tight:
-        figure.tight_layout()
+        tight_layout(figure)
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=dpi)
     return buffer.getvalue()

@@ -5,6 +5,11 @@ and the domain size nu [1]. eps_T stays at the base file's value: only nu*eps_T 
 transition width, and the remaining load term of dH(f) is too weak to separate the two.
 Starting values come from the data: the saturated ends of each sweep, the temperature
 half way through each transformation, and its width.
+
+A base file with a second stage or separate widths nu_h/nu_c (what ``sma-fmu fit isobaric``
+writes) already holds the transformation's temperatures and widths, fitted with every term
+this one-stage fit lacks: they are kept (:func:`kept_from_base`), and the resistance data
+complete the file with R_P, R_M, R_F, xi_F_inf and f_F.
 """
 import math
 
@@ -18,9 +23,18 @@ from sma_fmu.runtime.constants import BOLTZMANN, HEATING, KELVIN_OFFSET
 from sma_fmu.runtime.sensing import mixed_fractions_of_resistance, sense_temperature
 
 __all__ = ["FITTED", "MIN_LOADS", "model_resistance", "starting_parameters", "fit_constant_load",
-           "sensing_comparison"]
+           "sensing_comparison", "kept_from_base", "TRANSFORMATION"]
 
 FITTED = ("R_P", "R_M", "R_F", "a_h", "b_h", "a_c", "b_c", "xi_F_inf", "f_F", "nu")
+TRANSFORMATION = ("a_h", "b_h", "a_c", "b_c", "nu")   # kept from an isobaric fit's file
+
+
+def kept_from_base(base):
+    """The names of :data:`TRANSFORMATION` a fit keeps from ``base`` (a WireParameters):
+    all of them when it has a second stage or its own widths nu_h/nu_c, else none."""
+    if base.terms.two_stage or base.nu_h is not None or base.nu_c is not None:
+        return TRANSFORMATION
+    return ()
 MIN_LOADS = 3               # distinct loads needed to identify the load dependence
 MIN_RELATIVE_SPAN = 0.05    # a sweep must change R by 5 % of its mean to show a transformation
 
@@ -160,7 +174,8 @@ def sensing_comparison(params, data):
 def fit_constant_load(data, base):
     """Fit :data:`FITTED` to constant-load data; returns (FitResult, report dict)."""
     groups = _groups(data)
-    unknowns = starting_parameters(data, base)
+    kept = kept_from_base(base)
+    unknowns = [p for p in starting_parameters(data, base) if p.name not in kept]
 
     def residuals(params):
         return model_resistance(params, data, groups) - data.resistance
@@ -175,7 +190,12 @@ def fit_constant_load(data, base):
         "points": int(data.resistance.size),
         "parameters": result.table(),
         "covariance": result.covariance_table(),
-        "fixed_from_base": {"eps_T": base.eps_T},
+        "fixed_from_base": {"eps_T": base.eps_T, **{name: getattr(base, name) for name in kept}},
+        "kept_from_base": {
+            "parameters": list(kept),
+            "note": f"kept from the base file: {', '.join(kept)} (its transformation, fitted "
+                    f"with a second stage or separate widths nu_h/nu_c, terms this fit lacks)"}
+        if kept else None,
         "mape_percent": float(errors.mean()),
         "max_abs_error_ohm": float(np.max(np.abs(result.residuals))),
         "rmse_ohm": float(np.sqrt(np.mean(result.residuals ** 2))),

@@ -1,14 +1,18 @@
 """``sma-fmu fit``: read measurement files, identify parameters, write the results.
 
 Writes into ``out_dir``: ``identified.toml`` (a complete parameter file in the format of
-``models/``, ready for the FMUs and scenarios), ``report.json`` and PNG figures. All of it
-is computed first; nothing is written when reading, checking or fitting fails.
+``models/``, ready for the FMUs and scenarios, with the range its data covered),
+``report.json`` (with that range, the diameter of every MPa <-> kg and what the fit did not
+determine: :mod:`.coverage`) and PNG figures. All of it is computed first; nothing is
+written when reading, checking or fitting fails.
 """
 from datetime import datetime, timezone
 from pathlib import Path
 
 from sma_fmu.identification import constant_load as fit_constant_load
 from sma_fmu.identification import constant_temperature as fit_constant_temperature
+from sma_fmu.identification.coverage import (DATA_RANGE_MEANINGS, coverage_header,
+                                             coverage_lines, stress_of_load, with_coverage)
 from sma_fmu.identification.figures import constant_load_figures, constant_temperature_figures
 from sma_fmu.identification.measurements import read_constant_load, read_constant_temperature
 from sma_fmu.files.json_output import json_text
@@ -21,22 +25,27 @@ EXPERIMENTS = ("constant-load", "constant-temperature")
 
 
 def _fit(experiment, files, base, progress):
-    """(FitResult, report, {figure name: PNG bytes}) of one experiment."""
+    """(FitResult, report, {figure name: PNG bytes}, (temperatures [degC], loads [kg]) the
+    data cover, or None where they do not set the data range) of one experiment."""
     if experiment == "constant-load":
         data = read_constant_load(files)
-        progress(f"fitting {len(fit_constant_load.FITTED)} parameters to "
+        kept = fit_constant_load.kept_from_base(base)
+        progress(f"fitting {len(fit_constant_load.FITTED) - len(kept)} parameters to "
                  f"{data.resistance.size} points ...")
         result, report = fit_constant_load.fit_constant_load(data, base)
         progress("drawing the figures ...")
         sensed, _, _ = fit_constant_load.sensing_comparison(result.params, data)
-        return result, report, constant_load_figures(result.params, data, sensed)
+        return (result, report, constant_load_figures(result.params, data, sensed),
+                (data.temperature, data.load))
     experiments = [read_constant_temperature(f) for f in files]
     progress(f"fitting {len(fit_constant_temperature.FITTED)} parameters to "
              f"{sum(e.load.size for e in experiments)} points ...")
     result, report = fit_constant_temperature.fit_constant_temperature(experiments, base)
     progress("drawing the figures ...")
     model = fit_constant_temperature.model_resistance(result.params, experiments)
-    return result, report, constant_temperature_figures(result.params, experiments, model)
+    # eps_f, nu_f (the stress-induced transformation at one temperature) are not in the
+    # plant or the compensator: their data leave the FMUs' data range as the base gave it
+    return result, report, constant_temperature_figures(result.params, experiments, model), None
 
 
 def run_fit(experiment, files, out_dir, model=None, progress=lambda text: None):
@@ -46,16 +55,22 @@ def run_fit(experiment, files, out_dir, model=None, progress=lambda text: None):
     if not files:
         raise ValueError("no measurement file given")
     base_set = load_parameter_set(model)
-    result, report, figures = _fit(experiment, [Path(f) for f in files], base_set.params, progress)
-    fitted = ", ".join(p.name for p in result.parameters)
+    result, report, figures, spans = _fit(experiment, [Path(f) for f in files],
+                                          base_set.params, progress)
+    fitted = [p.name for p in result.parameters]
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     report["base_parameter_file"] = str(base_set.path)
+    temperatures, loads = spans or (None, [])
+    params, report["coverage"] = with_coverage(
+        result.params, base_set, fitted, temperatures,
+        [stress_of_load(float(load), base_set.params.diameter) for load in loads])
     text = parameter_file_text(
-        result.params, f"{base_set.name}-identified",
+        params, f"{base_set.name}-identified",
         f"{experiment} fit of {', '.join(Path(f).name for f in files)}; MAPE "
-        f"{report['mape_percent']:.3g} %", base_set.meanings,
+        f"{report['mape_percent']:.3g} %", {**base_set.meanings, **DATA_RANGE_MEANINGS},
         header=[f"Identified by sma-fmu fit {experiment} on {stamp}.",
-                f"Fitted: {fitted}; everything else from {base_set.path}.",
+                f"Fitted: {', '.join(fitted)}; everything else from {base_set.path}.",
+                coverage_header(report["coverage"]),
                 f"Data: {', '.join(str(f) for f in files)}"])
     with staged_folder(out_dir) as folder:
         (folder / "identified.toml").write_text(text, encoding="utf-8")
@@ -79,4 +94,8 @@ def format_report(report):
         core = sensing["core_5_95_percent"]
         lines.append(f"temperature sensing (5-95 % of the transformation): {core['points']} points, "
                      f"RMSE {core['rmse_K']:.3g} K, max {core['max_abs_K']:.3g} K")
+    if report.get("kept_from_base"):
+        lines.append(report["kept_from_base"]["note"])
+    if "coverage" in report:
+        lines += coverage_lines(report)
     return "\n".join(lines)

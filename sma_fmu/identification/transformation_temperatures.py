@@ -102,7 +102,8 @@ def branch_tangents_or_reason(temperature, strain, direction, band=BAND, tail=TA
                       "transformation not finished before the turn (no martensite baseline)")
     cold, hot = _line(t[cold_rows], e[cold_rows]), _line(t[hot_rows], e[hot_rows])
     low_line = hot[0] + hot[1] * t
-    progress = (e - low_line) / (cold[0] + cold[1] * t - low_line)
+    with np.errstate(divide="ignore", invalid="ignore"):   # baselines that cross
+        progress = (e - low_line) / (cold[0] + cold[1] * t - low_line)
     rows = (progress >= band[0]) & (progress <= band[1])
     if rows.sum() < 2 or np.ptp(e[rows]) == 0.0:
         return None, "fewer than 2 samples between 40 and 60 % of the transformation"

@@ -75,11 +75,13 @@ def second_centre(load, direction, params):
 
 
 def _checked_centre(centre, load, what):
+    """``centre`` [degC], refused when not finite or at or below 0 K; ``what`` names it and
+    the parameters it is made of (e.g. "hysteresis centre a_h + b_h f")."""
     if not centre < math.inf:
-        raise ValueError(f"load = {load!r} kg is beyond the model's range: the {what} "
+        raise ValueError(f"load = {load!r} kg is beyond the model's range: the {what} = "
                          f"{centre!r} degC is not finite")
     if centre <= -KELVIN_OFFSET:
-        raise ValueError(f"{what} {centre!r} degC at load {load!r} kg is below 0 K")
+        raise ValueError(f"{what} = {centre!r} degC at load {load!r} kg is below 0 K")
     return centre
 
 
@@ -108,7 +110,8 @@ def branch_constants(load, direction, params):
     heating = direction_sign(direction) == HEATING
     terms = params.terms
     centre = _checked_centre(hysteresis_centre(load, direction, params), load,
-                             "hysteresis centre")
+                             "hysteresis centre a_h + b_h f" if heating
+                             else "hysteresis centre a_c + b_c f")
     xi_f_min = residual_f_fraction(load, params)
     total = 1.0 - xi_f_min
     constants = BranchConstants(
@@ -121,7 +124,8 @@ def branch_constants(load, direction, params):
     )
     if terms.two_stage:
         centre2 = _checked_centre(second_centre(load, direction, params), load,
-                                  "second-stage centre")
+                                  "second-stage centre a2_h + b2_h f" if heating
+                                  else "second-stage centre a2_c + b2_c f")
         energy2 = domain_energy(load, params, terms.nu2_h if heating else terms.nu2_c)
         constants = constants._replace(
             w2=terms.w2, M1=total * (1.0 - terms.w2), M2=total * terms.w2,

@@ -37,6 +37,10 @@ makes the transformation, and so the inverse, climb to thousands of degC), T_ref
 bounded to T_max, P_ff is the steady-state power of T_max, ``saturated`` is True, and the
 first step of each such excursion sets a warning. The inverse's own memory (the minor-loop
 stack) keeps the unbounded temperature, as the plant's branch would.
+
+A wire that gives the range its data covered (``validity.T_data_min`` ...): the first step
+whose T_ref or load lies outside it sets one more warning, once in the stepper's life (as
+the plant does).
 """
 import math
 from collections import namedtuple
@@ -49,7 +53,7 @@ from .phase_lag import PhaseLagFilter
 from .sensing import invert_on_stack, mixed_fractions_of_resistance, temperature_of_fractions
 from .state_entries import (StateError, check_format, read_direction, read_entries,
                             read_optional_number, read_temperature)
-from .validity import validity_warning
+from .validity import data_range_warning, validity_warning
 
 __all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStepper",
            "STATE_FORMAT"]
@@ -116,6 +120,7 @@ class FeedforwardStepper:
         self._load_before = -math.inf     # load of the last step [kg]
         self._unconnected_warned = False  # the no-reference-yet warning was given
         self._bounded_before = False      # the last step's T_ref was bounded to T_max
+        self._data_unwarned = params.data_range   # the data-range warning is still to come
 
     def _invert(self, reference, load, direction):
         """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
@@ -197,11 +202,17 @@ class FeedforwardStepper:
                      f"{self.params.T_max:g} degC (R_ref = {reference:.6g} ohm, load = {load:.6g} "
                      f"kg): bounded to T_max, saturated")
             warning = bound if warning is None else f"{warning}; {bound}"
+        outside = (data_range_warning(self.params, temperature, load, "T_ref")
+                   if self._data_unwarned else None)
+        if outside is not None:
+            warning = outside if warning is None else f"{warning}; {outside}"
         output = self.filter.step(self._power(temperature), step_size)
         self.direction = direction
         self.previous_reference = reference
         self.reversals = points
         self.warning, self._load_before, self._bounded_before = warning, load, bounded
+        if outside is not None:
+            self._data_unwarned = False
         self.previous_temperature = sensed.temperature
         self.previous_fraction = fraction
         return _new_tuple(FeedforwardOutputs, (output, temperature, saturated))

@@ -14,101 +14,141 @@ from .lattice import lattice_constants
 from .model_terms import ModelTerms, model_terms
 from .thermal import thermal_gain, thermal_time_constant
 
-__all__ = ["ParameterError", "ParameterSpec", "PARAMETER_SPECS", "RULE_TEXT", "WireParameters",
-           "DEFAULT_STRESS_MAX"]
+__all__ = ["ParameterError", "ParameterSpec", "PARAMETER_SPECS", "RULES", "WireParameters",
+           "DEFAULT_STRESS_MAX", "DATA_RANGE", "range_text", "requirement_text",
+           "value_in_range"]
 
 
 class ParameterError(ValueError):
     """A parameter set or parameter file is malformed; the message names the key and value."""
 
 
-ParameterSpec = namedtuple("ParameterSpec", ["name", "section", "unit", "rule", "required"])
-ParameterSpec.__doc__ = "One entry of the parameter schema: where it lives, its unit, its rule."
+ParameterSpec = namedtuple("ParameterSpec",
+                           ["name", "section", "unit", "rule", "required", "limits"])
+ParameterSpec.__doc__ = """One entry of the parameter schema: where it lives, its unit, its rule
+and ``limits`` (low, high), the plausible range in its unit (docs/model.md says why)."""
 
-# rule: "positive" (> 0), "nonnegative" (>= 0), "fraction" (0 <= v < 1), "finite",
-#       "margin" (0 < v < 0.5), "depth" (a whole number in [2, MAX_MEMORY_DEPTH])
+MAX_MEMORY_DEPTH = 100_000
+# The plausible ranges (low, high) [unit]: wide enough for every Ti-Ni, NiTiHf or NiTiCo wire
+# and rod and for what the fits reach, narrow enough to refuse a unit slip (a length in mm, a
+# resistance in mohm, 1e30). The rule says whether an end is open: positive (low, high],
+# nonnegative [low, high], fraction [0, 1), margin (0, 0.5), finite and depth [low, high].
+LENGTH = (0.0, 10.0)               # m: from a few mm (a test coupon) to 10 m of wire
+DIAMETER = (0.0, 0.01)             # m: drawn wire 0.025-0.5 mm, rods up to 10 mm
+MASS = (0.0, 10.0)                 # kg: 10 m of a 10 mm rod is 5 kg
+RESISTANCE = (0.0, 1e5)            # ohm: 10 m of 25 um wire (1.4 kohm/m) is 14 kohm
+TEMPERATURE = (-273.15, 1000.0)    # degC: above 0 K; shape setting is at 400-650 degC
+CENTRE_SLOPE = (-1e5, 1e5)         # degC/kg: 0.5 K/MPa on a 10 um wire is 6e4 K/kg
+LOAD = (0.0, 1e5)                  # kg: 2000 MPa on a 10 mm rod is 1.6e4 kg
+STRESS = (0.0, 2000.0)             # MPa: Ti-Ni breaks at 1000-1900 MPa
+STRESS_SCALE = (0.0, 1e4)          # MPa: a stress law's scale (the fit reaches 5000)
+CELL_ENERGY = (0.0, 1e-17)         # J: 60 eV per cell, 3000 x Ti-Ni's latent heat per cell
+CELL_ENERGY_SIGNED = (-1e-17, 1e-17)  # J
+DOMAIN_SIZE = (0.0, 1e9)           # cells per domain: far past a step of a millikelvin
+EXPANSION = (-0.01, 0.01)          # 1/K: 1000 x a metal's (the fit reaches +-2e-3)
+SPAN_RATIO = (0.0, 100.0)          # 1: the stress law's scale of the strain span
+SURFACE = (0.0, 1.0)               # m2: 10 m of a 10 mm rod is 0.31 m2
+HEAT_CAPACITY = (0.0, 1e4)         # J/(kg.K): Ti-Ni 450-900 (water 4186)
+HEAT_TRANSFER = (0.0, 1e5)         # W/(m2.K): still air 5 to boiling water 1e5
+TIME = (0.0, 1e5)                  # s: a 10 mm rod in still air has tau_th of about 2700 s
+GAIN = (0.0, 1e6)                  # W/ohm, W/(ohm.s): a milliohm rod needs kW per ohm
+FRACTION = (0.0, 1.0)              # 1
+MARGIN = (0.0, 0.5)                # 1
+DEPTH = (2, MAX_MEMORY_DEPTH)      # 1: reversal points
+
 PARAMETER_SPECS = (
-    ParameterSpec("x0", "geometry", "m", "positive", True),
-    ParameterSpec("x_min", "geometry", "m", "positive", True),
-    ParameterSpec("diameter", "geometry", "m", "positive", True),
-    ParameterSpec("theta", "geometry", "1", "fraction", True),
-    ParameterSpec("mass", "geometry", "kg", "positive", True),
-    ParameterSpec("R_P", "phases", "ohm", "positive", True),
-    ParameterSpec("R_M", "phases", "ohm", "positive", True),
-    ParameterSpec("R_F", "phases", "ohm", "positive", True),
-    ParameterSpec("l_M", "phases", "m", "positive", True),
-    ParameterSpec("l_F", "phases", "m", "positive", True),
-    ParameterSpec("a_h", "hysteresis", "degC", "finite", True),
-    ParameterSpec("b_h", "hysteresis", "degC/kg", "finite", True),
-    ParameterSpec("a_c", "hysteresis", "degC", "finite", True),
-    ParameterSpec("b_c", "hysteresis", "degC/kg", "finite", True),
-    ParameterSpec("memory_depth", "hysteresis", "1", "depth", False),
-    ParameterSpec("xi_F_inf", "constant_load", "1", "fraction", True),
-    ParameterSpec("f_F", "constant_load", "kg", "positive", True),
-    ParameterSpec("eps_T", "constant_load", "J", "positive", True),
-    ParameterSpec("nu", "constant_load", "1", "positive", True),
-    ParameterSpec("nu_h", "constant_load", "1", "positive", False),
-    ParameterSpec("nu_c", "constant_load", "1", "positive", False),
-    ParameterSpec("w2", "second_stage", "1", "fraction", False),
-    ParameterSpec("a2_h", "second_stage", "degC", "finite", False),
-    ParameterSpec("b2_h", "second_stage", "degC/kg", "finite", False),
-    ParameterSpec("a2_c", "second_stage", "degC", "finite", False),
-    ParameterSpec("b2_c", "second_stage", "degC/kg", "finite", False),
-    ParameterSpec("nu2_h", "second_stage", "1", "positive", False),
-    ParameterSpec("nu2_c", "second_stage", "1", "positive", False),
-    ParameterSpec("alpha_P", "strain", "1/K", "finite", False),
-    ParameterSpec("alpha_MF", "strain", "1/K", "finite", False),
-    ParameterSpec("T_alpha", "strain", "degC", "finite", False),
-    ParameterSpec("span_ratio_0", "strain", "1", "positive", False),
-    ParameterSpec("span_ratio_sat", "strain", "1", "positive", False),
-    ParameterSpec("span_stress", "strain", "MPa", "positive", False),
-    ParameterSpec("eps_f", "constant_temperature", "J", "finite", True),
-    ParameterSpec("nu_f", "constant_temperature", "1", "positive", True),
-    ParameterSpec("A_s", "thermal", "m2", "positive", True),
-    ParameterSpec("c_p", "thermal", "J/(kg.K)", "positive", True),
-    ParameterSpec("h_c", "thermal", "W/(m2.K)", "positive", True),
-    ParameterSpec("T_room", "thermal", "degC", "finite", True),
-    ParameterSpec("saturation_margin", "sensing", "1", "margin", True),
-    ParameterSpec("model_load", "control", "kg", "nonnegative", True),
-    ParameterSpec("alpha", "control", "s", "nonnegative", False),
-    ParameterSpec("beta", "control", "s", "positive", True),
-    ParameterSpec("Kp", "control", "W/ohm", "nonnegative", True),
-    ParameterSpec("Ki", "control", "W/(ohm.s)", "nonnegative", True),
-    ParameterSpec("T_max", "validity", "degC", "finite", True),
-    ParameterSpec("stress_max", "validity", "MPa", "positive", False),
+    ParameterSpec("x0", "geometry", "m", "positive", True, LENGTH),
+    ParameterSpec("x_min", "geometry", "m", "positive", True, LENGTH),
+    ParameterSpec("diameter", "geometry", "m", "positive", True, DIAMETER),
+    ParameterSpec("theta", "geometry", "1", "fraction", True, FRACTION),
+    ParameterSpec("mass", "geometry", "kg", "positive", True, MASS),
+    ParameterSpec("R_P", "phases", "ohm", "positive", True, RESISTANCE),
+    ParameterSpec("R_M", "phases", "ohm", "positive", True, RESISTANCE),
+    ParameterSpec("R_F", "phases", "ohm", "positive", True, RESISTANCE),
+    ParameterSpec("l_M", "phases", "m", "positive", True, LENGTH),
+    ParameterSpec("l_F", "phases", "m", "positive", True, LENGTH),
+    ParameterSpec("a_h", "hysteresis", "degC", "finite", True, TEMPERATURE),
+    ParameterSpec("b_h", "hysteresis", "degC/kg", "finite", True, CENTRE_SLOPE),
+    ParameterSpec("a_c", "hysteresis", "degC", "finite", True, TEMPERATURE),
+    ParameterSpec("b_c", "hysteresis", "degC/kg", "finite", True, CENTRE_SLOPE),
+    ParameterSpec("memory_depth", "hysteresis", "1", "depth", False, DEPTH),
+    ParameterSpec("xi_F_inf", "constant_load", "1", "fraction", True, FRACTION),
+    ParameterSpec("f_F", "constant_load", "kg", "positive", True, LOAD),
+    ParameterSpec("eps_T", "constant_load", "J", "positive", True, CELL_ENERGY),
+    ParameterSpec("nu", "constant_load", "1", "positive", True, DOMAIN_SIZE),
+    ParameterSpec("nu_h", "constant_load", "1", "positive", False, DOMAIN_SIZE),
+    ParameterSpec("nu_c", "constant_load", "1", "positive", False, DOMAIN_SIZE),
+    ParameterSpec("w2", "second_stage", "1", "fraction", False, FRACTION),
+    ParameterSpec("a2_h", "second_stage", "degC", "finite", False, TEMPERATURE),
+    ParameterSpec("b2_h", "second_stage", "degC/kg", "finite", False, CENTRE_SLOPE),
+    ParameterSpec("a2_c", "second_stage", "degC", "finite", False, TEMPERATURE),
+    ParameterSpec("b2_c", "second_stage", "degC/kg", "finite", False, CENTRE_SLOPE),
+    ParameterSpec("nu2_h", "second_stage", "1", "positive", False, DOMAIN_SIZE),
+    ParameterSpec("nu2_c", "second_stage", "1", "positive", False, DOMAIN_SIZE),
+    ParameterSpec("alpha_P", "strain", "1/K", "finite", False, EXPANSION),
+    ParameterSpec("alpha_MF", "strain", "1/K", "finite", False, EXPANSION),
+    ParameterSpec("T_alpha", "strain", "degC", "finite", False, TEMPERATURE),
+    ParameterSpec("span_ratio_0", "strain", "1", "positive", False, SPAN_RATIO),
+    ParameterSpec("span_ratio_sat", "strain", "1", "positive", False, SPAN_RATIO),
+    ParameterSpec("span_stress", "strain", "MPa", "positive", False, STRESS_SCALE),
+    ParameterSpec("eps_f", "constant_temperature", "J", "finite", True, CELL_ENERGY_SIGNED),
+    ParameterSpec("nu_f", "constant_temperature", "1", "positive", True, DOMAIN_SIZE),
+    ParameterSpec("A_s", "thermal", "m2", "positive", True, SURFACE),
+    ParameterSpec("c_p", "thermal", "J/(kg.K)", "positive", True, HEAT_CAPACITY),
+    ParameterSpec("h_c", "thermal", "W/(m2.K)", "positive", True, HEAT_TRANSFER),
+    ParameterSpec("T_room", "thermal", "degC", "finite", True, TEMPERATURE),
+    ParameterSpec("saturation_margin", "sensing", "1", "margin", True, MARGIN),
+    ParameterSpec("model_load", "control", "kg", "nonnegative", True, LOAD),
+    ParameterSpec("alpha", "control", "s", "nonnegative", False, TIME),
+    ParameterSpec("beta", "control", "s", "positive", True, TIME),
+    ParameterSpec("Kp", "control", "W/ohm", "nonnegative", True, GAIN),
+    ParameterSpec("Ki", "control", "W/(ohm.s)", "nonnegative", True, GAIN),
+    ParameterSpec("T_max", "validity", "degC", "finite", True, TEMPERATURE),
+    ParameterSpec("stress_max", "validity", "MPa", "positive", False, STRESS),
+    ParameterSpec("T_data_min", "validity", "degC", "finite", False, TEMPERATURE),
+    ParameterSpec("T_data_max", "validity", "degC", "finite", False, TEMPERATURE),
+    ParameterSpec("stress_data_min", "validity", "MPa", "nonnegative", False, STRESS),
+    ParameterSpec("stress_data_max", "validity", "MPa", "nonnegative", False, STRESS),
 )
+# The data range (T_data_*, stress_data_*: optional, written by the fits) is where the
+# parameters were identified; a stepper warns once when a run leaves it (runtime/validity.py).
+DATA_RANGE = ("T_data_min", "T_data_max", "stress_data_min", "stress_data_max")
 
 SPEC_BY_NAME = {spec.name: spec for spec in PARAMETER_SPECS}
 
-RULE_TEXT = {
-    "positive": "must be > 0",
-    "nonnegative": "must be >= 0",
-    "fraction": "must be in [0, 1)",
-    "finite": "must be finite",
-    "margin": "must be in (0, 0.5)",
-    "depth": "must be a whole number in [2, 100000]",
-}
-MAX_MEMORY_DEPTH = 100_000
+# rule -> (low end open, high end open) of its range
+RULES = {"positive": (True, False), "nonnegative": (False, False), "fraction": (False, True),
+         "finite": (False, False), "margin": (True, True), "depth": (False, False)}
 # choice: Ti-Ni actuator wires are rated for 150-200 MPa over many cycles and yield or lose
 # their memory a little above 300 MPa; the reference wire's parameters come from loads up
 # to 0.25 kg (139 MPa on 0.15 mm). Above 300 MPa the model warns (0.54 kg on 0.15 mm).
 DEFAULT_STRESS_MAX = 300.0   # MPa
 
 
-def _rule_holds(rule, value):
+def range_text(spec):
+    """The plausible range of ``spec`` as an interval in its unit, e.g. ``(0, 100000]``."""
+    low_open, high_open = RULES[spec.rule]
+    low, high = spec.limits
+    return f"{'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
+
+
+def requirement_text(spec, value):
+    """What ``value`` of ``spec`` must be, as the refusal says it (after "must be")."""
+    if spec.rule == "depth":
+        return f"a whole number in {range_text(spec)}"
     if not math.isfinite(value):
+        return f"a finite number in {range_text(spec)}"
+    return f"in {range_text(spec)}"
+
+
+def value_in_range(spec, value):
+    """True if the number ``value`` holds ``spec``'s rule and lies in its plausible range."""
+    if not math.isfinite(value) or spec.rule == "depth" and value != int(value):
         return False
-    if rule == "positive":
-        return value > 0.0
-    if rule == "nonnegative":
-        return value >= 0.0
-    if rule == "fraction":
-        return 0.0 <= value < 1.0
-    if rule == "margin":
-        return 0.0 < value < 0.5
-    if rule == "depth":
-        return value == int(value) and 2 <= value <= MAX_MEMORY_DEPTH
-    return True
+    low_open, high_open = RULES[spec.rule]
+    low, high = spec.limits
+    return (low < value if low_open else low <= value) and \
+        (value < high if high_open else value <= high)
 
 
 @dataclass(frozen=True)
@@ -122,7 +162,11 @@ class WireParameters:
     ``memory_depth`` [1] is the most reversal points the minor-loop memory keeps (an int;
     optional in a file, default 64). ``load_max`` [kg] = stress_max pi d^2/4 / g is the
     largest load the model is valid for (``stress_max`` [MPa], optional, default
-    :data:`DEFAULT_STRESS_MAX`): the steppers warn above it.
+    :data:`DEFAULT_STRESS_MAX`): the steppers warn above it. The range the fitted data
+    covered, ``T_data_min``/``T_data_max`` [degC] and ``stress_data_min``/``stress_data_max``
+    [MPa], is optional (None: no bound); ``load_data_min``/``load_data_max`` [kg] are the
+    stress bounds as loads (None when not given), ``data_range`` is True when any bound is
+    given: the steppers then warn once when a run leaves the range.
 
     The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``) are
     None when not given; ``terms`` (:class:`~.model_terms.ModelTerms`) holds the values in
@@ -177,6 +221,10 @@ class WireParameters:
     span_ratio_0: float = None
     span_ratio_sat: float = None
     span_stress: float = None
+    T_data_min: float = None
+    T_data_max: float = None
+    stress_data_min: float = None
+    stress_data_max: float = None
     source: str = field(default="<parameters>", compare=False, repr=False)
 
     lattice: tuple = field(init=False, repr=False, compare=False)
@@ -190,6 +238,9 @@ class WireParameters:
     tau_th: float = field(init=False, repr=False, compare=False)
     phase_lag_alpha: float = field(init=False, repr=False, compare=False)
     load_max: float = field(init=False, repr=False, compare=False)
+    load_data_min: float = field(init=False, repr=False, compare=False)
+    load_data_max: float = field(init=False, repr=False, compare=False)
+    data_range: bool = field(init=False, repr=False, compare=False)
     terms: ModelTerms = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -210,8 +261,9 @@ class WireParameters:
         key = f"{spec.section}.{spec.name}"
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self._fail(f"parameter {key} must be a number [{spec.unit}], got {value!r}")
-        if not _rule_holds(spec.rule, float(value)):  # the value as given: an Integer stays one
-            self._fail(f"parameter {key} = {value!r} {RULE_TEXT[spec.rule]} [{spec.unit}]")
+        if not value_in_range(spec, float(value)):  # the value as given: an Integer stays one
+            self._fail(f"parameter {key} = {value!r} must be "
+                       f"{requirement_text(spec, float(value))} [{spec.unit}]")
         value = float(value)
         object.__setattr__(self, spec.name, int(value) if spec.rule == "depth" else value)
 
@@ -259,7 +311,16 @@ class WireParameters:
                 ("stress_max", "diameter"),
                 lambda: self.stress_max * 1e6 * math.pi * self.diameter ** 2 / 4.0 / STANDARD_GRAVITY),
             terms=model_terms(self, self._fail),
+            load_data_min=self._load_of_stress(self.stress_data_min),
+            load_data_max=self._load_of_stress(self.stress_data_max),
+            data_range=any(getattr(self, name) is not None for name in DATA_RANGE),
         )
+
+    def _load_of_stress(self, stress):
+        """The load [kg] of ``stress`` [MPa] on this wire (None for None), as load_max."""
+        if stress is None:
+            return None
+        return stress * 1e6 * math.pi * self.diameter ** 2 / 4.0 / STANDARD_GRAVITY
 
     def _check_consistency(self):
         if not self.R_MF > self.R_P:
@@ -275,6 +336,12 @@ class WireParameters:
         if not self.T_max > self.T_room:
             self._fail(f"parameter validity.T_max = {self.T_max!r} degC must exceed "
                        f"thermal.T_room = {self.T_room!r} degC")
+        for low, high, unit in (("T_data_min", "T_data_max", "degC"),
+                                ("stress_data_min", "stress_data_max", "MPa")):
+            lowest, highest = getattr(self, low), getattr(self, high)
+            if lowest is not None and highest is not None and not lowest <= highest:
+                self._fail(f"parameter validity.{low} = {lowest!r} {unit} must be <= "
+                           f"validity.{high} = {highest!r} {unit}")
 
     def values(self):
         """Parameter values by name (only the schema's entries; alpha omitted when not given)."""

@@ -11,7 +11,10 @@ paper's rule), so a compensator output wired straight to the plant is valid; non
 power is rejected, and so is a finite power so large that the temperature would leave the
 floating-point range. Leaving the validity range (T above ``validity.T_max``, or a load above the one
 ``validity.stress_max`` gives) sets :attr:`PlantStepper.warning` for that one step, so the
-FMU can warn once per excursion.
+FMU can warn once per excursion. A wire that gives the range its data covered
+(``validity.T_data_min`` ...) sets it once more, the first time (the start included) T or the
+load lies outside that range, and never again in that stepper's life (a restored state
+does not re-arm it).
 """
 import math
 from collections import namedtuple
@@ -25,7 +28,7 @@ from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_po
 from .state_entries import (StateError, check_format, read_direction, read_entries, read_number,
                             read_temperature)
 from .thermal import step_decay, thermal_step
-from .validity import validity_warning
+from .validity import data_range_warning, validity_warning
 
 __all__ = ["PlantOutputs", "PlantStepper", "STATE_FORMAT"]
 
@@ -60,7 +63,7 @@ class PlantStepper:
     The wire starts heating, on the major branch, with an empty reversal memory
     (:attr:`reversals`, at most ``params.memory_depth`` points). ``warning`` is a message for
     the one step (or the start) in which the temperature rises above ``params.T_max`` or the
-    load above ``params.load_max``, else None.
+    load above ``params.load_max``, or the first one outside the data range, else None.
     """
 
     def __init__(self, params, T_start=None, mode="continuous", load=0.0):
@@ -81,13 +84,24 @@ class PlantStepper:
         self.xi_MF, self.xi_P = branch_fractions(self.temperature, constants)
         self.outputs = self._evaluate(constants)
         self.warning = None
+        self._data_unwarned = params.data_range   # the data-range warning is still to come
         self._check_validity(-math.inf, -math.inf)
+        if self._data_unwarned:
+            self._check_data_range()
 
     def _check_validity(self, before, load_before):
         """Set :attr:`warning` when the temperature crosses ``T_max`` or the load crosses
         ``load_max`` upwards (once per excursion)."""
         self.warning = validity_warning(self.params, self.temperature, before, self.load,
                                         load_before)
+
+    def _check_data_range(self):
+        """Add the data-range warning to :attr:`warning` the first time T or the load is
+        outside the range the wire's data covered (once per stepper)."""
+        warning = data_range_warning(self.params, self.temperature, self.load)
+        if warning is not None:
+            self._data_unwarned = False
+            self.warning = warning if self.warning is None else f"{self.warning}; {warning}"
 
     def step(self, power, load, step_size):
         """Advance one step of ``step_size`` [s] with ``power`` [W] and ``load`` [kg] held.
@@ -134,6 +148,8 @@ class PlantStepper:
         self.warning = None
         if after > params.T_max or load > params.load_max:
             self._check_validity(before, load_before)
+        if self._data_unwarned:
+            self._check_data_range()
         return self.outputs
 
     def _evaluate(self, constants):

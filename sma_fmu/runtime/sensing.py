@@ -30,10 +30,10 @@ from .constants import HEATING
 from .minor_loops import (DENOMINATOR_FLOOR, fractions_of_value, fractions_on_stack, major_value,
                           value_of)
 from .reachable_band import band_of_branch
-from .two_stage_root import two_stage_inverse
+from .two_stage_root import ROOT_CAP, ROOT_TOLERANCE_K, two_stage_inverse
 
 __all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of_fractions",
-           "temperature_on_stack", "invert_on_stack", "sense_temperature"]
+           "temperature_on_stack", "invert_on_stack", "sense_temperature", "inverse_method"]
 
 SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
 SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
@@ -159,3 +159,14 @@ def sense_temperature(resistance, load, direction, params, reversals=()):
     xi_mf, xi_p = mixed_fractions_of_resistance(resistance, constants, params)
     return temperature_on_stack(xi_mf, xi_p, constants, sign, list(reversals),
                                 params.saturation_margin)[0]
+
+
+def inverse_method(two_stage):
+    """How :func:`temperature_of_fractions` finds T [text]: what the FMUs' pages say, so the
+    words follow the code. ``two_stage``: the branch has a second stage (w2 > 0)."""
+    if not two_stage:
+        return "closed form, T_K = 1/(1/tau_K - k_B Lambda/dH(f))"
+    return (f"Newton's method on 1/T_K, safeguarded: started from the steeper stage's "
+            f"closed-form inverse, kept inside the bracket of the two stages' closed forms "
+            f"(a step that would leave it halves it instead), stopped when the error left in "
+            f"T is below {ROOT_TOLERANCE_K:g} K (about 3 evaluations; at most {ROOT_CAP} rounds)")

@@ -4,8 +4,15 @@
 [MPa] and the wire's diameter) bound where the parameters were identified. Above them the
 model still computes, and a stepper says so once per excursion: in the step (or the start)
 in which a value rises past its limit. The FMUs log the message as fmi2Warning.
+
+A wire fitted to data also gives the range those data covered (``validity.T_data_min`` ...
+``stress_data_max``, optional): a run that leaves it is extrapolating the fit, and a stepper
+says so once, the first time (:func:`data_range_warning`); the model still computes.
 """
-__all__ = ["validity_warning"]
+__all__ = ["validity_warning", "data_range_warning", "DATA_RANGE_NOTE"]
+
+DATA_RANGE_NOTE = ("outside the range of the data the wire's parameters were fitted to "
+                   "(warned once per instance)")
 
 
 def validity_warning(params, temperature, temperature_before, load, load_before):
@@ -22,3 +29,26 @@ def validity_warning(params, temperature, temperature_before, load, load_before)
     if not messages:
         return None
     return "; ".join(messages) + ": outside the range the model's parameters describe"
+
+
+def data_range_warning(params, temperature, load, name="T"):
+    """The warning [str] when the temperature ``name`` [degC] or the load [kg] lies outside
+    the data range of ``params`` (its T_data_min ... stress_data_max; a bound not given does
+    not apply), or None. The C family writes the same text."""
+    messages = []
+    if params.T_data_min is not None and temperature < params.T_data_min:
+        messages.append(f"{name} = {temperature:.6g} degC is below validity.T_data_min = "
+                        f"{params.T_data_min:g} degC")
+    if params.T_data_max is not None and temperature > params.T_data_max:
+        messages.append(f"{name} = {temperature:.6g} degC is above validity.T_data_max = "
+                        f"{params.T_data_max:g} degC")
+    wire = f"on a {params.diameter * 1e3:g} mm wire"
+    if params.load_data_min is not None and load < params.load_data_min:
+        messages.append(f"load = {load:.6g} kg is below {params.load_data_min:.4g} kg "
+                        f"(validity.stress_data_min = {params.stress_data_min:g} MPa {wire})")
+    if params.load_data_max is not None and load > params.load_data_max:
+        messages.append(f"load = {load:.6g} kg is above {params.load_data_max:.4g} kg "
+                        f"(validity.stress_data_max = {params.stress_data_max:g} MPa {wire})")
+    if not messages:
+        return None
+    return "; ".join(messages) + ": " + DATA_RANGE_NOTE

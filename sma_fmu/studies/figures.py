@@ -6,6 +6,8 @@ successful runs only) and returns a Figure; the caller saves it.
 import numpy as np
 from matplotlib.figure import Figure
 
+from sma_fmu.files.png_output import tight_layout
+
 __all__ = ["heat_map_figure", "line_figure", "distribution_figure"]
 
 
@@ -26,7 +28,7 @@ def heat_map_figure(rows, x_key, y_key, title):
                   color="white" if (i, j) != best else "red")
     figure.colorbar(image, ax=axis, label="RMSE of R - R_ref [ohm]")
     axis.set_title(f"{title}: RMSE (best in red)")
-    figure.tight_layout()
+    tight_layout(figure)
     return figure
 
 
@@ -42,7 +44,7 @@ def line_figure(rows, key, title):
     axis.set(xlabel=key, ylabel="RMSE of R - R_ref [ohm]", title=title)
     axis.grid(alpha=0.3)
     axis.legend()
-    figure.tight_layout()
+    tight_layout(figure)
     return figure
 
 
@@ -67,7 +69,7 @@ def distribution_figure(rows, wire_keys, title):
                   title=f"strongest link: {key} (r = {correlations[key]:+.2f})")
     for axis in (left, right):
         axis.grid(alpha=0.3)
-    figure.tight_layout()
+    tight_layout(figure)
     return figure
 
 

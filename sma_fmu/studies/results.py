@@ -125,7 +125,7 @@ def write_results(spec, out):
     document = summary(spec, table)
     figures = {name: png_bytes(figure, dpi=100) for name, figure in _figures(spec, table).items()}
     csv = table.to_csv(index=False, na_rep="")
-    with staged_folder(out) as stage:
+    with staged_folder(out, report=False) as stage:   # beside the runs' parts
         table.to_parquet(stage / "results.parquet", index=False)
         (stage / "results.csv").write_text(csv, encoding="utf-8")
         (stage / "summary.json").write_text(json_text(document), encoding="utf-8")

@@ -10,8 +10,9 @@
     result.record()              # the same, flat: one row of a results table
 
 Paths: ``"library"`` (the runtime steppers, :func:`sma_fmu.cosim.loop.run_library`),
-``"fmu"`` (the built FMUs under fmpy, :func:`sma_fmu.cosim.master.run_fmus`) and
-``"batch"`` (:func:`sma_fmu.studies.batch.run_batches`; many runs in lock-step).
+``"fmu"`` (the built FMUs under fmpy, :func:`sma_fmu.cosim.master.run_fmus`; with
+``master="c"`` in one C master for all the runs, :class:`sma_fmu.systems.c_master.CMaster`)
+and ``"batch"`` (:func:`sma_fmu.studies.batch.run_batches`; many runs in lock-step).
 """
 from dataclasses import dataclass
 
@@ -77,21 +78,30 @@ def scenario(base, overrides=None):
     return template(base).scenario(overrides)
 
 
-def run(base, overrides=None, path="library", fmu_dir=DEFAULT_FMU_DIR):
+def run(base, overrides=None, path="library", fmu_dir=DEFAULT_FMU_DIR, master="fmpy"):
     """Run one scenario (see :func:`scenario`) on ``path``; returns a :class:`StudyRun`."""
-    return run_many([scenario(base, overrides)], path, fmu_dir)[0]
+    return run_many([scenario(base, overrides)], path, fmu_dir, master)[0]
 
 
-def run_many(scenarios, path="batch", fmu_dir=DEFAULT_FMU_DIR):
+def run_many(scenarios, path="batch", fmu_dir=DEFAULT_FMU_DIR, master="fmpy"):
     """Run Scenario objects on ``path``; returns a :class:`StudyRun` per scenario, in order.
 
     On the batch path, scenarios that share the step and duration run as one batch; a
     scenario with an option the batch engine lacks raises :class:`StudyError`. A run
-    that fails raises ``ValueError`` with the scalar path's message.
+    that fails raises ``ValueError`` with the scalar path's message. ``master`` (the fmu
+    path): ``"fmpy"``, or ``"c"``: every run in one C master (one host process, the FMUs
+    loaded once; native FMI 2.0 FMUs, ``sma-fmu build --native``).
     """
     if path not in PATHS:
         raise StudyError(f"path must be one of {', '.join(PATHS)}, got {path!r}")
+    if master not in ("fmpy", "c") or (master == "c" and path != "fmu"):
+        raise StudyError(f"master must be 'fmpy', or 'c' with path='fmu'; got master={master!r} "
+                         f"with path={path!r}")
     scenarios = list(scenarios)
+    if master == "c":
+        from sma_fmu.systems.c_master import CMaster
+        with CMaster(fmu_dir) as c_master:
+            return [_study_run(s, c_master.run(s), path) for s in scenarios]
     if path != "batch":
         return [_single(s, path, fmu_dir) for s in scenarios]
     for item in scenarios:
@@ -112,5 +122,9 @@ def _single(item, path, fmu_dir):
         result = run_fmus(item, fmu_dir)
     else:
         result = run_library(item)
+    return _study_run(item, result, path)
+
+
+def _study_run(item, result, path):
     return StudyRun(item, timeseries_frame(result.data), scenario_metrics(result.data, item),
                     path, result.wall_time_s)

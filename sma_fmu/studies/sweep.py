@@ -20,7 +20,6 @@ import json
 import logging
 import math
 import os
-import sys
 from pathlib import Path
 
 import pandas as pd
@@ -119,7 +118,8 @@ def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True, fmu_d
     """Run the study spec at ``spec_path`` into folder ``out``; returns the summary dict.
     ``fmu_dir``: run through the C master over the FMUs there (else the batch engine)."""
     from dask.distributed import as_completed
-    from tqdm import tqdm
+
+    from sma_fmu.console import progress as console_progress
 
     spec = load_spec(spec_path)
     runs = spec.runs()
@@ -136,8 +136,8 @@ def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True, fmu_d
             chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
             futures = {client.submit(run_task, spec.templates, chunk, fmu_dir, pure=False): chunk
                        for chunk in chunks}
-            with tqdm(total=len(runs), initial=len(runs) - len(todo), unit="run",
-                      disable=not progress, file=sys.stderr, desc="sweep") as bar:
+            with console_progress.bar(len(runs), "sweep", unit="run", disable=not progress,
+                                      initial=len(runs) - len(todo)) as bar:
                 for future in as_completed(futures):
                     chunk = futures.pop(future)
                     try:

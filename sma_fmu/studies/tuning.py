@@ -25,6 +25,7 @@ from datetime import datetime, timezone
 import numpy as np
 from scipy.optimize import differential_evolution
 
+from sma_fmu.console import progress
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.noise_seeds import noise_seed_rmse
@@ -92,10 +93,12 @@ def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
 
     began = time.perf_counter()
     start = [getattr(scenario.controller, name) for name in names]
-    result = differential_evolution(
-        cost, [BOUNDS[name] for name in names], maxiter=generations, popsize=population,
-        rng=seed, polish=False, vectorized=True, updating="deferred", tol=1e-4,
-        x0=np.clip(start, [BOUNDS[n][0] for n in names], [BOUNDS[n][1] for n in names]))
+    with progress.bar(generations, f"tuning {scenario.name}", unit="generation") as shown:
+        result = differential_evolution(
+            cost, [BOUNDS[name] for name in names], maxiter=generations, popsize=population,
+            rng=seed, polish=False, vectorized=True, updating="deferred", tol=1e-4,
+            x0=np.clip(start, [BOUNDS[n][0] for n in names], [BOUNDS[n][1] for n in names]),
+            callback=lambda *_: shown.update(1) and None)
     seconds = time.perf_counter() - began
     best = _with_gains(scenario, names, result.x)
     tuned = scenario_metrics(run_library(best).data, best)   # the reported RMSE: scalar path

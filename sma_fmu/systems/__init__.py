@@ -9,6 +9,7 @@
   :mod:`.omsimulator` and :mod:`.fmpy_ssp`: the SSP in OMSimulator and fmpy's ``simulate_ssp``;
 - :mod:`.host_needs`: what each known SSP host needs and applies;
 - :mod:`.loop_host`: the loop in the plain C loop host; :mod:`.c_master` (with
-  :mod:`.c_master_rows`): that host as the C master of ``sma-fmu run --master c``;
+  :mod:`.c_master_rows` and :mod:`.loop_host_process`): that host as the C master of
+  ``sma-fmu run --master c``, one process for many runs;
 - :mod:`.check`: the compliance check behind ``sma-fmu check``.
 """

@@ -8,7 +8,9 @@ the fmpy master's :func:`~sma_fmu.cosim.loop.run_loop` computes in Python (t_k =
 stroke x_0 - x_k), and hands the rows on in its blocks of
 :data:`~sma_fmu.cosim.loop.ROWS_PER_CHUNK` (the streaming metrics add per block: the same
 blocks give the same sums, to the bit). The host's first frame has one sample more, so
-each frame makes one such block, handed on without a copy.
+each frame makes one such block, handed on without a copy. A column the host does not
+record (a sink that reads only some, :func:`recorded_columns`) is NaN in every row (False
+for ``saturated``).
 """
 import math
 
@@ -20,11 +22,14 @@ from sma_fmu.systems.hosts import NO_COMPENSATOR, STATE_COLUMNS, STEP_COLUMNS
 __all__ = ["recorded_columns", "csv_columns", "RowAssembler"]
 
 
-def recorded_columns(system):
+def recorded_columns(system, read=None):
     """The columns the host records for ``system``, in the order of its samples: grouped by
-    component (the host reads neighbouring columns of one component in one call)."""
+    component (the host reads neighbouring columns of one component in one call). ``read``:
+    the loop's columns the sink reads (None: all); only those are recorded (``x`` for the
+    stroke)."""
     outputs = system.outputs
-    return sorted(outputs, key=lambda column: (outputs[column][0], column == "saturated"))
+    wanted = outputs if read is None else [c for c in outputs if c in read or (c == "x" and "stroke" in read)]
+    return sorted(wanted, key=lambda column: (outputs[column][0], column == "saturated"))
 
 
 def csv_columns(columns):
@@ -52,8 +57,9 @@ class RowAssembler:
     """Samples (raw doubles, ``columns`` per sample) in, the loop's rows out, to ``sink``
     (a callable taking structured arrays) or kept (``sink`` None)."""
 
-    def __init__(self, scenario, columns, sink=None):
+    def __init__(self, scenario, columns, sink=None, missing=()):
         self.step_s, self.sink = scenario.step_s, sink
+        self.missing = set(missing)   # loop columns not recorded: NaN (False) in every row
         self.index = {name: i for i, name in enumerate(columns)}
         self.width = len(columns)
         self.count = 0                  # rows made so far
@@ -67,7 +73,7 @@ class RowAssembler:
         if len(samples) == 0:
             return
         first = self._carry   # the sample before this frame (its row waited for this one)
-        if first is None:
+        if first is None and "x" in self.index:
             self._start_x = samples[0, self.index["x"]]
         self._carry = samples[-1].copy()
         if first is None:
@@ -84,13 +90,18 @@ class RowAssembler:
         block = np.empty(size, dtype=TIMESERIES_DTYPE)
         block["t"] = np.arange(self.count, self.count + size, dtype=np.float64) * self.step_s
         for name in STATE_COLUMNS:
-            column, index = block[name], self.index[name]
+            column, index = block[name], self.index.get(name)
+            if index is None:   # not recorded
+                column[:] = math.nan
+                continue
             if lead:
                 column[0] = first[index]
             column[lead:] = now[:, index]
-        block["stroke"] = self._start_x - block["x"]
+        block["stroke"] = math.nan if self._start_x is None else self._start_x - block["x"]
         for name in STEP_COLUMNS:
-            if after is None:
+            if name in self.missing:
+                block[name] = False if name == "saturated" else math.nan
+            elif after is None:
                 block[name] = False if name == "saturated" else math.nan
             elif name not in self.index:
                 block[name] = NO_COMPENSATOR[name]

@@ -6,36 +6,56 @@ For each scenario ``NAME`` in ``out_dir``: ``NAME/timeseries.csv`` (or ``.parque
 :attr:`~sma_fmu.cosim.scenario.Scenario.group`): ``comparison-GROUP.png``. Over the whole
 run: ``comparison.md``, which ranks the runs by RMSE in each group, and ``summary.json``.
 Everything is written into a temporary folder and moved into ``out_dir`` at the end.
+``figures=False`` (``--no-figures``) writes no PNG (and never imports matplotlib).
+
+The C master (``master="c"``) is one :class:`~sma_fmu.systems.c_master.CMaster` for all the
+scenarios: one host process, each FMU unpacked and loaded once; what that start-up cost is
+each row's ``startup_s`` (the run's own ``wall_time_s`` leaves it out), and the run table
+says so.
 """
+import contextlib
 import time
 from collections import Counter
-from functools import partial
 
 from sma_fmu.cosim.loop import run_library
-from sma_fmu.cosim.master import run_fmus
 from sma_fmu.cosim.recording import (RunRecorder, TimeseriesWriter, interval_steps, progress_bar,
                                      timeseries_name)
-from sma_fmu.cosim.plots import plot_comparison, plot_run
 from sma_fmu.cosim.report import comparison_markdown, groups, summary_table
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
-from sma_fmu.systems.c_master import run_c_master
-from sma_fmu.systems.runs import run_container, run_ssp
 
 __all__ = ["PATHS", "FMU_MASTERS", "run_scenarios", "timed_run", "write_timeseries", "result_names",
            "comparison_labels"]
 
+
+def _fmpy(scenario, fmu_dir, sink, events=False):
+    from sma_fmu.cosim.master import run_fmus
+    return run_fmus(scenario, fmu_dir, sink, events=events)
+
+
+def _host(kind):
+    def run(scenario, fmu_dir, sink):
+        from sma_fmu.systems import runs   # libcosim, the SSP and container writers
+        return getattr(runs, f"run_{kind}")(scenario, fmu_dir)
+    return run
+
+
+def _c_master(scenario, fmu_dir, sink):
+    from sma_fmu.systems.c_master import run_c_master
+    return run_c_master(scenario, fmu_dir, sink)
+
+
 # path -> run(scenario, fmu_dir, sink): the loops stream their rows into the sink; the
-# system hosts (libcosim) give a whole series, which the runner then feeds it
-PATHS = {"fmu": lambda scenario, fmu_dir, sink: run_fmus(scenario, fmu_dir, sink),
+# system hosts (libcosim) give a whole series, which the runner then feeds it (each path's
+# modules are imported when it runs: a command pays only for its own)
+PATHS = {"fmu": _fmpy,
          "library": lambda scenario, fmu_dir, sink: run_library(scenario, sink=sink),
-         "ssp": lambda scenario, fmu_dir, sink: run_ssp(scenario, fmu_dir),
-         "container": lambda scenario, fmu_dir, sink: run_container(scenario, fmu_dir)}
-# the masters of the "fmu" path (``--master``): fmpy (Python) or the C master (loop_host.c)
-FMU_MASTERS = {"fmpy": PATHS["fmu"], "c": lambda scenario, fmu_dir, sink: run_c_master(
-    scenario, fmu_dir, sink)}
+         "ssp": _host("ssp"), "container": _host("container")}
+# the masters of the "fmu" path (``--master``): fmpy (Python) or the C master (loop_host.c;
+# run_scenarios keeps one for all its scenarios)
+FMU_MASTERS = {"fmpy": PATHS["fmu"], "c": _c_master}
 
 
 def write_timeseries(data, path, fmt="csv"):
@@ -68,7 +88,7 @@ def comparison_labels(scenarios, names):
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print,
                   output_interval_s=None, fmt="csv", master="fmpy", events=False,
-                  timeout_s=None):
+                  timeout_s=None, figures=True):
     """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
@@ -82,6 +102,7 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     only): the longest the C master may send nothing before the run fails (None:
     :data:`~sma_fmu.systems.c_master.DEFAULT_TIMEOUT_S`). Each run streams into its files
     (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
+    ``figures``: write the figures (``--no-figures``: False).
     """
     if path not in PATHS:
         raise ValueError(f"path must be one of {', '.join(PATHS)}, got {path!r}")
@@ -98,9 +119,7 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         raise ValueError(f"--timeout must be a number of seconds > 0, got {timeout_s!r}")
     run = FMU_MASTERS[master] if path == "fmu" else PATHS[path]
     if events:
-        run = partial(run_fmus, events=True)
-    elif timeout_s is not None:
-        run = partial(run_c_master, timeout_s=timeout_s)
+        run = lambda scenario, fmu_dir, sink: _fmpy(scenario, fmu_dir, sink, events=True)  # noqa: E731
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
@@ -110,12 +129,20 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     names = result_names(scenarios)
     labels = comparison_labels(scenarios, names)
     rows, series = [], {}
-    with staged_folder(out_dir) as stage:
+    with staged_folder(out_dir) as stage, contextlib.ExitStack() as stack:
+        c_master = None
+        if path == "fmu" and master == "c":   # one C master for every scenario
+            from sma_fmu.systems.c_master import DEFAULT_TIMEOUT_S, CMaster
+            c_master = stack.enter_context(CMaster(fmu_dir, timeout_s=timeout_s or DEFAULT_TIMEOUT_S))
+            run = lambda scenario, fmu_dir, sink: c_master.run(scenario, sink)  # noqa: E731
+        if figures:
+            from sma_fmu.cosim.plots import plot_comparison, plot_run
         for index, (scenario, name, label) in enumerate(zip(scenarios, names, labels), start=1):
             if len(scenarios) > 1:
                 progress(f"[{index}/{len(scenarios)}] {name} ({path}) ...")
             folder = stage / name
             folder.mkdir()
+            startup_s = c_master.startup_s if c_master else 0.0
             metrics, figure_rows, wall_time_s = _record_run(scenario, run, fmu_dir, folder,
                                                              every[index - 1], fmt)
             metrics.update(path=path, wall_time_s=wall_time_s)
@@ -126,13 +153,16 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
             for warning in metrics["warnings"]:
                 progress(f"warning: {scenario.name}: {warning}")
             (folder / "metrics.json").write_text(json_text(metrics), encoding="utf-8")
-            plot_run(figure_rows, scenario, folder / "figure.png")
+            if figures:
+                plot_run(figure_rows, scenario, folder / "figure.png")
             rows.append({"scenario": name, "label": label, "group": scenario.group,
                          "metrics": metrics, "wall_time_s": wall_time_s,
                          "real_time_factor": scenario.stop_time_s / wall_time_s})
+            if c_master is not None:   # the host started, FMUs unpacked and loaded for it
+                rows[-1]["startup_s"] = c_master.startup_s - startup_s
             series[name] = (scenario, figure_rows)
         for group, members in groups(rows).items():
-            if len(members) > 1:
+            if len(members) > 1 and figures:
                 runs = {row["label"]: series[row["scenario"]][1] for row in members}
                 plot_comparison(runs, series[members[0]["scenario"]][0],
                                 f"{group}: controllers compared", stage / f"comparison-{group}.png")
@@ -159,11 +189,11 @@ def _record_run(scenario, run, fmu_dir, folder, every, fmt):
 
 
 def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv",
-              master="fmpy", events=False, timeout_s=None):
+              master="fmpy", events=False, timeout_s=None, figures=True):
     """:func:`run_scenarios`, then print the summary table; returns the rows."""
     start = time.perf_counter()
     rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master,
-                         events, timeout_s)
+                         events, timeout_s, figures)
     progress(summary_table(rows))
     progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)")
     return rows

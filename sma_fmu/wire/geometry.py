@@ -10,13 +10,16 @@ within :data:`AGREEMENT`; a contradiction is an error naming both keys.
 """
 import math
 
-from sma_fmu.runtime.parameters import ParameterError, ParameterSpec
+from sma_fmu.runtime.parameters import (ParameterError, ParameterSpec, requirement_text,
+                                        value_in_range)
 
 __all__ = ["GEOMETRY_INPUTS", "AGREEMENT", "complete_from_geometry"]
 
 GEOMETRY_INPUTS = (
-    ParameterSpec("density", "geometry", "kg/m3", "positive", False),
-    ParameterSpec("linear_density", "geometry", "kg/m", "positive", False),
+    # kg/m3: Ti-Ni 6450, NiTiHf about 8000+; the densest element (osmium) is 22,600
+    ParameterSpec("density", "geometry", "kg/m3", "positive", False, (0.0, 3e4)),
+    # kg/m: a 10 mm NiTiHf rod is 0.7 kg/m
+    ParameterSpec("linear_density", "geometry", "kg/m", "positive", False, (0.0, 1.0)),
 )
 AGREEMENT = 1e-3  # relative difference allowed between two ways of giving the mass
 DERIVABLE = ("A_s", "mass")
@@ -44,6 +47,11 @@ def complete_from_geometry(values, source):
     """
     values = dict(values)
     derived = {}
+    for spec in GEOMETRY_INPUTS:
+        if spec.name in values and not value_in_range(spec, values[spec.name]):
+            raise ParameterError(f"{source}: parameter {spec.section}.{spec.name} = "
+                                 f"{values[spec.name]!r} must be "
+                                 f"{requirement_text(spec, values[spec.name])} [{spec.unit}]")
     ways = _masses(values)
     keys = list(ways)
     for i, first in enumerate(keys):

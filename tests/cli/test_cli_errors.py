@@ -153,12 +153,8 @@ def test_csv_with_a_byte_order_mark_is_read(tmp_path, capsys, sweeps):
 
 # -- parameter values that pass the schema but break derived constants ------------------------
 
-@pytest.mark.parametrize("key,value,derived", [
-    ("diameter", "1e300", "lattice"), ("diameter", "5e-324", "lattice"),
-    ("x0", "1e300", "lattice"), ("x0", "1e-320", "line density"), ("mass", "1e300", "lattice"),
-    ("h_c", "1e-320", "thermal gain"), ("A_s", "1e-320", "thermal gain"),
-])
-def test_parameters_that_break_derived_constants(tmp_path, capsys, key, value, derived):
+def _wire_with(tmp_path, key, value):
+    """The shipped parameter file with ``key``'s value text replaced by ``value``; its path."""
     lines = shipped_file("models", "reference_wire.toml").read_text().splitlines()
     index = next(i for i, line in enumerate(lines) if line.split("=")[0].strip() == key)
     start = lines[index].index("value = ") + len("value = ")
@@ -166,7 +162,28 @@ def test_parameters_that_break_derived_constants(tmp_path, capsys, key, value, d
     lines[index] = lines[index][:start] + value + lines[index][end:]
     path = tmp_path / "wire.toml"
     path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("key,value,derived", [
+    ("diameter", "5e-324", "lattice"), ("x0", "1e-320", "line density"),
+    ("h_c", "1e-320", "thermal gain"), ("A_s", "1e-320", "thermal gain"),
+])
+def test_parameters_that_break_derived_constants(tmp_path, capsys, key, value, derived):
+    path = _wire_with(tmp_path, key, value)
     line = _fails(capsys, ["lattice", "--model", str(path)], str(path), f"derived {derived}")
+    assert f".{key} = {float(value)!r}" in line
+
+
+@pytest.mark.parametrize("key,value,limits", [
+    ("diameter", "1e300", "(0, 0.01] [m]"), ("x0", "1e300", "(0, 10] [m]"),
+    ("mass", "1e300", "(0, 10] [kg]"),
+])
+def test_parameters_outside_their_plausible_range(tmp_path, capsys, key, value, limits):
+    """Values that used to break only the derived constants (the lattice overflowed) are now
+    refused by their plausible range, naming the parameter, its unit and the range."""
+    path = _wire_with(tmp_path, key, value)
+    line = _fails(capsys, ["lattice", "--model", str(path)], str(path), f"must be in {limits}")
     assert f".{key} = {float(value)!r}" in line
 
 

@@ -10,6 +10,7 @@ import pytest
 from cli_failure import fails
 from sma_fmu.runtime.thermal import power_to_reach
 from sma_fmu.cli import main
+from sma_fmu.files.output_folder import MARKER
 from sma_fmu.wire.parameter_file import write_parameter_file
 from sma_fmu.runtime.constant_load import constant_load_resistance
 from sma_fmu.runtime.thermal import step_decay, thermal_step
@@ -58,7 +59,7 @@ def test_writes_the_csv_and_the_figure(tmp_path, capsys):
     assert main(["loops", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert str(out / "loops.csv") in printed and str(out / "loops.png") in printed
-    assert sorted(p.name for p in out.iterdir()) == ["loops.csv", "loops.png"]
+    assert sorted(p.name for p in out.iterdir()) == sorted([MARKER, "loops.csv", "loops.png"])
     assert (out / "loops.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert (out / "loops.png").stat().st_size > 20_000
     T, R, direction, depth = _read(out / "loops.csv")

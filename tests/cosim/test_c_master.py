@@ -49,11 +49,6 @@ def _scenario(name):
     return load_scenario(resolve_scenarios([name])[0])
 
 
-@pytest.fixture(scope="module")
-def native_dir(native_fmus):
-    return native_fmus["SmaActuator"].parent
-
-
 def _same(a, b):
     assert a.dtype == b.dtype and a.shape == b.shape
     for name in a.dtype.names:

@@ -114,9 +114,16 @@ def test_missing_section_is_named(tmp_path):
         load_scenario(path)
 
 
-def test_unknown_scenario_name_lists_the_known_ones():
-    with pytest.raises(ScenarioError, match=r"unknown scenario 'load-stpe-pi': no such file, .*shipped scenarios .*heavy-pi"):
+def test_unknown_scenario_name_suggests_the_closest_ones():
+    with pytest.raises(ScenarioError, match=r"unknown scenario 'load-stpe-pi': no such file, .*"
+                                            r"did you mean 'load-step-pi'(, '[^']+')*( or '[^']+')?\? "
+                                            r"\(sma-fmu examples lists the 18 shipped scenarios"):
         resolve_scenarios(["load-stpe-pi"])
+    with pytest.raises(ScenarioError, match=r"did you mean 'paper'\?"):
+        resolve_scenarios(["papr"])
+    with pytest.raises(ScenarioError) as refused:
+        resolve_scenarios(["xyz"])
+    assert "did you mean" not in str(refused.value) and "heavy-pi" not in str(refused.value)
 
 
 def test_resolve_paper_and_all():

@@ -22,6 +22,8 @@ def test_every_folder_is_registered_and_every_registered_fmu_has_its_folder():
 def test_an_unknown_fmu_is_refused_naming_the_registered_ones():
     with pytest.raises(ValueError, match=r"unknown FMU 'SmaNothing'; expected one of SmaActuator, "):
         declaration("SmaNothing")
+    with pytest.raises(ValueError, match=r"unknown FMU 'SmaActuater' \(did you mean 'SmaActuator'\?\); "):
+        declaration("SmaActuater")
 
 
 @pytest.mark.parametrize("name", REGISTRY)

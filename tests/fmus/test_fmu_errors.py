@@ -68,11 +68,11 @@ def test_feedforward_discards_bad_input_and_stays_usable(fmus, params, reference
     ("SmaActuator", {"hysteresis_mode": 3},
      "hysteresis_mode must be 1 (continuous) or 2 (switch), got 3"),
     ("SmaActuator", {"T_start": math.nan}, "T_start must be finite, got nan"),
-    ("SmaActuator", {"R_P": -33.0}, "parameter phases.R_P = -33.0 must be > 0 [ohm]"),
+    ("SmaActuator", {"R_P": -33.0}, "parameter phases.R_P = -33.0 must be in (0, 100000] [ohm]"),
     ("SmaActuator", {"memory_depth": 1},  # an Integer, printed as one (not 1.0)
      "parameter hysteresis.memory_depth = 1 must be a whole number in [2, 100000] [1]"),
     ("SmaActuator", {"load": -1.0}, "load must be >= 0, got -1.0"),
-    ("SmaFeedforward", {"beta": 0.0}, "parameter control.beta = 0.0 must be > 0 [s]"),
+    ("SmaFeedforward", {"beta": 0.0}, "parameter control.beta = 0.0 must be in (0, 100000] [s]"),
     ("SmaFeedforward", {"R_ref": math.nan}, "R_ref must be finite, got nan"),
 ])
 def test_bad_parameters_fail_initialization_with_a_message(fmus, name, start, message):

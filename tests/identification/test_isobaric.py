@@ -90,7 +90,7 @@ def test_single_load_recovery_with_noise_and_drift(tmp_path, params):
              "l_MF": 0.5 * (truth.l_M + truth.l_F), "R_P": truth.R_P, "R_MF": truth.R_MF}
     known.update({f"offset_0_{k}": v for k, v in enumerate(synthetic["offsets"])})
     _check(fit, known, {"a_h": 0.4, "a_c": 0.4, "nu_h": 0.03 * truth.nu, "nu_c": 0.03 * truth.nu,
-                        "alpha_P": 1e-5, "alpha_MF": 1e-5, "l_MF": 2e-5,
+                        "alpha_P": 1e-5, "alpha_MF": 1e-5, "l_MF": 3e-5,
                         "R_P": 0.01, "R_MF": 0.01, "offset_0_1": 3e-5, "offset_0_2": 3e-5})
 
 

@@ -96,7 +96,7 @@ def test_a_held_out_stress_is_predicted_by_the_plant_runtime(tmp_path):
     assert report["drive"]["largest_temperature_deviation_K"] < 1e-6
     assert report["stress_MPa"] == pytest.approx(172.0, abs=1.0)
     rows = np.loadtxt(out / "predicted.csv", delimiter=",", skiprows=1)
-    assert rows.shape == (report["points"], 3)
+    assert rows.shape == (report["points"], 4)
     assert (out / "predict_isobaric.png").stat().st_size > 10_000
 
 

@@ -34,7 +34,9 @@ span_ratio_sat = { value = 1.12,   unit = "1",    meaning = "s at high stress" }
 span_stress    = { value = 120.0,  unit = "MPa",  meaning = "stress scale" }
 
 [constant_temperature]'''
-NU = 'nu       = { value = 130.0,  unit = "1",  meaning = "cells per cooperative domain; sets the ~14 K transition width" }'
+NU = ('nu       = { value = 130.0,  unit = "1",  meaning = "cells per cooperative domain (both '
+      'directions unless nu_h, nu_c are given): the larger, the narrower the transition (10-90 % '
+      'over 2 ln 9 k_B tau_K^2/dH)" }')
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,7 @@
 
 The C side is generated at build time (sma_fmu/fmi/packaging/parameter_table.py). A small C
 program compiled from c_family/runtime/parameters.c prints what C holds: PARAMETER_SPECS
-(name, section, unit, rule, required), then every field of WireParameters and ModelTerms of a
+(name, section, unit, rule, required, range), then every field of WireParameters and ModelTerms of a
 parameter set, by name. The test compares that view with Python's: the schema, the values
 (the copies and the defaults: memory_depth, stress_max, every model term's fallback) and the
 names (every parameter reaches C). A new optional parameter, added to the Python schema only,
@@ -16,7 +16,8 @@ import pytest
 
 from sma_fmu.fmi.packaging import parameter_table
 from sma_fmu.runtime.model_terms import TERM_DEFAULTS
-from sma_fmu.runtime.parameters import PARAMETER_SPECS, RULE_TEXT, ParameterSpec, WireParameters
+from sma_fmu.runtime.parameters import (PARAMETER_SPECS, RULES, ParameterSpec, WireParameters,
+                                        range_text)
 
 from c_runtime import FLAGS, RUNTIME_DIR
 from system_needs import need
@@ -41,8 +42,8 @@ int main(void)
     int i;
     for (i = 0; i < PARAM_COUNT; i++) {
         const ParameterSpec *s = &PARAMETER_SPECS[i];
-        printf("spec\t%%s\t%%s\t%%s\t%%d\t%%d\n", s->name, s->section, s->unit, (int)s->rule,
-               s->required);
+        printf("spec\t%%s\t%%s\t%%s\t%%d\t%%d\t%%.17g\t%%.17g\t%%s\n", s->name, s->section,
+               s->unit, (int)s->rule, s->required, s->low, s->high, s->range);
     }
     if (wire_parameters_from_values(&p, values, &message)) {
         printf("error\t%%s\n", message.text);
@@ -76,7 +77,8 @@ def c_view(folder, values, specs=PARAMETER_SPECS, include=None):
     for line in lines:
         kind, *rest = line.split("\t")
         if kind == "spec":
-            view["spec"].append(tuple(rest[:3]) + (int(rest[3]), int(rest[4])))
+            view["spec"].append(tuple(rest[:3]) + (int(rest[3]), int(rest[4]), float(rest[5]),
+                                                   float(rest[6]), rest[7]))
         elif kind == "error":
             view["error"].append(rest[0])
         else:
@@ -85,8 +87,9 @@ def c_view(folder, values, specs=PARAMETER_SPECS, include=None):
 
 
 def _spec_rows(specs):
-    rules = list(RULE_TEXT)
-    return [(s.name, s.section, s.unit, rules.index(s.rule), int(s.required)) for s in specs]
+    rules = list(RULES)
+    return [(s.name, s.section, s.unit, rules.index(s.rule), int(s.required), float(s.limits[0]),
+             float(s.limits[1]), range_text(s)) for s in specs]
 
 
 def _same(a, b):
@@ -126,7 +129,8 @@ def test_c_values_and_defaults_equal_python_by_name(tmp_path, params, given):
 def test_a_new_optional_parameter_needs_no_c_edit(tmp_path, params, monkeypatch):
     """A model term added to PARAMETER_SPECS and TERM_DEFAULTS only: C's table has its row
     and C's ModelTerms its value, the fallback when not given and the value when given."""
-    specs = PARAMETER_SPECS + (ParameterSpec("dummy_scale", "strain", "1", "positive", False),)
+    specs = PARAMETER_SPECS + (ParameterSpec("dummy_scale", "strain", "1", "positive", False,
+                                             (0.0, 10.0)),)
     monkeypatch.setattr(parameter_table, "PARAMETER_SPECS", specs)
     monkeypatch.setattr(parameter_table, "WireParameters", dataclasses.make_dataclass(
         "WireParameters", [("dummy_scale", float, None)], bases=(WireParameters,), frozen=True))

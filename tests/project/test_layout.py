@@ -14,7 +14,7 @@ from graph_cycles import find_cycle
 ROOT = Path(sma_fmu.__file__).parent
 # lowest first; a subpackage may import only those before it (studies, analysis and
 # identification are side by side: none imports another)
-LAYERS = [{"runtime"}, {"files"}, {"wire"}, {"fmi"}, {"cosim"}, {"systems"},
+LAYERS = [{"runtime"}, {"console"}, {"files"}, {"wire"}, {"fmi"}, {"cosim"}, {"systems"},
           {"studies", "analysis", "identification"}, {"bench"}, {"cli"}]
 LEVEL = {name: level for level, names in enumerate(LAYERS) for name in names}
 DATA = {"models", "scenarios", "examples"}   # data folders (examples are user scripts)

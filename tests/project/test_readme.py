@@ -108,7 +108,7 @@ def test_every_command_the_readme_shows_exists():
     commands = shown_commands(text)
     # the scan sees code blocks, the generated list and the fenced install line
     assert len(commands) > 30 and "sma-fmu export ssp paper --out ssp/" in commands
-    assert "sma-fmu build [--out DIR] [--model FILE] [--native] [--fmi {2,3}] [--compile]" in commands
+    assert "sma-fmu build [--out DIR] [--model FILE] [--native] [--fmi {2,3}] [--compile] [--quiet]" in commands
     assert commands.count("sma-fmu run paper") >= 2
     parser = build_parser()
     problems = {command: found for command in commands if (found := command_problems(command, parser))}

@@ -114,12 +114,19 @@ def _zig_command_in_a_bare_python(path, **environment):
 
 
 def test_an_isolated_build_finds_zig_on_the_path(tmp_path):
+    import ziglang   # the test extra's
     for program in ("python-zig", "zig"):
         (tmp_path / program).write_text("#!/bin/sh\nexit 0\n")
         (tmp_path / program).chmod(0o755)
     assert _zig_command_in_a_bare_python(tmp_path) == "['zig', 'cc']"   # zig first
     (tmp_path / "zig").unlink()
-    assert _zig_command_in_a_bare_python(tmp_path) == "['python-zig', 'cc']"   # ziglang's script
+    # ziglang's script: the zig of the package its own Python imports (not the script, which
+    # the isolated build's PYTHONPATH would keep from importing ziglang)
+    (tmp_path / "python-zig").write_text(f"#!{sys.executable}\nimport ziglang\n")
+    zig = str(Path(ziglang.__file__).parent / "zig")
+    assert _zig_command_in_a_bare_python(tmp_path, PYTHONPATH=str(tmp_path)) == repr([zig, "cc"])
+    (tmp_path / "python-zig").write_text("#!/bin/false\n")   # a script whose Python has no ziglang
+    assert _zig_command_in_a_bare_python(tmp_path) == "None"
     assert _zig_command_in_a_bare_python(tmp_path, SMA_FMU_ZIG_CC="my-zig cc") == "['my-zig', 'cc']"
     assert _zig_command_in_a_bare_python(tmp_path, SMA_FMU_ZIG_CC="none") == "None"
     (tmp_path / "python-zig").unlink()

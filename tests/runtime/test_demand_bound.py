@@ -24,8 +24,9 @@ def test_a_demand_beyond_validity_is_bounded_and_warned_once_per_excursion(param
         warnings.append(stepper.warning)
     bounded = outputs[5:25] + outputs[30:]
     assert all(o.T_ref == params.T_max and o.saturated for o in bounded)
-    # P_ff is the (lead-filtered) power of T_max, far below what the unbounded inverse asks
-    free = FeedforwardStepper(dataclasses.replace(params, T_max=1e6), inverse=inverse,
+    # P_ff is the (lead-filtered) power of T_max, far below what a bound at the highest T_max
+    # the schema allows (1000 degC) lets the inverse ask
+    free = FeedforwardStepper(dataclasses.replace(params, T_max=1000.0), inverse=inverse,
                               adapt_to_load=True)
     asked = [free.step(reference, load, STEP).P_ff for load in [0.05] * 5 + [100.0] * 20]
     steady = (params.T_max - params.T_room) / params.K_th

@@ -46,9 +46,10 @@ def _write_variant(tmp_path, old, new):
     ("R_P = { value = 33.0,", "R_P = { value = \"33\",",
      r"parameter phases.R_P value must be a number \[ohm\], got '33'"),
     ("R_P = { value = 33.0,", "R_P = { value = nan,",
-     r"parameter geometry.R_P|parameter phases.R_P = nan must be > 0 \[ohm\]"),
+     r"parameter geometry.R_P|parameter phases.R_P = nan must be a finite number in "
+     r"\(0, 100000\] \[ohm\]"),
     ("R_P = { value = 33.0,", "R_P = { value = -33.0,",
-     r"parameter phases.R_P = -33.0 must be > 0 \[ohm\]"),
+     r"parameter phases.R_P = -33.0 must be in \(0, 100000\] \[ohm\]"),
     ("R_P = { value = 33.0,", "R_X = { value = 33.0,",
      r"unknown parameter phases.R_X"),
     ("[sensing]", "[sensors]", r"unknown section\(s\) sensors"),

@@ -29,7 +29,7 @@ def test_overrides_change_exactly_the_named_fields():
 
 @pytest.mark.parametrize("overrides, message", [
     ({"controller.Kp_W_per_ohm": -1.0}, r"Kp_W_per_ohm must be >= 0, got -1.0 .*overrides"),
-    ({"wire.R_P": 0.0}, r"R_P = 0.0 must be > 0"),
+    ({"wire.R_P": 0.0}, r"R_P = 0.0 must be in \(0, 100000\] \[ohm\]"),
     ({"wire.Kp": 1.0}, r"use controller.Kp_W_per_ohm"),
     ({"wire.colour": 1.0}, r"unknown wire parameter 'colour'"),
     ({"gains.Kp": 1.0}, r"expected SECTION.KEY"),

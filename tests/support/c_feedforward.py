@@ -130,7 +130,7 @@ class CStepper(StateDoubles):
         if not self.pointer:
             raise ValueError(error.value.decode())
         self._out, self._saturated = (ctypes.c_double * 2)(), ctypes.c_int()
-        self._warning = ctypes.create_string_buffer(512)  # feedforward.h: warning[512]
+        self._warning = ctypes.create_string_buffer(1024)  # feedforward.h: warning[1024]
         self._error = ctypes.create_string_buffer(512)
         self.warning = None
 

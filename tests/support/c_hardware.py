@@ -6,6 +6,7 @@ refusal, the saved state through the C state_write/state_read.
 """
 import ctypes
 
+from c_control import _Block as _ControlBlock
 from c_runtime import compile_runtime
 
 MODULES = ("noise", "measurement", "pi_control", "drive_limit", "pwm", "checks",
@@ -61,31 +62,13 @@ def load_library(folder):
     return lib
 
 
-class _Block:
-    prefix = ""
-    size_index = 0
-
-    def __init__(self, lib):
-        self.lib = lib
-        self.memory = ctypes.create_string_buffer(lib.shim_size(self.size_index))
-        self.message = ctypes.create_string_buffer(512)
+class _Block(_ControlBlock):
+    """c_control's block (memory, message, call, state, restore) with ``check`` for the
+    shims' status."""
 
     def check(self, status):
         if status != 0:
             raise ValueError(self.message.value.decode())
-
-    def call(self, name, *args):
-        self.check(getattr(self.lib, f"{self.prefix}_{name}")(self.memory, *args, self.message))
-
-    def state(self):
-        count = getattr(self.lib, f"{self.prefix}_state_size")(self.memory)
-        out = (ctypes.c_double * count)()
-        getattr(self.lib, f"{self.prefix}_state_write")(self.memory, out)
-        return list(out)
-
-    def restore(self, values):
-        array = (ctypes.c_double * max(1, len(values)))(*values)
-        self.call("state_read", array, ctypes.c_size_t(len(values)))
 
 
 class CSensor(_Block):

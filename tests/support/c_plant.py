@@ -140,7 +140,7 @@ class CPlant(StateDoubles):
             self.lib.plant_delete(self.pointer)
 
     def _read(self):
-        out, warning = (ctypes.c_double * 8)(), ctypes.create_string_buffer(256)
+        out, warning = (ctypes.c_double * 8)(), ctypes.create_string_buffer(512)  # plant.h: warning[512]
         self.lib.plant_outputs(self.pointer, out, warning)
         self.warning = warning.value.decode() or None
         return tuple(out[:7]) + (bool(out[7]),)

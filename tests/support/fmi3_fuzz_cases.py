@@ -4,7 +4,8 @@ both must answer with the same status, and a refusal (discard or error) must com
 logged message in both, naming the same variables.
 
 The cases: the refusals the native equivalence and fuzz findings pinned (illegal calls per
-state, bad parameters refusing initialization, absurd loads, non-finite inputs, steps off
+state, bad parameters refusing initialization (R_M, l_F of 1e30 among them: outside their
+plausible ranges), absurd loads, non-finite inputs, steps off
 the time line) and random call sequences over every scalar variable with the fuzz suite's
 special values (tests/fmus/test_fmu_fuzz.py's SPECIAL_FLOATS); and, FMI 3.0 only, the plant's
 arrays read with good and wrong sizes (array_cases). Used in-process by
@@ -103,7 +104,9 @@ def pinned_cases(pair, model):
         else None                                        # an output
     assert pair.enter() == 0
     if model == "SmaActuator":
-        for name, value in (("R_P", -33.0), ("stress_max", math.nan), ("T_start", -300.0)):
+        for name, value in (("R_P", -33.0), ("stress_max", math.nan), ("T_start", -300.0),
+                            ("R_M", 1e30), ("R_F", 1.7976931348623157e308), ("l_F", 1e30),
+                            ("a_h", -1e30), ("stress_max", math.inf)):  # out of range
             pair.set(name, value)
             assert pair.call("exitInitializationMode") == 3  # refused, naming the parameter
             pair.get("R")                                     # outputs undefined

@@ -12,6 +12,7 @@ from sma_fmu.cli import main
 from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
 from sma_fmu.systems.closed_loop import closed_loop
 from sma_fmu.systems.ssp import write_ssp
+from sma_fmu.files.output_folder import MARKER
 from system_needs import needs
 
 
@@ -28,9 +29,9 @@ def exported(fmu_dir, tmp_path_factory):
 
 def test_export_writes_one_ssp_per_scenario_into_a_folder(exported):
     names = sorted(p.name for p in (exported / "ssp").iterdir())
-    assert names == sorted(f"{name}.ssp" for name in
+    assert names == sorted([MARKER] + [f"{name}.ssp" for name in
                            ("load-step-pi", "load-step-pi+ff-fixed", "load-step-pi+ff-adaptive",
-                            "heavy-pi", "heavy-pi+ff-fixed", "heavy-pi+ff-adaptive"))
+                            "heavy-pi", "heavy-pi+ff-fixed", "heavy-pi+ff-adaptive")])
     with zipfile.ZipFile(exported / "ssp" / "heavy-pi+ff-fixed.ssp") as archive:
         assert "resources/SmaFeedforward.fmu" in archive.namelist()
 
@@ -109,5 +110,6 @@ def test_check_names_a_zip_that_is_no_fmu_or_ssp(tmp_path, capsys):
     captured = capsys.readouterr()
     assert captured.out.splitlines() == [
         f"FAIL  {wheel}: archive: not an FMU: no modelDescription.xml at the top of the archive",
-        f"FAIL  {package}: archive: not an SSP package: no SystemStructure.ssd at the top of the archive"]
+        f"FAIL  {package}: archive: not an SSP package: no SystemStructure.ssd at the top of the archive",
+        "check: 2 files, 2 checks: 2 FAIL"]
     assert captured.err == ""

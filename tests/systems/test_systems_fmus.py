@@ -109,7 +109,7 @@ def test_pi_controller_discards_non_finite_inputs_and_rejects_bad_gains(fmus):
         fmu.set_real(("R_ref",), (42.0,))
         fmu.step(0.0, STEP)  # the rejected step changed nothing: retry from the same time
         assert fmu.get_real(("P",))[0] == pytest.approx(0.3 * 2.0)
-    with pytest.raises(FmuError, match=r"control.Kp = -1.0 must be >= 0"):
+    with pytest.raises(FmuError, match=r"control.Kp = -1.0 must be in \[0, 1e\+06\] \[W/ohm\]"):
         FmuInstance(fmus["SmaPiController"], "pi", {"Kp": -1.0})
 
 

@@ -1,6 +1,7 @@
 """Scenarios by name: the shipped ones, the paper's set, and names or paths resolved to files."""
 from pathlib import Path
 
+from sma_fmu.console.suggest import did_you_mean
 from sma_fmu.cosim.scenario.settings import CONTROLLERS, ScenarioError
 from sma_fmu.files.package_data import shipped_file, shipped_files
 
@@ -36,6 +37,10 @@ def resolve_scenarios(items, everything=False):
         elif name in scenario_names():
             paths.append(shipped_file("scenarios", f"{name}.toml"))
         else:
-            raise ScenarioError(f"unknown scenario {name!r}: no such file, and not one of the "
-                                f"shipped scenarios ({', '.join(scenario_names())}) or 'paper'")
+            shipped = scenario_names()
+            hint = did_you_mean(name, shipped + ["paper"])
+            raise ScenarioError(f"unknown scenario {name!r}: no such file, and no shipped "
+                                f"scenario has that name{'; ' + hint if hint else ''} "
+                                f"(sma-fmu examples lists the {len(shipped)} shipped scenarios; "
+                                f"'paper' names the paper's {len(PAPER_SET)})")
     return list(dict.fromkeys(paths))

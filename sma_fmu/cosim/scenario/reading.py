@@ -51,7 +51,6 @@ A run may have at most :data:`MAX_STEPS` steps.
 import math
 from pathlib import Path
 
-from sma_fmu.cosim.recording import interval_steps
 from sma_fmu.cosim.scenario.settings import (CONTROLLERS, AnalysisWindow, ControllerSettings,
                                              DriveSettings, Scenario, ScenarioError,
                                              SensorSettings, default_analysis)
@@ -259,7 +258,7 @@ def scenario_from_document(document, path, parameter_set=None):
     if "output_interval_s" in head:
         interval = _number(path, "scenario", head, "output_interval_s", positive=True)
         try:
-            interval_steps(interval, step, "output_interval_s")
+            _interval_steps(interval, step, "output_interval_s")
         except ValueError as error:
             _fail(path, f"[scenario] {error}")
     model = _string(path, "scenario", head, "model")
@@ -294,3 +293,11 @@ def scenario_from_document(document, path, parameter_set=None):
         group_name=_string(path, "scenario", head, "group"), output_interval_s=interval,
         drive=_drive(path, document["drive"]) if "drive" in document else DriveSettings(),
         sensor=_sensor(path, document["sensor"]) if "sensor" in document else SensorSettings())
+
+
+def _interval_steps(*arguments):
+    """:func:`~sma_fmu.cosim.recording.interval_steps`, imported when a file sets an output
+    interval: the recording imports numpy, which naming a scenario need not wait for."""
+    from sma_fmu.cosim.recording import interval_steps
+
+    return interval_steps(*arguments)

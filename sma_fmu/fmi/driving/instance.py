@@ -18,6 +18,7 @@ from fmpy.logging import addLoggerProxy
 from fmpy.fmi2 import (FMU2Slave, defaultCallbacks, fmi2CallbackFunctions,
                        fmi2CallbackLoggerTYPE)
 
+from sma_fmu.console.interrupts import deferred
 from sma_fmu.fmi.driving import unpacked
 
 __all__ = ["FmuError", "FmuInstance"]
@@ -151,8 +152,9 @@ class FmuInstance:
         self.component = None
         self._alive = False
         try:
-            self._instantiate()
-            self._alive = True
+            with deferred():   # a Ctrl-C waits until the instance is made and known (freed below)
+                self._instantiate()
+                self._alive = True
             self.component = self._fmu.component
             self._enter_initialization(start_time)
             if start_values:
@@ -333,8 +335,9 @@ class FmuInstance:
         so a closed instance leaves no entry behind.
         """
         if self._alive:
-            self._alive = False
-            self._terminate_and_free()
+            with deferred():   # freed whole: a Ctrl-C comes after
+                self._alive = False
+                self._terminate_and_free()
         _LOGGERS.pop(self._key, None)  # after the instance's last message
         resources = str(Path(self._unzipped) / "resources")
         sys.path[:] = [entry for entry in sys.path if entry.rstrip("/") != resources]

@@ -1,7 +1,9 @@
 """Each FMU file unpacked once per process, shared by its instances (:class:`FmuInstance`).
 
-Unpacking an FMU (58 files) takes 8-70 ms, more than the rest of making an instance; the
-closed loop and the bench make several instances of the same files per process. The cache
+Unpacking an FMU takes 8-70 ms, more than the rest of making an instance; the closed loop
+and the bench make several instances of the same files per process. What running it needs
+is unpacked: all but its C sources and its documentation (``sources/``, ``documentation/``:
+of a native FMU's 92 files, 80; creating them was most of the time). The cache
 key is the file's resolved path, size and modification time [ns]: a rebuilt FMU at the same
 path gets a fresh folder, and the old folder is removed once no instance uses it.
 
@@ -35,6 +37,7 @@ __all__ = ["Unpacked", "acquire", "release", "folders", "remove_stale", "UNPACK_
 
 UNPACK_EACH_VARIABLE = "SMA_FMU_UNPACK_EACH"
 _PREFIX = "sma_fmu_unpacked_"
+_NOT_RUN = ("sources/", "documentation/")   # what no host reads to run an FMU
 
 
 class Unpacked:
@@ -145,7 +148,8 @@ def _unpack(path, key, cached):
         remove_stale()
     folder = tempfile.mkdtemp(prefix=f"{_PREFIX}{os.getpid()}_")
     try:
-        safe_extract(path, folder)   # the archive inspected once, before fmpy reads anything of it
+        # the archive inspected once, before fmpy reads anything of it
+        safe_extract(path, folder, lambda name: not name.startswith(_NOT_RUN))
         description = read_description(path)
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)

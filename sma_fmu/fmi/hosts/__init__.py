@@ -26,6 +26,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+from sma_fmu.console.interrupts import run_child
 from sma_fmu.fmi.c_common import FMI_HEADERS, include_flags
 
 __all__ = ["CHostError", "HOST_PROGRAMS", "SHARED_HEADER", "PREBUILT_HOSTS", "c_compiler",
@@ -107,7 +108,7 @@ def compile_host(name, cache=None, windows=False):
         command = [*compiler, *_FLAGS, *include_flags(HOSTS), "-o", str(built),
                    str(HOSTS / f"{name}.c"), *link]
         try:
-            result = subprocess.run(command, capture_output=True, text=True, timeout=300)
+            result = run_child(command, text=True, timeout=300)
         except (OSError, subprocess.SubprocessError) as error:
             hint = ("install gcc-mingw-w64-x86-64 or set SMA_FMU_WIN64_CC" if windows
                     else "install gcc or set CC")
@@ -161,7 +162,7 @@ def write_prebuilt_hosts(folder=None):
             command = [*c_compiler(), *_FLAGS, *include_flags(HOSTS), "-o", str(folder / name),
                        str(HOSTS / f"{name}.c"), f"-L{library}",
                        "-lcosimc", f"-Wl,-rpath,{_RELATIVE_LIBCOSIMC}"]
-            result = subprocess.run(command, capture_output=True, text=True, timeout=300)
+            result = run_child(command, text=True, timeout=300)
             if result.returncode != 0:
                 raise CHostError(f"could not build the prebuilt cosim_host: {result.stderr.strip()}")
         else:

@@ -8,6 +8,7 @@
  * usage: loop_host < SYSTEM   where SYSTEM has one item a line (strings hex-encoded):
  *   fmu NAME DIR                   a component (unpacked FMU folder); the order of these
  *                                  lines is the data-flow order of initialization
+ *   load DIR                       (a session) load the FMU in DIR now; answers LOAD
  *   real|integer|boolean NAME VR VALUE   a start value, set in Initialization Mode
  *   string NAME VR HEX             a String start value
  *   connect SRC VR DST VR          the Real output SRC.VR feeds the Real input DST.VR
@@ -30,8 +31,18 @@
  *         completes ROWS rows of the loop (row k holds the outputs after step k);
  *   LOG_  "STATUS NAME CATEGORY\tTEXT" of an FMU log message;
  *   FAIL  "NAME.CALL returned STATUS at t = T s" of a failed call (status > fmi2Warning),
- *         after the rows up to that step: the host then exits with status 1;
- *   DONE  the run ended (after the last rows).
+ *         after the rows up to that step: the run ends there (see the session);
+ *   DONE  the run ended (after the last rows; its instances terminated): one double, the
+ *         seconds it spent writing the CSV (0 without a csv line);
+ *   LOAD  (no payload) the answer to a "load" line: that FMU is loaded.
+ * A session (the C master's runs in one process): after a "binary" run the host reads the
+ * next system from stdin instead of exiting, until stdin closes (then it frees every
+ * instance and exits 0). Each FMU folder is loaded once per process ("load DIR" loads it
+ * ahead and answers a LOAD frame, so start-up and runs can be timed apart); its instance
+ * is kept across runs and reset (fmi2Reset) before the next one instead of freed, then set
+ * up, given the new run's start values and initialized as a new one is. A failed call
+ * (FAIL frame) ends only its run: that run's instances are freed, and the next run makes
+ * new ones; fmi2Fatal (the FMU's state unusable) ends the process with status 1.
  * "csv PATH EVERY LAST SPEC..." (before the run line, with "binary"): the host also appends the
  * loop's rows as CSV text to PATH (hex; its header already written), every EVERY-th row and
  * row LAST (the final one), each number as Python's "%.10g" writes it (format_g10), the
@@ -61,7 +72,7 @@
 
 typedef struct {
     char name[64], dir[PATH_SIZE], guid[256], model[256];
-    fmi2Component c;
+    fmi2Component c;   /* the instance (NULL: none yet, or freed after a failed run) */
     HOST_FMI2_FUNCTIONS(HOST_FMI2_POINTER)  /* its functions (host_platform.h) */
 } Fmu;
 
@@ -69,8 +80,12 @@ typedef struct { int kind, component; unsigned vr; double real; int integer; cha
 typedef struct { int source, target; unsigned output, input; } Link;
 typedef struct { int boolean, component; unsigned vr; } Column;
 
-static Fmu fmu[MAX_COMPONENTS];
+#define MAX_LOADED 16
+static Fmu loaded[MAX_LOADED];     /* every FMU folder this process loaded (a session's) */
+static int n_loaded, session;      /* session: a "load" or "binary" line came */
+static Fmu* fmu[MAX_COMPONENTS];   /* this run's components, in the order of their fmu lines */
 static int components, order[MAX_COMPONENTS], ordered;
+static int failed;                 /* a call of this run failed (binary: FAIL sent) */
 static Start start[MAX_ITEMS];
 static Link edge[MAX_ITEMS];
 static Column column[MAX_ITEMS];
@@ -91,6 +106,7 @@ static FILE* csv_file;
 static char csv_path[PATH_SIZE];
 static long csv_every, csv_last, csv_row;
 static double csv_step, csv_x0, csv_prev[MAX_ITEMS];
+static double csv_seconds;  /* [s] this run spent writing the CSV (DONE's payload) */
 static char* csv_buffer;
 static size_t csv_used;
 #define CSV_BUFFER (1u << 20)
@@ -345,7 +361,7 @@ static int bad(const char* what, const char* detail)
 static int find(const char* name)
 {
     for (int i = 0; i < components; ++i)
-        if (!strcmp(fmu[i].name, name)) return i;
+        if (!strcmp(fmu[i]->name, name)) return i;
     return bad("no component", name);
 }
 
@@ -378,21 +394,25 @@ static void resource_uri(const char* dir, char* uri, size_t size)
 }
 
 
-static void check(int status, const Fmu* f, const char* call)
+/* 0 when `status` is fmi2OK or fmi2Warning. Else, in binary mode, the rows up to this step,
+ * then what failed and when (FAIL), and 1: the run ends there (`failed`), the session goes
+ * on, but for fmi2Fatal; otherwise (and for fmi2Fatal) the host exits with status 1. */
+static int check(int status, const Fmu* f, const char* call)
 {
-    if (status > 1) {
-        if (binary) {  /* the rows up to this step, then what failed and when */
-            char text[512];
-            int size = snprintf(text, sizeof text, "%s.%s returned %d at t = %.9g s", f->name, call,
-                                status, now);
-            csv_finish();
-            flush_rows();
-            frame("FAIL", text, size < 0 ? 0 : size < (int)sizeof text ? (size_t)size : sizeof text - 1);
-            fflush(stdout);
-        }
-        fprintf(stderr, "loop_host: %s.%s returned %d\n", f->name, call, status);
-        exit(1);
+    if (status <= 1) return 0;
+    if (binary) {
+        char text[512];
+        int size = snprintf(text, sizeof text, "%s.%s returned %d at t = %.9g s", f->name, call,
+                            status, now);
+        csv_finish();
+        flush_rows();
+        frame("FAIL", text, size < 0 ? 0 : size < (int)sizeof text ? (size_t)size : sizeof text - 1);
+        fflush(stdout);
+        failed = 1;
+        if (status < 4) return 1;
     }
+    fprintf(stderr, "loop_host: %s.%s returned %d\n", f->name, call, status);
+    exit(1);
 }
 
 /* Each input of component i gets its source's output now. */
@@ -400,10 +420,11 @@ static void feed(int i)
 {
     for (int k = 0; k < links; ++k) {
         if (edge[k].target != i) continue;
-        const Fmu* s = &fmu[edge[k].source];
+        const Fmu* s = fmu[edge[k].source];
         double value;
-        check(s->GetReal(s->c, &edge[k].output, 1, &value), s, "fmi2GetReal");
-        check(fmu[i].SetReal(fmu[i].c, &edge[k].input, 1, &value), &fmu[i], "fmi2SetReal");
+        if (check(s->GetReal(s->c, &edge[k].output, 1, &value), s, "fmi2GetReal")
+            || check(fmu[i]->SetReal(fmu[i]->c, &edge[k].input, 1, &value), fmu[i], "fmi2SetReal"))
+            return;
     }
 }
 
@@ -414,18 +435,22 @@ static void print_row(void)
         double* row = block + block_rows * columns;
         for (int r = 0; r < n_reads; ++r) {
             const Read* read = &reads[r];
-            const Fmu* f = &fmu[read->component];
+            const Fmu* f = fmu[read->component];
             if (read->boolean) {
                 int value[MAX_ITEMS];
-                check(f->GetBoolean(f->c, &read_vr[read->first], (size_t)read->count, value), f,
-                      "fmi2GetBoolean");
+                if (check(f->GetBoolean(f->c, &read_vr[read->first], (size_t)read->count, value), f,
+                          "fmi2GetBoolean")) return;
                 for (int k = 0; k < read->count; ++k) row[read->first + k] = value[k] ? 1.0 : 0.0;
-            } else {
-                check(f->GetReal(f->c, &read_vr[read->first], (size_t)read->count, &row[read->first]),
-                      f, "fmi2GetReal");
+            } else if (check(f->GetReal(f->c, &read_vr[read->first], (size_t)read->count,
+                                        &row[read->first]), f, "fmi2GetReal")) {
+                return;
             }
         }
-        if (csv_file) csv_sample(row);
+        if (csv_file) {
+            const double begin = host_now();
+            csv_sample(row);
+            csv_seconds += host_now() - begin;
+        }
         if (++block_rows == frame_size) {
             flush_rows();
             frame_size = block_size;
@@ -434,7 +459,7 @@ static void print_row(void)
     }
     fputs("row", stdout);
     for (int k = 0; k < columns; ++k) {
-        const Fmu* f = &fmu[column[k].component];
+        const Fmu* f = fmu[column[k].component];
         if (column[k].boolean) {
             int value;
             check(f->GetBoolean(f->c, &column[k].vr, 1, &value), f, "fmi2GetBoolean");
@@ -451,16 +476,23 @@ static void print_row(void)
 static void initialize(double stop, const fmi2CallbackFunctions* callbacks)
 {
     for (int i = 0; i < components; ++i) {
-        Fmu* f = &fmu[i];
-        char uri[PATH_SIZE + 64];
-        resource_uri(f->dir, uri, sizeof uri);
-        f->c = f->Instantiate(f->name, fmi2CoSimulation, f->guid, uri, callbacks, fmi2False, fmi2False);
-        if (!f->c) { fprintf(stderr, "loop_host: %s: fmi2Instantiate returned NULL\n", f->name); exit(1); }
-        check(f->SetupExperiment(f->c, 0, 0.0, 0.0, 1, stop), f, "fmi2SetupExperiment");
-        check(f->EnterInitializationMode(f->c), f, "fmi2EnterInitializationMode");
+        Fmu* f = fmu[i];
+        if (f->c && f->Reset(f->c) > 1) {  /* an earlier run's instance: reset, else a new one */
+            f->FreeInstance(f->c);
+            f->c = NULL;
+        }
+        if (!f->c) {
+            char uri[PATH_SIZE + 64];
+            resource_uri(f->dir, uri, sizeof uri);
+            f->c = f->Instantiate(f->name, fmi2CoSimulation, f->guid, uri, callbacks, fmi2False, fmi2False);
+            if (!f->c) { fprintf(stderr, "loop_host: %s: fmi2Instantiate returned NULL\n", f->name); exit(1); }
+        }
+        if (check(f->SetupExperiment(f->c, 0, 0.0, 0.0, 1, stop), f, "fmi2SetupExperiment")
+            || check(f->EnterInitializationMode(f->c), f, "fmi2EnterInitializationMode"))
+            return;
     }
     for (int i = 0; i < components; ++i) {
-        Fmu* f = &fmu[i];
+        Fmu* f = fmu[i];
         for (int k = 0; k < starts; ++k) {
             const Start* s = &start[k];
             if (s->component != i) continue;
@@ -469,10 +501,10 @@ static void initialize(double stop, const fmi2CallbackFunctions* callbacks)
                        : s->kind == 1 ? f->SetInteger(f->c, &s->vr, 1, &s->integer)
                        : s->kind == 2 ? f->SetBoolean(f->c, &s->vr, 1, &s->integer)
                        : f->SetString(f->c, &s->vr, 1, &text);
-            check(status, f, "fmi2Set (start value)");
+            if (check(status, f, "fmi2Set (start value)")) return;
         }
         feed(i);
-        check(f->ExitInitializationMode(f->c), f, "fmi2ExitInitializationMode");
+        if (failed || check(f->ExitInitializationMode(f->c), f, "fmi2ExitInitializationMode")) return;
     }
 }
 
@@ -488,23 +520,25 @@ static void run(double h, long steps, int timing)
     if (timing && !cost) bad("out of memory for", "the timings");
     if (!timing) print_row();
     const double begin = host_now();
-    for (long k = 0; k < steps; ++k) {
+    for (long k = 0; k < steps && !failed; ++k) {
         const double t = (double)k * h, before = timing ? host_now() : 0.0;
         now = t;
         for (int j = 0; j < ordered; ++j) {
-            Fmu* f = &fmu[order[j]];
+            Fmu* f = fmu[order[j]];
             feed(order[j]);
-            check(f->DoStep(f->c, t, h, 1), f, "fmi2DoStep");
+            if (failed || check(f->DoStep(f->c, t, h, 1), f, "fmi2DoStep")) return;
         }
         if (timing) cost[k] = host_now() - before;
         else print_row();
     }
+    if (failed) return;
     now = (double)steps * h;
     const double total = host_now() - begin;
-    if (binary) {
+    if (binary) {   /* DONE follows when the instances have terminated (end_run) */
+        const double begin = host_now();
         csv_finish();
+        csv_seconds += host_now() - begin;
         flush_rows();
-        frame("DONE", NULL, 0);
     }
     if (timing) {
         qsort(cost, (size_t)steps, sizeof(double), by_value);
@@ -516,13 +550,20 @@ static void run(double h, long steps, int timing)
     }
 }
 
+/* Frames on stdout from now on (untranslated on Windows): the C master's session. */
+static void start_session(void)
+{
+#ifdef _WIN32
+    if (!session) _setmode(_fileno(stdout), _O_BINARY);
+#endif
+    session = 1;
+}
+
 /* Binary output (the C master): stdout untranslated, a block of `rows` rows. */
 static void start_binary(long rows)
 {
     if (rows < 1 || columns < 1) bad("bad binary block size or no recorded column", "run");
-#ifdef _WIN32
-    _setmode(_fileno(stdout), _O_BINARY);
-#endif
+    start_session();
     block = malloc(sizeof(double) * (size_t)((rows + 1) * columns));
     if (!block) bad("out of memory for", "the rows");
     block_size = rows;
@@ -561,7 +602,7 @@ static void start_csv(char** word, int n)
             if (c->index < 0 || c->index >= columns) bad("csv column out of the recorded ones", spec);
         }
     }
-    csv_buffer = malloc(CSV_BUFFER);
+    if (!csv_buffer) csv_buffer = malloc(CSV_BUFFER);   /* kept for a session's next runs */
     if (!csv_buffer) bad("out of memory for", "the CSV rows");
     csv_file = fopen(csv_path, "ab");
     if (!csv_file) bad("cannot open the CSV file", csv_path);
@@ -581,9 +622,61 @@ static void print_g10(char* values)
     fflush(stdout);
 }
 
+/* The loaded FMU of folder `dir`: loaded now (model description, binary) or before. */
+static Fmu* loaded_fmu(const char* dir)
+{
+    for (int i = 0; i < n_loaded; ++i)
+        if (!strcmp(loaded[i].dir, dir)) return &loaded[i];
+    if (n_loaded == MAX_LOADED) bad("more FMU folders than the host keeps loaded", dir);
+    Fmu* f = &loaded[n_loaded++];
+    snprintf(f->dir, sizeof f->dir, "%s", dir);
+    read_model_description(f);
+    load(f);
+    return f;
+}
+
+/* "fmu NAME DIR": the component NAME of this run, the FMU in DIR (its instance kept from an
+ * earlier run of the session if it had this name). */
+static void add_component(const char* name, const char* dir)
+{
+    Fmu* f = loaded_fmu(dir);
+    for (int i = 0; i < components; ++i)
+        if (fmu[i] == f) bad("one FMU folder for two components", dir);
+    if (f->c && strcmp(f->name, name)) {  /* the instance's name was another: a new one */
+        f->FreeInstance(f->c);
+        f->c = NULL;
+    }
+    snprintf(f->name, sizeof f->name, "%s", name);
+    fmu[components++] = f;
+}
+
+/* After a binary run: its instances terminated (kept for the next run) and DONE, or freed
+ * when a call failed (FAIL was sent); the system's lines forgotten, ready for the next. */
+static void end_run(void)
+{
+    for (int i = 0; i < components && !failed; ++i)
+        check(fmu[i]->Terminate(fmu[i]->c), fmu[i], "fmi2Terminate");
+    if (!failed) frame("DONE", &csv_seconds, sizeof csv_seconds);
+    for (int i = 0; i < components && failed; ++i) {
+        if (fmu[i]->c) fmu[i]->FreeInstance(fmu[i]->c);
+        fmu[i]->c = NULL;
+    }
+    for (int k = 0; k < starts; ++k) free(start[k].text);
+    starts = links = columns = ordered = components = n_reads = failed = 0;
+    free(block);
+    block = NULL;
+    block_rows = 0;
+    csv_columns = csv_have_prev = 0;
+    csv_seconds = 0.0;
+    csv_row = 0;
+}
+
 int main(void)
 {
     static char line[1 << 20];
+    /* stdout written 1 MiB at a time (the pipe's size): the master wakes once per MiB of
+     * rows, not once per 4 KiB (on a busy machine each wake-up waits for a core) */
+    setvbuf(stdout, NULL, _IOFBF, 1 << 20);
     init_tens();
     fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     while (fgets(line, sizeof line, stdin)) {
@@ -596,11 +689,12 @@ int main(void)
         for (char* p = strtok(line, " \r\n"); p && n < MAX_ITEMS + 8; p = strtok(NULL, " \r\n")) word[n++] = p;
         if (n == 0) continue;
         if (!strcmp(word[0], "fmu") && n == 3 && components < MAX_COMPONENTS) {
-            Fmu* f = &fmu[components++];
-            snprintf(f->name, sizeof f->name, "%s", word[1]);
-            snprintf(f->dir, sizeof f->dir, "%s", word[2]);
-            read_model_description(f);
-            load(f);
+            add_component(word[1], word[2]);
+        } else if (!strcmp(word[0], "load") && n == 2) {   /* a session's start-up: answers LOAD */
+            start_session();
+            loaded_fmu(word[1]);
+            frame("LOAD", NULL, 0);
+            fflush(stdout);
         } else if ((!strcmp(word[0], "real") || !strcmp(word[0], "integer") || !strcmp(word[0], "boolean")
                     || !strcmp(word[0], "string")) && n == 4 && starts < MAX_ITEMS) {
             Start* s = &start[starts++];
@@ -628,11 +722,17 @@ int main(void)
             if (csv_file && n != 5) bad("a csv line needs", "run ... binary ROWS");
             csv_step = h;
             if (n == 5) start_binary(atol(word[4]));
+            now = 0.0;   /* a failure before the first step is at t = 0 */
             initialize((double)steps * h, &callbacks);
-            run(h, steps, n == 4);
+            if (!failed) run(h, steps, n == 4);
+            if (binary) {   /* a session: the next system follows on stdin */
+                end_run();
+                fflush(stdout);
+                continue;
+            }
             for (int i = 0; i < components; ++i) {
-                check(fmu[i].Terminate(fmu[i].c), &fmu[i], "fmi2Terminate");
-                fmu[i].FreeInstance(fmu[i].c);
+                check(fmu[i]->Terminate(fmu[i]->c), fmu[i], "fmi2Terminate");
+                fmu[i]->FreeInstance(fmu[i]->c);
             }
             fflush(stdout);
             return 0;
@@ -640,5 +740,8 @@ int main(void)
             bad("bad line", word[0]);
         }
     }
-    return bad("no run line", "stdin");
+    if (!session) return bad("no run line", "stdin");
+    for (int i = 0; i < n_loaded; ++i)   /* stdin closed: the session ends */
+        if (loaded[i].c) loaded[i].FreeInstance(loaded[i].c);
+    return 0;
 }

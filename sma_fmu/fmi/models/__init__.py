@@ -18,6 +18,7 @@ FMU is its folder and its line here.
 """
 from functools import cache
 
+from sma_fmu.console.suggest import did_you_mean
 from sma_fmu.fmi.models.declaration import Declaration, read_declaration
 
 __all__ = ["REGISTRY", "Declaration", "declarations", "declaration"]
@@ -42,4 +43,6 @@ def declaration(name):
     for declared in declarations():
         if declared.name == name:
             return declared
-    raise ValueError(f"unknown FMU {name!r}; expected one of {', '.join(REGISTRY)}")
+    hint = did_you_mean(name, REGISTRY)
+    raise ValueError(f"unknown FMU {name!r}{f' ({hint})' if hint else ''}; expected one of "
+                     f"{', '.join(REGISTRY)}")

@@ -32,6 +32,7 @@ import zipfile
 from importlib import util
 from pathlib import Path
 
+from sma_fmu.console import progress
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.fmi.c_common import C_COMMON, FMI_HEADERS
 from sma_fmu.fmi.models import declaration, declarations
@@ -148,8 +149,9 @@ def exact_starts(model_name, resources_folder):
     return starts, defaults
 
 
-def _build_one(model_name, python_fmu, folder, work, compile=False):
-    """Write ``folder/<model_name>.fmu`` from the pythonfmu FMU; returns [warning texts]."""
+def _build_one(model_name, python_fmu, folder, work, compile=False, step=None):
+    """Write ``folder/<model_name>.fmu`` from the pythonfmu FMU; returns [warning texts].
+    ``step(text)``: called before each platform's binary (a progress bar's step)."""
     unpacked = work / model_name
     with zipfile.ZipFile(python_fmu) as archive:
         archive.extractall(unpacked)
@@ -171,6 +173,8 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
     for entry in fmi2_targets():
         binary = f"binaries/{entry.fmi2}/{model_name}{entry.suffix}"
         data = None if compile else find_prebuilt(model_name, entry.fmi2, digest)
+        if step is not None:
+            step(f"{model_name} {entry.fmi2}{' (prebuilt)' if data is not None else ''}")
         if data is None:
             output = work / entry.fmi2 / f"{model_name}{entry.suffix}"
             output.parent.mkdir(exist_ok=True)
@@ -203,22 +207,30 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
     return problems
 
 
-def build_from_twins(out_dir, parameter_file, names, build_one):
+def build_from_twins(out_dir, parameter_file, names, build_one, platforms, label):
     """Build each C-family FMU of ``names`` (default: every registered one) from its pythonfmu
     twin (the variables, units and exact starts: one interface for both families) into ``out_dir``;
-    ``build_one(name, twin path, staging folder, work folder)`` writes one FMU and returns its
-    problem texts. Built beside ``out_dir`` and moved there at the end (a failed build leaves
-    it as it was); returns (names, the distinct problems without their model names)."""
+    ``build_one(name, twin path, staging folder, work folder, step)`` writes one FMU, calling
+    ``step(text)`` before each of its ``platforms`` (their number), and returns its problem
+    texts. A progress bar ``label`` counts the binaries. Built beside ``out_dir`` and moved
+    there at the end (a failed build leaves it as it was); returns (names, the distinct
+    problems without their model names)."""
     names = [declared.name for declared in declarations()] if names is None else list(names)
     with tempfile.TemporaryDirectory(prefix="sma_fmu_native_") as work:
         work = Path(work)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FrontWarning)  # the twins' fronts: not shipped
-            python_fmus = build_pythonfmu_fmus(work / "python", parameter_file, names)
+            python_fmus = build_pythonfmu_fmus(work / "python", parameter_file, names,
+                                               label="pythonfmu twins")
         problems = []
-        with staged_folder(out_dir) as folder:
+        with staged_folder(out_dir) as folder, \
+                progress.bar(len(names) * platforms, label, unit="binary") as shown:
+            def step(text):
+                shown.set_postfix_str(text)
+                if shown.n < len(names) * platforms:
+                    shown.update(1)
             for name in names:
-                problems += build_one(name, python_fmus[name], folder, work)
+                problems += build_one(name, python_fmus[name], folder, work, step)
     return names, sorted(set(problem.split(": ", 1)[1] for problem in problems))
 
 
@@ -233,7 +245,8 @@ def build_native_fmus(out_dir, parameter_file=None, names=None, compile=False):
 
     names, problems = build_from_twins(
         out_dir, parameter_file, names,
-        lambda name, twin, folder, work: _build_one(name, twin, folder, work, compile))
+        lambda name, twin, folder, work, step: _build_one(name, twin, folder, work, compile, step),
+        len(fmi2_targets()), "native FMUs (FMI 2.0)")
     for message in problems:
         hint = " Their sources/ compile there: fmpy.build.build_platform_binary"
         if message.startswith("built without win64"):

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sma_fmu.fmi.c_common import include_flags
+from sma_fmu.console.interrupts import run_child
 from sma_fmu.fmi.hosts import HOSTS, c_compiler, windows_compiler
 
 __all__ = ["FLAGS", "Target", "TARGETS", "target", "fmi2_targets", "zig_command", "toolchain",
@@ -88,17 +89,37 @@ def fmi2_targets():
 def zig_command():
     """zig cc as a command list: ``$SMA_FMU_ZIG_CC`` split like a shell would (``none``: no
     zig), else ``python -m ziglang cc`` when PyPI's ``ziglang`` is installed in this Python,
-    else ``zig cc`` or ``python-zig cc`` (ziglang's script, e.g. of an activated venv: what
-    an isolated wheel build finds) on the PATH, else None."""
+    else ``zig cc`` on the PATH, else the zig of the ``ziglang`` package whose script
+    ``python-zig`` is on the PATH (e.g. of an activated venv: what an isolated wheel build
+    finds), else None."""
     given = os.environ.get("SMA_FMU_ZIG_CC", "").strip()
     if given:
         return None if given.lower() == "none" else shlex.split(given)
     if importlib.util.find_spec("ziglang") is not None:
         return [sys.executable, "-m", "ziglang", "cc"]
-    for program in ("zig", "python-zig"):
-        if shutil.which(program):
-            return [program, "cc"]
-    return None
+    if shutil.which("zig"):
+        return ["zig", "cc"]
+    script = shutil.which("python-zig")
+    return None if script is None else _ziglang_binary(script)
+
+
+def _ziglang_binary(script):
+    """[zig, "cc"] of the ``ziglang`` package whose script ``python-zig`` is ``script``: its
+    own Python (the script's first line) names the package's folder. That Python is asked
+    without the calling process's PYTHONPATH, which an isolated wheel build points at its own
+    packages only, so that the script itself, run there, cannot import ziglang."""
+    with open(script, "rb") as handle:
+        first = handle.readline().decode("utf-8", "replace").strip()
+    interpreter = shlex.split(first[2:]) if first.startswith("#!") else [sys.executable]
+    clean = {key: value for key, value in os.environ.items()
+             if key not in ("PYTHONPATH", "PYTHONNOUSERSITE", "PYTHONHOME")}
+    try:
+        found = subprocess.run([*interpreter, "-c", "import ziglang, os; print(os.path.dirname(ziglang.__file__))"],
+                               capture_output=True, text=True, env=clean, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    zig = Path(found.stdout.strip()) / ("zig.exe" if os.name == "nt" else "zig")
+    return [str(zig), "cc"] if found.returncode == 0 and zig.is_file() else None
 
 
 def _x86_64_linux():
@@ -150,8 +171,7 @@ def compile_shared(entry, sources_folder, output, prefer_zig=False):
                 if path.suffix in (".c", ".h"):
                     shutil.copyfile(path, Path(stage) / path.name)
             try:
-                result = subprocess.run(command, capture_output=True, text=True, timeout=900,
-                                        cwd=stage)
+                result = run_child(command, text=True, timeout=900, cwd=stage)
             except (OSError, subprocess.SubprocessError) as error:
                 return f"C compiler {' '.join(compiler)!r} could not run ({error})"
             if result.returncode != 0 or not (Path(stage) / name).is_file():
@@ -177,7 +197,7 @@ def compile_host_for(entry, name, output):
     command = [*zig, "-target", entry.zig, "-std=c11", "-O2", "-Wall", "-Wextra", "-Werror",
                f'-DPLATFORM="{entry.tuple}"', *include_flags(HOSTS), "-o", str(output),
                str(HOSTS / f"{name}.c"), "-ldl"]
-    result = subprocess.run(command, capture_output=True, text=True, timeout=900)
+    result = run_child(command, text=True, timeout=900)
     if result.returncode != 0:
         raise RuntimeError(f"zig cc could not build {name} for {entry.tuple}: {result.stderr[-3000:]}")
     return None

@@ -50,7 +50,7 @@ PLATFORMS = {name: (name, entry.suffix) for name, entry in TARGETS.items()}
 _GENERATED = "fmi3_model.h"
 
 
-def _build_one(model_name, python_fmu, folder, work, compile=False):
+def _build_one(model_name, python_fmu, folder, work, compile=False, step=None):
     """Write ``folder/<model_name>.fmu`` from the pythonfmu FMU; returns [problem texts]."""
     unpacked = work / model_name
     with zipfile.ZipFile(python_fmu) as archive:
@@ -75,6 +75,8 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
     binaries, problems = {}, []
     for platform, (target, suffix) in PLATFORMS.items():
         data = None if compile else find_prebuilt(fmi3_key(model_name), platform, digest)
+        if step is not None:
+            step(f"{model_name} {platform}{' (prebuilt)' if data is not None else ''}")
         if data is None:
             output = work / platform / f"{model_name}{suffix}"
             output.parent.mkdir(exist_ok=True)
@@ -86,6 +88,7 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
         binaries[f"binaries/{platform}/{model_name}{suffix}"] = data
         if NATIVE_MARKER not in data:
             raise RuntimeError(f"{platform}: the native marker is missing (layer_calls.c)")
+    _require_this_machine(model_name, binaries, problems)
     fmu = folder / f"{model_name}.fmu"
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.writestr("modelDescription.xml", description)
@@ -110,6 +113,22 @@ def _build_one(model_name, python_fmu, folder, work, compile=False):
     return problems
 
 
+def _require_this_machine(model_name, binaries, problems):
+    """Raise ValueError naming the missing compiler when no binary runs on this machine: the
+    build runs each FMU for its reference result and documentation."""
+    from fmpy import platform_tuple
+
+    if any(binary.split("/")[1] == platform_tuple for binary in binaries):
+        return
+    why = next((problem.split(": ", 2)[-1] for problem in problems
+                if f"without {platform_tuple}:" in problem),
+               f"the C family has no target {platform_tuple}")
+    raise ValueError(f"build --native --fmi 3: no binary of {model_name} for this machine "
+                     f"({platform_tuple}), which the build runs for each FMU's reference result: "
+                     f"{why}. The installed wheel carries them prebuilt; from a clone (an "
+                     f"editable install), install a C compiler or zig (pip install ziglang)")
+
+
 def build_fmi3_fmus(out_dir, parameter_file=None, names=None, compile=False):
     """Build the FMI 3.0 C-family FMUs (default: all five) into ``out_dir``; {name: path}.
 
@@ -119,7 +138,8 @@ def build_fmi3_fmus(out_dir, parameter_file=None, names=None, compile=False):
     """
     names, problems = build_from_twins(
         out_dir, parameter_file, names,
-        lambda name, twin, folder, work: _build_one(name, twin, folder, work, compile))
+        lambda name, twin, folder, work, step: _build_one(name, twin, folder, work, compile, step),
+        len(PLATFORMS), "native FMUs (FMI 3.0)")
     for message in problems:
         warnings.warn(NativeBuildWarning(f"FMI 3.0 FMUs {message}."), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}

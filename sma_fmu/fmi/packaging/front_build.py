@@ -31,6 +31,7 @@ from pathlib import Path
 from sma_fmu.fmi.c_common import C_COMMON, FMI_HEADERS, include_flags
 from sma_fmu.fmi.hosts import c_compiler, windows_compiler
 from sma_fmu.fmi.packaging.prebuilt import find_prebuilt_front, sources_digest
+from sma_fmu.console.interrupts import run_child
 from sma_fmu.fmi.packaging.platforms import (DEGRADED, HOW_PYTHON_IS_FOUND, PLATFORMS, PlatformEntry,
                                    annotate, check_build_machine)
 
@@ -126,7 +127,7 @@ def _compile(compiler, target, defines):
                    *[str(path) for name, path in sorted(_source_files().items()) if name.endswith(".c")],
                    *target["libraries"]]
         try:
-            result = subprocess.run(command, capture_output=True, text=True, timeout=300)
+            result = run_child(command, text=True, timeout=300)
         except (OSError, subprocess.SubprocessError) as error:
             return FrontBuild(problem=f"C compiler {' '.join(compiler)!r} could not run ({error})")
         if result.returncode != 0 or not output.is_file():

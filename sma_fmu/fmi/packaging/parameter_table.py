@@ -24,7 +24,7 @@ from pathlib import Path
 from sma_fmu.runtime.minor_loops import DEFAULT_DEPTH
 from sma_fmu.runtime.model_terms import TERM_DEFAULTS
 from sma_fmu.runtime.parameters import (DEFAULT_STRESS_MAX, MAX_MEMORY_DEPTH, PARAMETER_SPECS,
-                                        RULE_TEXT, WireParameters)
+                                        RULES, WireParameters, range_text)
 
 __all__ = ["TABLE_HEADER", "parameter_table_header", "generated_files", "generated_folder"]
 
@@ -85,7 +85,8 @@ def parameter_table_header():
         term_rows.append((name, _fallback(default, earlier)))
         earlier.add(name)
     specs = [(spec.name, f'"{spec.section}"', f'"{spec.unit}"', f"RULE_{spec.rule.upper()}",
-              str(int(spec.required)))
+              str(int(spec.required)), *(_number(float(end)) for end in spec.limits),
+              f'"{range_text(spec)}"')
              for spec in PARAMETER_SPECS]
     given_defaults = [(spec.name, _number(defaults[spec.name])) for spec in PARAMETER_SPECS
                       if not spec.required and defaults[spec.name] is not None]
@@ -99,10 +100,12 @@ def parameter_table_header():
         f"#define DEFAULT_DEPTH {DEFAULT_DEPTH}               /* minor_loops.DEFAULT_DEPTH */",
         f"#define MAX_MEMORY_DEPTH {MAX_MEMORY_DEPTH}",
         f"#define DEFAULT_STRESS_MAX {_number(DEFAULT_STRESS_MAX)}      /* MPa */", "",
-        *_list("SMA_PARAMETER_RULES", "X(rule, its refusal text): PARAMETER_SPECS' rules",
-               [(f"RULE_{rule.upper()}", f'"{text}"') for rule, text in RULE_TEXT.items()]),
-        *_list("SMA_PARAMETER_SPECS", "X(name, section, unit, rule, required): every "
-               "parameter, in PARAMETER_SPECS order", specs),
+        *_list("SMA_PARAMETER_RULES", "X(rule, low end open, high end open): PARAMETER_SPECS' "
+               "rules", [(f"RULE_{rule.upper()}", str(int(low)), str(int(high)))
+                         for rule, (low, high) in RULES.items()]),
+        *_list("SMA_PARAMETER_SPECS", "X(name, section, unit, rule, required, low, high, range "
+               "text): every\n * parameter, in PARAMETER_SPECS order, with its plausible range",
+               specs),
         *_list("SMA_PARAMETER_DEFAULTS", "X(name, value): the optional parameters that "
                "default to a number (the others to None: NaN)", given_defaults),
         *_list("SMA_WIRE_FIELDS", "X(C type, name): the parameters WireParameters holds as "

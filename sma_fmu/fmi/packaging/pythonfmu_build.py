@@ -33,6 +33,7 @@ from importlib import resources
 from pathlib import Path
 
 from sma_fmu import __version__
+from sma_fmu.console import progress
 from sma_fmu.fmi.packaging.extras import add_documentation_and_reference
 from sma_fmu.fmi.models import declaration, declarations
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
@@ -143,23 +144,30 @@ def _build_into(model_name, folder, parameter_set, stamp):
                 sys.path.remove(str(Path(stage)))
 
 
-def build_pythonfmu_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None):
+def build_pythonfmu_fmus(out_dir=DEFAULT_FMU_DIR, parameter_file=None, names=None,
+                         label="pythonfmu FMUs"):
     """Build the Python family's FMUs (default: every registered one, :mod:`sma_fmu.fmi.models`)
     into ``out_dir``; return {name: path}. Built in a temporary folder beside ``out_dir`` and
-    moved there at the end, so a failed build leaves ``out_dir`` as it was."""
+    moved there at the end, so a failed build leaves ``out_dir`` as it was. A progress bar
+    ``label`` counts the FMUs (:mod:`sma_fmu.console.progress`)."""
     names = [declared.name for declared in declarations()] if names is None else list(names)
     for name in names:
         declaration(name)   # ValueError for an unknown FMU, before anything is built
     parameter_set = load_parameter_set(parameter_file)
     stamp = code_stamp()
-    fronts = compile_fronts()
-    with staged_folder(out_dir) as folder:
-        for name in names:
-            path = _build_into(name, folder, parameter_set, stamp)
-            fix_timestamps(path, content_guid(path))  # reproducible.py: no random GUID, no date
-            install_fronts(path, name, fronts)
-            add_documentation_and_reference(path)  # documentation/, extra/ fmi-ls-ref (extras.py)
-            fix_timestamps(path)
+    with progress.bar(len(names) + 1, label, unit="step") as shown:   # the front, then each FMU
+        shown.set_postfix_str("compiling the C front")
+        fronts = compile_fronts()
+        shown.update(1)
+        with staged_folder(out_dir) as folder:
+            for name in names:
+                shown.set_postfix_str(name)
+                path = _build_into(name, folder, parameter_set, stamp)
+                fix_timestamps(path, content_guid(path))  # reproducible.py: no random GUID, no date
+                install_fronts(path, name, fronts)
+                add_documentation_and_reference(path)  # documentation/, extra/ fmi-ls-ref (extras.py)
+                fix_timestamps(path)
+                shown.update(1)
     for message in fronts.warnings():
         warnings.warn(FrontWarning(message), stacklevel=2)
     return {name: Path(out_dir) / f"{name}.fmu" for name in names}

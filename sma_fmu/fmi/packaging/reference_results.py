@@ -17,11 +17,13 @@ the result keeps every output, Booleans as 0/1, once every :func:`output_stride`
 :func:`reference_check` runs it again and compares (``sma-fmu check``).
 """
 import io
+import tempfile
 import xml.etree.ElementTree as ET
 import zipfile
 
 import numpy as np
 
+from sma_fmu.console.interrupts import deferred
 from sma_fmu.fmi.models import REGISTRY, declaration
 __all__ = ["LS_REF_FOLDER", "MANIFEST", "LS_REF_VERSION", "MAX_ROWS", "RTOL", "ATOL",
            "Experiment", "experiment_of", "stimuli", "output_stride", "simulate_experiment",
@@ -106,15 +108,27 @@ def output_stride(experiment):
 
 def simulate_experiment(fmu_path, description, experiment, inputs, outputs=None):
     """Run the default experiment in fmpy's ``simulate_fmu``; ``outputs`` (default: every
-    scalar output), once every stride step (rows from ``start``; Booleans as 0/1)."""
-    from fmpy import simulate_fmu
+    scalar output), once every stride step (rows from ``start``; Booleans as 0/1).
+
+    The FMU is unpacked and instantiated here, not by ``simulate_fmu``, which on an error or
+    a Ctrl-C would leave both behind (its unpacked folder, an instance never freed)."""
+    from fmpy import extract, simulate_fmu
+    from fmpy.simulation import instantiate_fmu
 
     if outputs is None:
         outputs = [v.name for v in description.modelVariables
                    if v.causality == "output" and not v.dimensions]
-    result = simulate_fmu(str(fmu_path), start_time=experiment.start, stop_time=experiment.stop,
-                          output_interval=experiment.step, input=inputs, output=outputs,
-                          validate=False)
+    with tempfile.TemporaryDirectory(prefix="sma_fmu_reference_") as folder:
+        extract(str(fmu_path), folder)
+        with deferred():   # made and held below, or not made
+            fmu = instantiate_fmu(folder, description, "CoSimulation")
+        try:
+            result = simulate_fmu(folder, start_time=experiment.start, stop_time=experiment.stop,
+                                  output_interval=experiment.step, input=inputs, output=outputs,
+                                  validate=False, model_description=description, fmu_instance=fmu)
+        finally:
+            with deferred():
+                fmu.freeInstance()
     result = result[::output_stride(experiment)]
     columns = [(name, np.float64) for name in result.dtype.names]
     plain = np.zeros(result.size, dtype=columns)

@@ -5,17 +5,21 @@ fragment, the page in the model's folder (``fmi/models/<Model>/page.html``). Its
 fields are the numbers of the wire the FMU was built for (:func:`limits`, from its
 ``resources/parameters.json``), each written as
 ``<span class="limit" data-name="name" data-value="repr">value unit</span>`` so a reader sees
-the value with its unit and a test can read the exact number back.
+the value with its unit and a test can read the exact number back. Three fields are blocks
+of HTML (:func:`~.term_pages.page_blocks`): ``${terms}``, the optional model terms, each
+with its equations and numbers when the wire switches it on, named as off when not;
+``${inverse}``, how the compensator inverts this wire's branch; ``${data_range}``, the range
+the wire's data covered.
 
 :func:`loop_section` says how to connect the FMU in the closed loop: the connections of
 :func:`sma_fmu.fmi.loop.wiring.loop_connections` that touch the model, and its place in
 the Gauss-Seidel order :data:`~sma_fmu.fmi.loop.wiring.STEP_ORDER`.
 """
 import html
-import math
 from string import Template
 
 from sma_fmu.fmi.models import REGISTRY, declaration
+from sma_fmu.fmi.packaging.term_pages import field, page_blocks
 from sma_fmu.fmi.loop.wiring import COMPONENT_MODELS, STEP_ORDER, loop_connections
 
 __all__ = ["limits", "page_template", "model_section", "loop_section"]
@@ -44,12 +48,6 @@ def limits(params):
     }
 
 
-def _field(name, value, unit):
-    shown = f"{value:.4g}" if math.isfinite(value) else repr(value)
-    return (f'<span class="limit" data-name="{html.escape(name)}" data-value="{value!r}">'
-            f"{html.escape(shown)} {html.escape(unit)}</span>")
-
-
 def page_template(model_name):
     """The page of ``model_name`` (a :class:`string.Template`); None for a model not registered."""
     if model_name not in REGISTRY:
@@ -63,7 +61,8 @@ def model_section(model_name, params):
     template = page_template(model_name)
     if template is None:
         return ""
-    fields = {name: _field(name, value, unit) for name, (value, unit) in limits(params).items()}
+    fields = {name: field(name, value, unit) for name, (value, unit) in limits(params).items()}
+    fields.update(page_blocks(params))   # the model terms, the inverse, the data range
     return template.substitute(fields)   # a field the page names and limits() lacks: KeyError
 
 

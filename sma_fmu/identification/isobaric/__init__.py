@@ -9,11 +9,14 @@ The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` w
   column holds, a strain given twice), :mod:`~.stress` (a stress column's load ramp, limit
   and spread), :mod:`~.timebase` (time stamps repeated at their resolution): the pieces of
   reading; :mod:`~.missing`: why a number is missing, named once;
-- :mod:`~.fit`: the joint fit of parameters, temperature profile and lag (:func:`fit_isobaric`),
-  on :mod:`~.terms` (the model with its optional terms, vectorised), :mod:`~.profile` and
-  :mod:`~.lag` (the wire's temperature), :mod:`~.layout` and :mod:`~.starts` (the unknowns,
-  their starts and bounds), :mod:`~.jacobian` and :mod:`~.solver` (sparse
-  Levenberg-Marquardt), :mod:`~.covariance`, :mod:`~.outliers` (outlier cycles, bounds);
+- :mod:`~.fit`: the fit of parameters, temperature profile and lag (:func:`fit_isobaric`):
+  a first fit at the thermocouple's profile (:mod:`~.first_fit`) that chooses the structure
+  (:mod:`~.structure`), then the joint fit; on :mod:`~.terms` (the model with its optional
+  terms, vectorised), :mod:`~.profile`, :mod:`~.lag` and :mod:`~.sensor` (the wire's
+  temperature, and when a lag can be fitted), :mod:`~.layout`, :mod:`~.centres` and
+  :mod:`~.starts` (the unknowns, their starts and bounds), :mod:`~.jacobian` and
+  :mod:`~.solver` (sparse Levenberg-Marquardt), :mod:`~.covariance`, :mod:`~.outliers`
+  (outlier cycles, bounds) and :mod:`~.outcome` (what the fit found, the verdict);
 - :mod:`~.halfway` and :mod:`~.summary`: half-strain temperatures and transformation strain
   of data and model per stress, and the text summary;
 - :mod:`~.predict` and :mod:`~.predict_runner`: ``sma-fmu predict isobaric``, the plant

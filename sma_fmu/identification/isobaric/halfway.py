@@ -65,7 +65,8 @@ def half_strain_temperature(temperature, strain, direction):
     e = np.asarray(strain, dtype=float)[order]
     cold = lines[0][0] + lines[0][1] * t
     hot = lines[1][0] + lines[1][1] * t
-    progress = (e - hot) / (cold - hot)
+    with np.errstate(divide="ignore", invalid="ignore"):   # baselines that cross: no progress
+        progress = (e - hot) / (cold - hot)
     near = np.abs(progress - 0.5) <= 0.05
     if near.sum() >= 5:
         return float(np.median(t[near]))

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from sma_fmu.identification.isobaric.centres import LinearCentres
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.model_terms import domain_widths
 from sma_fmu.runtime.parameters import ParameterError
@@ -18,26 +19,25 @@ __all__ = ["Layout"]
 class Layout:
     """Columns of the unknowns, and their map onto the wire parameters.
 
-    The centres are held as the cooling centre (a_c, b_c) and the heating centre's lead over
-    it, ``gap0`` = a_h - a_c at no load and, with two loads or more, ``gapF`` at the largest
-    load, both bounded below by 0: so each stage's heating centre is never below its cooling
-    centre anywhere between no load and the largest load. :meth:`physical` maps the vector
-    onto the parameter-file names (a linear map; :meth:`transform` is its matrix).
+    The centres of each stage are held by a :class:`~.centres.LinearCentres` (``centres``:
+    one per stage): with one load the two centres at that load, with several the cooling
+    line and the heating centre's lead over it at two loads, the lead bounded below by 0.
+    :meth:`physical` maps the vector onto the parameter-file names (a linear map;
+    :meth:`transform` is its matrix).
     """
 
     def __init__(self, files, base, fit_slopes, absolute, with_resistance, fit_lag, stages=1,
                  loads=(), widths="separate"):
         self.stages = stages
-        self.top_load = max(loads) if loads else 0.0
-        fit_slopes = fit_slopes and self.top_load > 0.0
-        self.fit_slopes = fit_slopes
+        loads = list(loads) if fit_slopes else sorted(set(loads))[:1]
+        measured = [f.thermocouple.values for f in files] or [np.array([-100.0, 400.0])]
+        span = (min(float(t.min()) for t in measured), max(float(t.max()) for t in measured))
+        self.centres = [LinearCentres(loads, base, stage, span) for stage in range(1, stages + 1)]
+        self.fit_slopes = self.centres[0].fit_slopes
         stresses = len({round(float(v), 9) for v in loads})
-        centres = ["a_c"] + (["b_c"] if fit_slopes else []) + ["gap0"] + \
-            (["gapF"] if fit_slopes else [])
-        self.phys = centres + (["nu_h", "nu_c"] if widths == "separate" else ["nu"])
+        self.phys = self.centres[0].names + (["nu_h", "nu_c"] if widths == "separate" else ["nu"])
         if stages == 2:
-            self.phys += ["w2"] + [n.replace("a_c", "a2_c").replace("b_c", "b2_c")
-                                   .replace("gap", "gap2_") for n in centres] + ["nu2_h", "nu2_c"]
+            self.phys += ["w2"] + self.centres[1].names + ["nu2_h", "nu2_c"]
         self.phys += ["l_MF"] + (["x_min"] if absolute else []) + ["alpha_P", "alpha_MF"]
         self.phys += (["span_ratio_0"] if stresses >= 2 else []) + \
             (["span_stress"] if stresses >= 3 else [])
@@ -69,24 +69,30 @@ class Layout:
         """{parameter-file name: value} that the physical unknowns of ``vector`` set."""
         u = dict(zip(self.phys, np.asarray(vector[:len(self.phys)], dtype=float).tolist()))
         out = {}
-        for stage, (a, b, g) in ((1, ("a", "b", "gap")), (2, ("a2", "b2", "gap2_"))):
-            if f"{a}_c" not in u:
-                continue
-            b_c = u.get(f"{b}_c", getattr(self.base, "b_c"))
-            gap0 = u[f"{g}0"]
-            if self.fit_slopes:
-                b_h = b_c + (u[f"{g}F"] - gap0) / self.top_load
-            else:
-                b_h = getattr(self.base, "b_h") + b_c - getattr(self.base, "b_c")
-            out.update({f"{a}_h": u[f"{a}_c"] + gap0, f"{b}_h": b_h, f"{a}_c": u[f"{a}_c"],
-                        f"{b}_c": b_c})
+        held = set()
+        for law in self.centres:
+            out.update(law.parameters(u))
+            held.update(law.names)
         for name, value in u.items():
-            if not (name.startswith(("a_c", "b_c", "a2_c", "b2_c", "gap"))):
+            if name not in held:
                 out[name] = value
         widths = domain_widths(out)   # one width for both directions, or two and their nu
         out.pop("nu", None)
         out.update(widths)
         return out
+
+    def settle(self, vector, base_name):
+        """Choices made after the fit (the one-load slopes, :meth:`LinearCentres.settle`);
+        returns the notes saying what was chosen and why."""
+        u = dict(zip(self.phys, np.asarray(vector[:len(self.phys)], dtype=float).tolist()))
+        for law in self.centres:
+            law.settle(u, base_name)
+        return [law.slope_note for law in self.centres if law.slope_note]
+
+    def centres_at(self, vector, load):
+        """[(heating, cooling) centre [degC] of each stage] at ``load`` [kg]."""
+        u = dict(zip(self.phys, np.asarray(vector[:len(self.phys)], dtype=float).tolist()))
+        return [law.centre_at(u, load) for law in self.centres]
 
     def transform(self, vector):
         """(names, matrix): d physical / d unknowns (exact: the map is linear)."""

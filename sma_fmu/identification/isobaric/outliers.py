@@ -2,8 +2,8 @@
 
 An outlier cycle is one whose strain residual RMS (the model at the thermocouple's own
 temperature profile, lagged by the fitted lag) exceeds OUTLIER_RATIO times the median
-cycle's (over every cycle of every file fitted together; with fewer than MIN_CYCLES cycles
-none is called an outlier). By default such cycles are left out: their strain rows get
+cycle's of its file (a file of fewer than MIN_CYCLES cycles has none: files at several
+stresses are not repeats of each other). By default such cycles are left out: their strain rows get
 weight 0 and the fit runs again (their temperature rows stay, so the profile stays whole);
 ``outliers="keep"`` keeps them. A lab's first cycle, unlike the rest, is the usual case.
 """
@@ -30,7 +30,7 @@ def cycle_rms(prepared, layout, x):
     out = []
     for f in prepared:
         tau = x[layout.lags[f.index]] if layout.lags[f.index] is not None else 0.0
-        wire = lagged(f.profile.values, tau, f.step)
+        wire = lagged(f.thermocouple.values, tau, f.step)
         direction, level, bounds = wire_rows(wire, f.data.branches, f.per_cycle)
         strain, _ = file_model(params, f.data, wire, layout.levels(x, f.index), direction, level,
                                f.per_cycle)
@@ -46,9 +46,18 @@ def cycle_rms(prepared, layout, x):
 
 
 def mark_outliers(prepared, layout, x, leave_out=True):
-    """[{"file", "cycle", "rms", "ratio", "name"}] of the outlier cycles (empty: none); with
-    ``leave_out`` their strain rows get weight 0."""
+    """[{"file", "cycle", "rms", "ratio", "name"}] of the outlier cycles (empty: none), each
+    file's cycles against that file's own median (files of fewer than MIN_CYCLES cycles have
+    none: a set of files at several stresses is not a set of repeats); with ``leave_out``
+    their strain rows get weight 0."""
     cycles = cycle_rms(prepared, layout, x)
+    out = []
+    for f in prepared:
+        out += _outliers(prepared, [c for c in cycles if c[0] == f.index], leave_out)
+    return out
+
+
+def _outliers(prepared, cycles, leave_out):
     if len(cycles) < MIN_CYCLES:
         return []
     median = float(np.median([rms for _, _, rms, _ in cycles]))

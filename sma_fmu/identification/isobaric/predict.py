@@ -4,7 +4,8 @@ lab file's measured temperature history at its stress, against the measured stra
 How the plant is driven: :class:`sma_fmu.runtime.plant.PlantStepper` takes electric power,
 not temperature. Its thermal stage is made to follow the file's temperature exactly: a copy
 of the parameters with the room temperature 50 K below the file's lowest reading and a
-convection coefficient 10^6 times larger (a thermal time constant far below one step), and
+heat capacity 10^6 times smaller (a thermal time constant far below one step; every value
+stays inside its plausible range), and
 each step's power from :func:`sma_fmu.runtime.thermal.power_to_reach`. Everything after the
 temperature, the branch switching, the minor-loop memory and the length with the
 optional model terms, is the FMU's own code, in its default ("continuous") hysteresis mode.
@@ -13,9 +14,11 @@ The temperature fed is the file's temperature profile (the piecewise-linear curv
 also starts from, :mod:`~.profile`): thermocouple noise would otherwise make the plant
 reverse at every sample and walk minor loops the wire never saw. ``--lag`` delays it by the
 wire's first-order lag behind the thermocouple (the value ``fit isobaric`` reports; default
-0: the FMU itself has no thermocouple). Strain = length /
-reference length - 1, shifted by one constant, the median difference from the measured
-strain (a lab's strain zero is its own; the fit gives each file its offset too).
+0: the FMU itself has no thermocouple). Two predicted strains are reported, and named:
+from the model's own zero, length / reference length - 1 (the reference length and the
+fitted phase lengths, nothing taken from the measured strain), and offset-matched, that
+shifted by one constant, the median difference from the measured strain (a lab's strain
+zero is its own; the fit gives each file its offset too).
 """
 import math
 import time
@@ -35,7 +38,7 @@ from sma_fmu.runtime.thermal import power_to_reach, step_decay
 __all__ = ["drive_plant", "predict_file", "TANGENT_KEYS"]
 
 _ROOM_BELOW_K = 50.0
-_CONVECTION_FACTOR = 1e6
+_CAPACITY_FACTOR = 1e6
 TANGENT_KEYS = {HEATING: ("A_s", "A_f"), -HEATING: ("M_s", "M_f")}
 
 
@@ -45,7 +48,7 @@ def drive_plant(params, temperature, load, step_s=1.0):
     the plant's temperature from the one asked for."""
     temperature = np.asarray(temperature, dtype=float)
     driven = params.replace(T_room=float(temperature.min()) - _ROOM_BELOW_K,
-                            h_c=params.h_c * _CONVECTION_FACTOR,
+                            c_p=params.c_p / _CAPACITY_FACTOR,
                             T_max=max(params.T_max, float(temperature.max()) + 1.0))
     plant = PlantStepper(driven, T_start=float(temperature[0]), load=load)
     decay = step_decay(step_s, driven.tau_th)
@@ -107,6 +110,7 @@ def predict_file(data, params, lag=0.0):
     offset = float(np.median(data.strain - raw))
     predicted = raw + offset
     residual = predicted - data.strain
+    own_rms = float(np.sqrt(np.mean((raw - data.strain) ** 2)))
     seconds = time.perf_counter() - began
     measured_t, measured_why = _tangents(data.smoothed, data.strain, data.branches)
     model_t, model_why = _tangents(data.smoothed, predicted, data.branches)
@@ -117,8 +121,10 @@ def predict_file(data, params, lag=0.0):
         "stress_column_MPa": data.stress_column,
         "columns": {q: list(v) for q, v in data.columns.items()},
         "strain_column_note": data.strain_note,
-        "residual_rms": {"strain": float(np.sqrt(np.mean(residual ** 2)))},
+        "residual_rms": {"strain": float(np.sqrt(np.mean(residual ** 2))),
+                         "strain_own_zero": own_rms},
         "strain_offset": offset,
+        "reference_length_m": data.reference_length,
         "transformation_temperatures": {"measured": measured_t, "predicted": model_t,
                                         "predicted_minus_measured": {
                                             k: model_t[k] - measured_t[k] for k in model_t},
@@ -129,10 +135,13 @@ def predict_file(data, params, lag=0.0):
                   "step_s": step, "largest_temperature_deviation_K": deviation,
                   "lag": {"value": lag, "unit": "s" if data.time is not None else "samples"},
                   "hysteresis_mode": "continuous", "seconds": seconds},
-        "note": "strain = plant length / reference length - 1 + strain_offset (the median "
-                "difference from the measured strain; the plant has no residual-strain drift "
-                "from cycle to cycle); tangent-line and half-strain temperatures of both "
-                "against the measured (smoothed) temperature",
+        "note": "residual_rms.strain: offset-matched, the prediction plant length / "
+                "reference length - 1 shifted by strain_offset (the median difference from the "
+                "measured strain; the plant has no residual-strain drift from cycle to cycle); "
+                "residual_rms.strain_own_zero: the same prediction unshifted, from the model's "
+                "own zero (reference_length_m and the fitted phase lengths); tangent-line and "
+                "half-strain temperatures of the offset-matched prediction and the data against "
+                "the measured (smoothed) temperature",
     }
-    return {"predicted": predicted, "measured": data.strain, "temperature": profile,
-            "report": report}
+    return {"predicted": predicted, "own_zero": raw, "measured": data.strain,
+            "temperature": profile, "report": report}

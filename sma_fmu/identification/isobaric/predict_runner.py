@@ -1,8 +1,9 @@
 """``sma-fmu predict isobaric FILE --model PARAMS [--stress MPA | --load KG] --out DIR``.
 
 Writes into DIR: ``predicted.csv`` (temperature fed [degC], measured and predicted strain
-[1] per sample), ``report.json`` (``residual_rms.strain``, the tangent-line and half-strain
-temperatures of both, how the plant was driven) and ``predict_isobaric.png`` (strain against
+[1] per sample, offset-matched and from the model's own zero), ``report.json``
+(``residual_rms``: both strain RMS; the tangent-line and half-strain temperatures of both,
+how the plant was driven) and ``predict_isobaric.png`` (strain against
 temperature, measured and predicted, and the residual against sample). Everything is
 computed first; a failure leaves DIR as it was.
 """
@@ -35,28 +36,32 @@ def _figure(data, result):
         left.plot(t[rows], 100 * result["measured"][rows], ".", ms=2, color=colour, alpha=0.35)
         left.plot(t[rows], 100 * result["predicted"][rows], "-", lw=1.2, color="k"
                   if b.direction == HEATING else "0.45")
+        left.plot(t[rows], 100 * result["own_zero"][rows], ":", lw=0.8, color="tab:purple")
     left.plot([], [], ".", color="tab:red", label="measured, heating")
     left.plot([], [], ".", color="tab:blue", label="measured, cooling")
-    left.plot([], [], "-", color="k", label="predicted (plant runtime), heating")
-    left.plot([], [], "-", color="0.45", label="predicted, cooling")
+    left.plot([], [], "-", color="k", label="predicted (plant runtime), offset-matched, heating")
+    left.plot([], [], "-", color="0.45", label="predicted, offset-matched, cooling")
+    left.plot([], [], ":", color="tab:purple", label="predicted from the model's own zero")
     report = result["report"]
-    left.set(title=f"{data.path.name}, {report['stress_MPa']:.4g} MPa: strain RMS "
-                   f"{report['residual_rms']['strain']:.3g}",
-             xlabel="temperature [degC]", ylabel="strain [%]")
+    rms = report["residual_rms"]
+    left.set(title=f"{data.path.name}, {report['stress_MPa']:.4g} MPa\nstrain RMS "
+                   f"{rms['strain']:.3g} offset-matched, {rms['strain_own_zero']:.3g} own zero",
+             xlabel="measured temperature (smoothed) [degC]", ylabel="strain [%]")
     left.legend(fontsize=7)
     sample = data.time if data.time is not None else np.arange(data.strain.size)
     right.plot(sample, 100 * (result["predicted"] - result["measured"]), ".", ms=1.5)
-    right.set(title="predicted - measured", xlabel="time [s]" if data.time is not None
-              else "sample", ylabel="strain [%]")
+    right.set(title="predicted (offset-matched) - measured", xlabel="time [s]"
+              if data.time is not None else "sample", ylabel="strain [%]")
     for axis in (left, right):
         axis.grid(alpha=0.3)
     return png_bytes(figure, dpi=90, tight=True)
 
 
 def _csv(result):
-    lines = ["temperature_C,strain_measured,strain_predicted"]
-    for t, m, p in zip(result["temperature"], result["measured"], result["predicted"]):
-        lines.append(f"{t:.6f},{m:.9g},{p:.9g}")
+    lines = ["temperature_C,strain_measured,strain_predicted,strain_predicted_own_zero"]
+    for t, m, p, z in zip(result["temperature"], result["measured"], result["predicted"],
+                          result["own_zero"]):
+        lines.append(f"{t:.6f},{m:.9g},{p:.9g},{z:.9g}")
     return "\n".join(lines) + "\n"
 
 
@@ -97,13 +102,16 @@ def format_predict_report(report):
     lines = [f"predict isobaric: {Path(report['file']).name}, {report['points']} points at "
              f"{report['stress_MPa']:.4g} MPa ({report['load_kg']:.4g} kg); plant runtime "
              f"{report['drive']['seconds']:.2f} s",
-             f"strain residual RMS {report['residual_rms']['strain']:.3g} (offset "
-             f"{report['strain_offset']:.3g})",
-             f"{'':<14}{'measured':>10}{'predicted':>11}{'difference':>12}"]
+             f"strain residual RMS {report['residual_rms']['strain']:.3g} offset-matched (the "
+             f"prediction shifted by {report['strain_offset']:.3g}, the median difference to the "
+             f"measured strain: a lab's strain zero is its own)",
+             f"strain residual RMS {report['residual_rms']['strain_own_zero']:.3g} from the "
+             f"model's own zero (length / {report['reference_length_m']:g} m - 1, unshifted)",
+             f"{'':<20}{'measured':>10}{'predicted':>11}{'difference':>12}"]
     why, reasons = tt.get("why_missing", {}), Reasons()
     for key, label, scale in [(k, f"{k} [degC]", 1.0) for k in ("A_s", "A_f", "M_s", "M_f",
                                                                 "half_heating", "half_cooling")] \
-            + [("transformation_strain", "strain span %", 100.0)]:
+            + [("transformation_strain", "strain span [%]", 100.0)]:
         cells = []
         for source in ("measured", "predicted"):
             value = tt[source][key]
@@ -112,7 +120,7 @@ def format_predict_report(report):
         difference = tt["predicted"][key] - tt["measured"][key]
         cells.append(f"{scale * difference:.{2 if scale == 1.0 else 3}f}"
                      if math.isfinite(difference) else "n/a")
-        lines.append(f"{label:<14}{cells[0]:>10}{cells[1]:>11}{cells[2]:>12}")
+        lines.append(f"{label:<20}{cells[0]:>10}{cells[1]:>11}{cells[2]:>12}")
     lines += reasons.lines()
     if report.get("warning"):
         lines.insert(1, f"warning: {report['warning']}")

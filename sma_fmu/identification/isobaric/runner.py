@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
+from sma_fmu.identification.coverage import DATA_RANGE_MEANINGS, coverage_header, with_coverage
 from sma_fmu.identification.isobaric.fit import LAG_OPTIONS, RESIDUAL_OPTIONS, fit_isobaric
 from sma_fmu.identification.isobaric.summary import format_isobaric_report, half_strain_table
 from sma_fmu.identification.isobaric.cycles import parse_cycles, splitting_note
@@ -153,6 +154,7 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
                             else getattr(params, name) for name in fixed},
         "stages": fit.stages,
         "stage_note": fit.stage_note,
+        "slopes_not_fitted": fit.slope_notes,
         "on_bound": fit.on_bound,
         "undetermined": {"unknowns": fit.undetermined,
                          "note": "touched by no residual (the strain levels of left-out cycles): "
@@ -174,42 +176,55 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
         "transformation_temperatures": rows,
         "base_parameter_file": str(base_set.path),
         "solver": {"converged": fit.converged, "message": fit.message,
-                   "evaluations": fit.evaluations, "seconds": fit.seconds},
+                   "evaluations": fit.evaluations, "seconds": fit.seconds,
+                   "first_fit": fit.first_fit,
+                   "note": "first fit: the parameters at the thermocouple's own temperature "
+                           "profile (chooses widths, stages, outliers, the lag's start); then "
+                           "the joint fit with the profile's knots, whose convergence is the "
+                           "verdict's"},
     }
 
 
-def resolve_lag(lag, data):
-    """("fit" or "none", note): ``auto`` fits the lag only when every file holds two complete
-    cycles or more. With one cycle at one ramp rate, a lag shifts heating up and cooling
-    down just as a wider hysteresis does, and only the one turn could tell them apart (the
-    shared Flexinol files: lags of 8-12 samples, stress slopes 0.17/0.11 K/MPa instead of
-    0.124/0.134)."""
-    if lag != "auto":
-        return lag, ""
-    fewest = min(sum(1 for b in d.branches if b.complete and b.direction == HEATING)
-                 for d in data)
-    if fewest >= 2:
-        return "fit", ""
-    return "none", ("--lag auto: no lag fitted, as a file holds a single complete cycle (one "
-                    "ramp rate: a lag cannot be told from a wider hysteresis); --lag fit "
-                    "fits it anyway")
+def hysteresis_report(data, fit, rows):
+    """Per file: the thermal hysteresis (heating minus cooling temperature at half the
+    actuation strain, median over the cycles) at the thermocouple (the data against the
+    measured temperature) and at the wire (the fitted model), and how much a lag of one
+    unit would narrow the wire's."""
+    out = []
+    for d in data:
+        mine = [r for r in rows if r["file"] == d.path.name and r["load_kg"] == d.load
+                and r["quantity"] == "thermal_hysteresis"]
+        entry = {"file": d.path.name}
+        for key, source in (("thermocouple_K", "data"), ("wire_K", "model")):
+            values = [r[source] for r in mine if np.isfinite(r[source])]
+            entry[key] = float(np.median(values)) if values else None
+        out.append(entry)
+    for entry, sensor in zip(out, fit.sensor):
+        entry["narrowing_K_per_lag_unit"] = sensor["narrowing"]
+        entry["note"] = (f"a lag of 1 {sensor['unit'].rstrip('s')} of the wire behind the "
+                         f"thermocouple would make the wire's hysteresis about "
+                         f"{sensor['narrowing']:.3g} K narrower than the thermocouple's (the "
+                         f"heating and cooling ramp rates, summed)")
+    return out
 
 
 def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
                      reference_length=None, progress=lambda text: None, cycles=None, lag="auto",
-                     stages=2, outliers="leave-out", widths="auto"):
+                     stages=2, outliers="leave-out", widths="auto", meter=None):
     """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report.
 
     ``cycles``: the text of ``--cycles`` (``5:``, ``3:10``, ``:20``, ``4``) or None for all;
-    ``lag``: "fit" (the wire's lag behind the thermocouple) or "none".
+    ``lag``: "auto", "fit" (the wire's lag behind the thermocouple) or "none"; ``meter``: a
+    callable returning a tqdm-like progress bar (or None). A fit that did not converge is
+    written too, marked so in identified.toml's header and report.json's ``solver``.
     """
     if not files:
         raise ValueError("no measurement file given")
     if residual not in RESIDUAL_OPTIONS:
         raise ValueError(f"--residual-strain must be one of {', '.join(RESIDUAL_OPTIONS)}, "
                          f"got {residual!r}")
-    if lag not in LAG_OPTIONS + ("auto",):
-        raise ValueError(f"--lag must be one of {', '.join(LAG_OPTIONS + ('auto',))}, got {lag!r}")
+    if lag not in LAG_OPTIONS:
+        raise ValueError(f"--lag must be one of {', '.join(LAG_OPTIONS)}, got {lag!r}")
     selection = parse_cycles(cycles) if cycles is not None else None
     check_folder(out_dir)
     base_set = load_parameter_set(model)
@@ -224,12 +239,9 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         for note in d.notes:
             progress(f"{d.path.name}: {note}")
         progress(f"{d.path.name}: {splitting_note(d.splitting, d.branches, d.time is not None)}")
-    lag, lag_note = resolve_lag(lag, data)
-    if lag_note:
-        progress(lag_note)
     progress(f"fitting {len(data)} file(s), {sum(d.strain.size for d in data)} points ...")
-    fit = fit_isobaric(data, base, residual, lag, progress=progress, stages=stages,
-                       outliers=outliers, widths=widths)
+    fit = fit_isobaric(data, base, residual, lag, stages=stages, outliers=outliers,
+                       widths=widths, meter=meter)
     progress("transformation temperatures and figures ...")
     per_cycle = residual == "per-cycle"
     rows = [row for d, offsets, profile, bounds in zip(data, fit.offsets, fit.profiles,
@@ -241,22 +253,35 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
         fit.params = fit.params.replace(stress_max=float(np.ceil(top)))
     if hottest > fit.params.T_max:
         fit.params = fit.params.replace(T_max=float(np.ceil(hottest)))
+    fit.params, covered = with_coverage(   # the data range; what the data did not determine
+        fit.params, base_set, fit.wire_names,
+        [t for d in data for t in (d.temperature.min(), d.temperature.max())],
+        [stress_of_load(d.load, base.diameter) for d in data])
     report = isobaric_report(data, fit, base_set, residual, rows, outliers)
-    report["lag_choice"] = {"option": lag, "note": lag_note}
+    report["coverage"] = covered
+    report["lag_choice"] = {"option": fit.lag_option, "note": fit.lag_note}
+    report["hysteresis"] = hysteresis_report(data, fit, rows)
     figures = isobaric_figures(data, fit, per_cycle, rows)
     stamp = datetime.now(timezone.utc).isoformat(timespec="seconds")
     names = ", ".join(Path(f).name for f in files)
+    verdict = [] if fit.converged else [
+        f"NOT CONVERGED: the solver stopped after {fit.evaluations} evaluations: {fit.message}; "
+        f"the values below are where it stopped, not a fit"]
     with staged_folder(out_dir) as folder:
         write_parameter_file(
             folder / "identified.toml", fit.params, f"{base_set.name}-isobaric",
-            f"isobaric fit of {names}; strain RMS {fit.residual_rms['strain']:.3g}",
-            {**TERM_MEANINGS, **(base_set.meanings or {})},
-            header=[f"Identified by sma-fmu fit isobaric on {stamp}.",
-                    f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}"
-                    f" (validity.stress_max and T_max raised to the largest fitted stress and "
-                    f"temperature where they were lower).",
-                    f"Data: {', '.join(str(f) for f in files)} at "
-                    f"{', '.join(f'{d.load:g}' for d in data)} kg"])
+            f"isobaric fit of {names}; strain RMS {fit.residual_rms['strain']:.3g}"
+            + ("" if fit.converged else " (not converged)"),
+            {**TERM_MEANINGS, **(base_set.meanings or {}), **DATA_RANGE_MEANINGS},
+            header=verdict + [
+                f"Identified by sma-fmu fit isobaric on {stamp}.",
+                f"Fitted: {', '.join(fit.wire_names)}; everything else from {base_set.path}"
+                f" (validity.stress_max and T_max raised to the largest fitted stress and "
+                f"temperature where they were lower).",
+                *fit.slope_notes,
+                coverage_header(covered),
+                f"Data: {', '.join(str(f) for f in files)} at "
+                f"{', '.join(f'{d.load:g}' for d in data)} kg"])
         (folder / "report.json").write_text(json_text(report), encoding="utf-8")
         (folder / "transformation_temperatures.csv").write_text(rows_csv(rows), encoding="utf-8")
         (folder / "transformation_temperatures.md").write_text(rows_markdown(rows), encoding="utf-8")

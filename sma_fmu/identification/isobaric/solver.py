@@ -5,8 +5,10 @@ iterative (lsmr) steps need thousands of inner iterations on this ill-conditione
 (the lag trades against the centres and the profile's knots). Here every step solves the
 damped normal equations (J^T J + lambda diag(J^T J)) dx = -J^T r with scipy's sparse LU
 (``splu``), so a 26,000-sample, 100-cycle fit with ~1,000 unknowns takes seconds. Bounds
-are kept by projecting each trial point onto the box (Marquardt's scaling makes the step
-invariant to the unknowns' units). Stops when three steps in a row lower the cost by less
+are kept by projecting each trial point onto the box, and an unknown on a bound whose
+gradient points out of the box is held there for the step (an active set), so the others
+move as if it were fixed (Marquardt's scaling makes the step invariant to the unknowns'
+units). Stops when three steps in a row lower the cost by less
 than ``ftol`` relative, a step moves every unknown by less than ``xtol`` relative, or after
 ``max_evaluations``.
 """
@@ -53,12 +55,17 @@ class OrderedLU:
         return out
 
 
-def _step(jac, gradient, damping, order):
-    normal = (jac.T @ jac).tocsc()
+def _step(normal, gradient, damping, order, active):
+    """The damped step of the free unknowns; the ``active`` ones (on a bound, the gradient
+    pushing outward) stay where they are."""
     diagonal = np.maximum(normal.diagonal(), 1e-12 * max(normal.diagonal().max(), 1e-300))
     damped = normal + sparse.diags(damping * diagonal)
+    if active.any():
+        free = sparse.diags((~active).astype(float))
+        damped = free @ damped @ free + sparse.diags(active.astype(float))
+        gradient = np.where(active, 0.0, gradient)
     try:
-        return -OrderedLU(damped, order).solve(gradient)
+        return -OrderedLU(damped.tocsc(), order).solve(gradient)
     except RuntimeError:           # exactly singular: damp harder
         return None
 
@@ -71,9 +78,13 @@ def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e
     r = fun(x)
     cost, evaluations, small = 0.5 * float(r @ r), 1, 0
     j = jac(x)
+    normal = None
     while evaluations < max_evaluations:
         gradient = j.T @ r
-        step = _step(j, gradient, damping, order)
+        if normal is None:
+            normal = (j.T @ j).tocsc()
+        active = ((x <= lower) & (gradient > 0)) | ((x >= upper) & (gradient < 0))
+        step = _step(normal, gradient, damping, order, active)
         if step is None or not np.all(np.isfinite(step)):
             damping *= 10.0
             if damping > 1e12:
@@ -93,7 +104,7 @@ def levenberg_marquardt(fun, jac, x0, lower, upper, max_evaluations=300, ftol=1e
                 return Solution(x, r, cost, evaluations, 2, "the cost changes by less than ftol")
             if moved <= xtol:
                 return Solution(x, r, cost, evaluations, 3, "the unknowns change by less than xtol")
-            j = jac(x)
+            j, normal = jac(x), None
         else:
             damping *= 4.0
             if damping > 1e12:

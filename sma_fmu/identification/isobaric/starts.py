@@ -4,6 +4,18 @@ Centres and widths come from the branches' half-way and 25/75 % crossings on the
 temperature-only profile (lagged by the starting lag), the stress law from the spans of the
 files, the levels from the strain. A second stage starts as a broader copy of the first
 (same centres, a third of the domain size) holding a fifth of the transformation.
+
+The temperature profile's knots are bounded: each stays within PROFILE_BOUND standard errors
+of the measured temperature's own least-squares fit at that knot (the standard error from the
+thermocouple noise, :func:`~.profile.pointwise_error`), or within PROFILE_TOLERANCE_K where
+that is wider (a filtered file's noise estimate is the filter's remains, and no thermocouple
+is that exact: 2.5 K is the class-2 tolerance of IEC 60584, the usual grade of a lab's
+thermocouple). Inside that band the
+temperature residual weighs every move; beyond it a move cannot be thermocouple noise (5
+sigma: about one knot in a million by chance), so a wire temperature the strain would want
+further away is the model not following the data, and shows as strain residual instead of a
+profile bent by tens of kelvin (on the shared raw file, 40 K at the bottom turns without the
+bound).
 """
 import math
 
@@ -11,18 +23,19 @@ import numpy as np
 
 from sma_fmu.identification.isobaric.jacobian import file_model
 from sma_fmu.identification.isobaric.lag import lagged
-from sma_fmu.identification.isobaric.profile import wire_rows
+from sma_fmu.identification.isobaric.profile import pointwise_error, wire_rows
 from sma_fmu.identification.isobaric.terms import stress_MPa
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constant_load import residual_f_fraction
 from sma_fmu.runtime.constants import BOLTZMANN, COOLING, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 from sma_fmu.runtime.model_terms import domain_widths
 
-__all__ = ["starts", "LAG_LIMIT", "BOUNDS"]
+__all__ = ["starts", "LAG_LIMIT", "BOUNDS", "PROFILE_BOUND", "PROFILE_TOLERANCE_K"]
 
 LAG_LIMIT = 1 / 20       # of a cycle: the largest lag the fit may reach (the lag guard)
-BOUNDS = {"a_c": (-100.0, 400.0), "b_c": (-5000.0, 5000.0), "gap0": (0.0, 200.0),
-          "gapF": (0.0, 200.0), "w2": (0.0, 0.95), "alpha_P": (-2e-3, 2e-3),
+PROFILE_BOUND = 5.0      # standard errors the profile's knots may move from the temperature's fit
+PROFILE_TOLERANCE_K = 2.5   # or this far where larger: IEC 60584 class-2 thermocouple tolerance
+BOUNDS = {"w2": (0.0, 0.95), "alpha_P": (-2e-3, 2e-3),
           "alpha_MF": (-2e-3, 2e-3), "span_ratio_0": (0.01, 10.0), "span_stress": (1.0, 5000.0)}
 
 
@@ -46,24 +59,19 @@ def _crossings(f, temperature):
     return out
 
 
-def _centre_starts(centres, layout, base):
-    """a_c, b_c, gap0, gapF (stage 1) from the half-way crossings per direction and load."""
-    start = {}
+def _centre_lines(centres, layout, base):
+    """{"h": (intercept, slope), "c": ...} of the half-way crossings against load: a straight
+    line with two loads or more, else the centre at the one load (the base file's slope)."""
     line = {}
-    for d, a, b in ((HEATING, "a_h", "b_h"), (COOLING, "a_c", "b_c")):
+    for d, key, b in ((HEATING, "h", "b_h"), (COOLING, "c", "b_c")):
         f_, tau = np.array(centres[d]).T
         if layout.fit_slopes and np.ptp(f_) > 0:
             slope, intercept = np.polyfit(f_, tau, 1)
         else:
             slope = getattr(base, b)
             intercept = float(np.mean(tau - slope * f_))
-        line[d] = (float(intercept), float(slope))
-    start["a_c"], start["b_c"] = line[COOLING]
-    top = layout.top_load
-    start["gap0"] = max(line[HEATING][0] - line[COOLING][0], 0.5)
-    start["gapF"] = max(line[HEATING][0] + line[HEATING][1] * top
-                        - line[COOLING][0] - line[COOLING][1] * top, 0.5)
-    return start
+        line[key] = (float(intercept), float(slope))
+    return line
 
 
 def _energy_starts(widths, base):
@@ -108,9 +116,16 @@ def starts(files, layout, base, lag_fraction=0.01):
     centres = {HEATING: [], COOLING: []}
     widths, spans, r_levels = [], [], []
     for f in files:
-        vector[layout.knots[f.index]] = f.profile.factor.solve(f.profile.basis.T @ f.data.temperature)
-        lower[layout.knots[f.index]] = -KELVIN_OFFSET + 1.0
-        profile = f.profile.values
+        # the knots stay within PROFILE_BOUND standard errors of the temperature's own fit
+        # on them; they start on the thermocouple profile (whose knots they include)
+        knots = layout.knots[f.index]
+        own = f.profile.factor.solve(f.profile.basis.T @ f.data.temperature)
+        error = np.maximum(PROFILE_BOUND * pointwise_error(f.profile)[f.profile.knots],
+                           PROFILE_TOLERANCE_K)
+        lower[knots] = np.maximum(own - error, -KELVIN_OFFSET + 1.0)
+        upper[knots] = own + error
+        vector[knots] = np.clip(f.thermocouple.values[f.profile.knots], lower[knots], upper[knots])
+        profile = f.thermocouple.values
         if layout.lags[f.index] is not None:
             period = f.data.splitting.period_samples * f.step if f.data.splitting else 100 * f.step
             lag = min(lag_fraction, LAG_LIMIT) * period
@@ -134,7 +149,10 @@ def starts(files, layout, base, lag_fraction=0.01):
             raise MeasurementError(f"{layout.paths}: no complete "
                                    f"{'heating' if d == HEATING else 'cooling'} branch crosses "
                                    f"the transformation")
-    start = _centre_starts(centres, layout, base)
+    lines = _centre_lines(centres, layout, base)
+    start = {}
+    for law in layout.centres:    # the second stage starts on the first one's centres
+        start.update(law.start(lines))
     start.update(domain_widths(_energy_starts(widths, base)))
     span = float(np.median([s for _, s, _, _ in spans]))
     if not span > 0:
@@ -148,9 +166,7 @@ def starts(files, layout, base, lag_fraction=0.01):
         if "span_stress" in layout.phys:
             start["span_stress"] = scale
     start["alpha_P"] = start["alpha_MF"] = 0.0
-    start.update({"w2": 0.2, "a2_c": start["a_c"], "b2_c": start.get("b_c", 0.0),
-                  "gap2_0": start["gap0"], "gap2_F": start["gapF"],
-                  "nu2_h": start["nu_h"] / 3.0, "nu2_c": start["nu_c"] / 3.0})
+    start.update({"w2": 0.2, "nu2_h": start["nu_h"] / 3.0, "nu2_c": start["nu_c"] / 3.0})
     data0 = spans[0][0]
     xi_f_min = residual_f_fraction(data0.load, base)
     reference = data0.reference_length
@@ -167,9 +183,8 @@ def starts(files, layout, base, lag_fraction=0.01):
         start["R_MF"] = r_cold - xi * layout.half_r
         start["R_P"] = (r_hot - xi * (start["R_MF"] + layout.half_r)) / (1.0 - xi)
     x_min = start.get("x_min", base.x_min)
-    bounds = dict(BOUNDS, **{
-        "a2_c": BOUNDS["a_c"], "b2_c": BOUNDS["b_c"], "gap2_0": BOUNDS["gap0"],
-        "gap2_F": BOUNDS["gapF"],
+    bounds = dict(BOUNDS, **{name: law.bounds(name) for law in layout.centres
+                             for name in law.names}, **{
         "l_MF": (x_min * (1 + 1e-9), 2.0 * x_min), "x_min": (0.5 * x_min, 2.0 * x_min),
         "R_P": (1e-3, start.get("R_MF", 1.0)), "R_MF": (start.get("R_P", 1.0), 1e4)})
     for name in ("nu", "nu_h", "nu_c", "nu2_h", "nu2_c"):
@@ -182,11 +197,13 @@ def starts(files, layout, base, lag_fraction=0.01):
     params = layout.params(vector)
     for f in files:
         first, count, fixed = layout.offsets[f.index]
-        direction, level, _ = wire_rows(f.profile.values, f.data.branches, f.per_cycle)
-        strain, _ = file_model(params, f.data, f.profile.values, np.zeros(count + fixed),
+        direction, level, _ = wire_rows(f.thermocouple.values, f.data.branches, f.per_cycle)
+        strain, _ = file_model(params, f.data, f.thermocouple.values, np.zeros(count + fixed),
                                direction, level, f.per_cycle)
         difference = f.data.strain - strain
+        previous = 0.0
         for lv in range(fixed, count + fixed):
-            rows = level == lv
-            vector[first + lv - fixed] = float(np.median(difference[rows])) if rows.any() else 0.0
+            rows = level == lv      # a level no row sits on (after the last cooling): as before
+            previous = float(np.median(difference[rows])) if rows.any() else previous
+            vector[first + lv - fixed] = previous
     return vector, lower, upper

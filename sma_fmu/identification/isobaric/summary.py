@@ -63,20 +63,32 @@ def half_strain_table(files, fit):
                     "transformation strain between the baselines at that temperature [1]"}
 
 
+def _table(rows, header):
+    """Lines of a table whose columns are as wide as their widest cell (first left-aligned)."""
+    widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
+    return ["  ".join(str(c).ljust(w) if i == 0 else str(c).rjust(w)
+                      for i, (c, w) in enumerate(zip(r, widths))).rstrip()
+            for r in [header] + rows]
+
+
 def format_isobaric_report(report):
-    """A short text summary of an isobaric fit report."""
+    """A short text summary of an isobaric fit report (each line once; how the cycles were
+    found is printed while reading)."""
     rms = report["residual_rms"]
     solver = report["solver"]
     noise = report["noise_estimates"]
+    state = "converged" if solver["converged"] else f"NOT CONVERGED ({solver['message']})"
     lines = [f"isobaric fit: {report['points']} points in {len(report['files'])} file(s); "
-             f"{solver['seconds']:.2f} s ({solver['evaluations']} evaluations)",
+             f"{solver['seconds']:.2f} s ({solver['evaluations']} evaluations), {state}",
              f"residual RMS (noise estimate): strain {rms['strain']:.3g} ({noise['strain']:.3g}), "
              f"temperature {rms['temperature_K']:.3g} K ({noise['temperature_K']:.3g} K)"
              + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
                 if rms["resistance_ohm"] else ""),
              report["verdict"]]
-    if report.get("stage_note"):
-        lines.append(report["stage_note"])
+    for note in (report.get("lag_choice", {}).get("note"), report.get("stage_note"),
+                 *report.get("slopes_not_fitted", [])):
+        if note:
+            lines.append(note)
     if report.get("on_bound"):
         lines.append("on a bound: " + "; ".join(report["on_bound"]))
     if report.get("outlier_cycles"):
@@ -84,19 +96,19 @@ def format_isobaric_report(report):
                      f"): " + "; ".join(c["note"] for c in report["outlier_cycles"]))
     half = report.get("half_strain")
     if half:
-        for row in half["per_file"]:
+        for row, entry in zip(half["per_file"], report["files"]):
             lines.append(f"{row['file']} ({row['stress_MPa']:.4g} MPa): half-strain heating "
                          f"{row['data_heating_degC']:.2f} data / {row['model_heating_degC']:.2f} "
                          f"model degC, cooling {row['data_cooling_degC']:.2f} / "
                          f"{row['model_cooling_degC']:.2f} degC; transformation strain "
                          f"{100 * row['data_transformation_strain']:.3g} / "
                          f"{100 * row['model_transformation_strain']:.3g} %; strain RMS "
-                         f"{report['files'][half['per_file'].index(row)]['residual_rms']['strain']:.3g}")
+                         f"{entry['residual_rms']['strain']:.3g}")
         first = report["files"][0]
         per_mpa = first["load_kg"] / first["stress_MPa"] if first["stress_MPa"] else 0.0
         centres = [f"{name} {report['parameters'][name]['value'] * per_mpa:.4g}"
                    for name in ("b_h", "b_c", "b2_h", "b2_c") if name in report["parameters"]]
-        if centres:
+        if centres and not report.get("slopes_not_fitted"):
             lines.append("fitted centre slopes [K/MPa]: " + ", ".join(centres))
         slopes = half["slopes_K_per_MPa"]
         if np.isfinite(slopes["data"]["heating"]):
@@ -104,15 +116,20 @@ def format_isobaric_report(report):
                          f"{slopes['data']['heating']:.4g} data, {slopes['model']['heating']:.4g} "
                          f"model; cooling {slopes['data']['cooling']:.4g} data, "
                          f"{slopes['model']['cooling']:.4g} model")
+    for entry in report.get("hysteresis", []):
+        thermocouple, wire = entry["thermocouple_K"], entry["wire_K"]
+        lines.append(f"{entry['file']}: thermal hysteresis (median over cycles) "
+                     + (f"{thermocouple:.3g} K" if thermocouple is not None else "n/a")
+                     + " at the thermocouple, "
+                     + (f"{wire:.3g} K" if wire is not None else "n/a") + " at the wire (model)")
     for entry in report["files"]:
-        lines.append(f"{Path(entry['file']).name}: {entry['cycles_found']}")
         if entry["lag"]:
             lag = entry["lag"]
             lines.append(f"{Path(entry['file']).name}: lag {lag['value']:.4g} +- "
                          f"{lag['std_error']:.2g} {lag['unit']} ({lag['note']})")
-    lines.append(f"{'parameter':<12}{'value':>14}{'std error':>12}")
-    for name, row in report["parameters"].items():
-        lines.append(f"{name:<12}{row['value']:>14.6g}{row['std_error']:>12.3g}")
+    lines += _table([(name, f"{row['value']:.6g}", f"{row['std_error']:.3g}")
+                     for name, row in report["parameters"].items()],
+                    ("parameter", "value", "std error"))
     for load, centre in report["hysteresis_centres_degC"].items():
         lines.append(f"centres at {load}: heating {centre['heating']['value']:.2f} +- "
                      f"{centre['heating']['std_error']:.2f} degC, cooling "

@@ -20,7 +20,10 @@ temperature has turned. The file reports:
 - optionally a first cycle unlike the rest: its transformation ``first_shift_K`` [K] hotter
   (a fresh wire's first cycle).
 
-A header of ``#`` lines states the load, the programme, the noise and the true drift.
+With ``rates`` each cycle ramps at its own rate, in turn: cycles that cross their
+transformation at different rates are what tells a lag from a wider hysteresis
+(:mod:`~.sensor`). A header of ``#`` lines states the load, the programme, the noise and
+the true drift.
 A lab-like file: ``IsobaricProgramme(t_low=20, t_high=115, rate=20, cycles=100,
 dwell=0, points=26000, noise_K=10, lag_s=20, decay=0.97)`` written without a time column:
 100 cycles of 260 samples, the heating transformation finishing after the measured turn.
@@ -69,6 +72,7 @@ class IsobaricProgramme:
     seed: int = 0
     lag_s: float = 0.0             # time constant of the wire behind the thermocouple [s]
     first_shift_K: float = 0.0     # the first cycle's transformation this much hotter [K]
+    rates: tuple = ()              # K/min of each cycle in turn (repeated); () = ``rate``
 
     def __post_init__(self):
         if not self.t_high > self.t_low:
@@ -76,9 +80,9 @@ class IsobaricProgramme:
         if self.cycles < 1 or self.points < 20 * self.cycles:
             raise ValueError(f"cycles = {self.cycles!r} and points = {self.points!r}: need at least "
                              f"one cycle and 20 points per cycle")
-        for name in ("rate",):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} = {getattr(self, name)!r} must be > 0")
+        for value in (self.rate,) + tuple(self.rates):
+            if not value > 0:
+                raise ValueError(f"rate = {value!r} K/min must be > 0")
         for name in ("dwell", "noise_K", "noise_strain", "noise_ohm", "residual", "decay", "lag_s",
                      "first_shift_K"):
             if not getattr(self, name) >= 0:
@@ -104,8 +108,31 @@ def wire_temperature(programme):
     return time, measured, wire, direction, cycle
 
 
+def _varying_programme(programme):
+    """:func:`temperature_programme` with each cycle's ramps at its own rate (``rates``)."""
+    p = programme
+    times, values, cycle_of = [0.0, p.dwell], [p.t_low, p.t_low], [0, 0]
+    for k in range(p.cycles):
+        ramp = (p.t_high - p.t_low) / p.rates[k % len(p.rates)] * 60.0
+        for step, value in ((ramp, p.t_high), (p.dwell, p.t_high), (ramp, p.t_low),
+                            (p.dwell, p.t_low)):
+            times.append(times[-1] + step)
+            values.append(value)
+            cycle_of.append(k)
+    times, values = np.array(times), np.array(values)
+    time = np.linspace(0.0, times[-1], p.points)
+    temperature = np.interp(time, times, values)
+    segment = np.clip(np.searchsorted(times, time, side="right") - 1, 0, times.size - 2)
+    # segments after the first dwell come in fours: up, top dwell, down, bottom dwell
+    direction = np.where((segment == 0) | ((segment - 1) % 4 < 2), HEATING, COOLING)
+    cycle = np.clip((segment - 1) // 4, 0, p.cycles - 1)
+    return time, temperature, direction, cycle
+
+
 def temperature_programme(programme):
     """(time [s], true temperature [degC], direction +1/-1, cycle index) of the programme."""
+    if programme.rates:
+        return _varying_programme(programme)
     ramp = (programme.t_high - programme.t_low) / programme.rate * 60.0
     period = 2.0 * (ramp + programme.dwell)
     total = programme.dwell + programme.cycles * period

@@ -132,7 +132,8 @@ def rows_csv(rows):
 
 
 def rows_markdown(rows):
-    """Markdown tables of :func:`cycle_rows` rows, one per file, data and model side by side."""
+    """Markdown tables of :func:`cycle_rows` rows, one per file, data and model side by side;
+    a value that cannot be had reads "n/a [k]", its reason k listed once under the table."""
     lines = ["# Transformation temperatures per cycle (tangent-line construction)", "",
              "A_s, A_f on heating and M_s, M_f on cooling where the transformation tangent meets "
              "the baselines; thermal hysteresis = heating minus cooling temperature at half the "
@@ -146,6 +147,7 @@ def rows_markdown(rows):
         if (row["file"], row["load_kg"]) not in files:
             files.append((row["file"], row["load_kg"]))
     for name, load in files:
+        reasons = []
         lines += ["", f"## {name} (load {load:g} kg)", "",
                   "| cycle | quantity | unit | data | data, wire T | model | model - data, wire T |",
                   "|---:|---|---|---:|---:|---:|---:|"]

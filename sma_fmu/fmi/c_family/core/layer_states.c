@@ -2,11 +2,19 @@
  *
  * A state is kept as its serialized bytes (layer_state_bytes.c), so restoring a state and
  * deserializing one take the same checked path. Restoring checks everything before it
- * changes anything (saved_state.py): then a new stepper is started from the saved
- * parameters and takes the saved doubles through the runtime's <x>_state_read, which
- * validates them as restore() does, and must write them back unchanged. A refused state
- * leaves the instance as it was: an error with the reason. The messages name the
- * front's function (`function`). */
+ * changes anything (saved_state.py), in this order:
+ *   1. the frame: length and CRC-32 (c_common/state_frame.c; at deserialization);
+ *   2. whose state it is: model, build (GUID), stepper format (layer_state_bytes.c's parse;
+ *      a check of the wire's digest belongs beside the GUID's);
+ *   3. the variables: each of its type, times finite;
+ *   4. the stepper's entries: a new stepper is started from the saved parameters (which
+ *      checks them as a parameter file's) and takes the saved doubles through the runtime's
+ *      <x>_state_read, which checks each entry as restore() does (finite, in its physical
+ *      range: runtime/state_entries.c), and must write them back unchanged;
+ *   5. the outputs: those the stepper holds must be what it gives (held_outputs_agree),
+ *      the others finite.
+ * A refused state leaves the instance as it was: an error with the reason, which names the
+ * entry. The messages name the front's function (`function`). */
 #include "fp_contract.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,8 +22,39 @@
 
 #include "layer.h"
 
+/* The saved outputs against those the restored stepper gives (a model whose stepper holds
+ * its outputs: SmaModel.held_outputs, into `scratch`): 1 if every one is the same, else 0
+ * with why naming the first that differs, its unit and the value the state gives. An edited
+ * output is refused like an edited entry (StepperSlave._set_fmu_state does the same). */
+static int held_outputs_agree(const SmaModel *model, const void *stepper, const SmaValue *saved,
+                              SmaValue *scratch, char *why, size_t size)
+{
+    size_t i;
+    if (!model->held_outputs) return 1;
+    model->held_outputs(stepper, scratch);
+    for (i = 0; i < model->count; ++i) {
+        const SmaVariable *v = &model->variables[i];
+        const char *unit = v->unit && strcmp(v->unit, "1") != 0 ? v->unit : "";  /* none for 1 */
+        if (v->causality != SMA_OUTPUT || v->kind == SMA_STRING) continue;
+        if (v->kind == SMA_REAL ? saved[i].real == scratch[i].real
+                                : saved[i].integer == scratch[i].integer) continue;
+        if (v->kind == SMA_REAL)
+            snprintf(why, size, "the model could not take it back (ValueError: output %s = "
+                     "%.17g%s%s is not what the saved model state gives (%.17g%s%s))", v->name,
+                     saved[i].real, *unit ? " " : "", unit, scratch[i].real, *unit ? " " : "",
+                     unit);
+        else
+            snprintf(why, size, "the model could not take it back (ValueError: output %s = %d "
+                     "is not what the saved model state gives (%d))", v->name, saved[i].integer,
+                     scratch[i].integer);
+        return 0;
+    }
+    return 1;
+}
+
 /* A new stepper from the saved parameters, then its saved doubles (StepperSlave._set_fmu_state);
- * NULL with why set. The start's outputs go to a scratch copy: the saved ones are kept. */
+ * NULL with why set. The start's outputs go to a scratch copy: the saved ones are kept, and
+ * must be those the restored stepper gives where it holds them (held_outputs_agree). */
 static void *restored_stepper(const Instance *in, const Parsed *p, char *why, size_t size)
 {
     const SmaModel *model = in->model;
@@ -46,6 +85,7 @@ static void *restored_stepper(const Instance *in, const Parsed *p, char *why, si
         snprintf(why, size, "the hidden model state is corrupt (the model does not save it back unchanged)");
         goto fail;
     }
+    if (!held_outputs_agree(model, stepper, p->values, scratch, why, size)) goto fail;
     layer_values_free(model, scratch);
     free(again);
     return stepper;

@@ -28,6 +28,7 @@ typedef struct {
     double start;               /* Real, Integer, Boolean (0/1) start value */
     const char *start_text;     /* String start value (NULL for the others) */
     int wire;                   /* index in PARAMETER_SPECS of a wire parameter, else -1 */
+    const char *unit;           /* its unit, e.g. "ohm" (NULL: none) */
 } SmaVariable;
 
 /* A variable's present value: Real -> real, Integer and Boolean -> integer, String -> text
@@ -89,6 +90,11 @@ typedef struct {
     int (*get_array)(const void *stepper, const SmaValue *values, size_t array, double values_out[],
                      size_t nValues, size_t *index);
     size_t (*live_count)(const void *stepper);
+    /* The outputs of a started stepper into `values`, every output (the adapter's publish):
+     * a restored state's saved outputs must be these (layer_states.c). NULL: the outputs are
+     * not held by the stepper (the model computes them from its inputs in a step), and a
+     * state's outputs are checked to be finite only. */
+    void (*held_outputs)(const void *stepper, SmaValue *values);
 } SmaModel;
 
 

@@ -39,15 +39,16 @@ double second_centre(double load, int direction, const WireParameters *params)
     return params->terms.a2_c + params->terms.b2_c * load;
 }
 
-/* A centre [degC] refused when not finite or below 0 K (`what` names it). */
+/* A centre [degC] refused when not finite or below 0 K (`what` names it and the
+ * parameters it is made of, e.g. "hysteresis centre a_h + b_h f"). */
 static int checked_centre(double centre, double load, const char *what, SmaMessage *message)
 {
     if (!(centre < HUGE_VAL)) {
-        return sma_message_set(message, "load = %.17g kg is beyond the model's range: the %s "
+        return sma_message_set(message, "load = %.17g kg is beyond the model's range: the %s = "
                                "%.17g degC is not finite", load, what, centre);
     }
     if (centre <= -KELVIN_OFFSET) {
-        return sma_message_set(message, "%s %.17g degC at load %.17g kg is below 0 K", what,
+        return sma_message_set(message, "%s = %.17g degC at load %.17g kg is below 0 K", what,
                                centre, load);
     }
     return 0;
@@ -96,7 +97,8 @@ int branch_constants(double load, int direction, const WireParameters *params,
         return 1;
     }
     centre = hysteresis_centre(load, direction, params);
-    if (checked_centre(centre, load, "hysteresis centre", message)) {
+    if (checked_centre(centre, load, heating ? "hysteresis centre a_h + b_h f"
+                                             : "hysteresis centre a_c + b_c f", message)) {
         return 1;
     }
     xi_f_min = residual_f_fraction(load, params);
@@ -114,7 +116,8 @@ int branch_constants(double load, int direction, const WireParameters *params,
     out->has_lengths = 0;
     if (terms->two_stage) {
         centre2 = second_centre(load, direction, params);
-        if (checked_centre(centre2, load, "second-stage centre", message)
+        if (checked_centre(centre2, load, heating ? "second-stage centre a2_h + b2_h f"
+                                                  : "second-stage centre a2_c + b2_c f", message)
                 || domain_energy(load, params, heating ? terms->nu2_h : terms->nu2_c, &energy2,
                                  message)) {
             return 1;

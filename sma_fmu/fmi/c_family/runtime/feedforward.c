@@ -62,6 +62,7 @@ int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *par
     self->load_before = -HUGE_VAL;
     self->unconnected_warned = 0;
     self->bounded_before = 0;
+    self->data_unwarned = params->data_range;
     return 0;
 }
 
@@ -186,7 +187,7 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     size_t kept;
     double fraction, output, temperature;
     char warning[sizeof self->warning];
-    int direction, saturated, bounded;
+    int direction, saturated, bounded, outside;
     if (no_reference_yet(self, reference)) {
         if (fast_nonnegative("load", load, message)
             || fast_positive("step_size", step_size, message)) {
@@ -225,6 +226,9 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
                  "saturated", used ? "; " : "", sensed.temperature, self->params.T_max, reference,
                  load);
     }
+    outside = self->data_unwarned
+              && data_range_warning(&self->params, temperature, load, "T_ref", warning,
+                                    sizeof warning);
     if (phase_lag_filter_step(&self->filter, power_of(self, temperature), step_size, &output,
                               message)) {
         return 1;
@@ -238,6 +242,9 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     memcpy(self->warning, warning, sizeof warning);
     self->load_before = load;
     self->bounded_before = bounded;
+    if (outside) {
+        self->data_unwarned = 0;
+    }
     self->previous_temperature = sensed.temperature;
     self->previous_fraction = fraction;
     outputs->P_ff = output;

@@ -18,6 +18,9 @@
  * one warning (the first such step only), no state change. After a reference has arrived,
  * R_ref <= 0 is refused as before.
  *
+ * A wire with a data range (validity.T_data_min ...): the first step whose T_ref or load lies
+ * outside it adds one warning, once per stepper.
+ *
  * Saved state (feedforward_stepper_state_*): 7 + 2 n doubles, Python's None stored as NaN
  * (SMA_STATE_NONE):
  *   [0] direction (+1 / -1)          [1] previous_reference [ohm] or None
@@ -77,10 +80,11 @@ typedef struct FeedforwardStepper {
     double previous_temperature;  /* T_ref,k-1 [degC]; NaN = None */
     double previous_fraction;     /* xi_MF,k-1 [1] the compensator assumed; NaN = None */
     BranchCache branches;
-    char warning[512];            /* validity warning of the last step; "" = None */
+    char warning[1024];           /* validity warning of the last step; "" = None */
     double load_before;           /* load of the last step [kg] (-inf before the first) */
     int unconnected_warned;       /* the no-reference-yet warning was given (not saved) */
     int bounded_before;           /* the last step's T_ref was bounded to T_max (not saved) */
+    int data_unwarned;            /* the data-range warning is still to come (not saved) */
 } FeedforwardStepper;
 
 /* Python's FeedforwardStepper(params, alpha, beta, model_load, adapt_to_load, inverse). For

@@ -9,31 +9,38 @@
 #include "constants.h"
 #include "thermal.h"
 
-#define SMA_SPEC_ROW(name, section, unit, rule, required) {#name, section, unit, rule, required},
+#define SMA_SPEC_ROW(name, section, unit, rule, required, low, high, range) \
+    {#name, section, unit, rule, required, low, high, range},
 const ParameterSpec PARAMETER_SPECS[PARAM_COUNT] = {
     SMA_PARAMETER_SPECS(SMA_SPEC_ROW)
 };
 #undef SMA_SPEC_ROW
 
-#define SMA_RULE_TEXT(rule, text) text,
-static const char *const RULE_TEXT[RULE_COUNT] = {
-    SMA_PARAMETER_RULES(SMA_RULE_TEXT)
+/* Whether each rule's range is open at its low and its high end. */
+#define SMA_RULE_ENDS(rule, low_open, high_open) {low_open, high_open},
+static const unsigned char RULE_OPEN[RULE_COUNT][2] = {
+    SMA_PARAMETER_RULES(SMA_RULE_ENDS)
 };
-#undef SMA_RULE_TEXT
+#undef SMA_RULE_ENDS
 
-static int rule_holds(ParameterRule rule, double value)
+/* value_in_range of parameters.py: the rule holds and the value lies in the spec's range. */
+static int value_in_range(const ParameterSpec *spec, double value)
 {
-    if (!isfinite(value)) {
+    const unsigned char *open = RULE_OPEN[spec->rule];
+    if (!isfinite(value) || (spec->rule == RULE_DEPTH && value != trunc(value))) {
         return 0;
     }
-    switch (rule) {
-    case RULE_POSITIVE: return value > 0.0;
-    case RULE_NONNEGATIVE: return value >= 0.0;
-    case RULE_FRACTION: return 0.0 <= value && value < 1.0;
-    case RULE_MARGIN: return 0.0 < value && value < 0.5;
-    case RULE_DEPTH: return value == trunc(value) && 2 <= value && value <= MAX_MEMORY_DEPTH;
-    default: return 1;
+    return (open[0] ? spec->low < value : spec->low <= value)
+           && (open[1] ? value < spec->high : value <= spec->high);
+}
+
+/* requirement_text of parameters.py, without the range: the words before it. */
+static const char *requirement_words(const ParameterSpec *spec, double value)
+{
+    if (spec->rule == RULE_DEPTH) {
+        return "a whole number in ";
     }
+    return isfinite(value) ? "in " : "a finite number in ";
 }
 
 static int is_finite_positive(double value)
@@ -134,10 +141,10 @@ static int check_values(WireParameters *p, const double values[], const unsigned
             checked[index] = NAN;     /* alpha and the terms: None (NaN below) */
             continue;
         }
-        if (!rule_holds(spec->rule, value)) {
-            return sma_message_set(message, "%s: parameter %s.%s = %.17g %s [%s]", p->source,
-                                   spec->section, spec->name, value, RULE_TEXT[spec->rule],
-                                   spec->unit);
+        if (!value_in_range(spec, value)) {
+            return sma_message_set(message, "%s: parameter %s.%s = %.17g must be %s%s [%s]",
+                                   p->source, spec->section, spec->name, value,
+                                   requirement_words(spec, value), spec->range, spec->unit);
         }
         checked[index] = value;
     }
@@ -219,6 +226,11 @@ int wire_parameters_from_given(WireParameters *out, const double values[],
                         STRESS, 2, &p.load_max, 1, failure, message)) {
         return 1;
     }
+    /* the data range's stress bounds as loads, as load_max (NaN stays NaN: not given) */
+    p.load_data_min = p.stress_data_min * 1e6 * SMA_PI * square / 4.0 / STANDARD_GRAVITY;
+    p.load_data_max = p.stress_data_max * 1e6 * SMA_PI * square / 4.0 / STANDARD_GRAVITY;
+    p.data_range = !isnan(p.T_data_min) || !isnan(p.T_data_max) || !isnan(p.stress_data_min)
+                   || !isnan(p.stress_data_max);
     if (model_terms(&p, v, &p.terms, message)) {
         return 1;
     }
@@ -238,6 +250,16 @@ int wire_parameters_from_given(WireParameters *out, const double values[],
     if (!(p.T_max > p.T_room)) {
         return sma_message_set(message, "%s: parameter validity.T_max = %.17g degC must exceed "
                                "thermal.T_room = %.17g degC", p.source, p.T_max, p.T_room);
+    }
+    if (p.T_data_min > p.T_data_max) {
+        return sma_message_set(message, "%s: parameter validity.T_data_min = %.17g degC must be <= "
+                               "validity.T_data_max = %.17g degC", p.source, p.T_data_min,
+                               p.T_data_max);
+    }
+    if (p.stress_data_min > p.stress_data_max) {
+        return sma_message_set(message, "%s: parameter validity.stress_data_min = %.17g MPa must be "
+                               "<= validity.stress_data_max = %.17g MPa", p.source,
+                               p.stress_data_min, p.stress_data_max);
     }
     *out = p;
     return 0;

@@ -9,26 +9,30 @@
 #include "sma_parameters_table.h"  /* generated from PARAMETER_SPECS at build time */
 
 /* The index of each parameter in the values[] array: PARAMETER_SPECS order. */
-#define SMA_PARAMETER_INDEX(name, section, unit, rule, required) PARAM_##name,
+#define SMA_PARAMETER_INDEX(name, section, unit, rule, required, low, high, range) PARAM_##name,
 typedef enum {
     SMA_PARAMETER_SPECS(SMA_PARAMETER_INDEX)
     PARAM_COUNT
 } ParameterIndex;
 #undef SMA_PARAMETER_INDEX
 
-#define SMA_RULE_NAME(rule, text) rule,
+#define SMA_RULE_NAME(rule, low_open, high_open) rule,
 typedef enum {
     SMA_PARAMETER_RULES(SMA_RULE_NAME)
     RULE_COUNT
 } ParameterRule;
 #undef SMA_RULE_NAME
 
+/* One parameter: its rule and its plausible range [low, high] in `unit` (the rule says
+ * which end is open), `range` the interval as the refusal prints it, e.g. "(0, 100000]". */
 typedef struct ParameterSpec {
     const char *name;
     const char *section;
     const char *unit;
     ParameterRule rule;
     int required;
+    double low, high;
+    const char *range;
 } ParameterSpec;
 
 extern const ParameterSpec PARAMETER_SPECS[PARAM_COUNT];
@@ -48,8 +52,10 @@ typedef struct ModelTerms {
 
 /* Validated parameters of one SMA wire (units as in PARAMETER_SPECS), with the derived
  * constants of Python's WireParameters: lattice, N [1], line_density [kg/m], l_P [m],
- * x_T [m], x_f [m], R_MF [ohm], K_th [K/W], tau_th [s], phase_lag_alpha [s], load_max [kg].
- * alpha is NaN where Python's is None (not given). */
+ * x_T [m], x_f [m], R_MF [ohm], K_th [K/W], tau_th [s], phase_lag_alpha [s], load_max [kg],
+ * load_data_min, load_data_max [kg] (the data range's stress bounds as loads, NaN when not
+ * given) and data_range (1 when any bound of the data range is given).
+ * alpha and the data range are NaN where Python's are None (not given). */
 #define SMA_WIRE_FIELD(type, name) type name;
 typedef struct WireParameters {
     SMA_WIRE_FIELDS(SMA_WIRE_FIELD)
@@ -57,6 +63,8 @@ typedef struct WireParameters {
 
     Lattice lattice;
     double N, line_density, l_P, x_T, x_f, R_MF, K_th, tau_th, phase_lag_alpha, load_max;
+    double load_data_min, load_data_max;
+    int data_range;
     ModelTerms terms;
 } WireParameters;
 #undef SMA_WIRE_FIELD

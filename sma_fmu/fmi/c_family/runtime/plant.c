@@ -40,6 +40,16 @@ static void check_validity(PlantStepper *stepper, double before, double load_bef
                      stepper->warning, sizeof stepper->warning);
 }
 
+/* Add the data-range warning the first time T or the load is outside the range the wire's
+ * data covered (once per stepper; plant.py's _check_data_range). */
+static void check_data_range(PlantStepper *stepper)
+{
+    if (data_range_warning(&stepper->params, stepper->temperature, stepper->load, "T",
+                           stepper->warning, sizeof stepper->warning)) {
+        stepper->data_unwarned = 0;
+    }
+}
+
 int plant_stepper_init(PlantStepper *stepper, const WireParameters *params,
                        const double *T_start, const char *mode, double load,
                        SmaMessage *message)
@@ -88,7 +98,11 @@ int plant_stepper_init(PlantStepper *stepper, const WireParameters *params,
     branch_fractions(stepper->temperature, &constants, &stepper->xi_MF, &stepper->xi_P);
     evaluate(stepper, &constants);
     stepper->warning[0] = '\0';
+    stepper->data_unwarned = params->data_range;
     check_validity(stepper, -HUGE_VAL, -HUGE_VAL);
+    if (stepper->data_unwarned) {
+        check_data_range(stepper);
+    }
     return 0;
 }
 
@@ -163,6 +177,9 @@ int plant_stepper_step(PlantStepper *stepper, double power, double load, double 
     stepper->warning[0] = '\0';
     if (after > params->T_max || load > params->load_max) {
         check_validity(stepper, before, load_before);
+    }
+    if (stepper->data_unwarned) {
+        check_data_range(stepper);
     }
     return 0;
 }

@@ -6,7 +6,8 @@
  * Mode "continuous": reversal stack with return-point memory (minor_loops); mode "switch":
  * the major branch of the direction. A power <= 0 W is applied as 0 W. `warning` is set
  * (non-empty) for the one step, or the start, in which T rises above validity.T_max or the
- * load above load_max.
+ * load above load_max, and for the first one in which T or the load lies outside the range
+ * the wire's data covered (validity.T_data_min ...: once per stepper).
  *
  * Saved state (plant_stepper_state_write/read), PLANT_STATE_FIXED + 2 n doubles:
  *   [0] temperature [degC]  [1] direction (+1/-1)  [2] load [kg]  [3] xi_MF [1]  [4] xi_P [1]
@@ -53,7 +54,8 @@ typedef struct PlantStepper {
     double power;                    /* [W] */
     double xi_MF, xi_P;              /* [1] */
     PlantOutputs outputs;
-    char warning[256];               /* "" = None */
+    int data_unwarned;               /* the data-range warning is still to come */
+    char warning[512];               /* "" = None */
 } PlantStepper;
 
 /* PlantStepper(params, T_start, mode, load): T_start NULL = params->T_room; mode "continuous"

@@ -3,6 +3,7 @@
 #include "validity.h"
 
 #include <stdio.h>
+#include <string.h>
 
 int validity_warning(const WireParameters *params, double temperature, double temperature_before,
                      double load, double load_before, char *text, size_t size)
@@ -27,5 +28,52 @@ int validity_warning(const WireParameters *params, double temperature, double te
     }
     snprintf(text, size, "%s%s%s: outside the range the model's parameters describe", hot,
              is_hot && is_heavy ? "; " : "", heavy);
+    return 1;
+}
+
+/* Where the next clause of text[size] starts: after "; " when it already holds one. */
+static size_t next_clause(char *text, size_t size)
+{
+    size_t used = strlen(text);
+    if (used > 0 && used + 3 <= size) {
+        memcpy(text + used, "; ", 3);
+        used += 2;
+    }
+    return used;
+}
+
+int data_range_warning(const WireParameters *params, double temperature, double load,
+                       const char *name, char *text, size_t size)
+{
+    char found[512] = "";
+    double mm = params->diameter * 1e3;
+    size_t used;
+    if (temperature < params->T_data_min) {
+        used = next_clause(found, sizeof found);
+        snprintf(found + used, sizeof found - used, "%s = %.6g degC is below "
+                 "validity.T_data_min = %g degC", name, temperature, params->T_data_min);
+    }
+    if (temperature > params->T_data_max) {
+        used = next_clause(found, sizeof found);
+        snprintf(found + used, sizeof found - used, "%s = %.6g degC is above "
+                 "validity.T_data_max = %g degC", name, temperature, params->T_data_max);
+    }
+    if (load < params->load_data_min) {
+        used = next_clause(found, sizeof found);
+        snprintf(found + used, sizeof found - used, "load = %.6g kg is below %.4g kg "
+                 "(validity.stress_data_min = %g MPa on a %g mm wire)", load,
+                 params->load_data_min, params->stress_data_min, mm);
+    }
+    if (load > params->load_data_max) {
+        used = next_clause(found, sizeof found);
+        snprintf(found + used, sizeof found - used, "load = %.6g kg is above %.4g kg "
+                 "(validity.stress_data_max = %g MPa on a %g mm wire)", load,
+                 params->load_data_max, params->stress_data_max, mm);
+    }
+    if (found[0] == '\0' || size == 0) {
+        return 0;
+    }
+    used = next_clause(text, size);
+    snprintf(text + used, size - used, "%s: %s", found, SMA_DATA_RANGE_NOTE);
     return 1;
 }

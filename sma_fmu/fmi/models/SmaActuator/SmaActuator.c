@@ -95,7 +95,12 @@ static size_t live_count(const void *stepper)
     return ((const PlantStepper *)stepper)->reversal_count;
 }
 
+static void held_outputs(const void *stepper, SmaValue *values)
+{
+    publish(values, &((const PlantStepper *)stepper)->outputs);
+}
+
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, PLANT_STATE_FORMAT, LOG_CATEGORIES, VARIABLES, VAR_COUNT,
     1, sizeof(PlantStepper), start, step, release, warning, state_size, state_write, state_read, NULL,
-    2, VAR_memory_depth, get_array, live_count};
+    2, VAR_memory_depth, get_array, live_count, held_outputs};

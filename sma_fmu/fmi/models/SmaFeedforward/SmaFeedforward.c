@@ -80,4 +80,4 @@ const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, FEEDFORWARD_STATE_FORMAT, LOG_CATEGORIES, VARIABLES, VAR_COUNT,
     1, sizeof(FeedforwardStepper), start, step, release, warning, state_size, state_write,
     state_read, NULL,
-    0, 0, NULL, NULL};
+    0, 0, NULL, NULL, NULL};

@@ -66,4 +66,4 @@ static int state_read(void *stepper, const double *in, size_t count, SmaMessage 
 const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, "sma-fmu PI state: integral, sensor sample", LOG_CATEGORIES,
     VARIABLES, VAR_COUNT, 1, sizeof(SensedPIController), start, step, NULL, NULL, state_size,
-    state_write, state_read, NULL, 0, 0, NULL, NULL};
+    state_write, state_read, NULL, 0, 0, NULL, NULL, NULL};

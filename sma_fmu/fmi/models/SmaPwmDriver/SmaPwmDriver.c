@@ -112,4 +112,4 @@ const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, "sma-fmu PWM state", LOG_CATEGORIES, VARIABLES, VAR_COUNT,
     0, sizeof(Driver), start, step, NULL, NULL, state_size, state_write, state_read,
     next_event,
-    0, 0, NULL, NULL};
+    0, 0, NULL, NULL, NULL};

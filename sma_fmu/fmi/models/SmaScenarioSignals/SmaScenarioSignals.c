@@ -86,4 +86,4 @@ const SmaModel SMA_MODEL = {
     MODEL_NAME, MODEL_GUID, "sma-fmu signals state", LOG_CATEGORIES, VARIABLES, VAR_COUNT,
     0, sizeof(SignalSource), start, step, release, NULL, state_size, state_write, state_read,
     next_event,
-    0, 0, NULL, NULL};
+    0, 0, NULL, NULL, NULL};

@@ -90,3 +90,15 @@ class StepperSlave(Fmi2Slave):
             outputs = getattr(self.stepper, "outputs", None)
             if outputs is not None:  # steppers that hold their outputs (the others' are variables)
                 self._publish(outputs)
+                self._check_held_outputs(variables)
+
+    def _check_held_outputs(self, variables):
+        """The saved outputs must be those the restored stepper gave (an edited output is
+        refused like an edited entry: ValueError naming it, its unit and the value)."""
+        units = self.interface.units
+        for name in self.published or ():
+            given, value = variables.get(name), getattr(self, name)
+            if given != value:
+                unit = f" {units[name]}" if units.get(name, "1") != "1" else ""
+                raise ValueError(f"output {name} = {given!r}{unit} is not what the saved model "
+                                 f"state gives ({value!r}{unit})")

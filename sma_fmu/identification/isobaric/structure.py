@@ -1,0 +1,252 @@
+"""Which model the data support, and where the joint fit starts: the first fit's choices of
+the lag's valley, the outlier cycles, the widths and the stages (:mod:`~.first_fit`), the
+joint fit's starts, and its second look at a richer structure the first fit did not keep.
+
+Richer models are kept only when they lower the cost by STAGE_GAIN_MIN (a second stage also
+needs w2 > STAGE_SHARE_MIN): with a fitted lag, separate widths blur the lag against the
+centres, so one width comes first.
+"""
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+
+from sma_fmu.identification.isobaric.first_fit import ROUNDS, first_fit
+from sma_fmu.identification.isobaric.jacobian import file_jacobian, scalar_sensitivities
+from sma_fmu.identification.isobaric.outcome import residual_blocks
+from sma_fmu.identification.isobaric.outliers import mark_outliers
+from sma_fmu.identification.isobaric.solver import levenberg_marquardt
+from sma_fmu.identification.isobaric.starts import starts
+from sma_fmu.runtime.model_terms import domain_widths
+
+__all__ = ["Clock", "Joint", "joint", "choose", "joint_starts", "second_look", "with_head",
+           "STAGE_SHARE_MIN", "STAGE_GAIN_MIN", "JOINT_FTOL", "FIRST_FTOL", "SCAN_EVALUATIONS",
+           "LAG_STARTS"]
+
+STAGE_SHARE_MIN = 1e-3  # a second stage holding less than this share of M is not kept
+STAGE_GAIN_MIN = 0.01   # nor one that lowers the cost by less than this fraction
+JOINT_FTOL = 1e-7       # the joint fit has converged when 3 steps in a row gain less, relative
+FIRST_FTOL = 1e-6       # the first fit only chooses and starts: a looser tolerance
+SCAN_EVALUATIONS = 6    # per starting lag before the full fit
+LAG_STARTS = (1 / 300, 1 / 100, 1 / 50, 1 / 25, 1 / 12, 1 / 6)   # of a cycle
+
+
+class Clock:
+    """Counts model evaluations and moves a progress bar (``meter()`` returns a tqdm-like bar;
+    None: no bar)."""
+
+    def __init__(self, meter):
+        self.began = time.perf_counter()
+        self.evaluations = 0
+        self.bar = meter() if meter is not None else None
+
+    def stage(self, text):
+        if self.bar is not None:
+            self.bar.set_description_str(text)
+
+    def tick(self, cost=None):
+        self.evaluations += 1
+        if self.bar is not None:
+            self.bar.update(1)
+            if cost is not None:
+                self.bar.set_postfix_str(f"cost {cost:.6g}", refresh=False)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def joint(prepared, layout, lower, upper, clock):
+    """(residuals, jacobian, solve, order) of the joint fit of one layout."""
+    order = layout.time_order(prepared)
+    loads = [f.data.load for f in prepared]
+
+    def residuals(x):
+        out = np.concatenate(residual_blocks(x, layout, prepared))
+        clock.tick(0.5 * float(out @ out))
+        return out
+
+    def jacobian(x):
+        sensitivities = scalar_sensitivities(x, layout, loads)
+        return sparse.vstack([b for f in prepared
+                              for b in file_jacobian(x, layout, f, sensitivities)]).tocsr()
+
+    def solve(x0, evaluations):
+        return levenberg_marquardt(residuals, jacobian, x0, lower, upper, evaluations,
+                                   ftol=JOINT_FTOL, order=order)
+    return residuals, jacobian, solve, order
+
+
+def _carry(old_layout, old_x, layout, vector):
+    """``vector`` with every unknown the two layouts share taken from ``old_x`` (one width
+    nu gives both nu_h and nu_c: :func:`~sma_fmu.runtime.model_terms.domain_widths`)."""
+    out = vector.copy()
+    old = dict(zip(old_layout.phys, old_x))
+    old.update(domain_widths(old))
+    for i, name in enumerate(layout.phys):
+        if name in old:
+            out[i] = old[name]
+    k_old, k = len(old_layout.phys), len(layout.phys)
+    out[k:len(layout.reported)] = old_x[k_old:len(old_layout.reported)]
+    if len(old_x) == old_layout.size:     # a joint solution: its profile's knots too
+        out[len(layout.reported):] = old_x[len(old_layout.reported):]
+    return out
+
+
+@dataclass
+class _Trial:
+    """A layout and its first fit: start vector and bounds (all unknowns), solution, weights."""
+
+    layout: object
+    vector: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    solution: object = None
+    weights: list = None
+
+
+def _first(prepared, trial, clock, evaluations=100, rounds=ROUNDS):
+    """``trial`` with its first fit done (at most ``evaluations`` per run, ``rounds`` runs)."""
+    trial.solution, trial.weights = first_fit(prepared, trial.layout, trial.vector, trial.lower,
+                                              trial.upper, evaluations, FIRST_FTOL,
+                                              tick=clock.tick, rounds=rounds)
+    return trial
+
+
+def choose(prepared, base, layout_of, kind, widths, stages, lagged, outliers, clock):
+    """The first fit: lag valley, outlier cycles, widths and stages. Returns (trial, stages,
+    width kind, outlier cycles, the richer structures it did not keep: "widths", "stages")."""
+    def trial_of(count, width_kind, fraction=0.01):
+        layout = layout_of(count, width_kind)
+        return _Trial(layout, *starts(prepared, layout, base, fraction))
+
+    clock.stage("first fit")
+    # on the data's own starting model first: a poor first fit can hide an odd cycle
+    left_out = mark_outliers(prepared, layout_of(1, kind), trial_of(1, kind).vector,
+                             outliers == "leave-out")
+    if lagged:    # short fits from lags of 1/300 to 1/6 of a cycle; the best two go on
+        scans = [_first(prepared, trial_of(1, kind, fraction), clock, SCAN_EVALUATIONS, 1)
+                 for fraction in LAG_STARTS]
+        scans.sort(key=lambda t: t.solution.cost)
+        best = [_first(prepared, _Trial(t.layout, with_head(t.vector, t.solution.x), t.lower,
+                                        t.upper), clock) for t in scans[:2]]
+    else:
+        best = [_first(prepared, trial_of(1, kind), clock)]
+    trial = min(best, key=lambda t: t.solution.cost)
+
+    def outlying(trial):
+        """``trial`` fitted again when its solution shows outlier cycles not yet left out (a
+        poor fit hides them: a wider model can show more)."""
+        found = mark_outliers(prepared, trial.layout, trial.solution.x, outliers == "leave-out")
+        known = {(c["file"], c["cycle"]) for c in left_out}
+        fresh = [c for c in found if (c["file"], c["cycle"]) not in known]
+        left_out.extend(fresh)
+        if fresh and outliers == "leave-out":
+            trial = _first(prepared, _Trial(trial.layout, with_head(trial.vector, trial.solution.x),
+                                            trial.lower, trial.upper), clock)
+        return trial
+
+    trial = outlying(trial)
+
+    def richer(count, width_kind):
+        """The richer layout from the kept one's solution, and from the data's own starts."""
+        fresh = trial_of(count, width_kind)
+        kept = with_head(trial.vector, trial.solution.x)
+        carried = _Trial(fresh.layout, _carry(trial.layout, kept, fresh.layout, fresh.vector),
+                         fresh.lower, fresh.upper)
+        tries = [_first(prepared, carried, clock)]
+        if count == 2:
+            tries.append(_first(prepared, fresh, clock))
+        return min(tries, key=lambda t: t.solution.cost)
+
+    rejected = []
+    if widths == "auto":
+        clock.stage("first fit: widths")
+        wider = richer(1, "separate")
+        if wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
+            trial, kind = outlying(wider), "separate"
+        else:
+            rejected.append("widths")
+    if stages == 2:
+        clock.stage("first fit: stages")
+        wider = richer(2, kind)
+        w2 = wider.solution.x[wider.layout.phys.index("w2")]
+        if w2 > STAGE_SHARE_MIN and \
+                wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
+            trial = outlying(wider)
+        else:
+            rejected.append("stages")
+            stages = 1
+    return trial, stages, kind, left_out, rejected
+
+
+def joint_starts(prepared, trial, start, solve, lagged):
+    """The joint fit's starts: the first fit's solution, and with a lag the two best of short
+    joint fits from it with the lag at the first fit's value and at 1/300 to 1/6 of a cycle
+    (the first fit holds a smoothed temperature, and can put the lag in another valley)."""
+    start = np.clip(start, trial.lower, trial.upper)
+    if not lagged:
+        return [start]
+    candidates = [start]
+    for fraction in LAG_STARTS:
+        x = start.copy()
+        for f in prepared:
+            column = trial.layout.lags[f.index]
+            period = f.data.splitting.period_samples * f.step if f.data.splitting else 100 * f.step
+            x[column] = min(fraction * period, trial.upper[column])
+        candidates.append(x)
+    scans = sorted((solve(x, SCAN_EVALUATIONS) for x in candidates), key=lambda s: s.cost)
+    return [s.x for s in scans[:2]]
+
+
+def second_look(prepared, base, layout_of, state, kind, rejected, clock, max_evaluations):
+    """The joint fit's word on each richer structure the first fit did not keep (the first
+    fit holds the temperature, and on filtered files, whose noise estimates are tiny, that
+    can hide what the joint fit sees): tried from the joint solution, kept when it lowers
+    the joint cost by STAGE_GAIN_MIN. Returns (state, width kind, stages, notes)."""
+    notes, stages = [], state.layout.stages
+    for what in rejected:
+        count, width_kind = (stages, "separate") if what == "widths" else (2, kind)
+        layout = layout_of(count, width_kind)
+        vector, lower, upper = starts(prepared, layout, base)
+        start = _carry(state.layout, state.solution.x, layout, vector)
+        residuals, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
+        solution = solve(np.clip(start, lower, upper), max_evaluations)
+        if what == "stages":
+            w2 = solution.x[layout.phys.index("w2")]
+            if w2 > STAGE_SHARE_MIN and \
+                    solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
+                state, stages = Joint(layout, solution, jacobian, order, lower, upper, vector), 2
+            else:
+                notes.append(f"a second stage does not fit these data better (w2 = {w2:.3g}, "
+                             f"cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
+                             f"one stage): one stage kept")
+        elif solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
+            state, kind = Joint(layout, solution, jacobian, order, lower, upper, vector), \
+                width_kind
+        else:
+            notes.append(f"separate heating and cooling widths do not fit these data better "
+                         f"(cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
+                         f"one): one width kept")
+    return state, kind, stages, notes
+
+
+@dataclass
+class Joint:
+    """A joint fit: its layout, solution, Jacobian function, order, bounds and start."""
+
+    layout: object
+    solution: object
+    jacobian: object
+    order: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    vector: np.ndarray
+
+
+def with_head(vector, head):
+    """``vector`` with its first entries replaced by ``head``."""
+    out = np.array(vector, dtype=float)
+    out[:len(head)] = head
+    return out

@@ -1,0 +1,105 @@
+"""Ctrl-C: one line ``sma-fmu: interrupted``, exit status 130, no traceback, nothing left
+behind, whenever it comes, in both masters, the in-process pythonfmu FMUs and the builds.
+
+The suite sends a seeded sample of SIGINTs (a few seconds each); tests/cli/interrupts_check.py
+sends 50 by hand. The unit tests below pin the rules of sma_fmu/console/interrupts.py."""
+import random
+import shutil
+import signal
+import sys
+
+import pytest
+
+from interrupting import interrupt
+from sma_fmu.console import interrupts
+from sma_fmu.files.package_data import shipped_file
+from sma_fmu.fmi.packaging.pythonfmu_build import _renamer, code_stamp
+
+# command -> (its arguments in the work folder, the latest moment of the interrupt [s]): each
+# ends well after that on this project's CI machine, so the interrupt lands inside its work
+COMMANDS = {
+    "run paper (fmpy master)": (["run", "paper", "--fmus", "fmus", "--out", "results"], 6.0),
+    "run paper (C master)": (["run", "paper", "--fmus", "native", "--master", "c", "--out", "rc"], 2.5),
+    "build": (["build", "--out", "fmus-new"], 8.0),
+    "build --native": (["build", "--native", "--out", "native-new"], 8.0),
+    "fit isobaric": (["fit", "isobaric", "isobaric.csv", "--out", "fit"], 4.0),
+}
+SAMPLE = 7   # interrupts in the suite: every command once, two more drawn (seeded)
+
+
+def _plan(seed=48):
+    rng = random.Random(seed)
+    names = list(COMMANDS) + rng.sample(list(COMMANDS), SAMPLE - len(COMMANDS))
+    return [(name, round(rng.uniform(0.3, COMMANDS[name][1]), 2)) for name in names]
+
+
+@pytest.fixture(scope="module")
+def work(tmp_path_factory, fmus, native_fmus):
+    """A folder holding the inputs: the FMUs of both families and the shipped isobaric file."""
+    folder = tmp_path_factory.mktemp("interrupts")
+    for name, paths in (("fmus", fmus), ("native", native_fmus)):
+        (folder / name).mkdir()
+        for path in paths.values():
+            shutil.copyfile(path, folder / name / path.name)
+    shutil.copyfile(shipped_file("examples", "isobaric.csv"), folder / "isobaric.csv")
+    return folder
+
+
+@pytest.mark.needs("gcc")
+@pytest.mark.parametrize("name, after_s", _plan())
+def test_a_ctrl_c_ends_with_one_line_and_leaves_nothing(work, name, after_s):
+    result = interrupt(COMMANDS[name][0], work, after_s)
+    assert result.status != 0, f"{name} ended before the interrupt at {after_s} s"
+    assert result.problems() == [], (name, after_s, result.stderr[-2000:])
+
+
+def _frame_of(module_name):
+    """A frame whose module is ``module_name`` (its code run in such a namespace)."""
+    namespace = {"__name__": module_name, "sys": sys}
+    exec("def probe():\n    return sys._getframe()\n", namespace)  # noqa: S102 - a fixed text
+    return namespace["probe"]()
+
+
+def test_code_of_a_pythonfmu_fmu_is_told_from_the_master():
+    stamp = code_stamp()
+    names, _ = _renamer("sma_actuator", stamp)
+    for module in (f"sma_actuator_{stamp}", f"{names['sma_fmu.runtime']}.plant",
+                   f"{names['sma_fmu.fmi.python_family.slave_support']}.guards",
+                   "pythonfmu.fmi2slave"):
+        assert interrupts.in_fmu_code(_frame_of(module)), module
+    for module in ("sma_fmu.cosim.master", "pythonfmu.builder", "numpy.core", "__main__"):
+        assert not interrupts.in_fmu_code(_frame_of(module)), module
+
+
+def test_without_the_handler_nothing_changes():
+    with interrupts.deferred():   # not installed: a no-op
+        pass
+    assert not interrupts.seen()
+
+
+def test_a_deferred_section_gets_its_interrupt_at_its_end():
+    finished = []
+    with interrupts.handle_interrupts():
+        with pytest.raises(KeyboardInterrupt):
+            with interrupts.deferred():
+                signal.raise_signal(signal.SIGINT)
+                finished.append("the section ran to its end")
+        assert interrupts.seen() and finished
+        signal.raise_signal(signal.SIGINT)   # after the first: ignored while ending
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_ctrl_c_inside_fmu_code_comes_when_the_fmu_call_returns():
+    """pythonfmu would turn a KeyboardInterrupt in its slave into fmi2Fatal: the slave's step
+    runs to its end, and the interrupt comes in the caller's next line."""
+    namespace = {"__name__": f"sma_actuator_{code_stamp()}", "signal": signal}
+    exec("def step(log):\n"  # noqa: S102 - a fixed text, a slave step's stand-in module
+         "    signal.raise_signal(signal.SIGINT)\n"
+         "    log.append('the step ran to its end')\n"
+         "    return True\n", namespace)
+    log = []
+    with interrupts.handle_interrupts():
+        with pytest.raises(KeyboardInterrupt):
+            namespace["step"](log)
+            log.append("the master went on")   # never: the interrupt comes here
+    assert log == ["the step ran to its end"] and sys.gettrace() is None

@@ -1,0 +1,111 @@
+"""Ctrl-C at a random moment of a long command, as a terminal sends it, and what it left.
+
+:func:`interrupt` starts ``sma-fmu ARGS`` in a folder of its own (its own process group, its
+own temporary folder), waits ``after_s`` seconds and sends SIGINT to the whole group (what a
+terminal's Ctrl-C does: compilers and C masters get it too), then checks the contract of
+the command line: exit status 130, one line ``sma-fmu: interrupted`` on stderr, no traceback
+anywhere, and no file or folder that was not there before (in the working folder and the
+temporary folder; the compiler caches under the temporary folder are kept on purpose, and
+left out). Used by tests/cli/test_interrupts.py and by hand by
+tests/cli/interrupts_check.py (50 of them).
+"""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = ["Interrupted", "interrupt", "sma_fmu_command", "tree"]
+
+# caches under the temporary folder, kept across runs on purpose, each filled atomically: the
+# C family's compiler cache, the C hosts (sma-fmu-<host>-<key>), zig's
+_CACHE_PREFIXES = ("sma-fmu-", "zig")
+
+
+def sma_fmu_command():
+    """The ``sma-fmu`` console script next to this Python, else ``python -m sma_fmu``-like."""
+    script = Path(sys.executable).with_name("sma-fmu")
+    return [str(script)] if script.is_file() else [sys.executable, "-c",
+                                                   "import sys; from sma_fmu.cli import main; "
+                                                   "sys.exit(main())"]
+
+
+def tree(folder, leave_out=()):
+    """The relative paths of everything under ``folder`` (a set); folders whose names start
+    with one of ``leave_out`` are skipped."""
+    folder = Path(folder)
+    found = set()
+    for root, dirs, files in os.walk(folder):
+        dirs[:] = [d for d in dirs if not d.startswith(tuple(leave_out))]
+        for name in dirs + files:
+            found.add(str((Path(root) / name).relative_to(folder)))
+    return found
+
+
+@dataclass
+class Interrupted:
+    """What one interrupted run did."""
+
+    args: list
+    after_s: float
+    status: int
+    stdout: str
+    stderr: str
+    new_entries: list     # files or folders left behind that were not there before
+
+    def problems(self):
+        """Why this run broke the contract ([] when it kept it; None when it ended before the
+        interrupt, so it says nothing)."""
+        if self.status == 0:
+            return None
+        found = []
+        if self.status != 130:
+            found.append(f"exit status {self.status}, not 130")
+        if self.stderr.strip().splitlines()[-1:] != ["sma-fmu: interrupted"]:
+            found.append(f"stderr does not end with 'sma-fmu: interrupted': {self.stderr[-600:]!r}")
+        other = [line for line in self.stderr.strip().splitlines()[:-1]
+                 if not line.startswith("sma-fmu: ") or line.startswith("sma-fmu: error")]
+        if other:
+            found.append(f"stderr has other lines: {other[:5]}")
+        if "Traceback" in self.stderr + self.stdout or "KeyboardInterrupt" in self.stderr + self.stdout:
+            found.append("a traceback or KeyboardInterrupt was printed")
+        if self.new_entries:
+            found.append(f"left behind: {self.new_entries[:8]}")
+        return found
+
+
+def interrupt(args, work, after_s, timeout_s=120.0, environment=None, group=True):
+    """Run ``sma-fmu args`` in the folder ``work`` and Ctrl-C it after ``after_s`` seconds;
+    returns :class:`Interrupted`. ``work`` holds the inputs; its ``tmp/`` is made the
+    process's temporary folder. ``group``: SIGINT to the whole process group (a terminal's
+    Ctrl-C), else to sma-fmu alone (``kill -INT``, ``timeout -s INT``)."""
+    work = Path(work)
+    temporary = work / "tmp"
+    temporary.mkdir(exist_ok=True)
+    before = tree(work, _CACHE_PREFIXES)
+    env = dict(os.environ if environment is None else environment)
+    env.update(TMPDIR=str(temporary), PYTHONDONTWRITEBYTECODE="1")
+    env.pop("PYTHONWARNINGS", None)
+    process = subprocess.Popen(sma_fmu_command() + list(args), cwd=work, env=env,
+                               stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        time.sleep(after_s)
+        if process.poll() is None:
+            (os.killpg if group else os.kill)(process.pid, signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        stdout, stderr = process.communicate()
+        stderr += f"\n(no end {timeout_s} s after the interrupt: killed)"
+    left = sorted(tree(work, _CACHE_PREFIXES) - before)
+    for name in left:   # the next run starts from the same inputs
+        path = work / name
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        elif path.exists() or path.is_symlink():
+            path.unlink()
+    return Interrupted(list(args), after_s, process.returncode, stdout, stderr, left)
