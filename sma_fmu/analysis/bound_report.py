@@ -2,57 +2,70 @@
 
 For each scenario file: the RMSE of its controller (library path, metric of
 :mod:`sma_fmu.cosim.metrics`) and the :class:`~.tracking_bound.TrackingBound` of its
-reference, loads and hysteresis mode. Scenarios that differ only in the controller share
-one bound (it does not depend on the controller). Writes ``bound.json`` and ``bound.md``.
+reference, loads, hysteresis mode and driver limits. Scenarios that differ only in the
+controller share one bound (it does not depend on the controller, nor on the sensor: the
+bound is for a controller that knows the wire's state, which noise can only make worse).
+With a noisy ``[sensor]`` the controller's RMSE is the median over
+:data:`~sma_fmu.cosim.noise_seeds.NOISE_SEEDS` noise streams (the scenario's seed and the
+next ones), each also listed. Writes ``bound.json`` and ``bound.md``.
 """
 import hashlib
 
-from sma_fmu.cosim.loop import run_library
-from sma_fmu.cosim.metrics import scenario_metrics
+from sma_fmu.cosim.noise_seeds import NOISE_SEEDS, noise_seed_rmse
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
 
+from .power_limit import PowerLimit
 from .tracking_bound import SMOOTH_REVERSALS_PER_S, tracking_bound
 from .tracking_problem import TrackingProblem
 
 __all__ = ["problem_key", "bound_scenarios", "bound_markdown"]
 
 
-def problem_key(scenario):
-    """A digest of what the bound depends on: reference, loads, mode, start, step and wire."""
+def problem_key(scenario, limit=None):
+    """A digest of what the bound depends on: reference, loads, mode, start, step, wire and
+    the driver's ``limit`` (a :class:`~.power_limit.PowerLimit`)."""
     problem = TrackingProblem.from_scenario(scenario)
     digest = hashlib.sha256()
     for part in (problem.references, problem.step_loads, problem.weights):
         digest.update(part.tobytes())
     digest.update(repr((problem.mode, problem.T_start, problem.step_s,
-                        sorted(problem.params.values().items()))).encode())
+                        sorted(problem.params.values().items()), limit)).encode())
     return digest.hexdigest()
+
+
 
 
 def _ratio(value, bound):
     return None if not bound > 0.0 else value / bound
 
 
-def bound_scenarios(paths, out_dir, power_cap=None, progress=print):
+def bound_scenarios(paths, out_dir, power_cap=None, progress=print, current_A=None,
+                    voltage_V=None):
     """Bound every scenario file in ``paths``; write ``bound.json`` and ``bound.md``; return rows.
 
-    ``power_cap`` P_max [W] or None. All files are read before the first computation.
+    ``power_cap`` P_cap [W] or None; ``current_A`` I_max [A] and ``voltage_V`` V_max [V], None:
+    each scenario's ``[drive]`` limits. All files are read before the first computation.
     """
     scenarios = [load_scenario(path) for path in paths]
     bounds, rows = {}, []
     with staged_folder(out_dir) as stage:
         for scenario in scenarios:
-            key = problem_key(scenario)
+            limit = PowerLimit.of(power_cap, scenario, current_A, voltage_V)
+            key = problem_key(scenario, limit)
             if key not in bounds:
-                progress(f"bounding {scenario.name} ({scenario.hysteresis_mode}) ...")
-                bounds[key] = tracking_bound(scenario, power_cap)
+                progress(f"bounding {scenario.name} ({scenario.hysteresis_mode}, "
+                         f"{limit.describe()}) ...")
+                bounds[key] = tracking_bound(scenario, limit)
             bound = bounds[key]
-            metrics = scenario_metrics(run_library(scenario).data, scenario)
-            rmse = metrics["overall"]["rmse_ohm"]
+            rmse, per_seed = noise_seed_rmse(scenario)
+            controller = scenario.controller
             smooth = bound.smooth
-            rows.append({"scenario": scenario.name, "controller": metrics["controller"],
-                         "inverse": metrics["inverse"], "rmse_ohm": rmse,
+            rows.append({"scenario": scenario.name, "controller": controller.kind,
+                         "inverse": controller.inverse if controller.feedforward else None,
+                         "rmse_ohm": rmse, "rmse_per_noise_seed_ohm": per_seed,
+                         "sensor": None if scenario.sensor.ideal else vars(scenario.sensor),
                          "rmse_over_lower_bound": _ratio(rmse, bound.lower_bound_ohm),
                          "rmse_over_achievable": _ratio(rmse, bound.achievable.rmse_ohm),
                          "rmse_over_smooth": None if smooth is None else _ratio(rmse, smooth.rmse_ohm),
@@ -66,14 +79,23 @@ def _number(value, digits=3):
     return "n/a" if value is None else f"{value:.{digits}f}"
 
 
+def _limit_text(bound):
+    return PowerLimit(bound["power_cap_W"], bound["current_limit_A"],
+                      bound["voltage_limit_V"]).describe()
+
+
 def bound_markdown(rows):
     """Markdown table of the rows of :func:`bound_scenarios`."""
-    cap = rows[0]["bound"]["power_cap_W"] if rows else None
+    limits = sorted({_limit_text(row["bound"]) for row in rows})
+    noisy = any(row["rmse_per_noise_seed_ohm"] for row in rows)
     lines = ["# Tracking bound", "",
-             f"RMSE of e = R - R_ref over the metric window, ohm; power 0 W <= P "
-             f"{'unlimited' if cap is None else f'<= {cap:g} W'}. The best any controller can "
-             "reach lies between the lower bound and the best benchmark; 'smooth' is the best "
-             f"benchmark with at most {SMOOTH_REVERSALS_PER_S:g} temperature reversals per second.",
+             f"RMSE of e = R - R_ref over the metric window, ohm; power P >= 0 W, "
+             f"{'; '.join(limits) or 'unlimited'} (the driver's limit at the wire's R). The best "
+             "any controller can reach lies between the lower bound and the best benchmark; "
+             f"'smooth' is the best benchmark with at most {SMOOTH_REVERSALS_PER_S:g} temperature "
+             "reversals per second." + (f" With sensor noise, RMSE is the median over "
+                                        f"{NOISE_SEEDS} noise seeds (the bound is noise-free)."
+                                        if noisy else ""),
              "", "| scenario | mode | controller | RMSE | lower bound | best benchmark (peak W, "
              "reversals/s) | smooth benchmark (peak W, reversals/s) | RMSE / lower bound | "
              "RMSE / smooth |", "|---|---|---|---:|---:|---:|---:|---:|---:|"]

@@ -23,20 +23,23 @@ from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.minor_loops import push_reversal
 from sma_fmu.runtime.sensing import mixed_fractions_of_resistance, temperature_on_stack
 
+from .power_limit import PowerLimit
+
 __all__ = ["OneStepInverse", "track"]
 
 
 class OneStepInverse:
     """Perfect-knowledge one-step inverse of a runtime :class:`PlantStepper`.
 
-    ``problem`` a :class:`~.tracking_problem.TrackingProblem`; ``power_cap`` P_max [W]
-    (None: no upper limit).
+    ``problem`` a :class:`~.tracking_problem.TrackingProblem`; ``power_cap`` P_max [W] or a
+    :class:`~.power_limit.PowerLimit` (None: no upper limit; a current or voltage limit is
+    taken at the plant's R at each step's start).
     """
 
     def __init__(self, problem, power_cap=None):
         self.problem = problem
         self.plant = problem.plant()
-        self.cap = np.inf if power_cap is None else power_cap
+        self.limit = PowerLimit.of(power_cap)
         self._branches = BranchCache(problem.params)
 
     def _temperature_towards(self, reference, load, direction):
@@ -61,7 +64,9 @@ class OneStepInverse:
         else:
             cooling = self._temperature_towards(reference, load, COOLING)
             aim = cooling if cooling < now else now
-        return min(self.cap, max(0.0, self.problem.power_to(now, aim)))
+        limit = self.limit
+        cap = float(limit.at(self.plant.outputs.R)) if limit.by_resistance else limit.cap
+        return min(cap, max(0.0, self.problem.power_to(now, aim)))
 
     def passive_resistance(self, load):
         """R [ohm] after a step at 0 W with ``load`` [kg] held; the plant is left unchanged."""

@@ -16,12 +16,20 @@ a rigorous bound for the model as implemented (to floating-point rounding).
 **Achievable** (:func:`node_path`): the same program on the nodes, with only moves a
 power in [0, P_max] makes exactly (hold, heat to a node, cool one node at P ~ 0). Its path
 is replayed through the runtime plant; the replayed RMSE is what a controller can reach.
+
+**A driver's current or voltage limit** (:class:`~.power_limit.PowerLimit`) makes P_max
+depend on the wire's R at the step's start: the lower bound gives each cell the most power
+over every resistance the cell holds (both directions, every load of the problem), a
+relaxation; the node program gives each node the least over its resistances, so its moves
+stay possible; the replay cuts each power to the limit at the plant's own R.
 """
 import numpy as np
 
 from sma_fmu.runtime.constant_load import constant_load_resistance
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.reachable_band import reachable_band
+
+from .power_limit import PowerLimit
 
 __all__ = ["cell_lower_bound", "node_path", "replay_path"]
 
@@ -77,12 +85,18 @@ def _squared_distance(value, low, high):
     return np.maximum(low - value, 0.0) ** 2 + np.maximum(value - high, 0.0) ** 2
 
 
+def _resistance_range(tables):
+    """(low, high) [ohm] per cell or node over the R tables given (each (2, size))."""
+    stacked = np.concatenate(tables)
+    return stacked.min(axis=0), stacked.max(axis=0)
+
+
 def cell_lower_bound(problem, grid, power_cap=None):
     """Rigorous lower bound on the RMSE [ohm] in mode "switch" (see the module docstring).
 
-    ``power_cap`` P_max [W]; None for no upper limit on the power.
+    ``power_cap`` P_max [W] or a :class:`~.power_limit.PowerLimit`; None for no upper limit.
     """
-    params, cap = problem.params, np.inf if power_cap is None else power_cap
+    params, limit = problem.params, PowerLimit.of(power_cap)
     low_t, high_t = grid.cell_bounds
     size = grid.count + 2
     charges = {}
@@ -91,6 +105,9 @@ def cell_lower_bound(problem, grid, power_cap=None):
         charges[load] = (
             np.stack([np.append(_resistances(high_t[:-1], load, d, params), hot) for d in _ROWS]),
             np.stack([_resistances(low_t, load, d, params) for d in _ROWS]))
+    cap = limit.cap
+    if limit.by_resistance:   # the most power over every R a cell holds (a branch is monotone)
+        cap = limit.most(*_resistance_range([t for pair in charges.values() for t in pair]))
     reach = problem.after_step(high_t, cap)
     can_heat = problem.after_step(low_t, cap) > low_t  # P_max can still raise T there
     cells = np.arange(size)
@@ -115,20 +132,23 @@ class _NodeProgram:
     """
 
     def __init__(self, problem, grid, power_cap):
-        params, cap = problem.params, np.inf if power_cap is None else power_cap
+        params, limit = problem.params, PowerLimit.of(power_cap)
         self.problem, self.nodes = problem, grid.nodes
         count = len(self.nodes)
         self.start = count
-        self.can_hold = np.append(problem.power_to(self.nodes, self.nodes) <= cap,
-                                  problem.power_to(problem.T_start, problem.T_start) <= cap)
-        reach = problem.after_step(self.nodes, cap)
-        self.heat = _WindowMin(np.arange(1, count + 1),
-                               np.searchsorted(self.nodes, reach, side="right") - 1, count)
         self.costs = {}
         for load in np.unique(problem.sample_loads).tolist():
             start_r = constant_load_resistance(problem.T_start, load, HEATING, params)
             self.costs[load] = np.stack([np.append(_resistances(self.nodes, load, d, params), start_r)
                                          for d in _ROWS])
+        cap = np.full(count + 1, limit.cap)
+        if limit.by_resistance:   # the least power over a node's resistances: always possible
+            cap = limit.least(*_resistance_range(list(self.costs.values())))
+        self.can_hold = np.append(problem.power_to(self.nodes, self.nodes) <= cap[:count],
+                                  problem.power_to(problem.T_start, problem.T_start) <= cap[count])
+        reach = problem.after_step(self.nodes, cap[:count])
+        self.heat = _WindowMin(np.arange(1, count + 1),
+                               np.searchsorted(self.nodes, reach, side="right") - 1, count)
 
     def cost(self, k):
         problem = self.problem
@@ -197,11 +217,12 @@ def node_path(problem, grid, power_cap=None):
 def replay_path(problem, temperatures, rows, power_cap=None):
     """Powers [W] that drive the runtime plant along a temperature path, and its R_k [ohm].
 
-    Each step aims at temperatures[k + 1] with P clamped into [0, P_max]; where the path holds
-    its temperature and the plant is on it, the aim is the plant's temperature moved by
-    1e-9 K in the held direction (rows[k + 1]), so the plant keeps that direction.
+    Each step aims at temperatures[k + 1] with P clamped into [0, P_max] (P_max at the plant's
+    R under a current or voltage limit); where the path holds its temperature and the plant
+    is on it, the aim is the plant's temperature moved by 1e-9 K in the held direction
+    (rows[k + 1]), so the plant keeps that direction.
     """
-    cap, plant = np.inf if power_cap is None else power_cap, problem.plant()
+    limit, plant = PowerLimit.of(power_cap), problem.plant()
     powers = np.empty(problem.steps)
     resistances = np.empty(problem.steps + 1)
     resistances[0] = plant.outputs.R
@@ -209,6 +230,7 @@ def replay_path(problem, temperatures, rows, power_cap=None):
         aim = temperatures[k + 1]
         if aim == temperatures[k] and abs(plant.temperature - aim) < 1e-6:
             aim = plant.temperature + (1e-9 if rows[k + 1] == 0 else -1e-9)
+        cap = float(limit.at(plant.outputs.R)) if limit.by_resistance else limit.cap
         powers[k] = min(cap, max(0.0, problem.power_to(plant.temperature, aim)))
         resistances[k + 1] = plant.step(float(powers[k]), float(problem.step_loads[k]),
                                         problem.step_s).R

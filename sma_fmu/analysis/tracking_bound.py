@@ -1,6 +1,8 @@
 """How well can any controller track a scenario's reference? A lower bound and benchmarks.
 
-For a scenario (reference, loads, hysteresis mode, wire) and powers 0 <= P <= P_max:
+For a scenario (reference, loads, hysteresis mode, wire) and powers 0 <= P <= P_max, where
+P_max = min(P_cap, I_max^2 R, V_max^2 / R) may depend on the wire's resistance through the
+driver's current and voltage limit (the scenario's ``[drive]``, :mod:`.power_limit`):
 
 - **saturation bound** (any mode): where R_ref lies outside the band the wire can reach
   at the load (:func:`~sma_fmu.runtime.reachable_band.reachable_band`), no controller gets
@@ -28,6 +30,7 @@ import numpy as np
 from sma_fmu.cosim.metrics import band_edges
 
 from .inverse_tracker import track
+from .power_limit import PowerLimit
 from .switch_dp import cell_lower_bound, node_path, replay_path
 from .tracking_problem import TemperatureGrid, TrackingProblem
 
@@ -59,6 +62,8 @@ class TrackingBound:
     scenario: str
     hysteresis_mode: str
     power_cap_W: object
+    current_limit_A: object     # I_max [A] of the driver, or None
+    voltage_limit_V: object     # V_max [V] of the driver, or None
     saturation_bound_ohm: float
     lower_bound_ohm: float
     lower_bound_method: str
@@ -107,29 +112,34 @@ def _benchmark(problem, method, powers, resistances):
                      float(powers[problem.weights[:-1] > 0].max()), reversal_rate(problem, powers))
 
 
-def tracking_bound(scenario, power_cap=None, mode=None):
+def tracking_bound(scenario, power_cap=None, mode=None, current_A=None, voltage_V=None):
     """:class:`TrackingBound` of a :class:`~sma_fmu.cosim.scenario.Scenario`.
 
-    ``power_cap`` P_max [W] (None: no upper limit); ``mode`` overrides the hysteresis mode.
+    ``power_cap`` P_cap [W] (None: no upper limit) or a whole
+    :class:`~.power_limit.PowerLimit`; ``current_A`` I_max [A] and ``voltage_V`` V_max [V]
+    (0: none), None: the scenario's ``[drive]`` limits (none by default); ``mode`` overrides
+    the hysteresis mode.
     """
     start = time.perf_counter()
     problem = TrackingProblem.from_scenario(scenario, mode)
+    limit = PowerLimit.of(power_cap, scenario, current_A, voltage_V)
     saturation = saturation_bound(problem)
     if problem.mode == "switch":
         grid = TemperatureGrid.for_problem(problem)
-        lower = max(saturation, cell_lower_bound(problem, grid, power_cap))
+        lower = max(saturation, cell_lower_bound(problem, grid, limit))
         lower_method = f"cell dynamic program, {grid.count} temperature nodes, exact passive cooling"
-        _, temperatures, rows = node_path(problem, grid, power_cap)
-        powers, resistances = replay_path(problem, temperatures, rows, power_cap)
+        _, temperatures, rows = node_path(problem, grid, limit)
+        powers, resistances = replay_path(problem, temperatures, rows, limit)
         benchmarks = (_benchmark(problem, "node dynamic program's path", powers, resistances),)
     else:
         lower, lower_method = saturation, "saturation (reachable band) only"
         benchmarks = tuple(
             _benchmark(problem, "one-step inverse of the plant" + (
                 f", 0 W where a passive step lands within {tolerance:g} ohm" if tolerance else ""),
-                *track(problem, tolerance, power_cap))
+                *track(problem, tolerance, limit))
             for tolerance in TOLERANCES)
     return TrackingBound(
-        scenario=scenario.name, hysteresis_mode=problem.mode, power_cap_W=power_cap,
+        scenario=scenario.name, hysteresis_mode=problem.mode, power_cap_W=limit.power_W,
+        current_limit_A=limit.current_A, voltage_limit_V=limit.voltage_V,
         saturation_bound_ohm=saturation, lower_bound_ohm=lower, lower_bound_method=lower_method,
         benchmarks=benchmarks, seconds=time.perf_counter() - start)

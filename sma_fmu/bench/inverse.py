@@ -71,26 +71,26 @@ def python_inverse_ns(constants, targets, margin, passes):
     return statistics.median(costs)
 
 
-def _timing_program(folder):
-    """Compile ``inverse_timing.c`` with the C runtime's sources; its path."""
+def timing_program(folder, name="inverse_timing"):
+    """Compile the bench's ``<name>.c`` with the C runtime's sources into ``folder``; its path."""
     from sma_fmu.fmi.hosts import c_compiler
     from sma_fmu.fmi.packaging.parameter_table import generated_folder
     import sma_fmu.fmi.c_family as c_family
     runtime = Path(c_family.__file__).parent / "runtime"
     sources = [str(path) for path in sorted(runtime.glob("*.c"))]
-    program = Path(folder) / "inverse_timing"
-    source = Path(folder) / "inverse_timing.c"
-    source.write_bytes((resources.files("sma_fmu.bench") / "inverse_timing.c").read_bytes())
+    program = Path(folder) / name
+    source = Path(folder) / f"{name}.c"
+    source.write_bytes((resources.files("sma_fmu.bench") / f"{name}.c").read_bytes())
     command = [*c_compiler(), "-std=c99", "-O2", "-ffp-contract=off", f"-I{runtime}",
                f"-I{generated_folder()}", "-o", str(program), str(source), *sources, "-lm"]
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
-        raise RuntimeError(f"the inverse timing program did not compile:\n{result.stderr}")
+        raise RuntimeError(f"the timing program {name} did not compile:\n{result.stderr}")
     return program
 
 
 def c_inverse_ns(program, params, load, direction, targets, passes=C_PASSES):
-    """Median CPU time [ns] of one C inversion (``program`` from :func:`_timing_program`)."""
+    """Median CPU time [ns] of one C inversion (``program`` from :func:`timing_program`)."""
     values = [getattr(params, spec.name) for spec in PARAMETER_SPECS]
     numbers = [math.nan if v is None else float(v) for v in values]
     numbers += [load, direction, passes, len(targets)] + [v for pair in targets for v in pair]
@@ -105,7 +105,7 @@ def inverse_costs(wires, runs, folder):
     """{wire: {"python_ns", "c_ns"}} for ``wires`` {name: WireParameters}, at
     :data:`LOAD_KG` heating; ``runs`` passes of the Python timing (at least 5). CPU time, not
     wall: on a shared machine it counts only this process's work."""
-    program = _timing_program(folder)
+    program = timing_program(folder)
     results = {}
     for name, params in wires.items():
         constants = branch_constants(LOAD_KG, 1, params)

@@ -28,6 +28,13 @@ def _bench(args):
         print("\n".join(inverse_lines(results)))
         print(f"written: {args.out / 'benchmark.json'}")
         return 0
+    if args.only == "hardware":
+        from sma_fmu.bench.hardware import hardware_lines, run_hardware_bench
+        say = lambda text: print(text, flush=True)  # noqa: E731
+        results = run_hardware_bench(args.out, args.runs, args.fmus, say)
+        print("\n".join(hardware_lines(results)))
+        print(f"written: {args.out / 'benchmark.json'}")
+        return 0
     if args.only == "pwm":
         from sma_fmu.bench.pwm_table import pwm_table_rows
         pwm_table_rows()
@@ -43,7 +50,8 @@ def register(commands):
                        help="output folder")
     bench.add_argument("--runs", type=bounded_integer(1, MAX_RUNS), default=5,
                        help=f"repetitions per measurement, 1-{MAX_RUNS}")
-    bench.add_argument("--only", choices=("batch", "hosts", "pwm", "c-master", "inverse"),
+    bench.add_argument("--only", choices=("batch", "hosts", "pwm", "c-master", "inverse",
+                                          "hardware"),
                        help="only this section (batch: the batch engine's throughput table; "
                             "hosts: every scenario in every host against the library loop, "
                             "docs/systems.md's table; pwm: the PWM table of docs/model.md; "
@@ -51,10 +59,12 @@ def register(commands):
                             "scenario, whole run commands, the run table's wall s, a sweep per "
                             "worker, the peak memory of a one-hour run; inverse: one inversion "
                             "of a two-stage wire in Python and C, and heavy-pi+ff-adaptive "
-                            "through its FMUs against the reference wire's)")
+                            "through its FMUs against the reference wire's; hardware: the "
+                            "sensor's and the drive limit's cost per step in Python and C, and "
+                            "the C master against the library on the bench scenarios)")
     bench.add_argument("--fmus", type=Path, metavar="DIR",
-                       help="with --only c-master: the native FMUs (sma-fmu build --native; "
-                            "default: built into the output folder)")
+                       help="with --only c-master or hardware: the native FMUs (sma-fmu build "
+                            "--native; default: built into the output folder)")
     bench.add_argument("--model", type=Path, metavar="FILE",
                        help="with --only inverse: the two-stage wire's parameter file (e.g. "
                             "a fit's identified.toml; default: the reference wire with a "

@@ -4,13 +4,14 @@ from pathlib import Path
 from sma_fmu.console.extras import require
 
 from .arguments import (add_quiet_argument, add_scenario_arguments, bounded_integer,
-                        require_inputs, scenario_paths)
+                        bounded_number, require_inputs, scenario_paths)
 
 # choice: ranges wide enough for any real study, narrow enough that a typo cannot start a
 # run that would never end or exhaust memory (checked before any work starts)
 MAX_WORKERS = 256
 MAX_GENERATIONS = 1000
 MAX_POPULATION = 100
+MAX_DRAWS = 100
 
 __all__ = ["register"]
 
@@ -39,10 +40,15 @@ def _tune(args):
     paths = scenario_paths(args)
     require("studies", "tune")
     from sma_fmu.console.progress import echo
+    from sma_fmu.studies.robust import RobustCriterion
     from sma_fmu.studies.tuning import run_tuning
     out = args.out or Path("results") / "tune"
+    robust = None
+    if args.robust:
+        robust = RobustCriterion(args.draws, args.spread, args.quantile, args.seed)
     run_tuning(paths, out, seed=args.seed, generations=args.generations,
-               population=args.population, stop_time_s=args.stop_time, progress=echo)
+               population=args.population, stop_time_s=args.stop_time, progress=echo,
+               robust=robust)
     print(f"written: {out}/report.md, report.json, NAME/controller.toml")
     return 0
 
@@ -78,5 +84,17 @@ def register(commands):
     tune.add_argument("--stop-time", type=float, metavar="S",
                       help="tune over the first S seconds, checked as a scenario's stop_time_s "
                            "(at most 4,000,000 steps) (default: the scenario's duration)")
+    tune.add_argument("--robust", action="store_true",
+                      help="score gains by a quantile of the RMSE over Monte Carlo draws of "
+                           "the noise stream and the wire (+- --spread on its thermal and "
+                           "transformation parameters; docs/studies.md)")
+    tune.add_argument("--draws", type=bounded_integer(1, MAX_DRAWS), default=5,
+                      help=f"with --robust: draws per candidate, 1-{MAX_DRAWS} (default 5)")
+    tune.add_argument("--spread", type=bounded_number(0.0, 0.5, closed=True), default=0.1,
+                      help="with --robust: relative spread of the wire's parameters, 0-0.5 "
+                           "(default 0.1: +-10 %%)")
+    tune.add_argument("--quantile", type=bounded_number(0.0, 1.0, closed=True), default=0.5,
+                      help="with --robust: the quantile of the draws' RMSEs minimised, 0-1 "
+                           "(default 0.5: the median)")
     add_quiet_argument(tune)
     tune.set_defaults(handler=_tune)

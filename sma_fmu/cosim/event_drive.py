@@ -27,8 +27,8 @@ class PassThroughDriver:
     """The loop's driver when the PWM driver sits inside :class:`EventDrivenPlant`: the PI's
     output goes on to the plant as the demand [W]."""
 
-    def step(self, time_s, demand, step_size):
-        """``demand`` [W], unchanged."""
+    def step(self, time_s, demand, step_size, resistance=None):
+        """``demand`` [W], unchanged (the driver inside the plant applies any limit)."""
         return demand
 
     def initial(self):
@@ -45,6 +45,8 @@ class EventDrivenPlant:
     def __init__(self, driver, plant, power_trace=None):
         self.driver, self.plant = driver, plant
         self._demand = driver.fmu.port(("P_demand",))
+        # a limited driver's R input: the wire's resistance at the grid step's start, held
+        self._resistance = driver.fmu.port(("R",)) if driver.limited else None
         self._power = driver.fmu.port(("P_in",))
         self.trace = power_trace
         self.steps = 0  # plant steps so far (one or more per grid step)
@@ -60,6 +62,8 @@ class EventDrivenPlant:
         end = time_s + step_size
         driver, plant_step = self.driver.fmu, self.plant.step
         self._demand.set((demand,))
+        if self._resistance is not None:
+            self._resistance.set((self.plant.outputs()[0],))
         start, energy = time_s, 0.0
         while True:
             event, early, last = driver.step_events(start, end - start)
@@ -83,8 +87,8 @@ def traced_driver(driver, power_trace):
     ``power_trace``: the fixed-step run's record of what the plant got."""
     step = driver.step
 
-    def traced(time_s, demand, step_size):
-        power = step(time_s, demand, step_size)
+    def traced(time_s, demand, step_size, *resistance):
+        power = step(time_s, demand, step_size, *resistance)
         power_trace.append((time_s, time_s + step_size, demand, power))
         return power
     driver.step = traced

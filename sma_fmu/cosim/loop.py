@@ -23,10 +23,21 @@ step before, so the power reaches the wire one step later than without a driver;
 the plant gets the driver's output after initialization (0 W for the PWM driver). The P
 column is the power the plant applied in both.
 
+A driver's current or voltage limit (``[drive] I_max_A``, ``V_max_V``) cuts the power to
+min(I_max^2 R_k, V_max^2 / R_k) with the wire's R_k at t_k (:mod:`sma_fmu.runtime.drive_limit`):
+the PWM wave's on-power, or, for kind "power", the demand itself (a linear driver).
+
+A ``[sensor]`` puts the controller's measurement between the plant and the PI: the PI's
+error is e_k = R_meas,k - R_ref(t_k), R_meas,k the reading of sample k
+(:class:`~sma_fmu.runtime.measurement.ResistanceSensor`: noise, ADC); the R column and the
+metrics stay the wire's true R.
+
 The driver is any object with
 
 - ``step(time_s, demand_W, step_size) -> P_in``: the power [W] the plant gets over
-  [time_s, time_s + step_size) for the demand ``demand_W`` [W] held over that step;
+  [time_s, time_s + step_size) for the demand ``demand_W`` [W] held over that step; for a
+  scenario whose drive has a limit, ``step(time_s, demand_W, step_size, resistance)``, the
+  wire at ``resistance`` [ohm] (R_k) at the step's start;
 - ``initial() -> P_in``: its output [W] after initialization, before its first step (what a
   Jacobi host passes to the plant at k = 0);
 
@@ -39,14 +50,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sma_fmu.runtime.drive_limit import DriveLimit, LinearDriver
 from sma_fmu.runtime.feedforward import FeedforwardStepper
+from sma_fmu.runtime.measurement import ResistanceSensor
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.pwm import PwmDriver
 
 __all__ = ["COLUMNS", "COLUMN_NAMES", "TIMESERIES_DTYPE", "PLANT_OUTPUTS", "COUPLINGS",
            "LoopResult", "run_loop", "LibraryPlant", "LibraryCompensator", "LibraryDriver",
-           "library_driver", "run_library"]
+           "library_driver", "library_sensor", "run_library"]
 
 COLUMNS = (("t", "s"), ("R_ref", "ohm"), ("R", "ohm"), ("T", "degC"), ("T_ref", "degC"),
            ("x", "m"), ("stroke", "m"), ("xi_P", ""), ("xi_M", ""), ("xi_F", ""),
@@ -110,28 +123,40 @@ class LibraryCompensator:
 
 
 class LibraryDriver:
-    """The scenario's PWM drive as the runtime :class:`PwmDriver` (library path)."""
+    """The scenario's drive as the runtime :class:`PwmDriver` or, for kind "power" with a
+    limit, :class:`~sma_fmu.runtime.drive_limit.LinearDriver` (library path)."""
 
     def __init__(self, scenario):
         drive = scenario.drive
-        self.pwm = PwmDriver(drive.frequency_Hz, drive.peak_W)
+        limit = DriveLimit(drive.I_max_A, drive.V_max_V)
+        self.pwm = (PwmDriver(drive.frequency_Hz, drive.peak_W, limit) if drive.pwm
+                    else LinearDriver(limit))
 
     def initial(self):
         """P_in [W] after initialization, before the first step: 0 W (the wave's first period
         has not started)."""
         return self.pwm.power
 
-    def step(self, time_s, demand, step_size):
-        """P_in [W]: the mean of the PWM wave over [time_s, time_s + step_size) for ``demand`` [W]."""
-        return self.pwm.step(demand, time_s, step_size)
+    def step(self, time_s, demand, step_size, resistance=None):
+        """P_in [W] over [time_s, time_s + step_size) for ``demand`` [W] with the wire at
+        ``resistance`` [ohm]: the mean of the PWM wave, or the demand within the limit."""
+        return self.pwm.step(demand, time_s, step_size, resistance)
 
     def close(self):
         """Nothing to release."""
 
 
 def library_driver(scenario):
-    """The :class:`LibraryDriver` of ``scenario``'s ``[drive]``, or None for kind "power"."""
-    return LibraryDriver(scenario) if scenario.drive.pwm else None
+    """The :class:`LibraryDriver` of ``scenario``'s ``[drive]``, or None for kind "power"
+    without a limit."""
+    return LibraryDriver(scenario) if scenario.drive.driver else None
+
+
+def library_sensor(scenario):
+    """The :class:`ResistanceSensor` of ``scenario``'s ``[sensor]``, or None when ideal."""
+    sensor = scenario.sensor
+    return None if sensor.ideal else ResistanceSensor(
+        sensor.noise_ohm_rms, sensor.full_scale_ohm, sensor.bits, sensor.seed)
 
 
 def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=None, sink=None):
@@ -165,6 +190,9 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
         data = np.empty(ROWS_PER_CHUNK, dtype=TIMESERIES_DTYPE)
     gains = scenario.controller
     pi = PIController(gains.Kp, gains.Ki)
+    sensor = library_sensor(scenario)
+    measure = None if sensor is None else sensor.measure
+    limited = scenario.drive.limited       # the driver takes the wire's R_k
     nan = math.nan
     no_compensator = (0.0, nan, False)
     rows, first_row = [], 0
@@ -178,12 +206,13 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
     if jacobi:  # what the blocks show after initialization: a Jacobi host passes it on at k = 0
         held_ff = (no_compensator if compensator is None
                    else compensator.initial(reference_at(0.0), load_at(0.0)))
-        held_power = pi.output(resistance - reference_at(0.0), held_ff[0])[0]
+        measured = resistance if sensor is None else sensor.preview(resistance)
+        held_power = pi.output(measured - reference_at(0.0), held_ff[0])[0]
         held_drive = None if driver is None else driver.initial()
     for k in range(n):
         time_s = k * h
         reference, load = reference_at(time_s), load_at(time_s)
-        error = resistance - reference
+        error = (resistance if measure is None else measure(resistance)) - reference
         if compensator_step is None:
             compensated = no_compensator
         else:
@@ -194,11 +223,18 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
             if driver_step is None:
                 plant_power = held_power
             else:
-                plant_power, held_drive = held_drive, driver_step(time_s, held_power, h)
+                plant_power, held_drive = held_drive, (
+                    driver_step(time_s, held_power, h, resistance) if limited
+                    else driver_step(time_s, held_power, h))
             held_ff, held_power = compensated, power
         else:
             power, feedback = pi_step(error, p_ff, h)
-            plant_power = power if driver_step is None else driver_step(time_s, power, h)
+            if driver_step is None:
+                plant_power = power
+            elif limited:
+                plant_power = driver_step(time_s, power, h, resistance)
+            else:
+                plant_power = driver_step(time_s, power, h)
         sample = (time_s, reference, resistance, temperature, t_ref, length, start_length - length,
                   xi_p, xi_m, xi_f, p_ff, feedback)
         resistance, temperature, length, xi_p, xi_m, xi_f, applied = plant_step(

@@ -200,17 +200,24 @@ class FmuCompensator:
 
 class FmuDriver:
     """The SmaPwmDriver FMU (``component`` "driver") as the loop's driver (the hook of
-    :func:`~sma_fmu.cosim.loop.run_loop`)."""
+    :func:`~sma_fmu.cosim.loop.run_loop`). ``limited``: the driver has a current or voltage
+    limit, so its R input gets the wire's resistance at each step's start."""
 
-    def __init__(self, component, instance_name="driver", combined=None, events=False):
+    def __init__(self, component, instance_name="driver", combined=None, events=False,
+                 limited=False):
         self.fmu = open_instance(component.fmu, instance_name, _starts(component), events=events)
+        self.limited = limited
         self._initial = self.fmu.port(("P_in",))
-        lean = LeanStep(self.fmu, ("P_demand",), ("P_in",), combined=combined)
+        lean = LeanStep(self.fmu, ("P_demand", "R") if limited else ("P_demand",), ("P_in",),
+                        combined=combined)
         inputs, outputs, lean_step = lean.inputs, lean.outputs, lean.step
 
-        def step(time_s, demand, step_size):
-            """Set P_demand [W], doStep, return P_in [W]: the wave's mean over the step."""
+        def step(time_s, demand, step_size, resistance=None):
+            """Set P_demand [W] (and R [ohm]), doStep, return P_in [W]: the wave's mean over
+            the step, or the demand within the limit."""
             inputs[0] = demand
+            if limited:
+                inputs[1] = resistance
             lean_step(time_s, step_size)
             return outputs[0]
         self.step = step
@@ -250,9 +257,9 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
         if scenario.controller.feedforward:
             parts["compensator"] = FmuCompensator(system.component("compensator"),
                                                   combined=combined, events=events)
-        if scenario.drive.pwm:
+        if scenario.drive.driver:
             parts["driver"] = FmuDriver(system.component("driver"), combined=combined,
-                                        events=events)
+                                        events=events, limited=scenario.drive.limited)
         plant, driver = parts["plant"], parts.get("driver")
         if events and driver is not None:
             plant, driver = EventDrivenPlant(driver, plant, power_trace), PassThroughDriver()

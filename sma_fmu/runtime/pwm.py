@@ -12,6 +12,11 @@ mean of the wave: a period much shorter than the step gives the demanded mean po
 the partial periods at the step's ends), a period longer than the step a square wave.
 Times within :data:`PERIOD_TOLERANCE` periods of a period start count as that start, so
 t = k h meets j / f although neither is exact in binary.
+
+With a :class:`~.drive_limit.DriveLimit` (a current-limited supply), the wave's on-power is
+``peak_W`` cut to the limit at the wire's resistance R at the step's start,
+min(peak_W, I_max^2 R, V_max^2 / R): the duty still comes from ``peak_W`` (the controller
+does not know its supply sags), the mean is that on-power times the on-fraction.
 """
 import math
 
@@ -31,13 +36,14 @@ DRIVE_KINDS = ("power", "pwm")
 class PwmDriver:
     """PWM of the heating power at ``frequency_Hz`` [Hz] between 0 and ``peak_W`` [W]."""
 
-    def __init__(self, frequency_Hz, peak_W):
+    def __init__(self, frequency_Hz, peak_W, limit=None):
         self.frequency = require_positive("frequency_Hz", frequency_Hz)
         if not MIN_FREQUENCY_HZ <= self.frequency <= MAX_FREQUENCY_HZ:
             raise ValueError(f"frequency_Hz must be in [{MIN_FREQUENCY_HZ:g}, {MAX_FREQUENCY_HZ:g}] "
                              f"Hz, got {frequency_Hz!r}")
         self.peak = require_positive("peak_W", peak_W)
         self.period = 1.0 / self.frequency
+        self.limit = limit if limit is not None and limit.limited else None   # DriveLimit
         self.held = None      # (index j, duty) of the period in progress at the last step's end
         self.power = 0.0      # mean power of the last step [W]
 
@@ -59,16 +65,21 @@ class PwmDriver:
         begin = index * self.period
         return max(0.0, min(begin + duty * self.period, end) - max(begin, start))
 
-    def step(self, demand_W, time_s, step_size):
+    def step(self, demand_W, time_s, step_size, resistance=None):
         """Mean power [W] over [time_s, time_s + step_size) with ``demand_W`` held.
 
         The period in progress at ``time_s`` keeps the duty it was given at its start (a
         first step, or a time that does not follow the last step, gives it the present
-        demand's). Non-finite demand or time, or a step <= 0, raise ``ValueError``.
+        demand's). ``resistance`` R [ohm] of the wire sets the on-power under a limit (else
+        unused). Non-finite demand or time, a step <= 0, or (with a limit) an R that is not
+        finite and > 0, raise ``ValueError``.
         """
         demand_W = fast_finite("P_demand", demand_W)
         time_s = fast_finite("time", time_s)
         step_size = fast_positive("step_size", step_size)
+        on_power = self.peak
+        if self.limit is not None:
+            on_power = self.limit.apply(on_power, fast_positive("R", resistance))
         end = time_s + step_size
         duty = self.duty_of(demand_W)
         first, starts = self._index(time_s)
@@ -89,7 +100,7 @@ class PwmDriver:
             on += self._on_time(last, duty, time_s, end)
             last_duty = duty
         self.held = (last, last_duty)
-        self.power = self.peak * min(1.0, on / step_size)
+        self.power = on_power * min(1.0, on / step_size)
         return self.power
 
     def state(self):

@@ -13,6 +13,8 @@ model the compensator was designed with, as a real one does; give the same chang
      "plant.hysteresis_mode": "continuous",
      "load.values_kg": 0.1,                # a number: that load throughout
      "reference.amplitude_ohm": 4.0,
+     "sensor.seed": 3,                     # the sensor's noise stream (a [sensor] section)
+     "drive.I_max_A": 0.4,                 # the driver's current limit
      "wire.a_h": 70.0}                     # degC, the plant's wire only
 
 The changed document goes through the scenario loader, so every value is checked as in a
@@ -32,7 +34,8 @@ from sma_fmu.runtime.parameters import PARAMETER_SPECS, ParameterError
 
 __all__ = ["StudyError", "SECTIONS", "ScenarioTemplate", "template", "with_overrides"]
 
-SECTIONS = ("scenario", "reference", "load", "controller", "plant", "wire", "model")
+SECTIONS = ("scenario", "reference", "load", "controller", "plant", "drive", "sensor", "wire",
+            "model")
 _WIRE = {spec.name for spec in PARAMETER_SPECS} - set(GAIN_KEYS)   # the gains are the controller's
 
 

@@ -8,6 +8,13 @@ for the least RMSE of R - R_ref over the scenario's metrics window (the same RMS
 RMSE is the one reported. Writes ``NAME/controller.toml`` (a ``[controller]`` table that
 pastes into the scenario), ``report.json`` and ``report.md`` (the controllers ranked at
 the scenario's own gains and at each controller's tuned gains).
+
+With a :class:`~sma_fmu.studies.robust.RobustCriterion` (``--robust``) the score of a set of
+gains is a quantile of the RMSEs over Monte Carlo draws of noise stream and wire, the same
+draws for every candidate (:mod:`sma_fmu.studies.robust`). Every record also carries the
+margins of the linearised loop at the given and the tuned gains
+(:mod:`sma_fmu.studies.margins`) and, for a noisy scenario, the median RMSE over five noise
+streams on the nominal wire at the tuned gains (:mod:`sma_fmu.cosim.noise_seeds`).
 """
 import dataclasses
 import json
@@ -21,12 +28,15 @@ from scipy.optimize import differential_evolution
 from sma_fmu.console import progress
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
+from sma_fmu.cosim.noise_seeds import noise_seed_rmse
 from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.fmi.loop.gains import GAIN_KEYS
 from sma_fmu.studies.batch import run_batch, unsupported_reason
+from sma_fmu.studies.margins import loop_margins
 from sma_fmu.studies.overrides import StudyError, template
+from sma_fmu.studies.robust import draw_scenarios, robust_value
 
 __all__ = ["BOUNDS", "TUNED", "tune_scenario", "controller_snippet", "run_tuning",
            "ranking_markdown"]
@@ -48,19 +58,38 @@ def _rmse(metrics):
     return _FAILED_RMSE if value is None or not math.isfinite(value) else value
 
 
-def tune_scenario(scenario, seed=1, generations=30, population=12):
-    """Tune one scenario's controller; returns a JSON-ready record (values, RMSE, effort)."""
+def _robust_record(scenario, best, names, start, robust):
+    """The draws' RMSEs [ohm] (scalar path) at the given and the tuned gains, and the score."""
+    record = robust.as_dict()
+    for label, values in (("given", start), ("tuned", [getattr(best.controller, n) for n in names])):
+        rmses = [_rmse(scenario_metrics(run_library(draw).data, draw))
+                 for draw in (_with_gains(d, names, values) for d in draw_scenarios(scenario, robust))]
+        record[f"rmse_{label}_ohm"] = rmses
+        record[f"score_{label}_ohm"] = float(robust_value(rmses, robust.quantile))
+    return record
+
+
+def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
+    """Tune one scenario's controller; returns a JSON-ready record (values, RMSE, effort).
+
+    ``robust``: a :class:`~sma_fmu.studies.robust.RobustCriterion`, or None for the RMSE of
+    the scenario as it is.
+    """
     reason = unsupported_reason(scenario)
     if reason:
         raise StudyError(f"tune needs the batch engine: {reason}")
     names = TUNED[scenario.controller.kind]
+    draws = [scenario] if robust is None else draw_scenarios(scenario, robust)
+    quantile = 0.5 if robust is None else robust.quantile
     evaluations = 0
 
     def cost(candidates):                      # (D, S) -> (S,)
         nonlocal evaluations
-        batch = [_with_gains(scenario, names, column) for column in np.atleast_2d(candidates).T]
+        batch = [_with_gains(draw, names, column) for column in np.atleast_2d(candidates).T
+                 for draw in draws]
         evaluations += len(batch)
-        return np.array([_rmse(run.metrics) for run in run_batch(batch)])
+        rmses = np.array([_rmse(run.metrics) for run in run_batch(batch)])
+        return robust_value(rmses.reshape(-1, len(draws)), quantile)
 
     began = time.perf_counter()
     start = [getattr(scenario.controller, name) for name in names]
@@ -74,6 +103,18 @@ def tune_scenario(scenario, seed=1, generations=30, population=12):
     best = _with_gains(scenario, names, result.x)
     tuned = scenario_metrics(run_library(best).data, best)   # the reported RMSE: scalar path
     given = scenario_metrics(run_library(scenario).data, scenario)
+    extra = {"margins": {"given": loop_margins(scenario), "tuned": loop_margins(best)}}
+    if scenario.sensor.noise_ohm_rms:
+        median, values = noise_seed_rmse(best)
+        extra["noise_seeds"] = {"median_ohm": median, "rmse_ohm": values}
+    if robust is not None:
+        extra["robust"] = _robust_record(scenario, best, names, start, robust)
+    return {**_record(scenario, names, result, start, tuned, given, evaluations, seconds, seed),
+            **extra}
+
+
+def _record(scenario, names, result, start, tuned, given, evaluations, seconds, seed):
+    """The record's fields common to both criteria."""
     return {"scenario": scenario.name, "group": scenario.group,
             "controller": scenario.controller.kind, "inverse": scenario.controller.inverse,
             "hysteresis_mode": scenario.hysteresis_mode,
@@ -97,8 +138,16 @@ def controller_snippet(record):
     """The tuned gains as a ``[controller]`` TOML table that pastes into the scenario."""
     lines = [f"# sma-fmu tune {record['scenario']} ({datetime.now(timezone.utc).date()}): "
              f"RMSE {record['rmse_ohm']['tuned']:.4f} ohm, against "
-             f"{record['rmse_ohm']['given']:.4f} ohm at the scenario's gains",
-             "[controller]", f"kind = {json.dumps(record['controller'])}"]
+             f"{record['rmse_ohm']['given']:.4f} ohm at the scenario's gains"]
+    robust = record.get("robust")
+    if robust:
+        lines.append(f"# robust: quantile {robust['quantile']:g} of {robust['draws']} draws "
+                     f"(noise, +-{100 * robust['spread']:g} % wire): "
+                     f"{robust['score_tuned_ohm']:.4f} ohm, against {robust['score_given_ohm']:.4f}")
+    margins = record["margins"]["tuned"]
+    lines += [f"# margins of the linearised loop: gain {margins['gain_margin_dB']:.1f} dB, "
+              f"phase {margins['phase_margin_deg']:.1f} deg",
+              "[controller]", f"kind = {json.dumps(record['controller'])}"]
     if record.get("inverse", "major") != "major":
         lines.append(f"inverse = {json.dumps(record['inverse'])}")
     lines += [f"{GAIN_KEYS[name]} = {value!r}" for name, value in record["tuned"].items()]
@@ -136,13 +185,26 @@ def ranking_markdown(records):
             lines.append(f"| {group} | {mode} | {gains} | " +
                          " | ".join(f"{rmse[c]:.3f}" if c in rmse else "-" for c in labels)
                          + f" | {order} |")
-    lines += ["", "| scenario | RMSE given | RMSE tuned | tuned values (* at a bound) |",
-              "|---|---:|---:|---|"]
+    robust = next((r["robust"] for r in records if r.get("robust")), None)
+    score = "" if robust is None else (f" | score given | score tuned")
+    lines += ["", f"| scenario | RMSE given | RMSE tuned{score} | tuned values (* at a bound) | "
+              "gain margin [dB] | phase margin [deg] |",
+              "|---|---:|---:|" + ("---:|---:|" if robust else "") + "---|---:|---:|"]
     for record in records:
         values = ", ".join(f"{name} = {value:.4g}{'*' if name in record['at_bound'] else ''}"
                            for name, value in record["tuned"].items())
+        scores = "" if robust is None else (
+            f" | {record['robust']['score_given_ohm']:.3f} | {record['robust']['score_tuned_ohm']:.3f}"
+            if record.get("robust") else " | - | -")
+        margins = record["margins"]["tuned"]
         lines.append(f"| {record['scenario']} | {record['rmse_ohm']['given']:.3f} | "
-                     f"{record['rmse_ohm']['tuned']:.3f} | {values} |")
+                     f"{record['rmse_ohm']['tuned']:.3f}{scores} | {values} | "
+                     f"{margins['gain_margin_dB']:.1f} | {margins['phase_margin_deg']:.1f} |")
+    if robust is not None:
+        lines += ["", f"Score: the {robust['quantile']:g} quantile of the RMSE over "
+                      f"{robust['draws']} draws (noise stream; {', '.join(robust['parameters'])} "
+                      f"each x U[{1 - robust['spread']:g}, {1 + robust['spread']:g}]). Margins: "
+                      "the loop linearised where the wire is steepest."]
     return "\n".join(lines) + "\n"
 
 
@@ -156,8 +218,11 @@ def _with_stop_time(scenario, stop_time_s):
 
 
 def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_s=None,
-               progress=print):
-    """Tune every scenario file in ``paths``; write snippets and reports; return the records."""
+               progress=print, robust=None):
+    """Tune every scenario file in ``paths``; write snippets and reports; return the records.
+
+    ``robust``: a :class:`~sma_fmu.studies.robust.RobustCriterion` or None (see the module
+    docstring)."""
     scenarios = [load_scenario(p) for p in paths]
     if stop_time_s is not None and not stop_time_s > 0.0:
         raise StudyError(f"--stop-time {stop_time_s!r}: must be > 0 s")
@@ -167,9 +232,12 @@ def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_
     for index, scenario in enumerate(scenarios, start=1):
         progress(f"[{index}/{len(scenarios)}] tuning {scenario.name} "
                  f"({', '.join(TUNED[scenario.controller.kind])}) ...")
-        record = tune_scenario(scenario, seed, generations, population)
+        record = tune_scenario(scenario, seed, generations, population, robust)
         progress(f"    RMSE {record['rmse_ohm']['given']:.4f} -> {record['rmse_ohm']['tuned']:.4f}"
                  f" ohm: " + ", ".join(f"{k} = {v:.4g}" for k, v in record["tuned"].items()))
+        if robust is not None:
+            progress(f"    robust score {record['robust']['score_given_ohm']:.4f} -> "
+                     f"{record['robust']['score_tuned_ohm']:.4f} ohm")
         records.append(record)
     with staged_folder(out_dir) as stage:
         for record in records:

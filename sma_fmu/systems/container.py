@@ -45,6 +45,10 @@ _EXPECTED = ("Loop of links through the embedded FMU 'pi'",
              "Sequential mode: the order of the configuration does not match")
 # ... and without a compensator the PI's P_ff keeps its start value, 0 W
 _EXPECTED_WITHOUT_COMPENSATOR = _EXPECTED + ("Input 'Port pi/P_ff' is not connected",)
+# ... and a driver with a current or voltage limit reads the plant's R (the same loop as the
+# PI's); one without a limit leaves that input unconnected (it is not read)
+_EXPECTED_LIMITED = ("Loop of links through the embedded FMU 'driver'",)
+_EXPECTED_UNLIMITED_DRIVER = ("Input 'Port driver/R' is not connected",)
 
 
 def _configure(container, system):
@@ -58,6 +62,7 @@ def _configure(container, system):
         for name, value in component.parameters.items():
             container.add_start_value(component.name, name, _text(value))
     container.drop_port("plant", "heating")
+    container.drop_port("pi", "R_measured")   # the sensor's reading: the PI's own business
     container.add_implicit_rule(auto_input=False, auto_output=False, auto_link=False)
 
 
@@ -98,6 +103,8 @@ def build_container(system, out, step_size=None, argument="--out"):
     scenario = system.scenario
     step_size = scenario.step_s if step_size is None else step_size
     expected = _EXPECTED if scenario.controller.feedforward else _EXPECTED_WITHOUT_COMPENSATOR
+    if scenario.drive.driver:
+        expected += _EXPECTED_LIMITED if scenario.drive.limited else _EXPECTED_UNLIMITED_DRIVER
     try:
         with toolbox_messages() as messages, \
                 tempfile.TemporaryDirectory(prefix="sma_fmu_container_") as folder:

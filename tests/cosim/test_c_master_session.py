@@ -2,10 +2,11 @@
 
 What is tested is that keeping the host changes nothing a run computes: every run in a
 long-lived master equals the same run in a fresh host (a C master of its own), every column
-of every row to the bit, over runs with different scenarios, gains, loads and wires one
-after the other, after a failed step, after a host killed by the watchdog and after a host
-that died between runs; that the runner and a sweep's tasks keep one host, and that a
-sweep on two Dask workers gives, to the bit, the metrics of its points run one at a time.
+of every row to the bit, over runs with different scenarios, gains, loads, wires, sensors
+(noise stream, ADC) and drive limits one after the other, after a failed step, after a host
+killed by the watchdog and after a host that died between runs; that the runner and a
+sweep's tasks keep one host, and that a sweep on two Dask workers gives, to the bit, the
+metrics of its points run one at a time.
 """
 import os
 import signal
@@ -59,7 +60,8 @@ def _same(a, b):
 
 def _varied():
     """Runs that differ in scenario (the components too: PI only, with a compensator, with
-    a PWM driver), gains, load, wire and hysteresis mode, short enough for a test."""
+    a PWM driver), gains, load, wire, hysteresis mode, the bench's sensor (its noise stream
+    and its sample held in the PI's state) and the driver's limit, short enough for a test."""
     short = {"scenario.stop_time_s": 3.0}
     return [_scenario(name, short) for name in PAPER_SET[:3]] + [
         _scenario(PWM, short),
@@ -67,6 +69,9 @@ def _varied():
         _scenario("load-step-pi+ff-adaptive", {**short, "load.values_kg": 0.1}),
         _scenario("load-step-pi+ff-fixed", {**short, "wire.a_h": 70.0, "plant.hysteresis_mode": "continuous"}),
         _scenario("heavy-pi", short),   # the first scenario's components again, other values before
+        _scenario("load-step-bench-pi+ff-adaptive", short),
+        _scenario("load-step-bench-pi+ff-adaptive", {**short, "sensor.seed": 3, "drive.I_max_A": 0.3}),
+        _scenario("heavy-continuous-bench-pi", short),
     ]
 
 
@@ -83,6 +88,7 @@ def test_runs_after_a_reset_equal_fresh_runs_to_the_bit(native_dir, started):
     assert len(started) == 1 and started[0].returncode == 0   # stdin closed: it ended itself
     assert not np.array_equal(fresh[4]["P"], fresh[7]["P"])   # the gains changed the run
     assert not np.array_equal(fresh[5]["R"], fresh[2]["R"])   # and so did the load
+    assert not np.array_equal(fresh[8]["P"], fresh[9]["P"])   # and the sensor's seed, the limit
 
 
 def test_a_failed_step_ends_its_run_only(native_dir, started, tmp_path, monkeypatch):

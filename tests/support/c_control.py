@@ -9,8 +9,8 @@ import re
 
 from c_runtime import compile_runtime
 
-MODULES = ("pi_control", "pwm", "signals", "scenario_signals", "json_text", "json_string",
-           "json_number", "json_repr", "checks", "state_entries", "sma_message")
+MODULES = ("pi_control", "pwm", "drive_limit", "signals", "scenario_signals", "json_text",
+           "json_string", "json_number", "json_repr", "checks", "state_entries", "sma_message")
 
 SHIM = r"""
 #include <string.h>

@@ -65,7 +65,10 @@ def test_driver_fmu_is_valid_and_declares_its_variables_with_units(fmus):
     declared = {name: (v.causality, v.unit) for name, v in variables.items()}
     assert declared == {"P_demand": ("input", "W"), "P_in": ("output", "W"),
                         "frequency_Hz": ("parameter", "Hz"), "peak_W": ("parameter", "W"),
-                        "wire_digest": ("local", None)}   # the wire it was built with
+                        "wire_digest": ("local", None),   # the wire it was built with
+                        # the drive limit (docs/scenarios.md, the bench)
+                        "R": ("input", "ohm"), "modulation": ("parameter", None),
+                        "I_max_A": ("parameter", "A"), "V_max_V": ("parameter", "V")}
     assert all(v.description for v in variables.values())
     with FmuInstance(path, "driver") as fmu:
         assert fmu.get_real(("P_in",)) == [0.0]  # after initialization: no wave yet

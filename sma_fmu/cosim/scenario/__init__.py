@@ -13,9 +13,10 @@ check) does not wait for the file reader's imports.
 from sma_fmu.cosim.scenario.names import PAPER_SET, resolve_scenarios, scenario_names
 from sma_fmu.cosim.scenario.settings import (CONTROLLERS, AnalysisWindow, ControllerSettings,
                                              DriveSettings, Scenario, ScenarioError,
-                                             default_analysis)
+                                             SensorSettings, default_analysis)
 
-__all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "AnalysisWindow", "Scenario",
+__all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "SensorSettings",
+           "AnalysisWindow", "Scenario",
            "CONTROLLERS", "PAPER_SET", "MAX_STEPS", "load_scenario", "read_scenario_document",
            "scenario_from_document", "check_sections", "default_analysis", "scenario_names",
            "resolve_scenarios"]

@@ -34,6 +34,14 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     kind = "pwm"                # "power" (default: the demanded power itself) or "pwm"
     frequency_Hz = 50.0         # pwm: switching frequency; the demand sets each period's duty
     peak_W = 1.0                # pwm: power while on (duty = clip(P_demand / peak_W, 0, 1))
+    # I_max_A = 0.5             # optional (either kind): current limit, P <= I_max^2 R
+    # V_max_V = 24.0            # optional (either kind): voltage limit, P <= V_max^2 / R
+
+    [sensor]                    # optional: the controller reads R through noise and an ADC
+    noise_ohm_rms = 0.05        # white noise [ohm RMS] (an approximately normal stream)
+    full_scale_ohm = 65.536     # ADC range 0 ... full scale [ohm], with
+    bits = 16                   # its resolution: step full_scale_ohm / 2^bits (0: none)
+    seed = 1                    # the noise stream, 0 ... 2^31 - 1
 
     [analysis]                  # optional; defaults derived from the duration (see AnalysisWindow)
     metrics_start_s = 2.0       # metrics over t >= this
@@ -48,7 +56,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.scenario.settings import (CONTROLLERS, AnalysisWindow, ControllerSettings,
                                              DriveSettings, Scenario, ScenarioError,
-                                             default_analysis)
+                                             SensorSettings, default_analysis)
 from sma_fmu.fmi.loop.gains import GAINS
 from sma_fmu.wire.parameter_file import load_parameter_set
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
@@ -57,6 +65,8 @@ from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.feedforward import INVERSES
 from sma_fmu.runtime.shaping import SHAPINGS
 from sma_fmu.runtime.phase_lag import tustin_coefficients
+from sma_fmu.runtime.drive_limit import DriveLimit
+from sma_fmu.runtime.measurement import ResistanceSensor
 from sma_fmu.runtime.pwm import DRIVE_KINDS, PwmDriver
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
@@ -73,8 +83,10 @@ _SECTIONS = {
     "controller": {"kind", "inverse", "shaping", "power_cap_W", *(gain.key for gain in GAINS)},
     "plant": {"hysteresis_mode", "T_start_degC"},
     "analysis": {"metrics_start_s", "zoom_start_s", "zoom_end_s"},
-    "drive": {"kind", "frequency_Hz", "peak_W"},
+    "drive": {"kind", "frequency_Hz", "peak_W", "I_max_A", "V_max_V"},
+    "sensor": set(SensorSettings.__dataclass_fields__),
 }
+_LIMITS = ("I_max_A", "V_max_V")
 
 def _fail(path, message):
     raise ScenarioError(f"{path}: {message}")
@@ -185,18 +197,39 @@ def _drive(path, table):
     kind = table.get("kind", "power")
     if kind not in DRIVE_KINDS:
         _fail(path, f"[drive] kind must be one of {', '.join(DRIVE_KINDS)}, got {kind!r}")
+    limits = {key: _number(path, "drive", table, key, positive=True)
+              for key in _LIMITS if key in table}
     if kind == "power":
-        extra = sorted(set(table) - {"kind"})
+        extra = sorted(set(table) - {"kind", *_LIMITS})
         if extra:
             _fail(path, f"[drive] {', '.join(extra)} only apply to kind = 'pwm'")
-        return DriveSettings()
+        return DriveSettings(**limits)
     drive = DriveSettings("pwm", _number(path, "drive", table, "frequency_Hz", positive=True),
-                          _number(path, "drive", table, "peak_W", positive=True))
+                          _number(path, "drive", table, "peak_W", positive=True), **limits)
     try:
-        PwmDriver(drive.frequency_Hz, drive.peak_W)
+        PwmDriver(drive.frequency_Hz, drive.peak_W, DriveLimit(drive.I_max_A, drive.V_max_V))
     except ValueError as error:
         _fail(path, f"[drive] {error}")
     return drive
+
+
+def _sensor(path, table):
+    """The ``[sensor]`` table: numbers where numbers go, whole numbers for bits and seed,
+    checked by the runtime's own :class:`ResistanceSensor` (its messages)."""
+    values = {}
+    for key, default in SensorSettings().__dict__.items():
+        value = table.get(key, default)
+        if isinstance(default, int):
+            if isinstance(value, bool) or not isinstance(value, int):
+                _fail(path, f"[sensor] {key} must be a whole number, got {value!r}")
+        else:
+            value = _number(path, "sensor", table, key, default=default)
+        values[key] = value
+    try:
+        ResistanceSensor(**values)
+    except ValueError as error:
+        _fail(path, f"[sensor] {error}")
+    return SensorSettings(**values)
 
 
 def check_sections(path, document, sections, required, error=ScenarioError):
@@ -276,7 +309,8 @@ def scenario_from_document(document, path, parameter_set=None):
         hysteresis_mode=mode, T_start=t_start, parameter_set=parameter_set,
         analysis_window=_analysis(path, document["analysis"], stop) if "analysis" in document else None,
         group_name=_string(path, "scenario", head, "group"), output_interval_s=interval,
-        drive=_drive(path, document["drive"]) if "drive" in document else DriveSettings())
+        drive=_drive(path, document["drive"]) if "drive" in document else DriveSettings(),
+        sensor=_sensor(path, document["sensor"]) if "sensor" in document else SensorSettings())
 
 
 def _interval_steps(*arguments):

@@ -1,11 +1,11 @@
 """What a validated scenario holds: the :class:`Scenario` record, its controller, drive and
 analysis settings, and :class:`ScenarioError`, the error of every scenario problem."""
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "AnalysisWindow", "Scenario",
-           "CONTROLLERS", "default_analysis"]
+__all__ = ["ScenarioError", "ControllerSettings", "DriveSettings", "SensorSettings",
+           "AnalysisWindow", "Scenario", "CONTROLLERS", "default_analysis"]
 
 CONTROLLERS = ("pi", "pi+ff-fixed", "pi+ff-adaptive")
 
@@ -68,11 +68,41 @@ class DriveSettings:
     kind: str = "power"
     frequency_Hz: float = None
     peak_W: float = None
+    # the limits are keyword-only: DriveSettings(kind, frequency_Hz, peak_W) keeps its meaning
+    I_max_A: float = field(default=0.0, kw_only=True)   # current limit [A] (0: none), DriveLimit
+    V_max_V: float = field(default=0.0, kw_only=True)   # voltage limit [V] (0: none)
 
     @property
     def pwm(self):
         """True when the power is switched by a PWM driver."""
         return self.kind == "pwm"
+
+    @property
+    def limited(self):
+        """True when the driver has a current or a voltage limit."""
+        return bool(self.I_max_A or self.V_max_V)
+
+    @property
+    def driver(self):
+        """True when a driver sits between the PI and the plant (PWM, or a limit)."""
+        return self.pwm or self.limited
+
+
+@dataclass(frozen=True)
+class SensorSettings:
+    """How the controller measures R (:class:`~sma_fmu.runtime.measurement.ResistanceSensor`):
+    white noise ``noise_ohm_rms`` [ohm RMS] of stream ``seed``, then a ``bits``-bit ADC over
+    0 ... ``full_scale_ohm`` [ohm] (bits 0: no quantisation). The default is ideal (R itself)."""
+
+    noise_ohm_rms: float = 0.0
+    full_scale_ohm: float = 0.0
+    bits: int = 0
+    seed: int = 0
+
+    @property
+    def ideal(self):
+        """True when the controller reads R exactly (no noise, no quantisation)."""
+        return self.noise_ohm_rms == 0.0 and self.bits == 0
 
 
 @dataclass(frozen=True)
@@ -95,6 +125,7 @@ class Scenario:
     compensator_parameter_set: object = None   # the compensator's model; None: the wire's
     drive: DriveSettings = DriveSettings()     # the file's [drive]; default: power as demanded
     output_interval_s: float = None            # record every k-th step [s]; None: every step
+    sensor: SensorSettings = SensorSettings()  # the file's [sensor]; default: R read exactly
 
     @property
     def params(self):

@@ -138,10 +138,10 @@ def loop_system(scenario, fmu_files, only=None):
     path}). ``only``: the names of the components to take (default: the whole loop); a
     master that runs the rest of the loop itself (the fmpy master: the PI and the signals)
     gets those components and the connections and outputs among them."""
-    feedforward, pwm = scenario.controller.feedforward, scenario.drive.pwm
-    names = [name for name in loop_components(feedforward, pwm) if only is None or name in only]
+    feedforward, driver = scenario.controller.feedforward, scenario.drive.driver
+    names = [name for name in loop_components(feedforward, driver) if only is None or name in only]
     paths = built_fmus(fmu_files, [COMPONENT_MODELS[name] for name in names])
-    connections = loop_connections(feedforward, pwm)
+    connections = loop_connections(feedforward, driver, scenario.drive.limited)
     starts = input_starts(scenario, connections)
     wire = WireSource(scenario.parameter_set.path, wire_digest(scenario.params))
     model = WireSource((scenario.compensator_parameter_set or scenario.parameter_set).path,

@@ -4,9 +4,10 @@ Computed here once for every master and system tool. Each component's parameters
 besides the scenario's wire in the FMUs that model it (:data:`WIRES`, set whole by
 :mod:`.wire_values`): the signals as JSON tables (SmaScenarioSignals), the compensator's
 filter, model load, adaptation, inverse, shaping and power cap (0 W: none), the PI's gains
-(:data:`~.gains.GAINS`), the driver's frequency and peak power, the plant's start
-temperature and hysteresis mode.
-Choices (the hysteresis mode, the inverse, the shaping) are the Integer codes of
+(:data:`~.gains.GAINS`) and its sensor (with a ``[sensor]``: noise, ADC, seed), the driver's
+frequency and peak power (and, with a limit, its modulation and current and voltage limits),
+the plant's start temperature and hysteresis mode.
+Choices (the hysteresis mode, the inverse, the shaping, the modulation) are the Integer codes of
 :mod:`sma_fmu.fmi.python_family.slave_support.choices`.
 
 An input the signals feed starts at the signal's value at t = 0 (:func:`input_starts`): what
@@ -42,9 +43,17 @@ def component_settings(scenario, name):
                 "shaping": choice_code("shaping", c.shaping),
                 "power_cap": 0.0 if c.power_cap_W is None else c.power_cap_W}
     if name == "pi":
-        return _gains(c, name)
+        sensor = scenario.sensor
+        return _gains(c, name) if sensor.ideal else {
+            **_gains(c, name), "noise_ohm_rms": sensor.noise_ohm_rms,
+            "adc_full_scale_ohm": sensor.full_scale_ohm, "adc_bits": sensor.bits,
+            "noise_seed": sensor.seed}
     if name == "driver":
-        return {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W}
+        settings = {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W} if drive.pwm \
+            else {"modulation": choice_code("modulation", "linear")}
+        if drive.limited:
+            settings.update(I_max_A=drive.I_max_A, V_max_V=drive.V_max_V)
+        return settings
     if name == "plant":
         return {"T_start": scenario.T_start,
                 "hysteresis_mode": choice_code("hysteresis_mode", scenario.hysteresis_mode)}

@@ -8,9 +8,13 @@ fmpy master, the C master, the SSP package, the container FMU) and each FMU's do
     compensator.P_ff --> pi.P_ff     pi.P --> plant.P_in     plant.R --> pi.R
 
 Without the compensator the PI's P_ff input keeps its start (0 W). With a PWM driver between
-the PI and the plant::
+the PI and the plant (or the same FMU as a linear driver with a current or voltage limit)::
 
     pi.P --> driver.P_demand     driver.P_in --> plant.P_in
+
+and a driver with a limit reads the wire's resistance::
+
+    plant.R --> driver.R
 """
 from dataclasses import dataclass
 
@@ -51,16 +55,19 @@ class Connection:
 
 def loop_components(feedforward, pwm):
     """The loop's component names in data-flow order, with the compensator (``feedforward``)
-    and the PWM driver (``pwm``) or without them."""
+    and the driver (``pwm``: the SmaPwmDriver FMU, switching or with a limit) or without them."""
     return [name for name in COMPONENT_MODELS
             if (name != "compensator" or feedforward) and (name != "driver" or pwm)]
 
 
-def loop_connections(feedforward, pwm):
-    """The loop's :class:`Connection` list, with the compensator (``feedforward``) and the PWM
-    driver (``pwm``) or without them."""
+def loop_connections(feedforward, pwm, limited=False):
+    """The loop's :class:`Connection` list, with the compensator (``feedforward``) and the
+    driver (``pwm``) or without them; ``limited``: the driver has a current or voltage limit
+    and reads the wire's R."""
     power = ([Connection("pi", "P", "driver", "P_demand"), Connection("driver", "P_in", "plant", "P_in")]
              if pwm else [Connection("pi", "P", "plant", "P_in")])
+    if pwm and limited:
+        power.append(Connection("plant", "R", "driver", "R"))
     connections = [Connection("signals", "R_ref", "pi", "R_ref"), *power,
                    Connection("signals", "load", "plant", "load"),
                    Connection("plant", "R", "pi", "R")]

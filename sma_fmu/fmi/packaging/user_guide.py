@@ -92,8 +92,10 @@ def _connection_rows(model_name):
     role = next(name for name, model in COMPONENT_MODELS.items() if model == model_name)
     full = loop_connections(feedforward=True, pwm=True)
     direct = [c for c in loop_connections(feedforward=True, pwm=False) if c not in full]
+    limited = [c for c in loop_connections(feedforward=True, pwm=True, limited=True) if c not in full]
     rows = []
-    for connection, note in [(c, "") for c in full] + [(c, "without the PWM driver") for c in direct]:
+    for connection, note in ([(c, "") for c in full] + [(c, "without the PWM driver") for c in direct]
+                             + [(c, "with a current or voltage limit") for c in limited]):
         if role in (connection.source, connection.target):
             rows.append((f"{COMPONENT_MODELS[connection.source]}.{connection.output}",
                          f"{COMPONENT_MODELS[connection.target]}.{connection.input}", note))

@@ -3,10 +3,12 @@
 Runs that share the step and the duration (different gains, filters, loads, references,
 wire parameters, hysteresis modes and controllers) go through one loop whose every
 quantity is an array of N. Per step k, as :func:`sma_fmu.cosim.loop.run_loop` does it:
-e_k = R_k - R_ref(t_k); u_k = max(0, u_ff,k + Kp e_k + Ki I_k), with the integrator held
-while clamped with e_k <= 0; the plants step with u_k and f(t_k) held, or, for runs with a
-PWM drive, with the mean of their PWM wave over the step for the demand u_k
-(:mod:`sma_fmu.studies.batch.pwm`; Gauss-Seidel, as the library path's default). The results
+e_k = R_k - R_ref(t_k) (with a ``[sensor]``, R_meas,k - R_ref(t_k) for the PI, the metrics
+keeping the true R: :mod:`sma_fmu.studies.batch.hardware`); u_k = max(0, u_ff,k + Kp e_k +
+Ki I_k), with the integrator held while clamped with e_k <= 0; the plants step with u_k and
+f(t_k) held, or, for runs with a PWM drive, with the mean of their PWM wave over the step for
+the demand u_k (:mod:`sma_fmu.studies.batch.pwm`; Gauss-Seidel, as the library path's
+default), and under a current or voltage limit with that power cut to it at R_k. The results
 equal the scalar library path's to rounding (tests/studies/test_batch.py,
 tests/runtime/test_pwm.py: <= 1e-10 on every column).
 
@@ -30,6 +32,7 @@ from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import CONTROLLERS, Scenario
 from sma_fmu.runtime.checks import HYSTERESIS_MODES
 from sma_fmu.studies.batch.feedforward import BatchFeedforward
+from sma_fmu.studies.batch.hardware import BatchLimits, BatchSensors
 from sma_fmu.studies.batch.inputs import BatchInputs
 from sma_fmu.studies.batch.metrics import MetricsAccumulator
 from sma_fmu.studies.batch.plant import BatchPlant
@@ -45,10 +48,11 @@ _KNOWN_SCENARIO_FIELDS = {"name", "path", "description", "stop_time_s", "step_s"
                           "load", "controller", "hysteresis_mode", "T_start", "parameter_set",
                           "analysis_window", "group_name", "compensator_parameter_set", "drive",
                           # what `sma-fmu run` records; metrics use every step here as there
-                          "output_interval_s"}
+                          "output_interval_s", "sensor"}
 _KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load", "inverse",
                             "shaping", "power_cap_W"}   # shaping: "none" only, checked below
-_KNOWN_DRIVE_FIELDS = {"kind", "frequency_Hz", "peak_W"}
+_KNOWN_DRIVE_FIELDS = {"kind", "frequency_Hz", "peak_W", "I_max_A", "V_max_V"}
+_KNOWN_SENSOR_FIELDS = {"noise_ohm_rms", "full_scale_ohm", "bits", "seed"}
 _DRIVE_KINDS = ("power", "pwm")   # not runtime.pwm.DRIVE_KINDS: a kind added there is refused
 
 
@@ -77,17 +81,20 @@ class BatchRun:
 
 @functools.lru_cache(maxsize=None)
 def _unknown_fields(*types):
-    """[fields the engine does not know] of the scenario's, controller's and drive's classes."""
+    """[fields the engine does not know] of the scenario's, controller's, drive's and sensor's
+    classes."""
     return [[f.name for f in dataclasses.fields(kind) if f.name not in known] for kind, known in
-            zip(types, (_KNOWN_SCENARIO_FIELDS, _KNOWN_CONTROLLER_FIELDS, _KNOWN_DRIVE_FIELDS))]
+            zip(types, (_KNOWN_SCENARIO_FIELDS, _KNOWN_CONTROLLER_FIELDS, _KNOWN_DRIVE_FIELDS,
+                        _KNOWN_SENSOR_FIELDS))]
 
 
 def unsupported_reason(scenario):
     """Why the batch engine cannot run ``scenario`` (a sentence), or None when it can."""
     if not isinstance(scenario, Scenario):
         return f"{scenario!r} is not a Scenario"
-    controller, drive = scenario.controller, scenario.drive
-    extra, options, drive_options = _unknown_fields(type(scenario), type(controller), type(drive))
+    controller, drive, sensor = scenario.controller, scenario.drive, scenario.sensor
+    extra, options, drive_options, sensor_options = _unknown_fields(
+        type(scenario), type(controller), type(drive), type(sensor))
     if extra:
         return f"scenario option(s) {', '.join(sorted(extra))} are not implemented in the batch engine"
     for name in options:                   # an option added later must be added here
@@ -96,6 +103,9 @@ def unsupported_reason(scenario):
     for name in drive_options:
         return (f"{scenario.name}: drive option {name} = "
                 f"{getattr(drive, name)!r} is not implemented in the batch engine")
+    for name in sensor_options:
+        return (f"{scenario.name}: sensor option {name} = "
+                f"{getattr(sensor, name)!r} is not implemented in the batch engine")
     if drive.kind not in _DRIVE_KINDS:
         return f"{scenario.name}: drive kind {drive.kind!r} is not implemented in the batch engine"
     if controller.shaping != "none":
@@ -177,6 +187,14 @@ def _loop(scenarios, inputs, record):
     pwm = (BatchPwm(inputs.pwm_frequency, inputs.pwm_peak, inputs.pwm_runs)
            if inputs.pwm_runs.size else None)
     every_run_pwm = pwm is not None and pwm.runs.size == inputs.size
+    sensors, limits = BatchSensors(scenarios, inputs.steps), BatchLimits(scenarios)
+    sensed, limited = sensors.runs.size > 0, limits.runs.size > 0
+    if limited and pwm is not None:   # where the PWM runs sit among the limited ones
+        pwm_position = {run: i for i, run in enumerate(pwm.runs.tolist())}
+        limited_pwm = ~limits.linear
+        pwm_limited = np.array([pwm_position[run] for run in limits.runs[limited_pwm].tolist()],
+                               dtype=int)
+    driven_runs = pwm is not None or limited   # the plants get what a driver gives
     times = inputs.times.tolist()             # t_k as run_loop has them (Python floats)
     feedforward = BatchFeedforward(inputs, scenarios)
     size, n, h = inputs.size, inputs.steps, inputs.step_s
@@ -202,7 +220,7 @@ def _loop(scenarios, inputs, record):
         feedback = np.empty((stop - start, size))
         power = np.empty((stop - start + 1, size))      # the PI's output u_k: the demand
         power[-1] = np.nan
-        applied = power if pwm is None else np.empty_like(power)   # what the plants get
+        applied = np.empty_like(power) if driven_runs else power   # what the plants get
         applied[-1] = np.nan
         P_ff = compensator.P_ff
         for j in range(stop - start):
@@ -213,6 +231,8 @@ def _loop(scenarios, inputs, record):
                 series.sample(k, plant)
             e, fb, u = errors[j], feedback[j], power[j]
             subtract(plant.R, references[j], e)
+            if sensed:                                 # the PI's error: the sensor's reading
+                e = subtract(sensors.read(plant.R, k), references[j])
             multiply(Kp, e, fb)                        # PIController.step
             multiply(Ki, integral, work)
             add(fb, work, fb)
@@ -226,13 +246,22 @@ def _loop(scenarios, inputs, record):
             multiply(step, e, work)
             multiply(work, mask, work)                 # I + (h e) * 1 = I + h e; * 0 adds 0
             add(integral, work, integral)
-            if pwm is not None:                        # the drivers between the PI and the plants
+            if driven_runs:                            # the drivers between the PI and the plants
                 driven = applied[j]
+                caps = limits.caps(plant.R) if limited else None
+                on_power = None
+                if limited and pwm is not None:        # a limited PWM's on-power
+                    on_power = pwm.peak.copy()
+                    on_power[pwm_limited] = np.minimum(on_power[pwm_limited], caps[limited_pwm])
                 if every_run_pwm:
-                    copyto(driven, pwm.step(u, times[k], h))
+                    copyto(driven, pwm.step(u, times[k], h, on_power))
                 else:
                     copyto(driven, u)
-                    driven[pwm.runs] = pwm.step(u[pwm.runs], times[k], h)
+                    if pwm is not None:
+                        driven[pwm.runs] = pwm.step(u[pwm.runs], times[k], h, on_power)
+                    if limited:                        # linear drivers: the demand within it
+                        lines = limits.runs[limits.linear]
+                        driven[lines] = np.minimum(u[lines], caps[limits.linear])
                 u = driven
             plant.step(u)
         np.subtract(plant.R, references[-1], out=errors[-1])   # e_stop, counted by the next chunk

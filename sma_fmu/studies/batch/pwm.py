@@ -56,12 +56,13 @@ class BatchPwm:
         self.held_index = np.full(self.runs.size, np.nan)   # no period held yet
         self.held_duty = np.zeros(self.runs.size)
 
-    def step(self, demand, time_s, step_size):
+    def step(self, demand, time_s, step_size, on_power=None):
         """Mean power [W] of each run's wave over [time_s, time_s + step_size) for ``demand`` [W].
 
         ``demand``: one entry per run of :attr:`runs`; ``time_s`` [s] and ``step_size`` [s]
-        are the batch's, as floats. Non-finite demands give duty 0 here (the scalar driver
-        raises; the batch reruns such runs on the scalar path).
+        are the batch's, as floats. ``on_power`` [W] per run: the wave's on-power under a
+        drive limit (None: ``peak_W``). Non-finite demands give duty 0 here (the scalar
+        driver raises; the batch reruns such runs on the scalar path).
         """
         frequency, period, peak = self.frequency, self.period, self.peak
         end = time_s + step_size
@@ -82,4 +83,4 @@ class BatchPwm:
             self.held_duty = np.where(several, duty, first_duty)
         else:
             self.held_index, self.held_duty = first, first_duty
-        return peak * np.minimum(1.0, on / step_size)
+        return (peak if on_power is None else on_power) * np.minimum(1.0, on / step_size)

@@ -135,7 +135,14 @@ int pwm_driver_init(PwmDriver *driver, double frequency_Hz, double peak_W, SmaMe
     driver->held_index.minus_one = 0;
     driver->held_duty = 0.0;
     driver->power = 0.0;
+    driver->limited = 0;
     return 0;
+}
+
+void pwm_driver_set_limit(PwmDriver *driver, const DriveLimit *limit)
+{
+    driver->limit = *limit;
+    driver->limited = limit->limited;
 }
 
 /* (j, starts): the period containing time_s [s] and whether it starts there; refused
@@ -178,12 +185,25 @@ static double on_time(const PwmDriver *driver, PwmIndex index, double duty, doub
 int pwm_driver_step(PwmDriver *driver, double demand_W, double time_s, double step_size,
                     double *power, SmaMessage *message)
 {
-    double end, duty, first_duty, last_duty, on;
+    return pwm_driver_step_limited(driver, demand_W, time_s, step_size, NAN, power, message);
+}
+
+int pwm_driver_step_limited(PwmDriver *driver, double demand_W, double time_s, double step_size,
+                            double resistance, double *power, SmaMessage *message)
+{
+    double end, duty, first_duty, last_duty, on, on_power;
     PwmIndex first, last;
     int starts, last_starts;
     if (fast_finite("P_demand", demand_W, message) || fast_finite("time", time_s, message)
         || fast_positive("step_size", step_size, message)) {
         return 1;
+    }
+    on_power = driver->peak;
+    if (driver->limited) {
+        if (fast_positive("R", resistance, message)) {
+            return 1;
+        }
+        on_power = drive_limit_apply(&driver->limit, on_power, resistance);
     }
     end = time_s + step_size;
     duty = pwm_driver_duty_of(driver, demand_W);
@@ -223,7 +243,7 @@ int pwm_driver_step(PwmDriver *driver, double demand_W, double time_s, double st
     driver->has_held = 1;
     driver->held_index = last;
     driver->held_duty = last_duty;
-    driver->power = driver->peak * py_min(1.0, on / step_size);
+    driver->power = on_power * py_min(1.0, on / step_size);
     *power = driver->power;
     return 0;
 }

@@ -6,6 +6,8 @@
  * d_j = clip(P_demand / peak_W, 0, 1), the wave being on over [j/f, (j + d_j)/f), and a period
  * keeps its duty to its end. pwm_driver_step returns the exact mean of the wave over
  * [t, t + h). Times within PERIOD_TOLERANCE periods of a period start count as that start.
+ * With a drive limit (pwm_driver_set_limit, drive_limit.h) the wave's on-power is peak_W cut
+ * to the limit at the wire's resistance at the step's start (pwm_driver_step_limited).
  *
  * Period indices: Python's are unbounded ints; here an index is a PwmIndex, the exact integer
  * base - minus_one with base an integer-valued double and minus_one 0 or 1 (1 only beyond
@@ -22,6 +24,7 @@
 
 #include <stddef.h>
 
+#include "drive_limit.h"
 #include "sma_message.h"
 
 #define PERIOD_TOLERANCE 1e-9    /* [periods] */
@@ -47,11 +50,16 @@ typedef struct PwmDriver {
     PwmIndex held_index;  /* the period in progress at the last step's end ... */
     double held_duty;     /* ... and its duty [1] */
     double power;       /* mean power of the last step [W] */
+    int limited;        /* a limit cuts the on-power (Python's limit is not None) */
+    DriveLimit limit;
 } PwmDriver;
 
 /* frequency_Hz finite in [MIN_FREQUENCY_HZ, MAX_FREQUENCY_HZ], peak_W finite and > 0, else
  * refused naming it (the driver is then untouched). */
 int pwm_driver_init(PwmDriver *driver, double frequency_Hz, double peak_W, SmaMessage *message);
+
+/* Put `limit` on the on-power (one without a limit set leaves the driver unlimited). */
+void pwm_driver_set_limit(PwmDriver *driver, const DriveLimit *limit);
 
 /* The duty [1] a period starting now takes from demand_W [W]: clip(P / peak, 0, 1). */
 double pwm_driver_duty_of(const PwmDriver *driver, double demand_W);
@@ -62,6 +70,10 @@ double pwm_driver_duty_of(const PwmDriver *driver, double demand_W);
  * OverflowError); the driver is then unchanged. */
 int pwm_driver_step(PwmDriver *driver, double demand_W, double time_s, double step_size,
                     double *power, SmaMessage *message);
+/* pwm_driver_step with the wire at `resistance` [ohm], which sets the on-power under a limit
+ * (refused, "R", unless finite and > 0; unused without a limit). */
+int pwm_driver_step_limited(PwmDriver *driver, double demand_W, double time_s, double step_size,
+                            double resistance, double *power, SmaMessage *message);
 
 size_t pwm_driver_state_size(const PwmDriver *driver);
 void pwm_driver_state_write(const PwmDriver *driver, double *out);

@@ -17,6 +17,7 @@ CHOICES = {
     "hysteresis_mode": {1: "continuous", 2: "switch"},
     "inverse": {1: "major", 2: "minor-loop"},
     "shaping": {1: "none", 2: "reachable"},
+    "modulation": {1: "pwm", 2: "linear"},   # the driver: switched, or the demand itself
 }
 
 

@@ -32,6 +32,8 @@ UNIT_DEFINITIONS = {
     "W/(ohm.s)": {"A": 2, "s": -1},
     "MPa": {"kg": 1, "m": -1, "s": -2, "factor": 1e6},
     "1/K": {"K": -1},
+    "A": {"A": 1},
+    "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
 }
 
 # schema order of fmiModelDescription's children (FMI 2.0 XSD)
