@@ -8,7 +8,7 @@
     xi_MF      = M/(1 + e^Lambda),  xi_P = M - xi_MF,  M = 1 - xi_Fmin
     xi_M = xi_MF/2,  xi_F = xi_Fmin + xi_MF/2
 
-With the optional terms of issue 36 (:mod:`.model_terms`) dH uses nu_d of the direction, and
+With the optional model terms (:mod:`.model_terms`) dH uses nu_d of the direction, and
 with a second stage (w2 > 0) the major branch is a weighted sum of two logistics,
 
     xi_MF = M (1 - w2)/(1 + e^Lambda1) + M w2/(1 + e^Lambda2),   Lambda2 with nu2_d, a2_d + b2_d f

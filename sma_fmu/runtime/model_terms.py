@@ -1,4 +1,4 @@
-"""The optional model terms of issue 36: what is in use when a file omits them, the stress
+"""The optional model terms (docs/model.md §4a): what is in use when a file omits them, the stress
 law of the transformation strain, and the wire length with thermal expansion.
 
     nu_d                 domain size on heating / cooling (omitted: nu)

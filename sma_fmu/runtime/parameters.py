@@ -173,7 +173,7 @@ class WireParameters:
     stress bounds as loads (None when not given), ``data_range`` is True when any bound is
     given: the steppers then warn once when a run leaves the range.
 
-    The optional terms of issue 36 (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``,
+    The optional model terms (``nu_h``, ``nu_c``, ``[second_stage]``, ``[strain]``,
     ``cc_share_h``, ``cc_share_c``) are
     None when not given; ``terms`` (:class:`~.model_terms.ModelTerms`) holds the values in
     use, defaults filled in (nu_h = nu_c = nu, w2 = 0, ...: today's model bit for bit).

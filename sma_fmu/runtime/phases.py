@@ -31,7 +31,7 @@ def length_of(fractions, params):
 def configurational_entropy(fractions, n_cells):
     """Configurational entropy S_C [J/K] of ``n_cells`` lattice cells mixed in these fractions."""
     # added left to right, not with sum(): from Python 3.12 sum() of floats compensates
-    # (Neumaier), and the FMU's result would depend on its host's Python (issue 32)
+    # (Neumaier), and the FMU's result would depend on its host's Python
     total = 0.0
     for xi in fractions:
         if xi > 0.0:

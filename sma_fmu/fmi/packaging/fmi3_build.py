@@ -104,7 +104,7 @@ def _build_one(model_name, python_fmu, folder, work, compile=False, step=None):
             archive.writestr(binary, data)
         archive.write(unpacked / "resources" / "parameters.json", "resources/parameters.json")
         # the start of every variable and the build's wire parameters: one binary serves
-        # every parameter file (issue 40), as in the FMI 2.0 build
+        # every parameter file, as in the FMI 2.0 build
         archive.writestr("resources/model_starts.json",
                          model_starts(fmi2_description, starts, defaults))
     # the default experiment run by this FMU: extra/ (fmi-ls-ref) and documentation/ (extras.py)

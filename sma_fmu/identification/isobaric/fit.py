@@ -1,4 +1,4 @@
-"""Identify the constant-load model (spec sections 2-4, with the issue-36 terms) from
+"""Identify the constant-load model (spec sections 2-4, with the optional model terms) from
 isobaric thermal cycling.
 
 The data: strain eps (and, where a file has it, resistance R) against a noisy thermocouple

@@ -4,7 +4,7 @@
  *   (cc_share_d > 0: the strain-weighted load f_d of centre_load in place of f)
  *   xi_Fmin(f) = xi_F_inf (1 - exp(-f/f_F)),  dH(f) = nu (eps_T - g f x_T / N)  [J]
  *   Lambda = (dH/k_B)(1/tau_K - 1/T_K),  xi_MF = M/(1 + e^Lambda),  xi_P = M - xi_MF
- * With the issue-36 terms (runtime/model_terms.py): dH with nu_h / nu_c, a second stage
+ * With the optional model terms (runtime/model_terms.py): dH with nu_h / nu_c, a second stage
  * xi_MF = M (1 - w2)/(1 + e^Lambda1) + M w2/(1 + e^Lambda2), the stress law and expansion. */
 #ifndef SMA_CONSTANT_LOAD_H
 #define SMA_CONSTANT_LOAD_H

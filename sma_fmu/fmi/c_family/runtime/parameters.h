@@ -37,7 +37,7 @@ typedef struct ParameterSpec {
 
 extern const ParameterSpec PARAMETER_SPECS[PARAM_COUNT];
 
-/* The optional terms of issue 36 in use, defaults filled in (runtime/model_terms.py's
+/* The optional model terms in use, defaults filled in (runtime/model_terms.py's
  * ModelTerms): nu_h, nu_c, nu2_h, nu2_c [1]; w2 [1]; a2_h, a2_c [degC] (NaN when not given);
  * b2_h, b2_c [degC/kg]; alpha_P, alpha_MF [1/K]; T_alpha [degC]; span_ratio_0,
  * span_ratio_sat [1]; span_stress [MPa] (the generated SMA_MODEL_TERMS); two_stage = w2 > 0;

@@ -4,7 +4,7 @@
 - ``ModelStructure/Outputs`` dependencies (empty: outputs change only in doStep);
 - ``ModelStructure/InitialUnknowns`` listing the outputs computed at initialization;
 - Real ``start`` values that read back exactly: pythonfmu writes ``f"{start:.16g}"``, and a
-  double can need 17 significant digits (issue 32: a fitted a_h of 59.713553341652535 came
+  double can need 17 significant digits (a fitted a_h of 59.713553341652535 came
   back from the FMU as 59.71355334165253, one unit in the last place away).
 """
 from xml.etree.ElementTree import Element, SubElement
