@@ -221,6 +221,16 @@ def test_tests_are_in_their_folders_only():
     assert all(list((TESTS / folder).glob("test_*.py")) for folder in TEST_FOLDERS - {"support"})
 
 
+def test_test_module_names_are_unique_across_the_folders():
+    """pytest imports each test module by its bare name (the folders are not packages), so two
+    modules of one name in two folders stop the whole run at collection."""
+    seen = defaultdict(list)
+    for path in TESTS.glob("*/*.py"):
+        seen[path.name].append(path.parent.name)
+    assert len(seen) > 100   # the walk sees the tests
+    assert {name: folders for name, folders in seen.items() if len(folders) > 1} == {}
+
+
 def test_a_test_module_imports_test_modules_of_its_own_folder_only():
     """pytest puts a test's own folder on sys.path (and tests/support, by pythonpath), so a
     module of another folder imports only when that folder was imported first: by chance."""
