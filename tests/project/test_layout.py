@@ -225,7 +225,7 @@ def test_test_module_names_are_unique_across_the_folders():
     """pytest imports each test module by its bare name (the folders are not packages), so two
     modules of one name in two folders stop the whole run at collection."""
     seen = defaultdict(list)
-    for path in TESTS.glob("*/*.py"):
+    for path in TESTS.glob("*/test_*.py"):
         seen[path.name].append(path.parent.name)
     assert len(seen) > 100   # the walk sees the tests
     assert {name: folders for name, folders in seen.items() if len(folders) > 1} == {}
