@@ -47,7 +47,7 @@ def test_the_inlined_step_returns_the_stepper_outputs(unpacked):
 def test_the_general_step_returns_the_changed_values(unpacked):
     slave, buffer, step = _attached(unpacked, "SmaPwmDriver")
     assert type(slave).declared_step is None
-    values = step(0.0, STEP, 1e9)                 # P_demand far above the peak: duty 1
+    values = step(0.0, STEP, 1e9, None)           # P_demand far above the peak: duty 1; R not set
     assert isinstance(values, tuple) and len(values) == int(buffer[_CHANGING])
     assert slave.P_in == slave.peak_W and slave.P_in in values
     assert buffer[_TIME] == STEP
