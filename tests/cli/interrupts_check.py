@@ -47,6 +47,9 @@ def main():
         kept, broke, finished = 0, 0, 0
         for name, after_s, group in plan:
             result = interrupt(COMMANDS[name][0], work, after_s, timeout_s=300, group=group)
+            while result.problems() is None and after_s > 0.3:   # ended first: earlier
+                after_s = max(0.3, after_s / 2)
+                result = interrupt(COMMANDS[name][0], work, after_s, timeout_s=300, group=group)
             problems = result.problems()
             how = "group" if group else "process"
             if problems is None:
@@ -59,7 +62,7 @@ def main():
                 kept += 1
                 print(f"ok               {name} at {after_s:6.2f} s ({how})", flush=True)
     print(f"{kept + broke + finished} interrupts: {kept} ok, {broke} broke the contract, "
-          f"{finished} came after the command had finished")
+          f"{finished} came after the command had finished (each retried earlier, down to 0.3 s)")
     return 1 if broke else 0
 
 

@@ -111,11 +111,11 @@ def test_memory_depth_is_set_in_configuration_mode_alone(actuator3):
         assert "memory_depth (value reference" in fmu.log[-1][1]
         assert "only in Configuration Mode" in fmu.log[-1][1]
         assert fmu.call("enterConfigurationMode")[0] == 0
+        ref = fmu.variables["memory_depth"].valueReference
         for bad in (0, 1, MAX_MEMORY_DEPTH + 1, 2 ** 63):
             assert fmu.set("memory_depth", bad) == 3
-            assert f"memory_depth (value reference 26) cannot be set: {bad} is outside " \
+            assert f"memory_depth (value reference {ref}) cannot be set: {bad} is outside " \
                    f"[2, {MAX_MEMORY_DEPTH}]" in fmu.log[-1][1]
-        ref = fmu.variables["memory_depth"].valueReference
         assert fmu.call("setInt32", [ref], [5])[0] == 3
         assert "UInt64 variable memory_depth, not an Int32" in fmu.log[-1][1]
         assert fmu.set("T_start", 20.0) == 3  # only the structural parameter in this mode

@@ -94,7 +94,12 @@ def test_the_plant_has_terminals_valid_by_the_schema(fmi3_fmus):
     assert schema.validate(root), schema.error_log
     members = {t.get("name"): [m.get("variableName") for m in t] for t in root.iter("Terminal")}
     assert members == {"electrical": ["P_in", "R"], "thermal": ["T"], "mechanical": ["load", "x"]}
-    with zipfile.ZipFile(fmi3_fmus["SmaPwmDriver"]) as archive:
+    with zipfile.ZipFile(fmi3_fmus["SmaPwmDriver"]) as archive:   # P_in out, R in (its limit)
+        driver = etree.fromstring(archive.read("terminalsAndIcons/terminalsAndIcons.xml"))
+    assert schema.validate(driver), schema.error_log
+    assert {t.get("name"): [m.get("variableName") for m in t] for t in driver.iter("Terminal")} \
+        == {"electrical": ["P_in", "R"]}
+    with zipfile.ZipFile(fmi3_fmus["SmaPiController"]) as archive:
         assert not any(n.startswith("terminalsAndIcons/") for n in archive.namelist())
 
 

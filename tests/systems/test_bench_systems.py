@@ -27,7 +27,7 @@ def test_the_ssp_binds_the_sensor_and_the_limit(bench, fmu_dir, tmp_path):
     path = write_ssp(closed_loop(bench, fmu_dir), tmp_path / "bench.ssp")
     with zipfile.ZipFile(path) as archive:
         ssd = archive.read(SSD_NAME).decode()
-    for name in ("noise_ohm_rms", "adc_full_scale_ohm", "adc_bits", "noise_seed", "modulation",
+    for name in ("noise_ohm_rms", "full_scale_ohm", "bits", "seed", "modulation",
                  "I_max_A", "V_max_V"):
         assert f'name="{name}"' in ssd, name
     assert 'startElement="plant" startConnector="R" endElement="driver" endConnector="R"' in ssd

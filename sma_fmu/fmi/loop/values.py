@@ -46,8 +46,8 @@ def component_settings(scenario, name):
         sensor = scenario.sensor
         return _gains(c, name) if sensor.ideal else {
             **_gains(c, name), "noise_ohm_rms": sensor.noise_ohm_rms,
-            "adc_full_scale_ohm": sensor.full_scale_ohm, "adc_bits": sensor.bits,
-            "noise_seed": sensor.seed}
+            "full_scale_ohm": sensor.full_scale_ohm, "bits": sensor.bits,
+            "seed": sensor.seed}
     if name == "driver":
         settings = {"frequency_Hz": drive.frequency_Hz, "peak_W": drive.peak_W} if drive.pwm \
             else {"modulation": choice_code("modulation", "linear")}

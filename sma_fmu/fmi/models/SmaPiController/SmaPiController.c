@@ -4,7 +4,7 @@
  * the resistance sensor), as the slave beside it (sma_pi_controller.py) is over
  * runtime/measurement.py, with the same semantics: a sampled block; doStep(t_k, h) samples
  * R, R_ref and P_ff as set before the call, reads R through the sensor (noise_ohm_rms,
- * adc_full_scale_ohm, adc_bits, noise_seed; all 0: R itself), its outputs then hold
+ * full_scale_ohm, bits, seed; all 0: R itself), its outputs then hold
  * u_k = max(0, P_ff + Kp e_k + Ki I_k) with e_k = R_measured - R_ref, and the integrator
  * advances. Before the first step the outputs are those the first step will give. Non-finite
  * inputs discard the step; invalid gains or sensor settings refuse
@@ -22,8 +22,8 @@ static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *messa
     if (sma_wire_parameters(&SMA_MODEL, values, run, &params, message) ||
         pi_controller_init(&controller->pi, params.Kp, params.Ki, message) ||
         resistance_sensor_init(&controller->sensor, values[VAR_noise_ohm_rms].real,
-                               values[VAR_adc_full_scale_ohm].real, values[VAR_adc_bits].integer,
-                               values[VAR_noise_seed].integer, message) ||
+                               values[VAR_full_scale_ohm].real, values[VAR_bits].integer,
+                               values[VAR_seed].integer, message) ||
         sensed_pi_preview(controller, values[VAR_R].real, values[VAR_R_ref].real,
                           values[VAR_P_ff].real, &power, &feedback, &measured, message))
         return 1;

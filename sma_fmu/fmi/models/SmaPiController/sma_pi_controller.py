@@ -3,7 +3,7 @@
 A thin adapter over ``sma_fmu.runtime.measurement.SensedPIController``: the PI block of the
 library loop (``sma_fmu.runtime.pi_control.PIController``) fed through the controller's
 resistance sensor (``ResistanceSensor``: white noise of ``noise_ohm_rms`` from stream
-``noise_seed``, then an ``adc_bits``-bit ADC over 0 ... ``adc_full_scale_ohm``; all 0 by
+``seed``, then a ``bits``-bit ADC over 0 ... ``full_scale_ohm``; all 0 by
 default: R read exactly). R is the wire's true resistance; the PI's error is
 e = R_measured - R_ref, and ``R_measured`` shows the reading of the step. Sample k of the
 noise is the k-th doStep.
@@ -46,17 +46,17 @@ class SmaPiController(StepperSlave):
                    "the resistance the PI read this step: R through the sensor's noise and ADC")
         fmi.parameter("noise_ohm_rms", 0.0, "ohm",
                       "sensor noise referred to R (>= 0; an Irwin-Hall normal stream)")
-        fmi.parameter("adc_full_scale_ohm", 0.0, "ohm",
-                      "the ADC's range 0 ... full scale in resistance (> 0 when adc_bits > 0)")
-        fmi.parameter("adc_bits", 0, None, "the ADC's resolution, 0-32 (0: no quantisation)",
+        fmi.parameter("full_scale_ohm", 0.0, "ohm",
+                      "the ADC's range 0 ... full scale in resistance (> 0 when bits > 0)")
+        fmi.parameter("bits", 0, None, "the ADC's resolution, 0-32 (0: no quantisation)",
                       kind=Integer)
-        fmi.parameter("noise_seed", 0, None, "the noise stream, 0 ... 2^31 - 1 (SplitMix64)",
+        fmi.parameter("seed", 0, None, "the noise stream, 0 ... 2^31 - 1 (SplitMix64)",
                       kind=Integer)
         self.stepper = None
 
     def _start(self):
         params = self.interface.wire_parameters()
-        sensor = ResistanceSensor(self.noise_ohm_rms, self.adc_full_scale_ohm, self.adc_bits,
-                                  self.noise_seed)
+        sensor = ResistanceSensor(self.noise_ohm_rms, self.full_scale_ohm, self.bits,
+                                  self.seed)
         stepper = SensedPIController(params.Kp, params.Ki, sensor)
         return stepper, stepper.preview(self.R, self.R_ref, self.P_ff)
