@@ -56,13 +56,14 @@ def _message(error, command):
 
 
 def main(argv=None):
-    """Run the command line; returns the exit status (130 after a Ctrl-C)."""
+    """Run the command line; returns the exit status (130 after a Ctrl-C). Called with no
+    ``argv`` (the ``sma-fmu`` process), it ignores Ctrl-C once the command is over."""
     args = build_parser().parse_args(argv)
     from sma_fmu.console import interrupts, progress
 
     previous = progress.configure(quiet=getattr(args, "quiet", False), notes=True)
     try:
-        with interrupts.handle_interrupts():
+        with interrupts.handle_interrupts(then_ignore=argv is None):
             try:
                 return args.handler(args)
             except (Exception, KeyboardInterrupt) as error:  # noqa: BLE001 - never a traceback

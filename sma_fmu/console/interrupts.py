@@ -140,8 +140,11 @@ def _unraisable(unraisable):
 
 
 @contextlib.contextmanager
-def handle_interrupts():
-    """Install the SIGINT handler for the body (main thread only; elsewhere a no-op)."""
+def handle_interrupts(then_ignore=False):
+    """Install the SIGINT handler for the body (main thread only; elsewhere a no-op).
+    ``then_ignore``: after the body, ignore SIGINT instead of restoring the handler before
+    it (a process about to exit: a Ctrl-C while the interpreter shuts down would otherwise
+    kill it by the signal, or raise KeyboardInterrupt outside the command, its work done)."""
     if threading.current_thread() is not threading.main_thread() or _State.installed:
         yield
         return
@@ -155,7 +158,7 @@ def handle_interrupts():
     finally:
         _State.installed = False
         _stop_tracing()
-        signal.signal(signal.SIGINT, _State.previous[0])
+        signal.signal(signal.SIGINT, signal.SIG_IGN if then_ignore else _State.previous[0])
         sys.unraisablehook = _State.previous[1]
 
 

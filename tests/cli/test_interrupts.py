@@ -109,3 +109,19 @@ def test_a_ctrl_c_inside_fmu_code_comes_when_the_fmu_call_returns():
             namespace["step"](log)
             log.append("the master went on")   # never: the interrupt comes here
     assert log == ["the step ran to its end"] and sys.gettrace() is None
+
+
+def test_a_process_about_to_exit_ignores_a_late_ctrl_c():
+    """The ``sma-fmu`` process (``then_ignore``): once the command is over, SIGINT is ignored,
+    so a Ctrl-C during the interpreter's shutdown neither kills it by the signal nor prints a
+    traceback; in-process callers get the handler they had back."""
+    before = signal.getsignal(signal.SIGINT)
+    try:
+        with interrupts.handle_interrupts():
+            pass
+        assert signal.getsignal(signal.SIGINT) is before
+        with interrupts.handle_interrupts(then_ignore=True):
+            assert signal.getsignal(signal.SIGINT) not in (before, signal.SIG_IGN)
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)
