@@ -21,9 +21,19 @@ MACHINE_PATH = re.compile(r"(?<![\w.~])(/(?:work|root|home|scratch)/[^\s`'\")]*)
 SHIPPED_TEXT = (".html", ".toml", ".md", ".py", ".txt", ".json")
 
 
+def _ignored_folders():
+    """The top-level folders .gitignore names (``results/``, ``fmus/``, ``build/``, ...): the
+    commands' outputs, which the README's main job writes into the checkout."""
+    lines = (REPO / ".gitignore").read_text(encoding="utf-8").splitlines()
+    return {line.strip().rstrip("/") for line in lines if line.strip().endswith("/")
+            and "/" not in line.strip().rstrip("/") and not line.startswith(("#", "!"))
+            and "*" not in line}
+
+
 def _repo_folders():
+    ignored = _ignored_folders()
     return sorted(p.name for p in REPO.iterdir() if p.is_dir() and not p.name.startswith((".git", "__"))
-                  and not p.name.endswith(".egg-info") and p.name not in ("build", "dist"))
+                  and not p.name.endswith(".egg-info") and p.name not in ignored)
 
 
 def _repo_path():
