@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "support"))
 
-from interrupting import interrupt  # noqa: E402
+from interrupting import interrupt_in_time  # noqa: E402
 from test_interrupts import COMMANDS  # noqa: E402
 
 from sma_fmu.files.package_data import shipped_file  # noqa: E402
@@ -46,11 +46,9 @@ def main():
         rng.shuffle(plan)
         kept, broke, finished = 0, 0, 0
         for name, after_s, group in plan:
-            result = interrupt(COMMANDS[name][0], work, after_s, timeout_s=300, group=group)
-            while result.problems() is None and after_s > 0.3:   # ended first: earlier
-                after_s = max(0.3, after_s / 2)
-                result = interrupt(COMMANDS[name][0], work, after_s, timeout_s=300, group=group)
-            problems = result.problems()
+            result = interrupt_in_time(COMMANDS[name][0], work, after_s, timeout_s=300,
+                                       group=group)   # ended first: again, earlier
+            after_s, problems = result.after_s, result.problems()
             how = "group" if group else "process"
             if problems is None:
                 finished += 1
