@@ -26,6 +26,8 @@ from .constants import BOLTZMANN, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
 from .model_terms import centre_load, stressed_lengths
 from .phases import PhaseFractions, resistance_of
 
+_exp = math.exp
+
 __all__ = [
     "BranchConstants", "slope_load", "hysteresis_centre", "second_centre", "residual_f_fraction",
     "domain_energy", "branch_constants", "logistic_split", "branch_fractions",
@@ -170,12 +172,28 @@ def branch_fractions(temperature, constants):
 
 def two_stage_fractions(inverse_kelvin, constants):
     """(xi_MF, xi_P) [1] of a two-stage major branch at 1/T_K = ``inverse_kelvin`` [1/K]:
-    each stage split by :func:`logistic_split`, the halves added (stage 1 first)."""
-    mf1, p1 = logistic_split(constants.M1, constants.energy_over_kB * (
-        constants.inv_centre_K - inverse_kelvin))
-    mf2, p2 = logistic_split(constants.M2, constants.energy2_over_kB * (
-        constants.inv_centre2_K - inverse_kelvin))
-    return mf1 + mf2, p1 + p2
+    each stage split by :func:`logistic_split`, the halves added (stage 1 first). The splits
+    are written out (the same operations): a plant calls this at every step, and the two
+    calls cost a fifth of it in Python."""
+    total = constants.M1
+    exponent = constants.energy_over_kB * (constants.inv_centre_K - inverse_kelvin)
+    if exponent > 0.0:
+        e = _exp(-exponent)
+        d = 1.0 + e
+        mf, p = total * e / d, total / d
+    else:
+        e = _exp(exponent)
+        d = 1.0 + e
+        mf, p = total / d, total * e / d
+    total = constants.M2
+    exponent = constants.energy2_over_kB * (constants.inv_centre2_K - inverse_kelvin)
+    if exponent > 0.0:
+        e = _exp(-exponent)
+        d = 1.0 + e
+        return mf + total * e / d, p + total / d
+    e = _exp(exponent)
+    d = 1.0 + e
+    return mf + total / d, p + total * e / d
 
 
 def phase_fractions(xi_mf, xi_p, xi_f_min):
