@@ -34,7 +34,14 @@ def validity_warning(params, temperature, temperature_before, load, load_before)
 def data_range_warning(params, temperature, load, name="T"):
     """The warning [str] when the temperature ``name`` [degC] or the load [kg] lies outside
     the data range of ``params`` (its T_data_min ... stress_data_max; a bound not given does
-    not apply), or None. The C family writes the same text."""
+    not apply), or None. The C family writes the same text. Inside the range it returns after
+    the comparisons alone: a stepper asks at every step until it has warned."""
+    low, high = params.T_data_min, params.T_data_max
+    load_low, load_high = params.load_data_min, params.load_data_max
+    if ((low is None or temperature >= low) and (high is None or temperature <= high)
+            and (load_low is None or load >= load_low)
+            and (load_high is None or load <= load_high)):
+        return None
     messages = []
     if params.T_data_min is not None and temperature < params.T_data_min:
         messages.append(f"{name} = {temperature:.6g} degC is below validity.T_data_min = "
