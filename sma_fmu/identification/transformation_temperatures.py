@@ -9,10 +9,14 @@ On one heating or cooling branch:
 2. Baselines: straight lines (least squares) through the samples colder than
    T50 - 2.5 |T75 - T25| (martensite, "cold") and hotter than T50 + 2.5 |T75 - T25|
    (austenite, "hot"); they keep the slope of the data (thermal expansion, creep).
-3. Transformation tangent: the straight line through the samples between 40 % and 60 % of
-   the way from the hot to the cold baseline: the steepest, most linear part of the
-   branch. It is fitted as temperature against strain, because the temperature carries the
-   noise, so its slope is not flattened by temperature noise.
+3. Transformation tangent: the tangent at the branch's steepest point (ASTM F2082 / E3097
+   practice, and what ASMADA does): a logistic step plus a straight line (scipy's
+   ``curve_fit``) is fitted to the branch, and the tangent is taken at the logistic's
+   centre, where the fitted curve is steepest. The smooth fit stands in for the noisy
+   samples, whose own steepest point noise would pick. Where that fit fails, the straight
+   line through the samples between 40 % and 60 % of the way from the hot to the cold
+   baseline is used instead (fitted as temperature against strain, because the temperature
+   carries the noise).
 4. Heating: A_s where the tangent meets the cold baseline, A_f where it meets the hot one;
    cooling: M_s at the hot baseline, M_f at the cold one. The midpoint is where the tangent
    crosses half way between the baselines.
@@ -27,8 +31,10 @@ Per cycle (a heating branch and the cooling branch after it):
 E3097 leaves the choice of the linear portions to the operator; these rules are ours.
 """
 import math
+import warnings
 
 import numpy as np
+from scipy import optimize
 
 from sma_fmu.runtime.constants import HEATING
 
@@ -62,6 +68,30 @@ def _meet(tangent, line):
     c, d = tangent
     a, b = line
     return (c + d * a) / (1.0 - d * b)
+
+
+def _logistic_step(t, low, high, rate, centre, slope):
+    """A logistic step from ``low`` to ``high`` [1] around ``centre`` [degC] plus a line."""
+    return low + (high - low) / (1.0 + np.exp(-rate * (t - centre))) + slope * (t - centre)
+
+
+def _steepest_tangent(t, e, cold, hot, t50, width):
+    """(intercept [degC], slope [K]) of T = c + d eps at the steepest point of a logistic step
+    fitted to the branch, or None when the fit fails or its centre leaves the branch."""
+    start = (cold[0] + cold[1] * t50, hot[0] + hot[1] * t50, 4.4 / width, t50,
+             0.5 * (cold[1] + hot[1]))
+    try:
+        with np.errstate(over="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", optimize.OptimizeWarning)
+            (low, high, rate, centre, slope), _ = optimize.curve_fit(
+                _logistic_step, t, e, p0=start, maxfev=2000)
+    except (RuntimeError, ValueError):
+        return None
+    steepest = (high - low) * rate / 4.0 + slope      # d eps / dT at the centre [1/K]
+    if not (t[0] < centre < t[-1]) or not math.isfinite(steepest) or steepest == 0.0:
+        return None
+    middle = _logistic_step(centre, low, high, rate, centre, slope)
+    return centre - middle / steepest, 1.0 / steepest
 
 
 def branch_tangents(temperature, strain, direction, band=BAND, tail=TAIL_WIDTHS):
@@ -104,10 +134,13 @@ def branch_tangents_or_reason(temperature, strain, direction, band=BAND, tail=TA
     low_line = hot[0] + hot[1] * t
     with np.errstate(divide="ignore", invalid="ignore"):   # baselines that cross
         progress = (e - low_line) / (cold[0] + cold[1] * t - low_line)
-    rows = (progress >= band[0]) & (progress <= band[1])
-    if rows.sum() < 2 or np.ptp(e[rows]) == 0.0:
-        return None, "fewer than 2 samples between 40 and 60 % of the transformation"
-    tangent = _line(e[rows], t[rows])
+    tangent = _steepest_tangent(t, e, cold, hot, t50, width)
+    if tangent is None:
+        rows = (progress >= band[0]) & (progress <= band[1])
+        if rows.sum() < 2 or np.ptp(e[rows]) == 0.0:
+            return None, ("no steepest point (the logistic fit failed) and fewer than 2 "
+                          "samples between 40 and 60 % of the transformation")
+        tangent = _line(e[rows], t[rows])
     middle = (0.5 * (cold[0] + hot[0]), 0.5 * (cold[1] + hot[1]))
     at_cold, at_hot = _meet(tangent, cold), _meet(tangent, hot)
     start, finish = (at_cold, at_hot) if heating else (at_hot, at_cold)

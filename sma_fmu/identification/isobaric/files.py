@@ -32,7 +32,7 @@ The load comes from the caller or a preamble line ``load: 0.15 kg`` (g and N too
 Branches and cycles: :mod:`sma_fmu.identification.isobaric.cycles` (scales from the
 temperature's dominant period, so 2 and 1,000 cycles per file read alike); ``cycles``
 keeps a range of them. The ``smoothed`` temperature kept for the tangent construction is
-filtered again over a quarter of the median branch length.
+filtered again over the square root of the median branch length.
 """
 import math
 import re
@@ -288,9 +288,11 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
         temperature, strain, rows = temperature[keep], strain[keep], rows[keep]
         resistance = resistance[keep] if resistance is not None else None
         time = time[keep] if time is not None else None
-    # the tangent construction gets a smoother signal: a quarter of a branch (a ramp is
-    # smooth; the turning points, where the window bends it, lie outside the transformation)
-    smoothed = smooth(temperature, int(np.median([b.stop - b.start for b in branches])) // 4)
+    # the tangent construction gets a smoother signal, over the square root of the median
+    # branch length (ASMADA's rule): a ramp bends where the transformation's latent heat
+    # slows it, and a wider window (a quarter branch) moved the heating tangents by 3-5 K
+    smoothed = smooth(temperature, round(math.sqrt(np.median([b.stop - b.start
+                                                              for b in branches]))))
     for b in branches:
         if b.complete and np.ptp(strain[b.start:b.stop]) < MIN_STRAIN_SPAN:
             raise MeasurementError(

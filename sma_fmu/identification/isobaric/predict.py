@@ -19,6 +19,14 @@ from the model's own zero, length / reference length - 1 (the reference length a
 fitted phase lengths, nothing taken from the measured strain), and offset-matched, that
 shifted by one constant, the median difference from the measured strain (a lab's strain
 zero is its own; the fit gives each file its offset too).
+
+The model's tangent temperatures (A_s, A_f, M_s, M_f) are taken on a clean sweep: the plant
+runtime driven at the file's load through two full cycles, linear in temperature between
+the file's lowest and highest (smoothed) reading, the second cycle's branches put through
+the same tangent construction as the data. Drawn against the file's own noisy temperature
+history, the predicted strain would inherit the thermocouple's scatter and the profile's
+minor turns; the sweep is the model's own curve. The half-strain temperatures and the strain
+span stay those of the file-driven prediction.
 """
 import math
 import time
@@ -35,11 +43,12 @@ from sma_fmu.runtime.constants import HEATING
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.thermal import power_to_reach, step_decay
 
-__all__ = ["drive_plant", "predict_file", "TANGENT_KEYS"]
+__all__ = ["drive_plant", "predict_file", "sweep_tangents", "TANGENT_KEYS"]
 
 _ROOM_BELOW_K = 50.0
 _CAPACITY_FACTOR = 1e6
 TANGENT_KEYS = {HEATING: ("A_s", "A_f"), -HEATING: ("M_s", "M_f")}
+SWEEP_POINTS = 2000
 
 
 def drive_plant(params, temperature, load, step_s=1.0):
@@ -62,6 +71,25 @@ def drive_plant(params, temperature, load, step_s=1.0):
                    step_s)
         length[i], reached[i] = out.x, out.T
     return length, float(np.max(np.abs(reached - temperature)))
+
+
+def sweep_tangents(params, load, low, high, points=SWEEP_POINTS):
+    """({"A_s", "A_f", "M_s", "M_f"} [degC], {key: why} of the NaN ones) of the model at
+    ``load`` [kg] on a clean sweep between ``low`` and ``high`` [degC]: two cycles of
+    ``points`` samples a branch, the second cycle's branches."""
+    up = np.linspace(low, high, points)
+    sweep = np.concatenate([up, up[-2::-1], up[1:], up[-2::-1]])
+    length, _ = drive_plant(params, sweep, load)
+    strain = length / params.x0 - 1.0
+    out, why = {}, {}
+    for direction, rows in ((HEATING, slice(2 * points - 2, 3 * points - 2)),
+                            (-HEATING, slice(3 * points - 3, 4 * points - 3))):
+        tangents, reason = branch_tangents_or_reason(sweep[rows], strain[rows], direction)
+        for key, name in zip(TANGENT_KEYS[direction], ("start", "finish")):
+            out[key] = tangents[name] if tangents is not None else math.nan
+            if tangents is None:
+                why[key] = f"clean sweep {low:.4g} to {high:.4g} degC: {reason}"
+    return out, why
 
 
 def _tangents(temperature, strain, branches):
@@ -114,6 +142,10 @@ def predict_file(data, params, lag=0.0):
     seconds = time.perf_counter() - began
     measured_t, measured_why = _tangents(data.smoothed, data.strain, data.branches)
     model_t, model_why = _tangents(data.smoothed, predicted, data.branches)
+    low, high = float(data.smoothed.min()), float(data.smoothed.max())
+    swept, swept_why = sweep_tangents(params, data.load, low, high)
+    model_t.update(swept)
+    model_why = {k: v for k, v in model_why.items() if k not in swept} | swept_why
     report = {
         "experiment": "isobaric",
         "file": str(data.path), "points": int(data.strain.size), "load_kg": data.load,
@@ -134,13 +166,17 @@ def predict_file(data, params, lag=0.0):
                                  "AIC), fed to the plant runtime sample by sample",
                   "step_s": step, "largest_temperature_deviation_K": deviation,
                   "lag": {"value": lag, "unit": "s" if data.time is not None else "samples"},
-                  "hysteresis_mode": "continuous", "seconds": seconds},
+                  "hysteresis_mode": "continuous", "seconds": seconds,
+                  "tangent_sweep_degC": [low, high]},
         "note": "residual_rms.strain: offset-matched, the prediction plant length / "
                 "reference length - 1 shifted by strain_offset (the median difference from the "
                 "measured strain; the plant has no residual-strain drift from cycle to cycle); "
                 "residual_rms.strain_own_zero: the same prediction unshifted, from the model's "
-                "own zero (reference_length_m and the fitted phase lengths); tangent-line and "
-                "half-strain temperatures of the offset-matched prediction and the data against "
+                "own zero (reference_length_m and the fitted phase lengths); measured tangent-"
+                "line and half-strain temperatures: the data against the measured (smoothed) "
+                "temperature, medians over the branches; predicted A_s, A_f, M_s, M_f: the "
+                "model on a clean sweep at the file's load over drive.tangent_sweep_degC; "
+                "predicted half-strain temperatures: the offset-matched prediction against "
                 "the measured (smoothed) temperature",
     }
     return {"predicted": predicted, "own_zero": raw, "measured": data.strain,
