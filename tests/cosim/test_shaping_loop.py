@@ -51,6 +51,10 @@ def test_the_shaped_scenarios_ship_beside_their_twins():
      r"\[controller\] power_cap_W = 5.0 needs shaping = 'reachable', got 'none'"),
     (lambda s: s.replace('shaping = "reachable"', 'shaping = "reachable"\npower_cap_W = -1.0'),
      r"power_cap_W"),
+    (lambda s: s.replace('shaping = "reachable"', 'anticipation_s = 0.2'),
+     r"\[controller\] anticipation_s = 0.2 needs shaping = 'reachable', got 'none'"),
+    (lambda s: s.replace('shaping = "reachable"', 'shaping = "reachable"\nanticipation_s = -0.1'),
+     r"\[controller\] anticipation_s must be >= 0, got -0.1"),
 ])
 def test_bad_shaping_keys_name_file_and_value(tmp_path, change, message):
     path = tmp_path / "custom.toml"

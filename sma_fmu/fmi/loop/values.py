@@ -18,7 +18,7 @@ from sma_fmu.fmi.loop.gains import GAINS
 from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
 
-__all__ = ["WIRES", "component_settings", "wire_of", "input_starts"]
+__all__ = ["WIRES", "component_settings", "wire_of", "input_starts", "not_in_fmus"]
 
 # component -> the scenario's attribute holding the wire parameters its FMU gets: the
 # plant is the wire, the compensator inverts its model of it (the wire's, unless a study
@@ -31,8 +31,25 @@ def _gains(controller, component):
             if gain.component == component}
 
 
+def not_in_fmus(scenario):
+    """Why the FMUs cannot run ``scenario`` (a message naming the file and key), or None.
+
+    **choice**: the compensator's anticipation of the reference's lower turn runs on the
+    library path only; the FMUs do not declare it."""
+    lead = scenario.controller.anticipation_s
+    if lead:
+        return (f"{scenario.path}: [controller] anticipation_s = {lead!r} runs on the library "
+                f"path only (--path library); the FMUs do not have it")
+    return None
+
+
 def component_settings(scenario, name):
-    """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters."""
+    """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters.
+
+    ``ValueError`` for a scenario the FMUs cannot run (:func:`not_in_fmus`)."""
+    reason = not_in_fmus(scenario)
+    if reason:
+        raise ValueError(reason)
     c, drive = scenario.controller, scenario.drive
     if name == "signals":
         return {"reference": table_text(scenario.reference.as_table()),
