@@ -264,8 +264,9 @@ class FeedforwardStepper:
         reference = fast_positive("R_ref", reference)
         load = fast_nonnegative("load", load)
         step_size = fast_positive("step_size", step_size)
+        sample = reference        # R_ref,k; the compensator works on the aim (anticipation)
         if self._anticipation is not None:
-            reference = self._anticipation.step(reference, step_size)
+            reference = self._anticipation.aim(sample, step_size)
         direction = self._direction_for(reference)
         if self._shaper is None:
             sensed, points, fraction = self._invert(reference, load, direction)
@@ -293,6 +294,8 @@ class FeedforwardStepper:
             output, temperature, moved = self._shaper.step(
                 temperature, way, load if self.adapt_to_load else self.model_load, step_size)
             saturated = saturated or moved
+        if self._anticipation is not None:
+            self._anticipation.step(sample, step_size)
         self.direction = direction
         self.previous_reference = reference
         self.warning, self._load_before, self._bounded_before = warning, load, bounded

@@ -22,7 +22,6 @@ from sma_fmu.cosim.recording import (RunRecorder, TimeseriesWriter, interval_ste
                                      timeseries_name)
 from sma_fmu.cosim.report import comparison_markdown, groups, summary_table
 from sma_fmu.cosim.scenario import load_scenario
-from sma_fmu.fmi.loop.values import not_in_fmus
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
@@ -123,9 +122,6 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         run = lambda scenario, fmu_dir, sink: _fmpy(scenario, fmu_dir, sink, events=True)  # noqa: E731
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
-    if path != "library":
-        for reason in filter(None, map(not_in_fmus, scenarios)):
-            raise ValueError(reason)
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
              if output_interval_s is not None
              else interval_steps(s.output_interval_s, s.step_s, f"{s.path}: [scenario] output_interval_s")

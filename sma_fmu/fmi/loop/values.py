@@ -3,10 +3,10 @@
 Computed here once for every master and system tool. Each component's parameters are,
 besides the scenario's wire in the FMUs that model it (:data:`WIRES`, set whole by
 :mod:`.wire_values`): the signals as JSON tables (SmaScenarioSignals), the compensator's
-filter, model load, adaptation, inverse, shaping and power cap (0 W: none), the PI's gains
-(:data:`~.gains.GAINS`) and its sensor (with a ``[sensor]``: noise, ADC, seed), the driver's
-frequency and peak power (and, with a limit, its modulation and current and voltage limits),
-the plant's start temperature and hysteresis mode.
+filter, model load, adaptation, inverse, shaping, power cap (0 W: none) and anticipation
+(0 s: none), the PI's gains (:data:`~.gains.GAINS`) and its sensor (with a ``[sensor]``:
+noise, ADC, seed), the driver's frequency and peak power (and, with a limit, its modulation
+and current and voltage limits), the plant's start temperature and hysteresis mode.
 Choices (the hysteresis mode, the inverse, the shaping, the modulation) are the Integer codes of
 :mod:`sma_fmu.fmi.python_family.slave_support.choices`.
 
@@ -18,7 +18,7 @@ from sma_fmu.fmi.loop.gains import GAINS
 from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
 
-__all__ = ["WIRES", "component_settings", "wire_of", "input_starts", "not_in_fmus"]
+__all__ = ["WIRES", "component_settings", "wire_of", "input_starts"]
 
 # component -> the scenario's attribute holding the wire parameters its FMU gets: the
 # plant is the wire, the compensator inverts its model of it (the wire's, unless a study
@@ -31,25 +31,8 @@ def _gains(controller, component):
             if gain.component == component}
 
 
-def not_in_fmus(scenario):
-    """Why the FMUs cannot run ``scenario`` (a message naming the file and key), or None.
-
-    **choice**: the compensator's anticipation of the reference's lower turn runs on the
-    library path only; the FMUs do not declare it."""
-    lead = scenario.controller.anticipation_s
-    if lead:
-        return (f"{scenario.path}: [controller] anticipation_s = {lead!r} runs on the library "
-                f"path only (--path library); the FMUs do not have it")
-    return None
-
-
 def component_settings(scenario, name):
-    """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters.
-
-    ``ValueError`` for a scenario the FMUs cannot run (:func:`not_in_fmus`)."""
-    reason = not_in_fmus(scenario)
-    if reason:
-        raise ValueError(reason)
+    """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters."""
     c, drive = scenario.controller, scenario.drive
     if name == "signals":
         return {"reference": table_text(scenario.reference.as_table()),
@@ -58,7 +41,8 @@ def component_settings(scenario, name):
         return {**_gains(c, name), "adapt_to_load": c.adapt_to_load,
                 "inverse": choice_code("inverse", c.inverse),
                 "shaping": choice_code("shaping", c.shaping),
-                "power_cap": 0.0 if c.power_cap_W is None else c.power_cap_W}
+                "power_cap": 0.0 if c.power_cap_W is None else c.power_cap_W,
+                "anticipation": c.anticipation_s}
     if name == "pi":
         sensor = scenario.sensor
         return _gains(c, name) if sensor.ideal else {
