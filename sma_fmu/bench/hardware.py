@@ -29,7 +29,10 @@ from sma_fmu.runtime.pwm import PwmDriver
 __all__ = ["SCENARIOS", "BLOCKS", "python_costs", "c_costs", "run_hardware_bench",
            "hardware_lines"]
 
-SCENARIOS = ("load-step-bench-pi+ff-adaptive", "heavy-continuous-bench-pi+ff-adaptive-minor-loop")
+SCENARIOS = ("load-step-bench-pi+ff-adaptive", "heavy-continuous-bench-pi+ff-adaptive-minor-loop",
+             # the bench's best controller: shaped, anticipating the lower turn
+             "load-step-bench-pi+ff-adaptive-reachable",
+             "heavy-continuous-bench-pi+ff-adaptive-reachable")
 BLOCKS = {"noise": "noise z(seed, k) alone",
           "sensor": "sensor: noise + 16-bit ADC",
           "pi": "PI (no sensor)",

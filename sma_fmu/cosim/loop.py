@@ -108,7 +108,7 @@ class LibraryCompensator:
         c = scenario.controller
         self.stepper = FeedforwardStepper(scenario.compensator_params, c.alpha, c.beta,
                                           c.model_load, c.adapt_to_load, c.inverse, c.shaping,
-                                          c.power_cap_W)
+                                          c.power_cap_W, c.anticipation_s)
 
     def initial(self, reference, load):
         """(P_ff [W], T_ref [degC], saturated) before the first step (what a Jacobi host passes on)."""

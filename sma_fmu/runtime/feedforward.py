@@ -29,6 +29,8 @@ phase-lag filter; ``"reachable"`` shapes the demand into what the wire can reach
 (heating up to ``power_cap``, cooling no faster than convection) over a model of the wire
 whose memory is the plant's, and outputs the thermal model's exact one-step power
 (:mod:`.shaping`; the filter is not used). The inverse is then taken on the model's branch.
+Shaped, ``anticipation`` L > 0 [s] aims the shaping L ahead of the reference near its lower
+turn, from its past samples (:mod:`.anticipation`); 0 (default): R_ref itself.
 
 No reference yet: R_ref <= 0 ohm before the first R_ref > 0 (a host that steps before its
 inputs are connected, as fmpy's ``simulate_ssp`` gives every input 0.0 at t = 0) is an
@@ -51,6 +53,7 @@ the plant does).
 import math
 from collections import namedtuple
 
+from .anticipation import TurnAnticipation
 from .checks import fast_nonnegative, fast_positive, require_nonnegative, require_positive
 from .constant_load import BranchCache
 from .constants import COOLING, HEATING
@@ -83,6 +86,17 @@ model wire does not reach the inverse's temperature in the step.
 """
 
 
+def _anticipation(lead, shaping):
+    """The :class:`TurnAnticipation` of ``lead`` L [s] (None for 0); L > 0 needs shaping
+    "reachable" (the paper's filter has no model to aim with)."""
+    lead = require_nonnegative("anticipation", lead)
+    if lead == 0.0:
+        return None
+    if shaping != "reachable":
+        raise ValueError(f"anticipation = {lead!r} s needs shaping 'reachable', got {shaping!r}")
+    return TurnAnticipation(lead)
+
+
 def require_inverse(inverse):
     """Return ``inverse`` if it is one of :data:`INVERSES`, else raise ``ValueError``."""
     if isinstance(inverse, str) and inverse in INVERSES:
@@ -110,10 +124,13 @@ class FeedforwardStepper:
         (:mod:`.shaping`).
     power_cap : float, optional
         P_max [W] the driver can deliver, with shaping "reachable"; None: no limit.
+    anticipation : float
+        L [s] >= 0, with shaping "reachable": aim L ahead near the reference's lower turn
+        (:mod:`.anticipation`); 0: no anticipation.
     """
 
     def __init__(self, params, alpha=None, beta=None, model_load=None, adapt_to_load=True,
-                 inverse="major", shaping="none", power_cap=None):
+                 inverse="major", shaping="none", power_cap=None, anticipation=0.0):
         self.params = params
         self.filter = PhaseLagFilter(
             params.phase_lag_alpha if alpha is None else alpha,
@@ -127,6 +144,7 @@ class FeedforwardStepper:
         self.power_cap = require_power_cap(power_cap, self.shaping)
         self._shaper = (ReachableShaping(params, self._minor_loops, self.power_cap,
                                          self.model_load) if self.shaping == "reachable" else None)
+        self._anticipation = _anticipation(anticipation, self.shaping)
         self.direction = HEATING
         self.previous_reference = None
         self.reversals = []               # minor-loop memory: ReversalPoint(T [degC], xi_MF [1])
@@ -246,6 +264,9 @@ class FeedforwardStepper:
         reference = fast_positive("R_ref", reference)
         load = fast_nonnegative("load", load)
         step_size = fast_positive("step_size", step_size)
+        sample = reference        # R_ref,k; the compensator works on the aim (anticipation)
+        if self._anticipation is not None:
+            reference = self._anticipation.aim(sample, step_size)
         direction = self._direction_for(reference)
         if self._shaper is None:
             sensed, points, fraction = self._invert(reference, load, direction)
@@ -273,6 +294,8 @@ class FeedforwardStepper:
             output, temperature, moved = self._shaper.step(
                 temperature, way, load if self.adapt_to_load else self.model_load, step_size)
             saturated = saturated or moved
+        if self._anticipation is not None:
+            self._anticipation.step(sample, step_size)
         self.direction = direction
         self.previous_reference = reference
         self.warning, self._load_before, self._bounded_before = warning, load, bounded
@@ -302,6 +325,8 @@ class FeedforwardStepper:
                  "filter": self.filter.state()}
         if self._shaper is not None:
             state["model"] = self._shaper.state()
+        if self._anticipation is not None:
+            state["anticipation"] = self._anticipation.state()
         return state
 
     def restore(self, state):
@@ -314,8 +339,9 @@ class FeedforwardStepper:
         """
         check_format(state, STATE_FORMAT, "compensator state")
         shaped = self._shaper is not None
-        read_entries(state, _STATE_ENTRIES + (("model",) if shaped else ()),
-                     what="compensator state")
+        anticipating = self._anticipation is not None
+        read_entries(state, _STATE_ENTRIES + (("model",) if shaped else ())
+                     + (("anticipation",) if anticipating else ()), what="compensator state")
         direction = read_direction(state)
         reference = read_optional_number(state, "previous_reference", 5e-324, unit="ohm")
         temperature = read_temperature(state, "previous_temperature", optional=True)
@@ -331,9 +357,20 @@ class FeedforwardStepper:
                 model.restore(state["model"])
             except ValueError as error:
                 raise StateError(f"state entry model: {error}") from None
+        if anticipating:
+            anticipation = TurnAnticipation(self._anticipation.lead)
+            try:
+                read_entries(state["anticipation"], ("earlier", "previous", "held"),
+                             what="anticipation state")
+                anticipation.restore(state["anticipation"], lambda table, key:
+                                     read_optional_number(table, key, 5e-324, unit="ohm"))
+            except ValueError as error:
+                raise StateError(f"state entry anticipation: {error}") from None
         self.filter.restore(state["filter"])          # checks, then changes: the last check
         if shaped:
             self._shaper = model
+        if anticipating:
+            self._anticipation = anticipation
         self.direction, self.previous_reference = direction, reference
         self.previous_temperature, self.previous_fraction = temperature, fraction
         self.reversals = points

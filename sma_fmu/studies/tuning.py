@@ -9,6 +9,11 @@ RMSE is the one reported. Writes ``NAME/controller.toml`` (a ``[controller]`` ta
 pastes into the scenario), ``report.json`` and ``report.md`` (the controllers ranked at
 the scenario's own gains and at each controller's tuned gains).
 
+A scenario the batch engine does not implement (the shaped compensator) is tuned on the
+scalar library path instead, one run at a time (about 1.5 s per 30-s run: keep
+``generations`` and ``population`` small); a shaped compensator has no phase-lag filter, so
+only Kp and Ki are searched.
+
 With a :class:`~sma_fmu.studies.robust.RobustCriterion` (``--robust``) the score of a set of
 gains is a quantile of the RMSEs over Monte Carlo draws of noise stream and wire, the same
 draws for every candidate (:mod:`sma_fmu.studies.robust`). Every record also carries the
@@ -20,6 +25,7 @@ import dataclasses
 import json
 import math
 import time
+from collections import namedtuple
 from datetime import datetime, timezone
 
 import numpy as np
@@ -46,6 +52,8 @@ BOUNDS = {"Kp": (0.0, 5.0), "Ki": (0.0, 20.0), "alpha": (0.0, 3.0), "beta": (0.0
 TUNED = {"pi": ("Kp", "Ki"), "pi+ff-fixed": ("Kp", "Ki", "alpha", "beta"),
          "pi+ff-adaptive": ("Kp", "Ki", "alpha", "beta")}
 _FAILED_RMSE = 1e6   # what a run that fails costs the optimiser [ohm]
+_SHAPED_KEYS = ("shaping", "power_cap_W", "anticipation_s")   # kept in the snippet as given
+_LibraryRun = namedtuple("_LibraryRun", "metrics")             # a library run, as a batch's
 
 
 def _with_gains(scenario, names, values):
@@ -69,16 +77,29 @@ def _robust_record(scenario, best, names, start, robust):
     return record
 
 
+def _tuned_names(scenario):
+    """The controller fields searched: :data:`TUNED`, without the filter's alpha and beta for
+    a shaped compensator (it does not use them)."""
+    names = TUNED[scenario.controller.kind]
+    return names[:2] if scenario.controller.shaping != "none" else names
+
+
+def _library_runs(scenarios):
+    """What :func:`run_batch` gives (objects with ``metrics``), one library run at a time."""
+    return [_LibraryRun(scenario_metrics(run_library(scenario).data, scenario))
+            for scenario in scenarios]
+
+
 def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
     """Tune one scenario's controller; returns a JSON-ready record (values, RMSE, effort).
 
     ``robust``: a :class:`~sma_fmu.studies.robust.RobustCriterion`, or None for the RMSE of
-    the scenario as it is.
+    the scenario as it is. A scenario the batch engine does not implement runs on the
+    library path (module docstring).
     """
     reason = unsupported_reason(scenario)
-    if reason:
-        raise StudyError(f"tune needs the batch engine: {reason}")
-    names = TUNED[scenario.controller.kind]
+    runs = _library_runs if reason else run_batch
+    names = _tuned_names(scenario)
     draws = [scenario] if robust is None else draw_scenarios(scenario, robust)
     quantile = 0.5 if robust is None else robust.quantile
     evaluations = 0
@@ -88,7 +109,7 @@ def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
         batch = [_with_gains(draw, names, column) for column in np.atleast_2d(candidates).T
                  for draw in draws]
         evaluations += len(batch)
-        rmses = np.array([_rmse(run.metrics) for run in run_batch(batch)])
+        rmses = np.array([_rmse(run.metrics) for run in runs(batch)])
         return robust_value(rmses.reshape(-1, len(draws)), quantile)
 
     began = time.perf_counter()
@@ -109,14 +130,18 @@ def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
         extra["noise_seeds"] = {"median_ohm": median, "rmse_ohm": values}
     if robust is not None:
         extra["robust"] = _robust_record(scenario, best, names, start, robust)
-    return {**_record(scenario, names, result, start, tuned, given, evaluations, seconds, seed),
-            **extra}
+    record = _record(scenario, names, result, start, tuned, given, evaluations, seconds, seed)
+    if reason:
+        record["optimiser"]["method"] = ("scipy differential_evolution, on the library path "
+                                         f"(not in the batch engine: {reason})")
+    return {**record, **extra}
 
 
 def _record(scenario, names, result, start, tuned, given, evaluations, seconds, seed):
     """The record's fields common to both criteria."""
     return {"scenario": scenario.name, "group": scenario.group,
             "controller": scenario.controller.kind, "inverse": scenario.controller.inverse,
+            **{key: getattr(scenario.controller, key) for key in _SHAPED_KEYS},
             "hysteresis_mode": scenario.hysteresis_mode,
             "tuned": {name: float(v) for name, v in zip(names, result.x)},
             "given": {name: float(v) for name, v in zip(names, start)},
@@ -150,6 +175,8 @@ def controller_snippet(record):
               "[controller]", f"kind = {json.dumps(record['controller'])}"]
     if record.get("inverse", "major") != "major":
         lines.append(f"inverse = {json.dumps(record['inverse'])}")
+    lines += [f"{key} = {json.dumps(record[key])}" for key in _SHAPED_KEYS
+              if record.get(key) not in (None, "none", 0.0)]
     lines += [f"{GAIN_KEYS[name]} = {value!r}" for name, value in record["tuned"].items()]
     return "\n".join(lines) + "\n"
 
@@ -231,7 +258,7 @@ def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_
     records = []
     for index, scenario in enumerate(scenarios, start=1):
         progress(f"[{index}/{len(scenarios)}] tuning {scenario.name} "
-                 f"({', '.join(TUNED[scenario.controller.kind])}) ...")
+                 f"({', '.join(_tuned_names(scenario))}) ...")
         record = tune_scenario(scenario, seed, generations, population, robust)
         progress(f"    RMSE {record['rmse_ohm']['given']:.4f} -> {record['rmse_ohm']['tuned']:.4f}"
                  f" ohm: " + ", ".join(f"{k} = {v:.4g}" for k, v in record["tuned"].items()))

@@ -51,6 +51,10 @@ def test_the_shaped_scenarios_ship_beside_their_twins():
      r"\[controller\] power_cap_W = 5.0 needs shaping = 'reachable', got 'none'"),
     (lambda s: s.replace('shaping = "reachable"', 'shaping = "reachable"\npower_cap_W = -1.0'),
      r"power_cap_W"),
+    (lambda s: s.replace('shaping = "reachable"', 'anticipation_s = 0.2'),
+     r"\[controller\] anticipation_s = 0.2 needs shaping = 'reachable', got 'none'"),
+    (lambda s: s.replace('shaping = "reachable"', 'shaping = "reachable"\nanticipation_s = -0.1'),
+     r"\[controller\] anticipation_s must be >= 0, got -0.1"),
 ])
 def test_bad_shaping_keys_name_file_and_value(tmp_path, change, message):
     path = tmp_path / "custom.toml"
@@ -80,3 +84,40 @@ def test_both_fmu_families_and_the_c_master_run_the_library_loop(fmus, native_di
         scenario.controller, shaping="none", power_cap_W=None))).data
     assert np.max(np.abs(unshaped["P_ff"][:-1] - library["P_ff"][:-1])) > 0.1   # not the paper's
     assert np.max(library["P_ff"][:-1]) <= 3.0                           # the cap holds
+
+
+BENCH = [f"{profile}{mode}-bench-pi+ff-adaptive-reachable" for profile in ("load-step", "heavy")
+         for mode in ("", "-continuous")]
+
+
+def test_the_bench_scenarios_of_the_shaped_compensator_ship_with_the_bench_and_its_limit():
+    """Their twins' reference, loads, mode, sensor and driver; the compensator's P_max is
+    no more than the driver's current limit gives at the lowest R the reference asks for."""
+    assert set(BENCH) <= set(scenario_names())
+    for name in BENCH:
+        scenario, twin = _scenario(name), _scenario(name.replace("-reachable", ""))
+        c = scenario.controller
+        assert (c.shaping, c.inverse) == ("reachable",
+                                          "minor-loop" if "continuous" in name else "major")
+        assert c.anticipation_s > 0 and twin.controller.shaping == "none"
+        assert (scenario.reference.settings, scenario.load.as_table(), scenario.hysteresis_mode,
+                scenario.sensor, scenario.drive) == (twin.reference.settings,
+                                                     twin.load.as_table(), twin.hysteresis_mode,
+                                                     twin.sensor, twin.drive)
+        lowest = twin.reference.settings["offset_ohm"] - twin.reference.settings["amplitude_ohm"]
+        assert c.power_cap_W <= scenario.drive.I_max_A ** 2 * lowest
+
+
+@needs("gcc")
+@pytest.mark.parametrize("name", ["load-step-bench-pi+ff-adaptive-reachable",
+                                  "heavy-continuous-bench-pi+ff-adaptive-reachable"])
+def test_the_anticipating_compensator_runs_alike_in_every_path(fmus, native_dir, name):
+    """3 s hold the reference's first lower turn (t = 1 s), where the anticipation acts."""
+    scenario = _scenario(name, stop_time_s=3.0)
+    library = run_library(scenario).data
+    _close(run_fmus(scenario, fmus["SmaActuator"].parent).data, library)
+    _close(run_fmus(scenario, native_dir).data, library)
+    _close(run_c_master(scenario, native_dir).data, library)
+    plain = run_library(dataclasses.replace(scenario, controller=dataclasses.replace(
+        scenario.controller, anticipation_s=0.0))).data
+    assert np.max(np.abs(plain["P_ff"][:-1] - library["P_ff"][:-1])) > 0.1

@@ -119,3 +119,21 @@ def test_tuning_without_robust_keeps_its_record(tmp_path):
     short = dataclasses.replace(scenario, stop_time_s=2.5)
     assert record["rmse_ohm"]["given"] == scenario_metrics(run_library(short).data,
                                                            short)["overall"]["rmse_ohm"]
+
+
+def test_the_shaped_compensator_is_tuned_on_the_library_path(tmp_path):
+    """The batch engine does not implement shaping: the candidates run on the scalar path,
+    only Kp and Ki are searched (no filter), and the snippet keeps the shaping's keys."""
+    out = tmp_path / "tune"
+    name = "heavy-bench-pi+ff-adaptive-reachable"
+    assert main(["tune", name, "--robust", "--draws", "2", "--stop-time", "1.5",
+                 "--generations", "1", "--population", "2", "--out", str(out)]) == 0
+    record = json.loads((out / "report.json").read_text())[0]
+    assert set(record["tuned"]) == {"Kp", "Ki"}
+    assert "library path" in record["optimiser"]["method"]
+    robust = record["robust"]
+    assert robust["score_tuned_ohm"] == pytest.approx(record["rmse_ohm"]["tuned_batch"], rel=1e-12)
+    assert robust["score_tuned_ohm"] <= robust["score_given_ohm"] + 1e-12
+    text = (out / name / "controller.toml").read_text()
+    assert 'shaping = "reachable"' in text and "power_cap_W = 8.3" in text
+    assert "anticipation_s = 0.15" in text

@@ -27,6 +27,8 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     # shaping = "reachable"     # "none" (default, the paper's phase-lag filter) or
                                 # "reachable" (the demand shaped into what the wire can reach)
     # power_cap_W = 10.0        # with shaping "reachable": the driver's P_max (default none)
+    # anticipation_s = 0.2      # with shaping "reachable": aim this far ahead near the
+                                # reference's lower turn (default 0: none)
     [plant]
     hysteresis_mode = "switch"  # default "continuous"; optional T_start_degC (default T_room)
 
@@ -80,7 +82,7 @@ _SECTIONS = {
     "scenario": {"description", "stop_time_s", "step_s", "model", "group", "output_interval_s"},
     "reference": None,  # checked by signals.reference_from_table
     "load": None,       # checked by signals.load_from_table
-    "controller": {"kind", "inverse", "shaping", "power_cap_W", *(gain.key for gain in GAINS)},
+    "controller": {"kind", "inverse", "shaping", "power_cap_W", "anticipation_s", *(gain.key for gain in GAINS)},
     "plant": {"hysteresis_mode", "T_start_degC"},
     "analysis": {"metrics_start_s", "zoom_start_s", "zoom_end_s"},
     "drive": {"kind", "frequency_Hz", "peak_W", "I_max_A", "V_max_V"},
@@ -168,7 +170,16 @@ def _controller(path, table, params):
         if shaping != "reachable":
             _fail(path, f"[controller] power_cap_W = {cap!r} needs shaping = 'reachable', "
                         f"got {shaping!r}")
-    return ControllerSettings(kind, inverse=inverse, shaping=shaping, power_cap_W=cap, **values)
+    lead = 0.0
+    if "anticipation_s" in table:
+        lead = _number(path, "controller", table, "anticipation_s")
+        if lead < 0:
+            _fail(path, f"[controller] anticipation_s must be >= 0, got {lead!r}")
+        if lead > 0 and shaping != "reachable":
+            _fail(path, f"[controller] anticipation_s = {lead!r} needs shaping = 'reachable', "
+                        f"got {shaping!r}")
+    return ControllerSettings(kind, inverse=inverse, shaping=shaping, power_cap_W=cap,
+                              anticipation_s=lead, **values)
 
 
 def _compensator_choice(path, table, kind, key, names):

@@ -36,7 +36,7 @@ class ControllerSettings:
     """Controller of a scenario: kind and gains (Kp [W/ohm], Ki [W/(ohm.s)], alpha, beta [s],
     model_load [kg] of the fixed compensator), the compensator's inverse ("major" or
     "minor-loop") and shaping ("none" or "reachable", with the driver's P_max ``power_cap_W``
-    [W] or None), see :class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`."""
+    [W] or None, and the lower turn's anticipation ``anticipation_s`` [s], 0: none), see :class:`~sma_fmu.runtime.feedforward.FeedforwardStepper`."""
 
     kind: str
     Kp: float
@@ -47,6 +47,7 @@ class ControllerSettings:
     inverse: str = "major"
     shaping: str = "none"
     power_cap_W: float = None
+    anticipation_s: float = 0.0
 
     @property
     def feedforward(self):

@@ -3,10 +3,10 @@
 Computed here once for every master and system tool. Each component's parameters are,
 besides the scenario's wire in the FMUs that model it (:data:`WIRES`, set whole by
 :mod:`.wire_values`): the signals as JSON tables (SmaScenarioSignals), the compensator's
-filter, model load, adaptation, inverse, shaping and power cap (0 W: none), the PI's gains
-(:data:`~.gains.GAINS`) and its sensor (with a ``[sensor]``: noise, ADC, seed), the driver's
-frequency and peak power (and, with a limit, its modulation and current and voltage limits),
-the plant's start temperature and hysteresis mode.
+filter, model load, adaptation, inverse, shaping, power cap (0 W: none) and anticipation
+(0 s: none), the PI's gains (:data:`~.gains.GAINS`) and its sensor (with a ``[sensor]``:
+noise, ADC, seed), the driver's frequency and peak power (and, with a limit, its modulation
+and current and voltage limits), the plant's start temperature and hysteresis mode.
 Choices (the hysteresis mode, the inverse, the shaping, the modulation) are the Integer codes of
 :mod:`sma_fmu.fmi.python_family.slave_support.choices`.
 
@@ -41,7 +41,8 @@ def component_settings(scenario, name):
         return {**_gains(c, name), "adapt_to_load": c.adapt_to_load,
                 "inverse": choice_code("inverse", c.inverse),
                 "shaping": choice_code("shaping", c.shaping),
-                "power_cap": 0.0 if c.power_cap_W is None else c.power_cap_W}
+                "power_cap": 0.0 if c.power_cap_W is None else c.power_cap_W,
+                "anticipation": c.anticipation_s}
     if name == "pi":
         sensor = scenario.sensor
         return _gains(c, name) if sensor.ideal else {

@@ -50,7 +50,8 @@ _KNOWN_SCENARIO_FIELDS = {"name", "path", "description", "stop_time_s", "step_s"
                           # what `sma-fmu run` records; metrics use every step here as there
                           "output_interval_s", "sensor"}
 _KNOWN_CONTROLLER_FIELDS = {"kind", "Kp", "Ki", "alpha", "beta", "model_load", "inverse",
-                            "shaping", "power_cap_W"}   # shaping: "none" only, checked below
+                            "shaping", "power_cap_W",   # shaping: "none" only, checked below
+                            "anticipation_s"}           # > 0 only with shaping "reachable"
 _KNOWN_DRIVE_FIELDS = {"kind", "frequency_Hz", "peak_W", "I_max_A", "V_max_V"}
 _KNOWN_SENSOR_FIELDS = {"noise_ohm_rms", "full_scale_ohm", "bits", "seed"}
 _DRIVE_KINDS = ("power", "pwm")   # not runtime.pwm.DRIVE_KINDS: a kind added there is refused

@@ -77,7 +77,47 @@ int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *par
     self->unconnected_warned = 0;
     self->bounded_before = 0;
     self->data_unwarned = params->data_range;
+    self->anticipation = 0.0;
+    self->earlier_reference = SMA_STATE_NONE;
+    self->last_reference = SMA_STATE_NONE;
+    self->held_aim = SMA_STATE_NONE;
     return 0;
+}
+
+int feedforward_stepper_set_anticipation(FeedforwardStepper *self, double lead,
+                                         SmaMessage *message)
+{
+    if (require_nonnegative("anticipation", lead, message)) {
+        return 1;
+    }
+    if (lead > 0.0 && self->shaping != SHAPING_REACHABLE) {
+        return sma_message_set(message, "anticipation = %.17g s needs shaping 'reachable', "
+                               "got 'none'", lead);
+    }
+    self->anticipation = lead;
+    return 0;
+}
+
+/* runtime/anticipation.py's TurnAnticipation: the aim [ohm] for the sample `reference` and
+ * the aim to hold after it (*held; NaN = None), no state change. */
+static double anticipated_aim(const FeedforwardStepper *self, double reference,
+                              double step_size, double *held)
+{
+    double earlier = self->earlier_reference, previous = self->last_reference;
+    double lead = self->anticipation, aim = reference, slope, curvature;
+    if (earlier == earlier) {
+        slope = (reference - earlier) / (2.0 * step_size);
+        curvature = (reference - 2.0 * previous + earlier) / (step_size * step_size);
+        if (slope < 0.0 && 0.0 < curvature && -slope < curvature * lead) {
+            aim = reference + slope * lead + 0.5 * curvature * lead * lead;
+        }
+    }
+    if (aim == reference && self->held_aim == self->held_aim && reference < self->held_aim) {
+        *held = self->held_aim;
+        return self->held_aim;
+    }
+    *held = aim == reference ? SMA_STATE_NONE : aim;
+    return aim;
 }
 
 /* One sample's inversion (Python's _invert), no state change: *sensed, the stack after it
@@ -265,7 +305,7 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     SensedTemperature sensed;
     ReversalPoint *stack;
     size_t kept;
-    double fraction, output, temperature;
+    double fraction, output, temperature, sample, held = SMA_STATE_NONE;
     char warning[sizeof self->warning];
     int direction, way, saturated, bounded, outside, moved;
     if (no_reference_yet(self, reference)) {
@@ -287,6 +327,10 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     if (fast_positive("R_ref", reference, message) || fast_nonnegative("load", load, message)
         || fast_positive("step_size", step_size, message)) {
         return 1;
+    }
+    sample = reference;   /* R_ref,k; the compensator works on the aim (anticipation) */
+    if (self->anticipation > 0.0) {
+        reference = anticipated_aim(self, sample, step_size, &held);
     }
     direction = direction_for(self, reference);
     if (self->shaping == SHAPING_REACHABLE
@@ -330,6 +374,11 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
         self->previous_temperature = sensed.temperature;
         self->previous_fraction = fraction;
     }
+    if (self->anticipation > 0.0) {
+        self->earlier_reference = self->last_reference;
+        self->last_reference = sample;
+        self->held_aim = held;
+    }
     self->direction = direction;
     self->previous_reference = reference;
     memcpy(self->warning, warning, sizeof warning);
@@ -346,7 +395,8 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
 
 size_t feedforward_stepper_state_size(const FeedforwardStepper *self)
 {
-    size_t own = FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count;
+    size_t own = FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count
+                 + (self->anticipation > 0.0 ? 3 : 0);
     return self->shaping == SHAPING_REACHABLE
            ? own + plant_stepper_state_size(&self->shaper.model) : own;
 }
@@ -364,9 +414,15 @@ void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out
         out[FEEDFORWARD_STATE_FIXED + 2 * i] = self->reversals[i].temperature;
         out[FEEDFORWARD_STATE_FIXED + 2 * i + 1] = self->reversals[i].xi_MF;
     }
+    out += FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count;
+    if (self->anticipation > 0.0) {
+        out[0] = self->earlier_reference;
+        out[1] = self->last_reference;
+        out[2] = self->held_aim;
+        out += 3;
+    }
     if (self->shaping == SHAPING_REACHABLE) {
-        plant_stepper_state_write(&self->shaper.model,
-                                  out + FEEDFORWARD_STATE_FIXED + 2 * self->reversal_count);
+        plant_stepper_state_write(&self->shaper.model, out);
     }
 }
 
@@ -391,7 +447,10 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
                                    SmaMessage *message)
 {
     int direction, reference_present, temperature_present, fraction_present;
-    int shaped = self->shaping == SHAPING_REACHABLE;
+    int shaped = self->shaping == SHAPING_REACHABLE, present;
+    size_t anticipated = self->anticipation > 0.0 ? 3 : 0, i;
+    static const char *const entries[3] = {"earlier", "previous", "held"};
+    SmaMessage reason;
     double points_given;
     ReachableShaping model;
     size_t depth = (size_t)self->params.memory_depth, points, own;
@@ -418,17 +477,24 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
                                "pairs, got a count of %.17g", (unsigned long)depth, points_given);
     }
     points = (size_t)points_given;
-    own = FEEDFORWARD_STATE_FIXED + 2 * points;
+    own = FEEDFORWARD_STATE_FIXED + 2 * points + anticipated;
     if (shaped ? count < own : count != own) {
         return sma_message_set(message, "reversals: the compensator state holds %lu numbers, "
-                               "not %d + 2 x %lu for its %lu reversal points%s",
+                               "not %d + 2 x %lu for its %lu reversal points%s%s",
                                (unsigned long)count, FEEDFORWARD_STATE_FIXED,
                                (unsigned long)points, (unsigned long)points,
+                               anticipated ? ", 3 of the anticipation" : "",
                                shaped ? " and the model wire's state" : "");
     }
     if (read_points(in + FEEDFORWARD_STATE_FIXED, points, depth, "reversals", NULL,
                     message)) {
         return 1;
+    }
+    for (i = 0; i < anticipated; i++) {
+        if (read_optional_number(in[own - 3 + i], entries[i], 5e-324, HUGE_VAL, "ohm",
+                                 &present, &reason)) {
+            return sma_message_set(message, "state entry anticipation: %s", reason.text);
+        }
     }
     if (shaped && read_model(self, in + own, count - own, &model, message)) {
         return 1;
@@ -447,6 +513,11 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
     self->previous_reference = in[1];
     self->previous_temperature = in[2];
     self->previous_fraction = in[3];
+    if (anticipated) {
+        self->earlier_reference = in[own - 3];
+        self->last_reference = in[own - 2];
+        self->held_aim = in[own - 1];
+    }
     read_points(in + FEEDFORWARD_STATE_FIXED, points, depth, "reversals", self->reversals,
                 NULL);
     self->reversal_count = points;

@@ -32,9 +32,15 @@
  *   [4] filter previous_input [W] or None        [5] filter previous_output [W] or None
  *   [6] n, the number of reversal points (0 .. memory_depth)
  *   [7 + 2 i], [8 + 2 i]  reversal i (oldest first): T [degC], xi_MF [1]
+ *   anticipation > 0: then 3 doubles, the anticipation's R_ref,k-2, R_ref,k-1 and held aim
+ *   [ohm] (each NaN = None)
  *   shaping "reachable": then the model wire's state, PLANT_STATE_FIXED + 2 m doubles (plant.h)
  * Python's state() dict has the same entries (its "format" is the FMI layer's header; the
- * model's is its "model" entry). */
+ * model's is its "model" entry, the anticipation's its "anticipation" entry).
+ *
+ * Anticipation (feedforward_stepper_set_anticipation, runtime/anticipation.py): shaped, the
+ * compensator aims L [s] ahead near the reference's lower turn, from the slope and curvature
+ * of its last three samples, and holds that aim after the turn until R_ref catches up. */
 #ifndef SMA_FEEDFORWARD_H
 #define SMA_FEEDFORWARD_H
 
@@ -94,6 +100,10 @@ typedef struct FeedforwardStepper {
     int unconnected_warned;       /* the no-reference-yet warning was given (not saved) */
     int bounded_before;           /* the last step's T_ref was bounded to T_max (not saved) */
     int data_unwarned;            /* the data-range warning is still to come (not saved) */
+    double anticipation;          /* L [s]; 0: none */
+    double earlier_reference;     /* the anticipation's R_ref,k-2 [ohm]; NaN = None */
+    double last_reference;        /* the anticipation's R_ref,k-1 [ohm]; NaN = None */
+    double held_aim;              /* the anticipated aim held after the turn [ohm]; NaN = None */
 } FeedforwardStepper;
 
 /* Python's FeedforwardStepper(params, alpha, beta, model_load, adapt_to_load, inverse,
@@ -106,6 +116,11 @@ int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *par
                              double alpha, double beta, double model_load, int adapt_to_load,
                              const char *inverse, const char *shaping, double power_cap,
                              SmaMessage *message);
+/* Python's FeedforwardStepper(..., anticipation=lead): after init, before the first step.
+ * Refuses lead < 0 ("anticipation") and lead > 0 without shaping "reachable" ("anticipation =
+ * ... s needs shaping 'reachable', got 'none'"); 0 leaves it off. */
+int feedforward_stepper_set_anticipation(FeedforwardStepper *self, double lead,
+                                         SmaMessage *message);
 /* Outputs before the first step (filter in steady state); the state is unchanged.
  * Refuses after the first step, and a bad `reference` R_ref [ohm] ("R_ref") or `load` [kg]
  * ("load"); R_ref <= 0 gives the unconnected outputs. */

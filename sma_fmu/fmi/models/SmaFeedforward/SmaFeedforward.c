@@ -7,7 +7,8 @@
  * initialization the outputs are those of the first sample (filter in steady state).
  * Invalid parameters refuse fmi2ExitInitializationMode; inverse is an Integer
  * (1 = major, 2 = minor-loop), shaping too (1 = none, 2 = reachable), power_cap [W] the
- * driver's P_max (0: no limit). */
+ * driver's P_max (0: no limit), anticipation [s] the lead at the reference's lower turn
+ * (0: none). */
 #include "fp_contract.h"
 #include "feedforward.h"
 #include "checks.h"
@@ -38,6 +39,10 @@ static int start(void *stepper, SmaValue *values, SmaRun *run, SmaMessage *messa
                                  params.model_load, values[VAR_adapt_to_load].integer, inverse,
                                  shaping, cap == 0.0 ? SMA_STATE_NONE : cap, message))
         return 1;
+    if (feedforward_stepper_set_anticipation(self, values[VAR_anticipation].real, message)) {
+        feedforward_stepper_free(self);
+        return 1;
+    }
     if (feedforward_stepper_initial_outputs(self, values[VAR_R_ref].real, values[VAR_load].real,
                                             &outputs, message)) {
         feedforward_stepper_free(self);

@@ -12,7 +12,7 @@ Invalid parameters make exitInitializationMode fail with fmi2Error naming the re
 the instance stays in Initialization Mode, where they can be corrected. ``inverse`` is an
 Integer: 1 = major, 2 = minor-loop; ``shaping`` too: 1 = none (the phase-lag filter),
 2 = reachable (``slave_support/choices.py``), with ``power_cap`` [W] the driver's P_max
-(0: no limit). A step within a millionth of the first step's size is taken as that size
+(0: no limit) and ``anticipation`` [s] the lead at the reference's lower turn (0: none). A step within a millionth of the first step's size is taken as that size
 (the time grid, docs/systems.md).
 """
 from sma_fmu.runtime.feedforward import FeedforwardStepper
@@ -60,6 +60,8 @@ class SmaFeedforward(StepperSlave):
                              "the demand shaped into what the wire can reach, over a model of it")
         fmi.parameter("power_cap", 0.0, "W", "with shaping reachable: the most power the "
                       "driver delivers, P_max (0: no limit)")
+        fmi.parameter("anticipation", 0.0, "s", "with shaping reachable: aim this far ahead "
+                      "near the reference's lower turn, from its past samples (0: none)")
         self.stepper = None
 
     def _start(self):
@@ -67,5 +69,6 @@ class SmaFeedforward(StepperSlave):
                                      adapt_to_load=self.adapt_to_load,
                                      inverse=choice_name("inverse", self.inverse),
                                      shaping=choice_name("shaping", self.shaping),
-                                     power_cap=power_cap_of(self.power_cap))
+                                     power_cap=power_cap_of(self.power_cap),
+                                     anticipation=self.anticipation)
         return stepper, stepper.initial_outputs(self.R_ref, self.load)
