@@ -85,3 +85,13 @@ def test_stroke_metrics_are_the_stroke_error_in_micrometres(tmp_path):
     assert metrics["max_abs_um"] == pytest.approx(1e6 * np.max(np.abs(error)), rel=1e-9)
     assert metrics["samples"] == int(window.sum())
     assert len(metrics["segments_rmse_um"]) == 3
+
+
+@pytest.mark.parametrize("path", ["fmu", "ssp", "container"])
+def test_a_stroke_scenario_is_refused_off_the_library_path_before_any_run(tmp_path, path):
+    from sma_fmu.systems.runner import run_scenarios
+
+    out = tmp_path / "out"
+    with pytest.raises(ValueError, match=rf"runs on --path library only.*not --path {path}"):
+        run_scenarios([shipped_file("scenarios", f"{HOLD}.toml")], out, path=path)
+    assert not out.exists()
