@@ -13,15 +13,16 @@ so at one temperature both are affine in xi_MF. **The method:** without thermal 
 does not depend on T, and xi_MF = M (x* - x(0)) / (x(M) - x(0)) for the target length
 x* = x_0 - s is closed form; R_ref follows on the same line. With thermal expansion
 (alpha_P or alpha_MF != 0) the temperature that goes with xi_MF is the branch's own: the map
-iterates T -> xi_MF (the affine solve at T) -> T = the major branch's inverse at xi_MF
+finds the root of F(T) = T'(T) - T, where T' is the major branch's inverse
 (:func:`~.sensing.temperature_of_fractions`: closed form, or the two-stage Newton search of
-:mod:`.two_stage_root`), from the branch's centre, until T moves by less than
-:data:`~.two_stage_root.ROOT_TOLERANCE_K`. The root lies between the temperatures of the
-branch's two ends (T' never leaves them), and each round narrows that bracket by the sign of
-T' - T; a step that would leave it halves it instead, as the two-stage search does (near
-saturation the fixed point alone would jump between the ends). Inside the transformation a
-round shrinks the error by the ratio of the thermal slope of x to its transformation slope
-(a few per cent for the Flexinol fit): 4-6 rounds; at most :data:`~.two_stage_root.ROOT_CAP`.
+:mod:`.two_stage_root`) at the xi_MF the affine solve gives at T. The root lies between the
+temperatures of the branch's two ends (T' never leaves them, so F changes sign there). From
+the branch's centre: one fixed-point step (T <- T'), then secant steps through the last two
+residuals, the bracket narrowed by each residual's sign; a step that would leave it halves it
+instead, as the two-stage search does (near saturation the fixed point alone jumps between the
+ends). Stopped when |F| <= :data:`~.two_stage_root.ROOT_TOLERANCE_K`; at most
+:data:`~.two_stage_root.ROOT_CAP` rounds. Every step depends on the asked stroke and load
+only, not on earlier calls, so the map is a function.
 
 The branch is the major branch of ``direction`` (the sign of the stroke reference's last
 change: a rising stroke heats). On a minor branch the wire holds the same (R, xi_MF) pairs;
@@ -33,8 +34,9 @@ than all of M transformed to P, or less than none) maps to the end's R_ref, and 
 says ``clamped`` and the stroke it does give.
 
 **Cost per step:** the last target is kept, so a reference and load held over a step cost one
-comparison; a new (stroke, load, direction) costs one affine solve without thermal expansion,
-else 4-6 branch inverses (``sma-fmu bench`` measures both).
+comparison; a new (stroke, load, direction) costs one affine solve and one branch inverse
+without thermal expansion, else a handful of rounds of one each (``sma-fmu bench --only
+stroke`` measures the cost and counts the rounds).
 """
 from collections import namedtuple
 
@@ -73,6 +75,7 @@ class StrokeMap:
         terms = params.terms
         self._thermal = terms.alpha_P != 0.0 or terms.alpha_MF != 0.0
         self._last = (None, None, None, None)   # (stroke, load, direction, target)
+        self._ends_of, self._ends = None, None  # a branch's constants, its ends' T [degC]
 
     def target(self, stroke, load, direction=HEATING):
         """The :class:`StrokeTarget` of ``stroke`` [m] under ``load`` [kg] on the major branch
@@ -110,20 +113,30 @@ class StrokeMap:
         if not self._thermal:   # x does not depend on T: one affine solve
             xi_mf, clamped = self._fraction_at(constants.centre, length, constants)
             temperature = branch_temperature(xi_mf)
-        else:   # T -> xi_MF(T) -> T' has its root between the branch's two ends
-            low, high = branch_temperature(total - delta), branch_temperature(delta)
-            temperature = min(max(constants.centre, low), high)
+        else:   # F(T) = T'(T) - T, T' = the inverse at xi_MF(T): a root between the two ends
+            if constants is not self._ends_of:   # the ends' temperatures, once per branch
+                self._ends_of = constants
+                self._ends = (branch_temperature(total - delta), branch_temperature(delta))
+            low, high = self._ends
+            temperature, before, residual_before = min(max(constants.centre, low), high), None, 0.0
             for _ in range(ROOT_CAP):
                 xi_mf, clamped = self._fraction_at(temperature, length, constants)
                 proposal = branch_temperature(xi_mf)
-                if abs(proposal - temperature) <= ROOT_TOLERANCE_K or high - low <= ROOT_TOLERANCE_K:
+                residual = proposal - temperature
+                if abs(residual) <= ROOT_TOLERANCE_K or high - low <= ROOT_TOLERANCE_K:
                     break
-                if proposal > temperature:
+                if residual > 0.0:
                     low = temperature
                 else:
                     high = temperature
-                # the fixed-point step where it stays inside the bracket, else its middle
-                temperature = proposal if low < proposal < high else 0.5 * (low + high)
+                if before is None or residual == residual_before:   # the fixed-point step
+                    step = proposal
+                else:   # the secant through the last two residuals
+                    step = temperature - residual * (temperature - before) / (
+                        residual - residual_before)
+                before, residual_before = temperature, residual
+                # a step that would leave the bracket halves it instead
+                temperature = step if low < step < high else 0.5 * (low + high)
             temperature = proposal
         xi_p, xi_m, xi_f = total - xi_mf, 0.5 * xi_mf, constants.xi_F_min + 0.5 * xi_mf
         reached = self.start_length - branch_length(temperature, xi_p, xi_m, xi_f, constants,
