@@ -7,12 +7,17 @@ costs per step in the Python runtime (:mod:`sma_fmu.runtime.stroke`).
   point over the branch inverse), with the rounds it takes;
 - R_ref(t) of the shipped 0.5 Hz stroke profile, step by step (the trend and the map);
 - the two shipped stroke scenarios on the library path against the same runs with the
-  mapped R_ref given as a table (what the mapping adds to a whole run), wall time.
+  mapped R_ref given as a table (what the mapping adds to a whole run), wall time;
+- with native FMUs (``--fmus``): the same scenarios through the C master against the library
+  path (:func:`~sma_fmu.bench.c_master.c_master_times`, recording included; the C master's
+  wall includes the master's mapping of the stroke into the signals FMU's table).
 
 CPU time per step, the median of the passes (a shared machine's other work is not counted).
-The C family has no stroke map yet: there is no C figure to print.
+The C family has no stroke map of its own (the master maps the stroke for the FMUs): there is
+no C figure per step to print.
 """
 import dataclasses
+import shutil
 import statistics
 import time
 
@@ -110,8 +115,9 @@ def _as_table(scenario):
     return dataclasses.replace(scenario, reference=_Sampled(scenario))
 
 
-def run_stroke_bench(out_dir, runs, progress=print):
-    """Measure; write ``benchmark.json`` into ``out_dir``; return the results."""
+def run_stroke_bench(out_dir, runs, progress=print, fmus=None):
+    """Measure; write ``benchmark.json`` into ``out_dir``; return the results. ``fmus``: a
+    folder of native FMUs for the C master's runs (None: none)."""
     progress("the stroke map per step (Python) ...")
     costs, rounds = map_costs(max(runs, 3))
     progress("the stroke scenarios on the library path ...")
@@ -120,6 +126,12 @@ def run_stroke_bench(out_dir, runs, progress=print):
                "library_wall_s": {name: {"stroke": a, "mapped_beforehand": b}
                                   for name, (a, b) in walls.items()}}
     with staged_folder(out_dir) as stage:
+        if fmus is not None:
+            from sma_fmu.bench.c_master import c_master_times
+            progress("the stroke scenarios through the C master ...")
+            results["c_master"] = c_master_times(fmus, runs, stage / "runs", SCENARIOS,
+                                                 ("csv",))
+            shutil.rmtree(stage / "runs", ignore_errors=True)
         (stage / "benchmark.json").write_text(json_text(results), encoding="utf-8")
     return results
 
@@ -134,4 +146,10 @@ def stroke_lines(results):
     lines.append("library path, wall [s] (median): stroke run / R_ref mapped beforehand")
     for name, walls in results["library_wall_s"].items():
         lines.append(f"  {name:<48} {walls['stroke']:>7.2f} / {walls['mapped_beforehand']:.2f}")
+    if "c_master" in results:
+        lines.append("C master / library path, wall [s] (median, csv recorded; the C master's "
+                     "includes mapping the stroke)")
+        for name, times in results["c_master"].items():
+            lines.append(f"  {name:<48} {times['c_s']:>7.2f} / {times['library_s']:.2f}  "
+                         f"ratio {times['ratio']:.3f} ({times['min']:.3f}-{times['max']:.3f})")
     return lines

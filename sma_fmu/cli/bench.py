@@ -38,7 +38,7 @@ def _bench(args):
     if args.only == "stroke":
         from sma_fmu.bench.stroke import run_stroke_bench, stroke_lines
         say = lambda text: print(text, flush=True)  # noqa: E731
-        results = run_stroke_bench(args.out, args.runs, say)
+        results = run_stroke_bench(args.out, args.runs, say, args.fmus)
         print("\n".join(stroke_lines(results)))
         print(f"written: {args.out / 'benchmark.json'}")
         return 0
@@ -72,7 +72,8 @@ def register(commands):
                             "the stroke map's cost per step and the stroke scenarios' runs)")
     bench.add_argument("--fmus", type=Path, metavar="DIR",
                        help="with --only c-master or hardware: the native FMUs (sma-fmu build "
-                            "--native; default: built into the output folder)")
+                            "--native; default: built into the output folder); with --only "
+                            "stroke: the C master's runs too (default: none)")
     bench.add_argument("--model", type=Path, metavar="FILE",
                        help="with --only inverse: the two-stage wire's parameter file (e.g. "
                             "a fit's identified.toml; default: the reference wire with a "

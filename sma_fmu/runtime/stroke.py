@@ -171,6 +171,18 @@ class StrokeReference:
                   for stroke in (low, high) for load in self.load.values for direction in (1, -1)]
         return min(values), max(values)
 
+    def resistance_table(self, step_s, steps):
+        """R_ref at t_k = k ``step_s`` [s], k = 0 ... ``steps``, as a ``[reference]`` table in
+        ohm: what a signals source without a stroke map (the FMUs') is given. A table gives
+        its knots exactly at those times, so it samples the same R_ref as this map; knots
+        inside a run of equal values are left out (a held stroke and load: a few knots)."""
+        times = [k * step_s for k in range(steps + 1)]
+        values = [self.value(t) for t in times]
+        kept = [k for k in range(len(values))
+                if k in (0, steps) or not values[k - 1] == values[k] == values[k + 1]]
+        return {"kind": "table", "times_s": [times[k] for k in kept],
+                "values_ohm": [values[k] for k in kept]}
+
     def stroke(self, t):
         """The stroke reference [m] at ``t`` [s]."""
         return 1e-3 * self.signal.value(t)
