@@ -62,3 +62,19 @@ def test_a_reachable_stroke_has_no_saturation_and_benchmarks_in_micrometres(tmp_
     bound = tracking_bound(_scenario(tmp_path, 10.0)).stroke
     assert bound["lower_bound_um"] == 0.0
     assert 0.0 < bound["achievable_um"] < 5e3   # the 5 mm step itself would be 5e3 um
+
+
+def test_sma_fmu_bound_reports_the_stroke_rmse_beside_its_bound(tmp_path):
+    from sma_fmu.analysis.bound_report import bound_scenarios
+    from sma_fmu.cosim.loop import run_library
+    from sma_fmu.cosim.metrics import scenario_metrics
+
+    scenario = _scenario(tmp_path, 10.0)
+    rows = bound_scenarios([scenario.path], tmp_path / "bound", progress=lambda text: None)
+    stroke = rows[0]["stroke"]
+    run = scenario_metrics(run_library(scenario).data, scenario)["stroke"]
+    assert stroke["rmse_um"] == run["rmse_um"]
+    assert stroke["rmse_over_achievable"] == pytest.approx(
+        run["rmse_um"] / stroke["achievable_um"])
+    table = (tmp_path / "bound" / "bound.md").read_text()
+    assert "| stroke | pi+ff-adaptive | " in table and f"{run['rmse_um']:.1f}" in table
