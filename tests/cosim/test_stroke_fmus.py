@@ -1,6 +1,7 @@
-"""A stroke scenario through the C-family FMUs: the fmpy master and the C master against the
-library path, every column to 1e-9 (the master maps the stroke to the signals FMU's R_ref
-table; the plant, compensator and PI are the FMUs')."""
+"""A stroke scenario through the FMUs: the C-family FMUs under the fmpy master and the C
+master, and the pythonfmu family under the fmpy master, against the library path, every
+column to 1e-9 (the master maps the stroke to the signals FMU's R_ref table; the plant and
+the compensator are the FMUs')."""
 import numpy as np
 import pytest
 
@@ -42,3 +43,12 @@ def test_the_c_family_fmus_give_the_library_paths_stroke_run(native_dir, tmp_pat
     assert np.ptp(library["stroke"][500:]) > 10e-3   # the wire moved through the profile
     ours, theirs = (scenario_metrics(data, scenario)["stroke"] for data in (fmus, library))
     assert ours["rmse_um"] == pytest.approx(theirs["rmse_um"], abs=1e-3)
+
+
+def test_the_pythonfmu_family_gives_the_library_paths_stroke_run(fmus, tmp_path):
+    scenario = _short_profile(tmp_path)
+    library = run_library(scenario).data
+    python_family = run_fmus(scenario, fmus["SmaActuator"].parent).data
+    for column in COLUMNS:
+        assert np.allclose(python_family[column], library[column], rtol=0.0, atol=1e-9,
+                           equal_nan=True), column
