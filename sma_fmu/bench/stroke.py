@@ -12,13 +12,16 @@ costs per step in the Python runtime (:mod:`sma_fmu.runtime.stroke`).
   path (:func:`~sma_fmu.bench.c_master.c_master_times`, recording included; the C master's
   wall includes the master's mapping of the stroke into the signals FMU's table).
 
-CPU time per step, the median of the passes (a shared machine's other work is not counted).
-The C family has no stroke map of its own (the master maps the stroke for the FMUs): there is
-no C figure per step to print.
+CPU time per step, the median of the passes (a shared machine's other work is not counted);
+the moving strokes in C too (``stroke_timing.c`` compiled with the C family's sources: the
+C runtime's stroke map, bit-equal to Python's).
 """
 import dataclasses
+import math
 import shutil
 import statistics
+import subprocess
+import tempfile
 import time
 
 from sma_fmu.cosim.loop import run_library
@@ -26,12 +29,14 @@ from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
+from sma_fmu.bench.inverse import timing_program
 from sma_fmu.runtime import stroke as stroke_module
+from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.stroke import StrokeMap, start_length
 from sma_fmu.wire.parameter_file import load_parameter_set
 
-__all__ = ["SCENARIOS", "STEPS", "map_costs", "scenario_walls", "run_stroke_bench",
-           "stroke_lines"]
+__all__ = ["SCENARIOS", "STEPS", "map_costs", "c_map_ns", "c_map_costs", "scenario_walls",
+           "run_stroke_bench", "stroke_lines"]
 
 SCENARIOS = ("flexinol-stroke-load-step-pi+ff-adaptive", "flexinol-stroke-profile-pi+ff-adaptive")
 STEPS = 2000     # map calls per pass
@@ -85,6 +90,34 @@ def map_costs(passes):
     return costs, _rounds(fitted, strokes, 0.2)
 
 
+def c_map_ns(program, stroke_map, load, direction, strokes, passes):
+    """Median CPU time [ns] of one C mapping (``program``: stroke_timing) of ``strokes`` [m]."""
+    values = [getattr(stroke_map.params, spec.name) for spec in PARAMETER_SPECS]
+    numbers = [math.nan if v is None else float(v) for v in values]
+    numbers += [stroke_map.start_length, load, direction, passes, len(strokes), *strokes]
+    result = subprocess.run([str(program)], input=" ".join(map(repr, numbers)),
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        raise RuntimeError(f"the stroke timing program failed: {result.stderr.strip()}")
+    return statistics.median(float(line.split()[0]) for line in result.stdout.splitlines())
+
+
+def c_map_costs(passes):
+    """{case: C CPU ns per mapping} of the two moving-stroke cases of :func:`map_costs`."""
+    reference = load_parameter_set().params
+    flexinol = load_parameter_set(shipped_file("models", "flexinol_fit.toml")).params
+    strokes = [7e-3 + 16e-3 * k / STEPS for k in range(STEPS)]
+    with tempfile.TemporaryDirectory() as folder:
+        program = timing_program(folder, "stroke_timing")
+        return {
+            "moving stroke, reference wire (closed form)": c_map_ns(
+                program, StrokeMap(reference, start_length(reference, None, 0.05)), 0.05, 1,
+                [s - 2e-3 for s in strokes], passes),
+            "moving stroke, Flexinol fit (secant on T)": c_map_ns(
+                program, StrokeMap(flexinol, start_length(flexinol, None, 0.1)), 0.2, 1,
+                strokes, passes)}
+
+
 def scenario_walls(runs):
     """{scenario: (stroke run [s], the same with the mapped R_ref as a table [s])}, medians."""
     walls = {}
@@ -120,9 +153,12 @@ def run_stroke_bench(out_dir, runs, progress=print, fmus=None):
     folder of native FMUs for the C master's runs (None: none)."""
     progress("the stroke map per step (Python) ...")
     costs, rounds = map_costs(max(runs, 3))
+    progress("the stroke map per step (C) ...")
+    c_costs = c_map_costs(max(runs, 5) * 4)
     progress("the stroke scenarios on the library path ...")
     walls = scenario_walls(runs)
-    results = {"map_ns_per_step": costs, "flexinol_inverses_per_solve": rounds,
+    results = {"map_ns_per_step": costs, "c_map_ns_per_step": c_costs,
+               "flexinol_inverses_per_solve": rounds,
                "library_wall_s": {name: {"stroke": a, "mapped_beforehand": b}
                                   for name, (a, b) in walls.items()}}
     with staged_folder(out_dir) as stage:
@@ -138,9 +174,12 @@ def run_stroke_bench(out_dir, runs, progress=print, fmus=None):
 
 def stroke_lines(results):
     """The printed table of :func:`run_stroke_bench`'s results."""
-    lines = ["stroke map, CPU per step (Python runtime; the C family has no stroke map yet)"]
+    c_costs = results.get("c_map_ns_per_step", {})
+    lines = ["stroke map, CPU per step: Python runtime / C runtime"]
     for case, ns in results["map_ns_per_step"].items():
-        lines.append(f"  {case:<48} {ns / 1e3:>8.2f} us")
+        c = c_costs.get(case)
+        lines.append(f"  {case:<48} {ns / 1e3:>8.2f} us" +
+                     ("" if c is None else f" / {c / 1e3:.3f} us"))
     lines.append(f"  Flexinol fit: {results['flexinol_inverses_per_solve']:.1f} branch inverses "
                  f"per solve (mean over 7-23 mm at 0.2 kg)")
     lines.append("library path, wall [s] (median): stroke run / R_ref mapped beforehand")
