@@ -41,6 +41,20 @@ def _ratio(value, bound):
     return None if not bound > 0.0 else value / bound
 
 
+def _stroke_row(scenario, bound):
+    """The controller's stroke RMSE [um] (one library run, the scenario's own sensor) beside
+    the stroke's bound [um]."""
+    from sma_fmu.cosim.loop import run_library
+    from sma_fmu.cosim.metrics import scenario_metrics
+
+    rmse = scenario_metrics(run_library(scenario).data, scenario)["stroke"]["rmse_um"]
+    return {"rmse_um": rmse, "lower_bound_um": bound["lower_bound_um"],
+            "achievable_um": bound["achievable_um"], "smooth_um": bound["smooth_um"],
+            "rmse_over_achievable": _ratio(rmse, bound["achievable_um"]),
+            "rmse_over_smooth": None if bound["smooth_um"] is None
+            else _ratio(rmse, bound["smooth_um"])}
+
+
 def bound_scenarios(paths, out_dir, power_cap=None, progress=print, current_A=None,
                     voltage_V=None):
     """Bound every scenario file in ``paths``; write ``bound.json`` and ``bound.md``; return rows.
@@ -60,6 +74,7 @@ def bound_scenarios(paths, out_dir, power_cap=None, progress=print, current_A=No
                 bounds[key] = tracking_bound(scenario, limit)
             bound = bounds[key]
             rmse, per_seed = noise_seed_rmse(scenario)
+            stroke = None if bound.stroke is None else _stroke_row(scenario, bound.stroke)
             controller = scenario.controller
             smooth = bound.smooth
             rows.append({"scenario": scenario.name, "controller": controller.kind,
@@ -69,7 +84,8 @@ def bound_scenarios(paths, out_dir, power_cap=None, progress=print, current_A=No
                          "rmse_over_lower_bound": _ratio(rmse, bound.lower_bound_ohm),
                          "rmse_over_achievable": _ratio(rmse, bound.achievable.rmse_ohm),
                          "rmse_over_smooth": None if smooth is None else _ratio(rmse, smooth.rmse_ohm),
-                         "bound": {k: v for k, v in bound.as_dict().items() if k != "scenario"}})
+                         "bound": {k: v for k, v in bound.as_dict().items() if k != "scenario"},
+                         **({} if stroke is None else {"stroke": stroke})})
         (stage / "bound.json").write_text(json_text(rows), encoding="utf-8")
         (stage / "bound.md").write_text(bound_markdown(rows), encoding="utf-8")
     return rows
@@ -108,6 +124,22 @@ def bound_markdown(rows):
                      f"{_benchmark(bound['achievable'])} | {_benchmark(bound['smooth'])} | "
                      f"{_number(row['rmse_over_lower_bound'], 1)} | "
                      f"{_number(row['rmse_over_smooth'], 1)} |")
+    strokes = [row for row in rows if "stroke" in row]
+    if strokes:
+        lines += ["", "Stroke (a stroke reference mapped to R_ref through the model): RMSE of the "
+                  "stroke x_0 - x against the stroke reference, um; the lower bound is the "
+                  "reference's distance to the stroke the wire gives at the load, the benchmarks' "
+                  "strokes are their powers replayed through the plant.", "",
+                  "| scenario | controller | stroke RMSE | lower bound | best benchmark | "
+                  "smooth benchmark | RMSE / best | RMSE / smooth |",
+                  "|---|---|---:|---:|---:|---:|---:|---:|"]
+        for row in strokes:
+            stroke = row["stroke"]
+            lines.append(f"| {row['scenario']} | {row['controller']} | "
+                         f"{_number(stroke['rmse_um'], 1)} | {_number(stroke['lower_bound_um'], 1)} | "
+                         f"{_number(stroke['achievable_um'], 1)} | {_number(stroke['smooth_um'], 1)} | "
+                         f"{_number(stroke['rmse_over_achievable'], 1)} | "
+                         f"{_number(stroke['rmse_over_smooth'], 1)} |")
     methods = {(r["bound"]["hysteresis_mode"], r["bound"]["lower_bound_method"]) for r in rows}
     lines += [""] + [f"- {mode}: lower bound by {method}." for mode, method in sorted(methods)]
     benchmarks = {(r["bound"]["hysteresis_mode"], b["method"]) for r in rows

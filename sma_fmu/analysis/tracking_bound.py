@@ -21,6 +21,14 @@ how tight the bound is. Each benchmark also reports its peak power and how often
 temperature reverses: the best continuous-mode benchmarks chatter at the step rate, which
 no real driver and wire would follow, so the best one with at most
 :data:`SMOOTH_REVERSALS_PER_S` reversals per second is reported as well. Units: ohm, W, s.
+
+**Stroke** (a scenario whose reference is a stroke, mapped to R_ref through the model): the
+same bound for the stroke, in micrometres (:func:`stroke_bound`). The saturation bound is the
+stroke reference's distance to what the wire gives at the load (the stroke map's clamp); the
+benchmarks are the same power sequences, their strokes x_0 - x replayed through the plant. The
+benchmarks track R_ref, so what R cannot tell (on a minor branch the wire is at another
+temperature than the map's major branch, and thermal expansion moves x) is in their stroke
+error too: they bound what a self-sensing controller reaches, not one that measures x.
 """
 import time
 from dataclasses import asdict, dataclass
@@ -35,7 +43,7 @@ from .switch_dp import cell_lower_bound, node_path, replay_path
 from .tracking_problem import TemperatureGrid, TrackingProblem
 
 __all__ = ["Benchmark", "TrackingBound", "TOLERANCES", "SMOOTH_REVERSALS_PER_S",
-           "saturation_bound", "reversal_rate", "tracking_bound"]
+           "saturation_bound", "reversal_rate", "stroke_bound", "tracking_bound"]
 
 TOLERANCES = (0.0, 0.01, 0.02, 0.03)  # ohm: passive-cooling tolerances of the continuous benchmark
 SMOOTH_REVERSALS_PER_S = 10.0         # 1/s: a benchmark reversing at most this often does not chatter
@@ -69,6 +77,7 @@ class TrackingBound:
     lower_bound_method: str
     benchmarks: tuple
     seconds: float
+    stroke: dict = None         # the stroke's bound [um] (:func:`stroke_bound`), or None
 
     @property
     def achievable(self):
@@ -107,6 +116,26 @@ def reversal_rate(problem, powers):
     return float(np.count_nonzero(np.diff(signs))) / (np.sum(problem.weights[1:]) * problem.step_s)
 
 
+def stroke_bound(scenario, problem, runs):
+    """The stroke's bound [um] of a stroke scenario: {"saturation_bound_um", "lower_bound_um",
+    "benchmarks": [{"method", "rmse_um"}], "achievable_um", "smooth_um"}. ``runs`` are
+    (Benchmark, powers [W]) pairs; the lower bound is the saturation bound (the switch-mode
+    cell program bounds the R error, not the stroke's)."""
+    reference = scenario.reference
+    times = np.arange(problem.steps + 1) * problem.step_s
+    reached = np.array([reference.map.target(stroke, load, reference.signal.trend(t)).stroke
+                        for stroke, load, t in zip(problem.stroke_references.tolist(),
+                                                   problem.sample_loads.tolist(), times.tolist())])
+    saturation = problem.stroke_rmse_um(reached)
+    benchmarks = [{"method": benchmark.method,
+                   "rmse_um": problem.stroke_rmse_um(problem.replay_strokes(powers)),
+                   "reversals_per_s": benchmark.reversals_per_s} for benchmark, powers in runs]
+    smooth = [b["rmse_um"] for b in benchmarks if b["reversals_per_s"] <= SMOOTH_REVERSALS_PER_S]
+    return {"saturation_bound_um": saturation, "lower_bound_um": saturation,
+            "benchmarks": benchmarks, "achievable_um": min(b["rmse_um"] for b in benchmarks),
+            "smooth_um": min(smooth) if smooth else None}
+
+
 def _benchmark(problem, method, powers, resistances):
     return Benchmark(method, problem.rmse_of(resistances),
                      float(powers[problem.weights[:-1] > 0].max()), reversal_rate(problem, powers))
@@ -130,16 +159,21 @@ def tracking_bound(scenario, power_cap=None, mode=None, current_A=None, voltage_
         lower_method = f"cell dynamic program, {grid.count} temperature nodes, exact passive cooling"
         _, temperatures, rows = node_path(problem, grid, limit)
         powers, resistances = replay_path(problem, temperatures, rows, limit)
-        benchmarks = (_benchmark(problem, "node dynamic program's path", powers, resistances),)
+        runs = [(_benchmark(problem, "node dynamic program's path", powers, resistances),
+                 powers)]
     else:
         lower, lower_method = saturation, "saturation (reachable band) only"
-        benchmarks = tuple(
-            _benchmark(problem, "one-step inverse of the plant" + (
+        runs = []
+        for tolerance in TOLERANCES:
+            powers, resistances = track(problem, tolerance, limit)
+            runs.append((_benchmark(problem, "one-step inverse of the plant" + (
                 f", 0 W where a passive step lands within {tolerance:g} ohm" if tolerance else ""),
-                *track(problem, tolerance, limit))
-            for tolerance in TOLERANCES)
+                powers, resistances), powers))
+    benchmarks = tuple(benchmark for benchmark, _ in runs)
+    stroke = (None if problem.stroke_references is None
+              else stroke_bound(scenario, problem, runs))
     return TrackingBound(
         scenario=scenario.name, hysteresis_mode=problem.mode, power_cap_W=limit.power_W,
         current_limit_A=limit.current_A, voltage_limit_V=limit.voltage_V,
         saturation_bound_ohm=saturation, lower_bound_ohm=lower, lower_bound_method=lower_method,
-        benchmarks=benchmarks, seconds=time.perf_counter() - start)
+        benchmarks=benchmarks, seconds=time.perf_counter() - start, stroke=stroke)

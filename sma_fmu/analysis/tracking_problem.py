@@ -29,7 +29,8 @@ class TrackingProblem:
     references : R_ref(t_k) [ohm], n + 1 values;
     step_loads : f(t_k) held over step k [kg], n values;
     sample_loads : load R_k is evaluated with [kg] (f(0) for k = 0, else step_loads[k-1]);
-    weights : 1 where t_k is in the metric window, else 0.
+    weights : 1 where t_k is in the metric window, else 0;
+    stroke_references : a stroke reference's stroke(t_k) [m] (None: R_ref is the reference).
     """
 
     name: str
@@ -41,6 +42,7 @@ class TrackingProblem:
     step_loads: np.ndarray
     sample_loads: np.ndarray
     weights: np.ndarray
+    stroke_references: np.ndarray = None
 
     @classmethod
     def from_scenario(cls, scenario, mode=None):
@@ -54,7 +56,9 @@ class TrackingProblem:
             step_s=h, T_start=scenario.T_start,
             references=np.array([scenario.reference.value(t) for t in times]),
             step_loads=loads[:-1], sample_loads=np.concatenate((loads[:1], loads[:-1])),
-            weights=(times >= scenario.analysis.metrics_start_s - 1e-9 * h).astype(float))
+            weights=(times >= scenario.analysis.metrics_start_s - 1e-9 * h).astype(float),
+            stroke_references=None if getattr(scenario.reference, "quantity", None) != "stroke"
+            else np.array([scenario.reference.stroke(t) for t in times]))
 
     @property
     def steps(self):
@@ -94,6 +98,21 @@ class TrackingProblem:
         """RMSE [ohm] of the samples R_k [ohm] against the reference, over the metric window."""
         error = np.asarray(resistances) - self.references
         return self.rmse(np.sum(self.weights * error * error))
+
+    def stroke_rmse_um(self, strokes):
+        """RMSE [um] of the strokes x_0 - x_k [m] against the stroke reference, metric window."""
+        error = np.asarray(strokes) - self.stroke_references
+        return 1e6 * self.rmse(np.sum(self.weights * error * error))
+
+    def replay_strokes(self, powers):
+        """Strokes x_0 - x_k [m], k = 0 ... n, of ``powers`` [W] through a fresh plant."""
+        plant = self.plant()
+        start = plant.outputs.x
+        lengths = [start]
+        step, h = plant.step, self.step_s
+        for power, load in zip(powers.tolist(), self.step_loads.tolist()):
+            lengths.append(step(power, load, h).x)
+        return start - np.array(lengths)
 
     def plant(self):
         """A fresh runtime plant at the problem's start (T_start, heating, major branch)."""

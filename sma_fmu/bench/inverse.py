@@ -81,6 +81,8 @@ def timing_program(folder, name="inverse_timing"):
     program = Path(folder) / name
     source = Path(folder) / f"{name}.c"
     source.write_bytes((resources.files("sma_fmu.bench") / f"{name}.c").read_bytes())
+    shared = Path(folder) / "timing_input.h"   # what the timing programs share
+    shared.write_bytes((resources.files("sma_fmu.bench") / "timing_input.h").read_bytes())
     command = [*c_compiler(), "-std=c99", "-O2", "-ffp-contract=off", f"-I{runtime}",
                f"-I{generated_folder()}", "-o", str(program), str(source), *sources, "-lm"]
     result = subprocess.run(command, capture_output=True, text=True)

@@ -10,30 +10,16 @@
  * keeps the compiler from dropping the work). A refusal prints it on stderr, exit 1.
  */
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
+#define TIMING_PROGRAM "inverse_timing"
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
 
+#include "timing_input.h"
+
 #include "constant_load.h"
 #include "parameters.h"
 #include "sensing.h"
-
-/* This process's CPU time [s] (the machine may be shared). */
-static double seconds_now(void)
-{
-    struct timespec now;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
-    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
-}
-
-static int read_double(double *value)
-{
-    if (scanf("%lf", value) != 1) {
-        fprintf(stderr, "inverse_timing: input ends early\n");
-        return 1;
-    }
-    return 0;
-}
 
 int main(void)
 {

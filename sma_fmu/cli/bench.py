@@ -35,6 +35,13 @@ def _bench(args):
         print("\n".join(hardware_lines(results)))
         print(f"written: {args.out / 'benchmark.json'}")
         return 0
+    if args.only == "stroke":
+        from sma_fmu.bench.stroke import run_stroke_bench, stroke_lines
+        say = lambda text: print(text, flush=True)  # noqa: E731
+        results = run_stroke_bench(args.out, args.runs, say, args.fmus)
+        print("\n".join(stroke_lines(results)))
+        print(f"written: {args.out / 'benchmark.json'}")
+        return 0
     if args.only == "pwm":
         from sma_fmu.bench.pwm_table import pwm_table_rows
         pwm_table_rows()
@@ -51,7 +58,7 @@ def register(commands):
     bench.add_argument("--runs", type=bounded_integer(1, MAX_RUNS), default=5,
                        help=f"repetitions per measurement, 1-{MAX_RUNS}")
     bench.add_argument("--only", choices=("batch", "hosts", "pwm", "c-master", "inverse",
-                                          "hardware"),
+                                          "hardware", "stroke"),
                        help="only this section (batch: the batch engine's throughput table; "
                             "hosts: every scenario in every host against the library loop, "
                             "docs/systems.md's table; pwm: the PWM table of docs/model.md; "
@@ -61,10 +68,12 @@ def register(commands):
                             "of a two-stage wire in Python and C, and heavy-pi+ff-adaptive "
                             "through its FMUs against the reference wire's; hardware: the "
                             "sensor's and the drive limit's cost per step in Python and C, and "
-                            "the C master against the library on the bench scenarios)")
+                            "the C master against the library on the bench scenarios; stroke: "
+                            "the stroke map's cost per step and the stroke scenarios' runs)")
     bench.add_argument("--fmus", type=Path, metavar="DIR",
                        help="with --only c-master or hardware: the native FMUs (sma-fmu build "
-                            "--native; default: built into the output folder)")
+                            "--native; default: built into the output folder); with --only "
+                            "stroke: the C master's runs too (default: none)")
     bench.add_argument("--model", type=Path, metavar="FILE",
                        help="with --only inverse: the two-stage wire's parameter file (e.g. "
                             "a fit's identified.toml; default: the reference wire with a "

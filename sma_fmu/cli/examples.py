@@ -26,10 +26,13 @@ def _examples(args):
         (folder / "scenarios").mkdir()
         for name in scenarios:
             shutil.copyfile(shipped_file("scenarios", name), folder / "scenarios" / name)
+        (folder / "models").mkdir()   # the wires scenarios name as ../models/NAME.toml
+        for name in shipped_files("models", ".toml"):
+            shutil.copyfile(shipped_file("models", name), folder / "models" / name)
     for name in names:
         print(Path(args.out) / name)
     print(f"{Path(args.out) / 'scenarios'}/: the {len(scenarios)} shipped scenarios "
-          "(sma-fmu run FILE.toml runs an edited copy)")
+          "(sma-fmu run FILE.toml runs an edited copy); models/: the wires they name")
     return 0
 
 
@@ -39,6 +42,6 @@ def register(commands):
         "examples", help="list the shipped scenarios and example files (measurements, study "
                          "specs, scripts), or copy them")
     examples.add_argument("--out", type=Path, metavar="DIR",
-                          help="copy the examples, and the scenarios into DIR/scenarios/ "
-                               "(default: only list them)")
+                          help="copy the examples, the scenarios into DIR/scenarios/ and the "
+                               "wires they name into DIR/models/ (default: only list them)")
     examples.set_defaults(handler=_examples)

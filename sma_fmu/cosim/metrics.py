@@ -12,6 +12,9 @@ Reachability: where R_ref(t_k) lies outside the band (R_hot(f_k), R_cold(f_k)) t
 reach at the load of that sample (:func:`sma_fmu.runtime.reachable_band.reachable_band`),
 no controller can track it. The metrics give the fraction of the window where that is
 so, the metrics over the reachable rest, the intervals (whole run) and a warning.
+
+Stroke: a scenario whose reference is a stroke adds ``stroke``, the error of the stroke
+x_0 - x against the stroke reference, in micrometres (RMSE, max |e|, IAE, per load segment).
 """
 import math
 
@@ -20,7 +23,7 @@ import numpy as np
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK
 from sma_fmu.runtime.reachable_band import reachable_band
 
-__all__ = ["EMPTY_METRICS", "error_metrics", "band_edges", "unreachable_samples",
+__all__ = ["EMPTY_METRICS", "error_metrics", "band_edges", "stroke_metrics", "unreachable_samples",
            "unreachable_intervals", "reachability_warning", "metric_windows", "assemble_metrics",
            "scenario_metrics", "ErrorSums", "StreamingMetrics"]
 
@@ -118,13 +121,26 @@ def metric_windows(times, scenario):
     return window, segments
 
 
+def stroke_metrics(overall, segments):
+    """The ``stroke`` record [um] from :class:`ErrorSums` of stroke errors [m]: overall and
+    one RMSE per load segment."""
+    def in_um(metrics):
+        return {"rmse_um": None if metrics["rmse_ohm"] is None else 1e6 * metrics["rmse_ohm"],
+                "max_abs_um": None if metrics["max_abs_ohm"] is None
+                else 1e6 * metrics["max_abs_ohm"],
+                "iae_um_s": None if metrics["iae_ohm_s"] is None else 1e6 * metrics["iae_ohm_s"],
+                "samples": metrics["samples"]}
+    return {**in_um(overall), "segments_rmse_um": [in_um(m)["rmse_um"] for m in segments]}
+
+
 def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped_fraction,
-                     unreachable_fraction, reachable, intervals):
+                     unreachable_fraction, reachable, intervals, stroke=None):
     """The metrics record of one run of ``scenario``, ready for JSON, from its parts.
 
     ``overall``, ``reachable`` and each of ``segments`` (one per load segment, in order) are
     :func:`error_metrics` dicts; the fractions [1] are shares of the metrics window;
-    ``intervals`` are the :func:`unreachable_intervals` of the whole run. Adds the header
+    ``intervals`` are the :func:`unreachable_intervals` of the whole run; ``stroke`` the
+    :func:`stroke_metrics` of a stroke reference (None: none). Adds the header
     (scenario, controller, the wire: its parameter file and digest, and the compensator's
     model where a study gives it other values, window), each segment's times and load, and
     the warning.
@@ -151,6 +167,7 @@ def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped
         "reachable": reachable,
         "unreachable_intervals_s": intervals,
         "warnings": [] if warning is None else [warning],
+        **({} if stroke is None else {"stroke": stroke}),
     }
 
 
@@ -202,12 +219,16 @@ class StreamingMetrics:
     others unrecorded, as the C master of a sweep does; the sweep's test compares its
     metrics with those of whole rows, so a column read but not listed fails it)."""
 
-    COLUMNS_READ = ("t", "R", "R_ref", "load", "saturated", "P")
+    COLUMNS_READ = ("t", "R", "R_ref", "load", "saturated", "P", "stroke")
 
     def __init__(self, scenario):
         self.scenario = scenario
         self.overall, self.reachable = ErrorSums(), ErrorSums()
         self.segments = [ErrorSums() for _ in scenario.load.segments(scenario.stop_time_s)]
+        self._stroke_at = (scenario.reference.stroke
+                           if getattr(scenario.reference, "quantity", None) == "stroke" else None)
+        self.stroke = ErrorSums()                      # stroke errors [m], the window's
+        self.stroke_segments = [ErrorSums() for _ in self.segments]
         self.window = self.saturated = self.clamped = self.unreachable = 0
         self.intervals = []
         self._last_time = None   # the time of the last row seen [s]
@@ -247,6 +268,12 @@ class StreamingMetrics:
         self.unreachable += 0 if reachable else int(np.count_nonzero(unreachable[window]))
         self._join(unreachable_intervals(t, below, above), float(t[0]))
         self._last_time = float(t[-1])
+        if self._stroke_at is not None:
+            stroke_at = self._stroke_at
+            stroke_error = block["stroke"] - np.array([stroke_at(time) for time in t.tolist()])
+            self.stroke.add(stroke_error[window])
+            for sums, inside in zip(self.stroke_segments, segments):
+                sums.add(stroke_error[inside])
 
     def _join(self, intervals, first_time):
         """Add a block's unreachable intervals, joining one that goes on from the last block."""
@@ -272,7 +299,9 @@ class StreamingMetrics:
             clamped_fraction=self.clamped / (window - 1) if window > 1 else None,
             unreachable_fraction=self.unreachable / window if window else math.nan,
             reachable=self.reachable.metrics(step),
-            intervals=sorted(self.intervals))
+            intervals=sorted(self.intervals),
+            stroke=None if self._stroke_at is None else stroke_metrics(
+                self.stroke.metrics(step), [sums.metrics(step) for sums in self.stroke_segments]))
 
 
 def scenario_metrics(data, scenario):

@@ -85,9 +85,13 @@ def _mark(axis, data, metrics_start, label=False):
 
 
 def plot_run(data, scenario, path):
-    """Resistance, temperature, power (total, feedforward, feedback), load and stroke; PNG at ``path``."""
+    """Resistance, temperature, power (total, feedforward, feedback), load and stroke (with a
+    stroke reference's curve, its panel taller); PNG at ``path``."""
+    stroke_at = (scenario.reference.stroke
+                 if getattr(scenario.reference, "quantity", None) == "stroke" else None)
     figure = Figure(figsize=(10, 10))
-    axes = figure.subplots(4, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2, 2, 1.4]})
+    axes = figure.subplots(4, 1, sharex=True, gridspec_kw={
+        "height_ratios": [3, 2, 2, 1.4 if stroke_at is None else 2.6]})
     t = data["t"]
     start = scenario.analysis.metrics_start_s
     resistance, temperature, power, load = axes
@@ -111,6 +115,9 @@ def plot_run(data, scenario, path):
     load.set_ylabel("load [kg]")
     load.set_ylim(0.0, max(0.3, 1.15 * float(data["load"].max())))
     stroke = load.twinx()
+    if stroke_at is not None:
+        _line(stroke, t, [1e3 * stroke_at(time) for time in t.tolist()], color="black", ls="--",
+              lw=0.9, label="stroke reference")
     _line(stroke, t, 1e3 * data["stroke"], color="tab:green", lw=0.9, label="stroke x_0 - x")
     stroke.set_ylabel("stroke [mm]")
     load.set_xlabel("time t [s]")

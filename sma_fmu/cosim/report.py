@@ -27,14 +27,24 @@ def summary_table(rows):
     lines = [f"{'scenario':<48}{'controller':<16}{'mode':<12}{'RMSE':>8}{'max|e|':>8}"
              f"{'IAE':>8}{'wall s':>8}{'x real':>8}",
              f"{'':<76}{'[ohm]':>8}{'[ohm]':>8}{'[ohm.s]':>8}"]
+    strokes = [row for row in rows if "stroke" in row["metrics"]]
+    if strokes:
+        lines[0] += f"{'stroke':>10}{'max|e|':>10}"
+        lines[1] += f"{'':<16}{'RMSE [um]':>10}{'[um]':>10}"
     for row in rows:
         m = row["metrics"]["overall"]
+        stroke = row["metrics"].get("stroke")
         lines.append(f"{row['scenario']:<48}{row['metrics']['controller']:<16}"
                      f"{row['metrics']['hysteresis_mode']:<12}{_number(m['rmse_ohm'], '>8.3f'):>8}"
                      f"{_number(m['max_abs_ohm'], '>8.3f'):>8}{_number(m['iae_ohm_s'], '>8.2f'):>8}"
-                     f"{row['wall_time_s']:>8.2f}{row['real_time_factor']:>8.0f}")
+                     f"{row['wall_time_s']:>8.2f}{row['real_time_factor']:>8.0f}"
+                     + ("" if stroke is None else f"{_number(stroke['rmse_um'], '>10.1f'):>10}"
+                        f"{_number(stroke['max_abs_um'], '>10.1f'):>10}"))
     lines.append("wall s: each run's own time, from its start to its last row, less the time "
                  "spent writing its files")
+    if strokes:
+        lines.append("stroke: the stroke x_0 - x against a stroke reference, over the metrics "
+                     "window")
     startup = [row["startup_s"] for row in rows if "startup_s" in row]
     if startup:
         lines.append(f"the C master's start-up (host started, FMUs read, unpacked and loaded), "

@@ -30,7 +30,7 @@ from .state_entries import (StateError, check_format, read_direction, read_entri
 from .thermal import step_decay, thermal_step
 from .validity import data_range_warning, validity_warning
 
-__all__ = ["PlantOutputs", "PlantStepper", "STATE_FORMAT"]
+__all__ = ["PlantOutputs", "PlantStepper", "STATE_FORMAT", "branch_length"]
 
 STATE_FORMAT = "sma-fmu plant state 2: reversal stack"   # what state() writes, restore() reads
 _STATE_ENTRIES = ("format", "temperature", "direction", "reversals", "load", "xi_MF", "xi_P",
@@ -44,6 +44,16 @@ R : resistance [ohm]; T : temperature [degC]; x : wire length [m];
 xi_P, xi_M, xi_F : phase fractions [1]; P : power applied over the last step, max(0, P_in) [W]
 (0 before the first step); heating : True while dT/dt > 0 (last sign kept).
 """
+
+
+def branch_length(temperature, xi_p, xi_m, xi_f, constants, params):
+    """Wire length x [m] of the fractions [1] at ``temperature`` [degC] on a branch with
+    :class:`~.constant_load.BranchConstants` (the strain terms' stressed lengths and thermal
+    expansion where the wire has them)."""
+    if constants.length_M is None:
+        return params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f
+    return wire_length(temperature, xi_p, xi_m, xi_f, constants.length_M, constants.length_F,
+                       params)
 
 
 class PlantStepper:
@@ -157,11 +167,7 @@ class PlantStepper:
         xi_p = self.xi_P
         xi_m = 0.5 * self.xi_MF
         xi_f = constants.xi_F_min + xi_m
-        if constants.length_M is None:
-            length = params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f
-        else:   # the strain terms (model_terms): stress law and thermal expansion
-            length = wire_length(self.temperature, xi_p, xi_m, xi_f, constants.length_M,
-                                 constants.length_F, params)
+        length = branch_length(self.temperature, xi_p, xi_m, xi_f, constants, params)
         # tuple.__new__ builds the namedtuple in C: a third of the cost of PlantOutputs(...)
         return _new_tuple(PlantOutputs, (
             params.R_P * xi_p + params.R_M * xi_m + params.R_F * xi_f,

@@ -64,6 +64,9 @@ def signals_from_text(reference_text, load_text):
         except ValueError as error:
             message = str(error)
             raise ValueError(message if message.startswith(name) else f"{name}: {message}") from None
+    if signals[0].quantity != "resistance":   # it has no wire to map a stroke through
+        raise ValueError(f"reference: quantity {signals[0].quantity!r} is not taken here; "
+                         f"this source gives a resistance reference in ohm")
     return tuple(signals)
 
 

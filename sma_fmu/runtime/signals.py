@@ -2,14 +2,20 @@
 
 Built from the ``[reference]`` and ``[load]`` tables of a scenario file. Problems raise
 ``ValueError`` naming the key; the scenario loader adds the file and section.
+
+A reference of ``quantity = "stroke"`` is a stroke [mm] (contraction from the start length)
+with the same kinds, its keys ending in ``_mm`` instead of ``_ohm``; :mod:`.stroke` maps it
+to R_ref through the model.
 """
 import bisect
 import math
 
-__all__ = ["REFERENCE_KINDS", "MAX_REFERENCE_OHM", "ReferenceSignal", "LoadProfile", "reference_from_table",
+__all__ = ["REFERENCE_KINDS", "MAX_REFERENCE_OHM", "MAX_STROKE_MM", "QUANTITIES", "ReferenceSignal", "LoadProfile", "reference_from_table",
            "load_from_table"]
 
 MAX_REFERENCE_OHM = 1e6  # a wire's resistance is ohms to kilo-ohms; beyond this is a typo
+MAX_STROKE_MM = 1e4      # |stroke| [mm]: a wire's stroke is millimetres; beyond this is a typo
+QUANTITIES = {"resistance": "ohm", "stroke": "mm"}   # quantity -> unit of its keys
 
 # kind -> (required keys, optional keys with defaults)
 REFERENCE_KINDS = {
@@ -41,16 +47,31 @@ def _increasing(times, key):
         raise ValueError(f"{key} must be strictly increasing, got {times!r}")
 
 
-class ReferenceSignal:
-    """R_ref(t) [ohm]: one of :data:`REFERENCE_KINDS`, with its settings."""
+def _unit_key(key, unit):
+    """``key`` of :data:`REFERENCE_KINDS` (unit ohm) with its unit suffix for ``unit``."""
+    return key[:-3] + unit if key.endswith("_ohm") else key
 
-    def __init__(self, kind, settings):
+
+class ReferenceSignal:
+    """R_ref(t) [ohm], or a stroke [mm] (``quantity`` "stroke"): one of
+    :data:`REFERENCE_KINDS`, with its settings (keys in the quantity's unit)."""
+
+    def __init__(self, kind, settings, quantity="resistance"):
         self.kind = kind
+        self.quantity = quantity
+        self.unit = QUANTITIES[quantity]
         self.settings = dict(settings)
-        s = self.settings
+        # the values under the kinds' own keys (..._ohm), whatever the unit
+        self._s = s = {key[:-len(self.unit)] + "ohm" if key.endswith("_" + self.unit) else key:
+                       value for key, value in self.settings.items()}
         if kind == "table":
             self._times, self._values = s["times_s"], s["values_ohm"]
         lowest, highest = self.bounds()
+        if quantity == "stroke":
+            if not max(-lowest, highest) <= MAX_STROKE_MM:
+                raise ValueError(f"the stroke reference must stay within +-{MAX_STROKE_MM:g} mm, "
+                                 f"but reaches {lowest!r} ... {highest!r} mm")
+            return
         if not lowest > 0.0:
             raise ValueError(f"the reference must stay > 0 ohm, but reaches {lowest!r} ohm")
         if not highest <= MAX_REFERENCE_OHM:
@@ -58,8 +79,8 @@ class ReferenceSignal:
                              f"but reaches {highest!r} ohm")
 
     def bounds(self):
-        """(lowest, highest) value of R_ref over all time [ohm]."""
-        s = self.settings
+        """(lowest, highest) value of the reference over all time [its unit: ohm or mm]."""
+        s = self._s
         if self.kind == "constant":
             values = [s["value_ohm"]]
         elif self.kind == "step":
@@ -73,8 +94,8 @@ class ReferenceSignal:
         return min(values), max(values)
 
     def value(self, t):
-        """R_ref [ohm] at time ``t`` [s]."""
-        s = self.settings
+        """The reference [ohm, or mm for a stroke] at time ``t`` [s]."""
+        s = self._s
         if self.kind == "constant":
             return s["value_ohm"]
         if self.kind == "step":
@@ -89,9 +110,36 @@ class ReferenceSignal:
             return s["offset_ohm"] + s["amplitude_ohm"] * wave(angle)
         return _interpolate(self._times, self._values, t)
 
+    def trend(self, t):
+        """+1 or -1 [1]: the sign of the change the reference last made at or before ``t`` [s]
+        (its slope at t where it moves; +1 while it never moved). A pure function of t, so a
+        host's step size or a restored state never changes it."""
+        s = self._s
+        kind = self.kind
+        if kind == "step":
+            change = s["final_ohm"] - s["initial_ohm"] if t >= s["time_s"] else 0.0
+        elif kind == "ramp":
+            change = s["end_ohm"] - s["start_ohm"] if t > s["start_time_s"] else 0.0
+        elif kind in ("sine", "cosine"):
+            angle = 2.0 * math.pi * s["frequency_hz"] * t + math.radians(s["phase_deg"])
+            slope, curvature = ((math.cos(angle), -math.sin(angle)) if kind == "sine"
+                                else (-math.sin(angle), -math.cos(angle)))
+            # at a turn (slope 0) the curvature says where it came from: a maximum, rising
+            change = s["amplitude_ohm"] * s["frequency_hz"] * (slope or -curvature)
+        elif kind == "table":
+            change, last = 0.0, bisect.bisect_left(self._times, t)   # knots before t
+            for i in range(min(last, len(self._values) - 1) - 1, -1, -1):
+                change = self._values[i + 1] - self._values[i]
+                if change:
+                    break
+        else:
+            change = 0.0
+        return -1 if change < 0.0 else 1
+
     def as_table(self):
         """The scenario file's ``[reference]`` table of this signal (kind and settings)."""
-        return {"kind": self.kind, **self.settings}
+        quantity = {} if self.quantity == "resistance" else {"quantity": self.quantity}
+        return {"kind": self.kind, **quantity, **self.settings}
 
 
 def _interpolate(times, values, t):
@@ -127,12 +175,18 @@ class LoadProfile:
 
 
 def reference_from_table(table):
-    """A :class:`ReferenceSignal` from a scenario's ``[reference]`` table."""
+    """A :class:`ReferenceSignal` from a scenario's ``[reference]`` table (``quantity``:
+    one of :data:`QUANTITIES`, default "resistance"; a stroke's keys end in ``_mm``)."""
     kind = table.get("kind")
     if kind not in REFERENCE_KINDS:
         raise ValueError(f"kind must be one of {', '.join(REFERENCE_KINDS)}, got {kind!r}")
+    quantity = table.get("quantity", "resistance")
+    if quantity not in QUANTITIES:
+        raise ValueError(f"quantity must be one of {', '.join(QUANTITIES)}, got {quantity!r}")
+    unit = QUANTITIES[quantity]
     required, optional = REFERENCE_KINDS[kind]
-    unknown = sorted(set(table) - set(required) - set(optional) - {"kind"})
+    required = tuple(_unit_key(key, unit) for key in required)
+    unknown = sorted(set(table) - set(required) - set(optional) - {"kind", "quantity"})
     if unknown:
         raise ValueError(f"unknown key(s) {', '.join(unknown)} for kind {kind!r}; expected "
                          f"{', '.join(required + tuple(optional))}")
@@ -141,18 +195,19 @@ def reference_from_table(table):
         raise ValueError(f"missing key(s) {', '.join(missing)} for kind {kind!r}")
     settings = dict(optional)
     for key in table:
-        if key == "kind":
+        if key in ("kind", "quantity"):
             continue
         settings[key] = _numbers(table, key) if key.startswith(("times", "values")) else _number(table, key)
     if kind == "table":
-        if len(settings["times_s"]) != len(settings["values_ohm"]):
-            raise ValueError("times_s and values_ohm must have the same length")
+        values = _unit_key("values_ohm", unit)
+        if len(settings["times_s"]) != len(settings[values]):
+            raise ValueError(f"times_s and {values} must have the same length")
         _increasing(settings["times_s"], "times_s")
     if kind == "ramp" and not settings["end_time_s"] > settings["start_time_s"]:
         raise ValueError("end_time_s must be after start_time_s")
     if kind in ("sine", "cosine") and settings["frequency_hz"] < 0.0:
         raise ValueError(f"frequency_hz must be >= 0, got {settings['frequency_hz']!r}")
-    return ReferenceSignal(kind, settings)
+    return ReferenceSignal(kind, settings, quantity)
 
 
 def load_from_table(table):

@@ -56,3 +56,7 @@ def test_examples_copies_the_scenarios_too(tmp_path, capsys):
     assert copied == sorted(scenario_names()) and len(copied) >= 18
     assert main(["run", str(tmp_path / "ex" / "scenarios" / "heavy-pi.toml"), "--path", "library",
                  "--out", str(tmp_path / "r")]) == 0
+    # a scenario on another wire names it as ../models/NAME.toml: the copy loads
+    from sma_fmu.cosim.scenario import load_scenario
+    stroke = load_scenario(tmp_path / "ex" / "scenarios" / "flexinol-stroke-profile-pi+ff-adaptive.toml")
+    assert stroke.parameter_set.params.terms.two_stage

@@ -14,6 +14,9 @@ Example (``scenarios/load-step-pi+ff-adaptive.toml``)::
     offset_ohm = 41.85
     amplitude_ohm = 6.05
     frequency_hz = 0.5
+    # quantity = "stroke"       # a stroke reference instead (contraction from the start
+                                # length): the same kinds, keys in mm (offset_mm ...); the
+                                # controller maps it to R_ref through the model at the load
 
     [load]                      # piecewise constant: values_kg[i] from times_s[i] on
     times_s = [0.0, 10.0, 20.0]
@@ -72,6 +75,7 @@ from sma_fmu.runtime.measurement import ResistanceSensor
 from sma_fmu.runtime.pwm import DRIVE_KINDS, PwmDriver
 from sma_fmu.runtime.parameters import ParameterError
 from sma_fmu.runtime.signals import load_from_table, reference_from_table
+from sma_fmu.runtime.stroke import StrokeMap, StrokeReference, start_length
 from sma_fmu.files.toml_files import read_toml
 
 __all__ = ["MAX_STEPS", "load_scenario", "read_scenario_document", "scenario_from_document",
@@ -311,6 +315,8 @@ def scenario_from_document(document, path, parameter_set=None):
     if not -273.15 < t_start <= parameter_set.params.T_max:
         _fail(path, f"[plant] T_start_degC = {t_start!r} must be above -273.15 degC and at most "
                     f"validity.T_max = {parameter_set.params.T_max!r} degC")
+    if signals["reference"].quantity == "stroke":
+        signals["reference"] = _stroke_reference(path, signals, parameter_set.params, t_start)
     controller = _controller(path, document["controller"], parameter_set.params)
     _check_filter(path, controller, step)
     return Scenario(
@@ -322,6 +328,20 @@ def scenario_from_document(document, path, parameter_set=None):
         group_name=_string(path, "scenario", head, "group"), output_interval_s=interval,
         drive=_drive(path, document["drive"]) if "drive" in document else DriveSettings(),
         sensor=_sensor(path, document["sensor"]) if "sensor" in document else SensorSettings())
+
+
+def _stroke_reference(path, signals, params, t_start):
+    """The R_ref of a ``[reference] quantity = "stroke"``: the stroke [mm] mapped through the
+    wire's model at the load (:class:`~sma_fmu.runtime.stroke.StrokeReference`), counted from
+    the plant's length at the start."""
+    load = signals["load"]
+    try:
+        stroke_map = StrokeMap(params, start_length(params, t_start, load.value(0.0)))
+        reference = StrokeReference(signals["reference"], load, stroke_map)
+        reference.bounds()   # every stroke end at every load maps (or the model says why not)
+    except (ValueError, ArithmeticError) as error:
+        _fail(path, f"[reference] quantity = 'stroke': {error}")
+    return reference
 
 
 def _interval_steps(*arguments):

@@ -344,11 +344,20 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
     putchar('\n');
 }
 
+static int hex_digit(char c)
+{
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10
+         : c >= 'A' && c <= 'F' ? c - 'A' + 10 : 0;
+}
+
+/* decoded by hand: sscanf per byte measures the rest of the string each call, quadratic in
+ * a long String start value (a stroke scenario's R_ref table: 1 MB of hex took 17 s) */
 static char* unhex(const char* hex)
 {
     size_t n = strcmp(hex, "_") ? strlen(hex) / 2 : 0;
     char* out = calloc(n + 1, 1);
-    for (size_t i = 0; out && i < n; ++i) sscanf(hex + 2 * i, "%2hhx", (unsigned char*)&out[i]);
+    for (size_t i = 0; out && i < n; ++i)
+        out[i] = (char)(hex_digit(hex[2 * i]) << 4 | hex_digit(hex[2 * i + 1]));
     return out;
 }
 
@@ -673,7 +682,9 @@ static void end_run(void)
 
 int main(void)
 {
-    static char line[1 << 20];
+    /* a line holds a String start value hex-coded: up to twice the runtime's JSON_TEXT_MAX_BYTES
+     * (8 MiB), e.g. a stroke scenario's R_ref table, one knot per step */
+    static char line[(1 << 24) + (1 << 20)];
     /* stdout written 1 MiB at a time (the pipe's size): the master wakes once per MiB of
      * rows, not once per 4 KiB (on a busy machine each wake-up waits for a core) */
     setvbuf(stdout, NULL, _IOFBF, 1 << 20);

@@ -2,11 +2,12 @@
 
 Computed here once for every master and system tool. Each component's parameters are,
 besides the scenario's wire in the FMUs that model it (:data:`WIRES`, set whole by
-:mod:`.wire_values`): the signals as JSON tables (SmaScenarioSignals), the compensator's
-filter, model load, adaptation, inverse, shaping, power cap (0 W: none) and anticipation
-(0 s: none), the PI's gains (:data:`~.gains.GAINS`) and its sensor (with a ``[sensor]``:
-noise, ADC, seed), the driver's frequency and peak power (and, with a limit, its modulation
-and current and voltage limits), the plant's start temperature and hysteresis mode.
+:mod:`.wire_values`): the signals as JSON tables (SmaScenarioSignals; a stroke reference as
+the R_ref table it maps to, step by step), the compensator's filter, model load, adaptation,
+inverse, shaping, power cap (0 W: none) and anticipation (0 s: none), the PI's gains
+(:data:`~.gains.GAINS`) and its sensor (with a ``[sensor]``: noise, ADC, seed), the driver's
+frequency and peak power (and, with a limit, its modulation and current and voltage limits),
+the plant's start temperature and hysteresis mode.
 Choices (the hysteresis mode, the inverse, the shaping, the modulation) are the Integer codes of
 :mod:`sma_fmu.fmi.python_family.slave_support.choices`.
 
@@ -35,7 +36,7 @@ def component_settings(scenario, name):
     """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters."""
     c, drive = scenario.controller, scenario.drive
     if name == "signals":
-        return {"reference": table_text(scenario.reference.as_table()),
+        return {"reference": table_text(_reference_table(scenario)),
                 "load_profile": table_text(scenario.load.as_table())}
     if name == "compensator":
         return {**_gains(c, name), "adapt_to_load": c.adapt_to_load,
@@ -59,6 +60,16 @@ def component_settings(scenario, name):
         return {"T_start": scenario.T_start,
                 "hysteresis_mode": choice_code("hysteresis_mode", scenario.hysteresis_mode)}
     raise KeyError(name)
+
+
+def _reference_table(scenario):
+    """The signals FMU's ``reference``: the scenario's table, or for a stroke reference the
+    R_ref it maps to at every step, as a table in ohm (the FMUs hold no stroke map: the
+    master maps the stroke, and the table gives those values at the steps exactly)."""
+    reference = scenario.reference
+    if getattr(reference, "quantity", None) == "stroke":
+        return reference.resistance_table(scenario.step_s, scenario.steps)
+    return reference.as_table()
 
 
 def wire_of(scenario, name):

@@ -43,6 +43,10 @@ def _row(heating, cooling, params):
 
 
 def _reference_key(reference):
+    """What makes two scenarios' R_ref the same: a resistance reference's kind and settings;
+    a stroke reference's R_ref depends on its wire and loads too, so it is shared with none."""
+    if getattr(reference, "quantity", None) == "stroke":
+        return "stroke", id(reference)
     settings = tuple(sorted((key, tuple(value) if isinstance(value, list) else value)
                             for key, value in reference.settings.items()))
     return reference.kind, settings
