@@ -9,16 +9,16 @@ every panel that shows the whole run.
 30,001 samples a line, some 40 times the pixels a panel is wide, and matplotlib spent most
 of a figure's time on them. Cut into 1,500 spans, each span's lowest and highest sample in
 their order keeps every peak a pixel column shows, so the figure looks the same and takes
-a quarter of the time. The run figure's margins are fixed (the values ``tight_layout``
-found for every shipped scenario: its labels and legends are the same text for each run),
-which saves a layout pass; the comparison keeps ``tight_layout``, as its legends hold the
-runs' names (but not the second drawing matplotlib adds after it,
-:func:`~sma_fmu.files.png_output.tight_layout`).
+a quarter of the time. **No layout pass** (``tight_layout`` draws the whole figure once
+to measure it, a third of a comparison's time): the run figure's margins are fixed (the
+values ``tight_layout`` found for every shipped scenario: its labels and legends are the
+same text for each run); the comparison's are too, but for its right margin, which makes
+room for the widest of its outside legends (they hold the runs' names), measured alone
+(:func:`_legend_margin`).
 """
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-
-from sma_fmu.files.png_output import tight_layout
 
 __all__ = ["plot_run", "plot_comparison", "rolling_rms", "envelope", "ENVELOPE_SPANS"]
 
@@ -26,6 +26,10 @@ ENVELOPE_SPANS = 1500   # spans a line is cut into: more than the pixels a panel
 # the run figure's margins (as fractions of the figure): what tight_layout gave for all the
 # shipped scenarios, the left one a little wider (0.076-0.079 there)
 _RUN_MARGINS = {"left": 0.08, "right": 0.782, "top": 0.964, "bottom": 0.059, "hspace": 0.121}
+# the comparison's margins: tight_layout's for the paper's groups; its right margin at most
+_COMPARISON_MARGINS = {"left": 0.063, "right": 0.817, "top": 0.964, "bottom": 0.059,
+                       "wspace": 0.18, "hspace": 0.321}
+_LEGEND_PAD = 1.08   # [font sizes] beside an outside legend, tight_layout's pad
 # zlib level 1 instead of Pillow's 6: a figure's PNG 35 % faster to write, 5 % larger
 _PNG = {"compress_level": 1}
 
@@ -146,6 +150,18 @@ def _reference_period(scenario):
     return 1.0 / frequency if frequency > 0.0 else scenario.stop_time_s / 20.0
 
 
+def _legend_margin(figure, legends, left, widest):
+    """The right margin (a fraction of the figure) that leaves room for ``legends``, placed
+    just outside their axes' right edge (``bbox_to_anchor`` (1.01, 1)): ``widest`` at most.
+    Measures the legends alone, not the figure."""
+    renderer = FigureCanvasAgg(figure).get_renderer()   # the canvas savefig draws PNGs on
+    width = figure.bbox.width
+    room = max(legend.get_window_extent(renderer).width for legend in legends)
+    pad = _LEGEND_PAD * legends[0].prop.get_size_in_points() * figure.dpi / 72.0
+    # the legend starts at right + 0.01 * (right - left), ends ``room`` + ``pad`` later
+    return min(widest, (1.0 - (room + pad) / width + 0.01 * left) / 1.01)
+
+
 def plot_comparison(runs, scenario, title, path):
     """Overlay runs of one group: the whole run, an enlarged window, and the error.
 
@@ -188,11 +204,13 @@ def plot_comparison(runs, scenario, title, path):
         _mark(axis, first, window.metrics_start_s, label=index == 0)
     overview.axvspan(window.zoom_start_s, window.zoom_end_s, color="tab:blue", alpha=0.08, lw=0,
                      label="enlarged below")
-    for axis in (overview, rms):
-        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0)
+    outside = [axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
+                           borderaxespad=0) for axis in (overview, rms)]
     for axis in (zoomed, zoomed_error):
         axis.legend(loc="best", fontsize=7, framealpha=0.7)
     for axis in (overview, zoomed, zoomed_error, rms):
         axis.grid(alpha=0.3)
-    tight_layout(figure)
+    margins = dict(_COMPARISON_MARGINS)
+    margins["right"] = _legend_margin(figure, outside, margins["left"], margins["right"])
+    figure.subplots_adjust(**margins)
     figure.savefig(path, dpi=110, pil_kwargs=_PNG)
