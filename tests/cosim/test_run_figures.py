@@ -1,0 +1,55 @@
+"""Run figures: a kept figure draws each run as a new one would; the comparison figure's
+right margin keeps its outside legends inside the figure, without a layout pass."""
+import dataclasses
+
+import pytest
+
+pytest.importorskip("matplotlib")
+
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+from sma_fmu.cosim import plots  # noqa: E402
+from sma_fmu.cosim.loop import run_library  # noqa: E402
+from sma_fmu.cosim.scenario import load_scenario  # noqa: E402
+from sma_fmu.files.package_data import shipped_file  # noqa: E402
+from sma_fmu.cosim.plots import _legend_margin  # noqa: E402
+
+
+def _run(name, stop_time_s):
+    scenario = load_scenario(shipped_file("scenarios", f"{name}.toml"))
+    scenario = dataclasses.replace(scenario, stop_time_s=stop_time_s)
+    return run_library(scenario).data, scenario
+
+
+def test_a_kept_run_figure_draws_each_run_as_a_new_figure(tmp_path):
+    """The same PNG bytes, whatever the kept figure drew before (other limits, load
+    changes, metrics window, feedforward lines, room temperature)."""
+    runs = [_run("load-step-pi+ff-adaptive", 12.0), _run("heavy-pi", 4.0),
+            _run("heavy-pi+ff-fixed", 1.5), _run("load-step-pi+ff-adaptive", 21.0)]
+    plots._RUN_FIGURES.clear()
+    for index, (data, scenario) in enumerate(runs):
+        plots.plot_run(data, scenario, tmp_path / f"kept-{index}.png")
+    assert len(plots._RUN_FIGURES) == 2   # one with the feedforward's lines, one without
+    for index, (data, scenario) in enumerate(runs):
+        plots._RUN_FIGURES.clear()
+        plots.plot_run(data, scenario, tmp_path / f"new-{index}.png")
+        kept = (tmp_path / f"kept-{index}.png").read_bytes()
+        assert kept == (tmp_path / f"new-{index}.png").read_bytes(), index
+    assert (tmp_path / "new-0.png").read_bytes() != (tmp_path / "new-3.png").read_bytes()
+
+
+@pytest.mark.parametrize("label", ["pi", "a-scenario-name-" * 6])
+def test_outside_legend_fits_the_figure(label):
+    figure = Figure(figsize=(12, 10))
+    axis = figure.add_subplot(1, 1, 1)
+    axis.plot([0.0, 1.0], [0.0, 1.0], label=label)
+    legend = axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0)
+    right = _legend_margin(figure, [legend], 0.063, 0.817)
+    figure.subplots_adjust(left=0.063, right=right)
+    renderer = FigureCanvasAgg(figure).get_renderer()
+    box = legend.get_window_extent(renderer)
+    assert box.x0 > axis.get_window_extent(renderer).x1   # outside the axes, to its right
+    assert box.x1 < figure.bbox.width                       # and inside the figure
+    assert right <= 0.817
+    assert (right < 0.6) == (len(label) > 40)              # a long label takes room, a short one none
