@@ -17,7 +17,7 @@ room for the widest of its outside legends (they hold the runs' names), measured
 (:func:`_legend_margin`). **The run figure is made once** (one for runs with the
 feedforward's lines, one without) and drawn again for each run with its data: making the
 axes and their ticks was half of its time, and a kept figure draws the same PNG bytes as
-a new one.
+a new one. The comparison's axes are kept too, emptied of the last comparison's artists.
 """
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -211,6 +211,33 @@ def _legend_margin(figure, legends, left, widest):
     return min(widest, (1.0 - (room + pad) / width + 0.01 * left) / 1.01)
 
 
+_COMPARISON_AXES = []   # the comparison figure and its axes, drawn last time
+
+
+def _comparison_axes():
+    """(figure, its four axes) for a comparison: made once, then kept with their ticks and
+    emptied of the last comparison's lines, spans, texts and legends (making the axes and
+    their ticks was half of a comparison's time; the test compares its PNG with a new
+    figure's, byte for byte)."""
+    if not _COMPARISON_AXES:
+        figure = Figure(figsize=(12, 10))
+        grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
+        overview = figure.add_subplot(grid[0, :])
+        zoomed = figure.add_subplot(grid[1, 0])
+        zoomed_error = figure.add_subplot(grid[1, 1], sharex=zoomed)
+        rms = figure.add_subplot(grid[2, :], sharex=overview)
+        for axis in (overview, zoomed, zoomed_error, rms):
+            axis.grid(alpha=0.3)
+        _COMPARISON_AXES.append((figure, (overview, zoomed, zoomed_error, rms)))
+    figure, axes = _COMPARISON_AXES[0]
+    for axis in axes:
+        for artist in [*axis.lines, *axis.patches, *axis.texts]:
+            artist.remove()
+        if axis.get_legend() is not None:
+            axis.get_legend().remove()
+    return figure, axes
+
+
 def plot_comparison(runs, scenario, title, path):
     """Overlay runs of one group: the whole run, an enlarged window, and the error.
 
@@ -225,12 +252,7 @@ def plot_comparison(runs, scenario, title, path):
     t = first["t"]
     window = scenario.analysis
     zoom = (t >= window.zoom_start_s) & (t <= window.zoom_end_s)
-    figure = Figure(figsize=(12, 10))
-    grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
-    overview = figure.add_subplot(grid[0, :])
-    zoomed = figure.add_subplot(grid[1, 0])
-    zoomed_error = figure.add_subplot(grid[1, 1], sharex=zoomed)
-    rms = figure.add_subplot(grid[2, :], sharex=overview)
+    figure, (overview, zoomed, zoomed_error, rms) = _comparison_axes()
     _line(overview, t, first["R_ref"], color="black", ls="--", lw=0.8, label="R_ref")
     _line(zoomed, t[zoom], first["R_ref"][zoom], color="black", ls="--", lw=1.1, label="R_ref")
     # the series may hold every k-th step (an output interval, a long run's figure rows)
@@ -260,7 +282,9 @@ def plot_comparison(runs, scenario, title, path):
     for axis in (zoomed, zoomed_error):
         axis.legend(loc="best", fontsize=7, framealpha=0.7)
     for axis in (overview, zoomed, zoomed_error, rms):
-        axis.grid(alpha=0.3)
+        axis.relim()   # the kept axes' data limits: those of this figure's artists only
+    for axis in (overview, zoomed, zoomed_error, rms):
+        axis.autoscale_view()
     margins = dict(_COMPARISON_MARGINS)
     margins["right"] = _legend_margin(figure, outside, margins["left"], margins["right"])
     figure.subplots_adjust(**margins)

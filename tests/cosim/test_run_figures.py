@@ -53,3 +53,19 @@ def test_outside_legend_fits_the_figure(label):
     assert box.x1 < figure.bbox.width                       # and inside the figure
     assert right <= 0.817
     assert (right < 0.6) == (len(label) > 40)              # a long label takes room, a short one none
+
+
+def test_a_kept_comparison_figure_draws_each_group_as_a_new_figure(tmp_path):
+    """The same PNG bytes, whatever the kept axes drew before (other runs, labels, windows)."""
+    load_step = {"pi": _run("load-step-pi", 12.0)[0],
+                 "pi+ff-adaptive": _run("load-step-pi+ff-adaptive", 12.0)[0]}
+    heavy = {name: _run(f"heavy-{name}", 6.0)[0] for name in ("pi", "pi+ff-fixed", "pi+ff-adaptive")}
+    groups = [(load_step, _run("load-step-pi", 12.0)[1], "load-step"),
+              (heavy, _run("heavy-pi", 6.0)[1], "heavy")]
+    plots._COMPARISON_AXES.clear()
+    for index, (runs, scenario, title) in enumerate(groups):
+        plots.plot_comparison(runs, scenario, title, tmp_path / f"kept-{index}.png")
+    for index, (runs, scenario, title) in enumerate(groups):
+        plots._COMPARISON_AXES.clear()
+        plots.plot_comparison(runs, scenario, title, tmp_path / f"new-{index}.png")
+        assert (tmp_path / f"kept-{index}.png").read_bytes() == (tmp_path / f"new-{index}.png").read_bytes()
