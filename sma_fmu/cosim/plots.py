@@ -18,7 +18,10 @@ room for the widest of its outside legends (they hold the runs' names), measured
 feedforward's lines, one without) and drawn again for each run with its data: making the
 axes and their ticks was half of its time, and a kept figure draws the same PNG bytes as
 a new one. The comparison's axes are kept too, emptied of the last comparison's artists.
+Each thread keeps figures of its own.
 """
+import threading
+
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -168,17 +171,23 @@ class _RunFigure:
         self.figure.savefig(path, dpi=110, pil_kwargs=_PNG)
 
 
-_RUN_FIGURES = {}   # feedforward (bool) -> the _RunFigure drawn last time
+_KEPT = threading.local()   # each thread's kept figures: one figure is never drawn by two at once
+
+
+def _kept(name, make):
+    """This thread's kept figure ``name``, made by ``make()`` at its first use."""
+    value = getattr(_KEPT, name, None)
+    if value is None:
+        value = make()
+        setattr(_KEPT, name, value)
+    return value
 
 
 def plot_run(data, scenario, path):
     """Resistance, temperature, power (total, feedforward, feedback), load and stroke; PNG at
     ``path``. The figure is kept for the next run of the same kind (:class:`_RunFigure`)."""
     feedforward = bool(scenario.controller.feedforward)
-    figure = _RUN_FIGURES.get(feedforward)
-    if figure is None:
-        figure = _RUN_FIGURES[feedforward] = _RunFigure(feedforward)
-    figure.draw(data, scenario, path)
+    _kept(f"run_{feedforward}", lambda: _RunFigure(feedforward)).draw(data, scenario, path)
 
 
 def rolling_rms(values, window):
@@ -211,7 +220,17 @@ def _legend_margin(figure, legends, left, widest):
     return min(widest, (1.0 - (room + pad) / width + 0.01 * left) / 1.01)
 
 
-_COMPARISON_AXES = []   # the comparison figure and its axes, drawn last time
+def _new_comparison_axes():
+    """(figure, its four axes: overview, zoomed, zoomed error, RMS) for a comparison."""
+    figure = Figure(figsize=(12, 10))
+    grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
+    overview = figure.add_subplot(grid[0, :])
+    zoomed = figure.add_subplot(grid[1, 0])
+    zoomed_error = figure.add_subplot(grid[1, 1], sharex=zoomed)
+    rms = figure.add_subplot(grid[2, :], sharex=overview)
+    for axis in (overview, zoomed, zoomed_error, rms):
+        axis.grid(alpha=0.3)
+    return figure, (overview, zoomed, zoomed_error, rms)
 
 
 def _comparison_axes():
@@ -219,17 +238,7 @@ def _comparison_axes():
     emptied of the last comparison's lines, spans, texts and legends (making the axes and
     their ticks was half of a comparison's time; the test compares its PNG with a new
     figure's, byte for byte)."""
-    if not _COMPARISON_AXES:
-        figure = Figure(figsize=(12, 10))
-        grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
-        overview = figure.add_subplot(grid[0, :])
-        zoomed = figure.add_subplot(grid[1, 0])
-        zoomed_error = figure.add_subplot(grid[1, 1], sharex=zoomed)
-        rms = figure.add_subplot(grid[2, :], sharex=overview)
-        for axis in (overview, zoomed, zoomed_error, rms):
-            axis.grid(alpha=0.3)
-        _COMPARISON_AXES.append((figure, (overview, zoomed, zoomed_error, rms)))
-    figure, axes = _COMPARISON_AXES[0]
+    figure, axes = _kept("comparison", _new_comparison_axes)
     for axis in axes:
         for artist in [*axis.lines, *axis.patches, *axis.texts]:
             artist.remove()

@@ -27,12 +27,12 @@ def test_a_kept_run_figure_draws_each_run_as_a_new_figure(tmp_path):
     changes, metrics window, feedforward lines, room temperature)."""
     runs = [_run("load-step-pi+ff-adaptive", 12.0), _run("heavy-pi", 4.0),
             _run("heavy-pi+ff-fixed", 1.5), _run("load-step-pi+ff-adaptive", 21.0)]
-    plots._RUN_FIGURES.clear()
+    vars(plots._KEPT).clear()
     for index, (data, scenario) in enumerate(runs):
         plots.plot_run(data, scenario, tmp_path / f"kept-{index}.png")
-    assert len(plots._RUN_FIGURES) == 2   # one with the feedforward's lines, one without
+    assert sorted(vars(plots._KEPT)) == ["run_False", "run_True"]   # with the feedforward's lines, without
     for index, (data, scenario) in enumerate(runs):
-        plots._RUN_FIGURES.clear()
+        vars(plots._KEPT).clear()
         plots.plot_run(data, scenario, tmp_path / f"new-{index}.png")
         kept = (tmp_path / f"kept-{index}.png").read_bytes()
         assert kept == (tmp_path / f"new-{index}.png").read_bytes(), index
@@ -62,10 +62,31 @@ def test_a_kept_comparison_figure_draws_each_group_as_a_new_figure(tmp_path):
     heavy = {name: _run(f"heavy-{name}", 6.0)[0] for name in ("pi", "pi+ff-fixed", "pi+ff-adaptive")}
     groups = [(load_step, _run("load-step-pi", 12.0)[1], "load-step"),
               (heavy, _run("heavy-pi", 6.0)[1], "heavy")]
-    plots._COMPARISON_AXES.clear()
+    vars(plots._KEPT).clear()
     for index, (runs, scenario, title) in enumerate(groups):
         plots.plot_comparison(runs, scenario, title, tmp_path / f"kept-{index}.png")
     for index, (runs, scenario, title) in enumerate(groups):
-        plots._COMPARISON_AXES.clear()
+        vars(plots._KEPT).clear()
         plots.plot_comparison(runs, scenario, title, tmp_path / f"new-{index}.png")
         assert (tmp_path / f"kept-{index}.png").read_bytes() == (tmp_path / f"new-{index}.png").read_bytes()
+
+
+def test_each_thread_keeps_figures_of_its_own(tmp_path):
+    """A run figure drawn on another thread is that thread's, never the one this thread keeps
+    (run_scenarios may be called from threads at once); its PNG is the same."""
+    import threading
+
+    data, scenario = _run("heavy-pi", 2.0)
+    plots.plot_run(data, scenario, tmp_path / "here.png")
+    mine = plots._KEPT.run_False
+    theirs = []
+
+    def draw():
+        plots.plot_run(data, scenario, tmp_path / "there.png")
+        theirs.append(plots._KEPT.run_False)
+
+    thread = threading.Thread(target=draw)
+    thread.start()
+    thread.join()
+    assert theirs and theirs[0] is not mine and plots._KEPT.run_False is mine
+    assert (tmp_path / "here.png").read_bytes() == (tmp_path / "there.png").read_bytes()
