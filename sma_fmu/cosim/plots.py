@@ -9,16 +9,22 @@ every panel that shows the whole run.
 30,001 samples a line, some 40 times the pixels a panel is wide, and matplotlib spent most
 of a figure's time on them. Cut into 1,500 spans, each span's lowest and highest sample in
 their order keeps every peak a pixel column shows, so the figure looks the same and takes
-a quarter of the time. The run figure's margins are fixed (the values ``tight_layout``
-found for every shipped scenario: its labels and legends are the same text for each run),
-which saves a layout pass; the comparison keeps ``tight_layout``, as its legends hold the
-runs' names (but not the second drawing matplotlib adds after it,
-:func:`~sma_fmu.files.png_output.tight_layout`).
+a quarter of the time. **No layout pass** (``tight_layout`` draws the whole figure once
+to measure it, a third of a comparison's time): the run figure's margins are fixed (the
+values ``tight_layout`` found for every shipped scenario: its labels and legends are the
+same text for each run); the comparison's are too, but for its right margin, which makes
+room for the widest of its outside legends (they hold the runs' names), measured alone
+(:func:`_legend_margin`). **The run figure is made once** (one for runs with the
+feedforward's lines, one without) and drawn again for each run with its data: making the
+axes and their ticks was half of its time, and a kept figure draws the same PNG bytes as
+a new one. The comparison's axes are kept too, emptied of the last comparison's artists.
+Each thread keeps figures of its own.
 """
-import numpy as np
-from matplotlib.figure import Figure
+import threading
 
-from sma_fmu.files.png_output import tight_layout
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
 __all__ = ["plot_run", "plot_comparison", "rolling_rms", "envelope", "ENVELOPE_SPANS"]
 
@@ -26,6 +32,10 @@ ENVELOPE_SPANS = 1500   # spans a line is cut into: more than the pixels a panel
 # the run figure's margins (as fractions of the figure): what tight_layout gave for all the
 # shipped scenarios, the left one a little wider (0.076-0.079 there)
 _RUN_MARGINS = {"left": 0.08, "right": 0.782, "top": 0.964, "bottom": 0.059, "hspace": 0.121}
+# the comparison's margins: tight_layout's for the paper's groups; its right margin at most
+_COMPARISON_MARGINS = {"left": 0.063, "right": 0.817, "top": 0.964, "bottom": 0.059,
+                       "wspace": 0.18, "hspace": 0.321}
+_LEGEND_PAD = 1.08   # [font sizes] beside an outside legend, tight_layout's pad
 # zlib level 1 instead of Pillow's 6: a figure's PNG 35 % faster to write, 5 % larger
 _PNG = {"compress_level": 1}
 
@@ -64,6 +74,12 @@ def _line(axis, x, y, **style):
     return axis.plot(*envelope(x, y), **style)
 
 
+def _title(axis, text):
+    """``axis.set_title`` at the top edge: no axis here has tick labels above it, where
+    matplotlib would move a title to, and looking for them cost a sixth of a figure's drawing."""
+    axis.set_title(text, y=1.0)
+
+
 def _load_changes(data):
     """[(time [s], new load [kg])] where the load steps."""
     load = data["load"]
@@ -72,67 +88,117 @@ def _load_changes(data):
 
 
 def _mark(axis, data, metrics_start, label=False):
-    """Grey out the samples before the metrics window and draw a line at each load change."""
+    """Grey out the samples before the metrics window and draw a line at each load change;
+    returns the artists (a reused figure removes them before the next run)."""
+    marks = []
     if metrics_start > 0.0:
-        axis.axvspan(data["t"][0], metrics_start, color="0.85", alpha=0.6, lw=0,
-                     label="outside the metrics window" if label else None)
+        marks.append(axis.axvspan(data["t"][0], metrics_start, color="0.85", alpha=0.6, lw=0,
+                                  label="outside the metrics window" if label else None))
     for index, (time, load) in enumerate(_load_changes(data)):
-        axis.axvline(time, color="0.35", ls=":", lw=1.0,
-                     label="load change" if label and index == 0 else None)
+        marks.append(axis.axvline(time, color="0.35", ls=":", lw=1.0,
+                                  label="load change" if label and index == 0 else None))
         if label:
-            axis.annotate(f"{load:g} kg", (time, 1.0), xycoords=("data", "axes fraction"),
-                          xytext=(3, -12), textcoords="offset points", fontsize=8, color="0.3")
+            marks.append(axis.annotate(f"{load:g} kg", (time, 1.0), xycoords=("data", "axes fraction"),
+                                       xytext=(3, -12), textcoords="offset points", fontsize=8,
+                                       color="0.3"))
+    return marks
+
+
+class _RunFigure:
+    """The run figure's axes and lines, made once and drawn again for each run with its
+    data (:func:`plot_run`): making the axes and their ticks was half of a figure's time.
+    One per kind (with or without the feedforward's lines, T_ref and P_ff; with or without a
+    stroke reference's curve, its panel taller)."""
+
+    def __init__(self, feedforward, stroke_reference=False):
+        self.figure = Figure(figsize=(10, 10))
+        self.axes = self.figure.subplots(4, 1, sharex=True, gridspec_kw={
+            "height_ratios": [3, 2, 2, 2.6 if stroke_reference else 1.4]})
+        resistance, temperature, power, load = self.axes
+        self.stroke = load.twinx()
+        thin = {"lw": 0.9}
+        self.lines = {   # column -> (axis, its line; whether it ends one row early: no step there)
+            "R_ref": (resistance, dict(color="black", ls="--", label="R_ref", **thin), False),
+            "R": (resistance, dict(color="tab:red", label="R", **thin), False),
+            "T": (temperature, dict(color="tab:red", label="T (wire)", **thin), False),
+            "T_ref": (temperature, dict(color="black", ls="--", label="T_ref (inverse model)",
+                                        **thin), False),
+            "P": (power, dict(color="black", label="P applied", **thin), True),
+            "P_ff": (power, dict(color="tab:blue", lw=0.8, label="P_ff (feedforward)"), True),
+            "P_fb": (power, dict(color="tab:orange", lw=0.8, label="P_fb (PI feedback)"), True),
+            "stroke_reference": (self.stroke, dict(color="black", ls="--", label="stroke reference",
+                                                   **thin), False),
+            "stroke": (self.stroke, dict(color="tab:green", label="stroke x_0 - x", **thin), False)}
+        if not stroke_reference:
+            del self.lines["stroke_reference"]
+        if not feedforward:
+            del self.lines["T_ref"], self.lines["P_ff"]
+        self.lines = {name: (axis.plot([], [], **style)[0], early)
+                      for name, (axis, style, early) in self.lines.items()}
+        self.room = temperature.axhline(0.0, color="tab:blue", lw=0.8, ls="-.", label="T_room")
+        power.axhline(0.0, color="0.5", lw=0.6)
+        self.load = load.step([], [], where="post", color="tab:blue", label="load")[0]
+        for axis, label in zip((*self.axes, self.stroke), ("resistance [ohm]", "temperature [degC]",
+                                                          "power [W]", "load [kg]", "stroke [mm]")):
+            axis.set_ylabel(label)
+        load.set_xlabel("time t [s]")
+        for axis in self.axes:
+            axis.grid(alpha=0.3)
+        self.figure.subplots_adjust(**_RUN_MARGINS)
+        self.marks = []
+
+    def draw(self, data, scenario, path):
+        """Draw the run ``data`` of ``scenario`` and write the PNG at ``path``."""
+        resistance, temperature, power, load = self.axes
+        t = data["t"]
+        for name, (line, early) in self.lines.items():
+            if name == "stroke_reference":
+                values = 1e3 * np.array([scenario.reference.stroke(time) for time in t.tolist()])
+            else:
+                values = 1e3 * data["stroke"] if name == "stroke" else data[name]
+            line.set_data(*envelope(t[:-1], values[:-1]) if early else envelope(t, values))
+        self.room.set_ydata([scenario.params.T_room] * 2)
+        changes = np.concatenate([[0], np.nonzero(np.diff(data["load"]) != 0.0)[0] + 1, [len(t) - 1]])
+        self.load.set_data(t[changes], data["load"][changes])
+        load.set_ylim(0.0, max(0.3, 1.15 * float(data["load"].max())))
+        for mark in self.marks:
+            mark.remove()
+        self.marks = [mark for index, axis in enumerate(self.axes)
+                      for mark in _mark(axis, data, scenario.analysis.metrics_start_s, index == 0)]
+        for axis in (*self.axes, self.stroke):
+            axis.relim()
+        for axis in (*self.axes, self.stroke):
+            axis.autoscale_view()
+        for axis in (resistance, temperature, power):
+            axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0)
+        handles = load.get_legend_handles_labels()[0] + self.stroke.get_legend_handles_labels()[0]
+        load.legend(handles, [h.get_label() for h in handles], loc="upper left",
+                    bbox_to_anchor=(1.08, 1.0), fontsize=8, borderaxespad=0)
+        _title(resistance, f"{scenario.name}: {scenario.controller.kind}, "
+                           f"{scenario.hysteresis_mode} hysteresis")
+        self.figure.savefig(path, dpi=110, pil_kwargs=_PNG)
+
+
+_KEPT = threading.local()   # each thread's kept figures: one figure is never drawn by two at once
+
+
+def _kept(name, make):
+    """This thread's kept figure ``name``, made by ``make()`` at its first use."""
+    value = getattr(_KEPT, name, None)
+    if value is None:
+        value = make()
+        setattr(_KEPT, name, value)
+    return value
 
 
 def plot_run(data, scenario, path):
     """Resistance, temperature, power (total, feedforward, feedback), load and stroke (with a
-    stroke reference's curve, its panel taller); PNG at ``path``."""
-    stroke_at = (scenario.reference.stroke
-                 if getattr(scenario.reference, "quantity", None) == "stroke" else None)
-    figure = Figure(figsize=(10, 10))
-    axes = figure.subplots(4, 1, sharex=True, gridspec_kw={
-        "height_ratios": [3, 2, 2, 1.4 if stroke_at is None else 2.6]})
-    t = data["t"]
-    start = scenario.analysis.metrics_start_s
-    resistance, temperature, power, load = axes
-    _line(resistance, t, data["R_ref"], color="black", ls="--", lw=0.9, label="R_ref")
-    _line(resistance, t, data["R"], color="tab:red", lw=0.9, label="R")
-    resistance.set_ylabel("resistance [ohm]")
-    _line(temperature, t, data["T"], color="tab:red", lw=0.9, label="T (wire)")
-    if scenario.controller.feedforward:
-        _line(temperature, t, data["T_ref"], color="black", ls="--", lw=0.9,
-              label="T_ref (inverse model)")
-    temperature.axhline(scenario.params.T_room, color="tab:blue", lw=0.8, ls="-.", label="T_room")
-    temperature.set_ylabel("temperature [degC]")
-    _line(power, t[:-1], data["P"][:-1], color="black", lw=0.9, label="P applied")
-    if scenario.controller.feedforward:
-        _line(power, t[:-1], data["P_ff"][:-1], color="tab:blue", lw=0.8, label="P_ff (feedforward)")
-    _line(power, t[:-1], data["P_fb"][:-1], color="tab:orange", lw=0.8, label="P_fb (PI feedback)")
-    power.axhline(0.0, color="0.5", lw=0.6)
-    power.set_ylabel("power [W]")
-    changes = np.concatenate([[0], np.nonzero(np.diff(data["load"]) != 0.0)[0] + 1, [len(t) - 1]])
-    load.step(t[changes], data["load"][changes], where="post", color="tab:blue", label="load")
-    load.set_ylabel("load [kg]")
-    load.set_ylim(0.0, max(0.3, 1.15 * float(data["load"].max())))
-    stroke = load.twinx()
-    if stroke_at is not None:
-        _line(stroke, t, [1e3 * stroke_at(time) for time in t.tolist()], color="black", ls="--",
-              lw=0.9, label="stroke reference")
-    _line(stroke, t, 1e3 * data["stroke"], color="tab:green", lw=0.9, label="stroke x_0 - x")
-    stroke.set_ylabel("stroke [mm]")
-    load.set_xlabel("time t [s]")
-    for index, axis in enumerate(axes):
-        _mark(axis, data, start, label=index == 0)
-        axis.grid(alpha=0.3)
-    for axis in (resistance, temperature, power):
-        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0)
-    handles = load.get_legend_handles_labels()[0] + stroke.get_legend_handles_labels()[0]
-    load.legend(handles, [h.get_label() for h in handles], loc="upper left",
-                bbox_to_anchor=(1.08, 1.0), fontsize=8, borderaxespad=0)
-    resistance.set_title(f"{scenario.name}: {scenario.controller.kind}, "
-                         f"{scenario.hysteresis_mode} hysteresis")
-    figure.subplots_adjust(**_RUN_MARGINS)
-    figure.savefig(path, dpi=110, pil_kwargs=_PNG)
+    stroke reference's curve, its panel taller); PNG at ``path``. The figure is kept for the
+    next run of the same kind (:class:`_RunFigure`)."""
+    feedforward = bool(scenario.controller.feedforward)
+    stroke_reference = getattr(scenario.reference, "quantity", None) == "stroke"
+    _kept(f"run_{feedforward}" + ("_stroke" if stroke_reference else ""),
+          lambda: _RunFigure(feedforward, stroke_reference)).draw(data, scenario, path)
 
 
 def rolling_rms(values, window):
@@ -153,6 +219,45 @@ def _reference_period(scenario):
     return 1.0 / frequency if frequency > 0.0 else scenario.stop_time_s / 20.0
 
 
+def _legend_margin(figure, legends, left, widest):
+    """The right margin (a fraction of the figure) that leaves room for ``legends``, placed
+    just outside their axes' right edge (``bbox_to_anchor`` (1.01, 1)): ``widest`` at most.
+    Measures the legends alone, not the figure."""
+    renderer = FigureCanvasAgg(figure).get_renderer()   # the canvas savefig draws PNGs on
+    width = figure.bbox.width
+    room = max(legend.get_window_extent(renderer).width for legend in legends)
+    pad = _LEGEND_PAD * legends[0].prop.get_size_in_points() * figure.dpi / 72.0
+    # the legend starts at right + 0.01 * (right - left), ends ``room`` + ``pad`` later
+    return min(widest, (1.0 - (room + pad) / width + 0.01 * left) / 1.01)
+
+
+def _new_comparison_axes():
+    """(figure, its four axes: overview, zoomed, zoomed error, RMS) for a comparison."""
+    figure = Figure(figsize=(12, 10))
+    grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
+    overview = figure.add_subplot(grid[0, :])
+    zoomed = figure.add_subplot(grid[1, 0])
+    zoomed_error = figure.add_subplot(grid[1, 1], sharex=zoomed)
+    rms = figure.add_subplot(grid[2, :], sharex=overview)
+    for axis in (overview, zoomed, zoomed_error, rms):
+        axis.grid(alpha=0.3)
+    return figure, (overview, zoomed, zoomed_error, rms)
+
+
+def _comparison_axes():
+    """(figure, its four axes) for a comparison: made once, then kept with their ticks and
+    emptied of the last comparison's lines, spans, texts and legends (making the axes and
+    their ticks was half of a comparison's time; the test compares its PNG with a new
+    figure's, byte for byte)."""
+    figure, axes = _kept("comparison", _new_comparison_axes)
+    for axis in axes:
+        for artist in [*axis.lines, *axis.patches, *axis.texts]:
+            artist.remove()
+        if axis.get_legend() is not None:
+            axis.get_legend().remove()
+    return figure, axes
+
+
 def plot_comparison(runs, scenario, title, path):
     """Overlay runs of one group: the whole run, an enlarged window, and the error.
 
@@ -167,12 +272,7 @@ def plot_comparison(runs, scenario, title, path):
     t = first["t"]
     window = scenario.analysis
     zoom = (t >= window.zoom_start_s) & (t <= window.zoom_end_s)
-    figure = Figure(figsize=(12, 10))
-    grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
-    overview = figure.add_subplot(grid[0, :])
-    zoomed = figure.add_subplot(grid[1, 0])
-    zoomed_error = figure.add_subplot(grid[1, 1], sharex=zoomed)
-    rms = figure.add_subplot(grid[2, :], sharex=overview)
+    figure, (overview, zoomed, zoomed_error, rms) = _comparison_axes()
     _line(overview, t, first["R_ref"], color="black", ls="--", lw=0.8, label="R_ref")
     _line(zoomed, t[zoom], first["R_ref"][zoom], color="black", ls="--", lw=1.1, label="R_ref")
     # the series may hold every k-th step (an output interval, a long run's figure rows)
@@ -184,22 +284,28 @@ def plot_comparison(runs, scenario, title, path):
         _line(zoomed, t[zoom], data["R"][zoom], color=colour, lw=1.2, label=label)
         _line(zoomed_error, t[zoom], error[zoom], color=colour, lw=1.2, label=label)
         _line(rms, t, rolling_rms(error, samples), color=colour, lw=1.2, label=label)
-    overview.set(ylabel="resistance [ohm]", title=f"{title}: whole run")
-    zoomed.set(ylabel="resistance [ohm]", xlabel="time t [s]",
-               title=f"enlarged: {window.zoom_start_s:g} s to {window.zoom_end_s:g} s")
-    zoomed_error.set(ylabel="error R - R_ref [ohm]", xlabel="time t [s]", title="error, enlarged")
+    overview.set(ylabel="resistance [ohm]")
+    _title(overview, f"{title}: whole run")
+    zoomed.set(ylabel="resistance [ohm]", xlabel="time t [s]")
+    _title(zoomed, f"enlarged: {window.zoom_start_s:g} s to {window.zoom_end_s:g} s")
+    zoomed_error.set(ylabel="error R - R_ref [ohm]", xlabel="time t [s]")
+    _title(zoomed_error, "error, enlarged")
     zoomed_error.axhline(0.0, color="0.5", lw=0.6)
-    rms.set(ylabel="RMS error [ohm]", xlabel="time t [s]",
-            title=f"RMS of R - R_ref over {samples * spacing:g} s (one reference period)")
+    rms.set(ylabel="RMS error [ohm]", xlabel="time t [s]")
+    _title(rms, f"RMS of R - R_ref over {samples * spacing:g} s (one reference period)")
     for index, axis in enumerate((overview, rms)):
         _mark(axis, first, window.metrics_start_s, label=index == 0)
     overview.axvspan(window.zoom_start_s, window.zoom_end_s, color="tab:blue", alpha=0.08, lw=0,
                      label="enlarged below")
-    for axis in (overview, rms):
-        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0)
+    outside = [axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
+                           borderaxespad=0) for axis in (overview, rms)]
     for axis in (zoomed, zoomed_error):
         axis.legend(loc="best", fontsize=7, framealpha=0.7)
     for axis in (overview, zoomed, zoomed_error, rms):
-        axis.grid(alpha=0.3)
-    tight_layout(figure)
+        axis.relim()   # the kept axes' data limits: those of this figure's artists only
+    for axis in (overview, zoomed, zoomed_error, rms):
+        axis.autoscale_view()
+    margins = dict(_COMPARISON_MARGINS)
+    margins["right"] = _legend_margin(figure, outside, margins["left"], margins["right"])
+    figure.subplots_adjust(**margins)
     figure.savefig(path, dpi=110, pil_kwargs=_PNG)

@@ -1,7 +1,8 @@
 """Reading an FMU's model description with fmpy, with one named error for a file that is no FMU."""
+from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["FmuFileError", "read_description"]
+__all__ = ["FmuFileError", "read_description", "described"]
 
 
 class FmuFileError(ValueError):
@@ -27,3 +28,11 @@ def read_description(path):
         raise FmuFileError(f"{path}: not an FMU: no modelDescription.xml in the archive") from None
     except Exception as error:  # fmpy raises bare Exceptions for XML problems
         raise FmuFileError(f"{path}: not a usable FMU: {error}") from None
+
+
+@lru_cache(maxsize=64)
+def described(version):
+    """:func:`read_description` of the FMU file ``version`` (its resolved path, size and
+    modification time [ns]), read once per file version and shared (read only): the loop's
+    system and the unpacked FMU each read it, and a C master's start-up read every file twice."""
+    return read_description(version[0])

@@ -31,7 +31,7 @@ import threading
 from pathlib import Path
 
 from sma_fmu.files.archives import require_safe_archive, safe_extract
-from sma_fmu.fmi.driving.description import read_description
+from sma_fmu.fmi.driving.description import described
 
 __all__ = ["Unpacked", "acquire", "release", "folders", "remove_stale", "UNPACK_EACH_VARIABLE"]
 
@@ -150,7 +150,7 @@ def _unpack(path, key, cached):
     try:
         # the archive inspected once, before fmpy reads anything of it
         safe_extract(path, folder, lambda name: not name.startswith(_NOT_RUN))
-        description = read_description(path)
+        description = described(key)   # read once per file version
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)
         raise

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
-from sma_fmu.fmi.driving.description import read_description
+from sma_fmu.fmi.driving.description import described
 from sma_fmu.fmi.loop.values import component_settings, input_starts, wire_of
 from sma_fmu.fmi.loop.wire_values import built_wire, mismatch_error, wire_values
 from sma_fmu.fmi.loop.wiring import (COMPONENT_MODELS, STEP_ORDER, loop_components,
@@ -108,7 +108,7 @@ def _read_fmu(version):
     """({name: ScalarVariable}, FMI major version) of the FMU file ``version`` (:func:`_version`);
     once per file version (a sweep or a bench builds many systems). Only the model description
     is read: whatever unpacks or repacks the archive inspects it first."""
-    description = read_description(version[0])
+    description = described(version)
     return {v.name: v for v in description.modelVariables}, description.fmiVersion.split(".")[0]
 
 
