@@ -112,9 +112,11 @@ def test_ssp_wires_the_loop_and_binds_the_scenario_and_the_wire(fmu_dir, tmp_pat
 def test_each_fmu_is_read_once_for_the_ssp_and_the_container(fmu_dir, tmp_path, monkeypatch):
     import fmpy
 
+    from sma_fmu.fmi.driving.description import described
     from sma_fmu.fmi.loop import system as loop_module
 
-    loop_module._read_fmu.cache_clear()   # earlier tests read these files already
+    loop_module._read_fmu.cache_clear()   # earlier tests read these files already,
+    described.cache_clear()               # and the description each read is kept once per file
     reads, read = [], fmpy.read_model_description
     monkeypatch.setattr(fmpy, "read_model_description",
                         lambda filename, *args, **kwargs: reads.append(Path(filename).name)
