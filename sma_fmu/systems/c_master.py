@@ -38,7 +38,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
 from sma_fmu.fmi.driving.instance import FmuError
-from sma_fmu.fmi.driving.unpacked import acquire, release
+from sma_fmu.fmi.driving.unpacked import WIN64, acquire, release
 from sma_fmu.fmi.hosts import CHostError, compile_host
 from sma_fmu.fmi.loop.system import check_variables
 from sma_fmu.systems.loop_host_process import (STATUS_NAMES, HostProcess, failed_call,
@@ -159,7 +159,8 @@ class CMaster:
             self._stop_host()
             release(self._unpacked.pop(str(path)))
         if held is None:
-            held = self._unpacked[str(path)] = acquire(path)
+            platforms = WIN64 if self.windows is not None else None   # what the host loads
+            held = self._unpacked[str(path)] = acquire(path, platforms)
         return self._text(held)
 
     def _ready(self, system):

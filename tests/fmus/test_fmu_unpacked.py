@@ -268,3 +268,36 @@ def test_the_c_master_unpacks_per_process_and_removes_them_at_exit(native_fmus, 
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip() == "30001"
     assert _ours(tmp_path) == set() and not (tmp_path / "sma-fmu-unpacked").exists()
+
+
+def test_only_what_a_host_runs_is_unpacked_and_another_platform_is_added_later(native_fmus, tmp_path):
+    """The model description, resources/ and this platform's binaries; not the sources, the
+    documentation, extra/ or other platforms' binaries, which the archive holds. A win64 host
+    (under wine) asking later gets win64's binaries in the same folder, byte for byte."""
+    import zipfile
+
+    import fmpy
+
+    path = tmp_path / "Plant.fmu"
+    shutil.copyfile(native_fmus["SmaActuator"], path)
+    with zipfile.ZipFile(path) as archive:
+        names = [n for n in archive.namelist() if not n.endswith("/")]
+        dll = archive.read("binaries/win64/SmaActuator.dll")
+    for prefix in ("sources/", "documentation/", "extra/", "binaries/win64/", "binaries/darwin64/"):
+        assert any(n.startswith(prefix) for n in names), prefix   # in the archive
+    resources = {n for n in names if n.startswith("resources/")}
+    first = unpacked.acquire(path)
+    try:
+        folder = Path(first.folder)
+        got = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()}
+        assert resources and got == {"modelDescription.xml", f"binaries/{fmpy.platform}/SmaActuator.so",
+                                     *resources}
+        second = unpacked.acquire(path, unpacked.WIN64)
+        try:
+            assert second is first
+            assert (folder / "binaries/win64/SmaActuator.dll").read_bytes() == dll
+            assert not (folder / "binaries/darwin64").exists() and not (folder / "sources").exists()
+        finally:
+            unpacked.release(second)
+    finally:
+        unpacked.release(first)

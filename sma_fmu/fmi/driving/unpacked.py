@@ -1,11 +1,13 @@
 """Each FMU file unpacked once per process, shared by its instances (:class:`FmuInstance`).
 
 Unpacking an FMU takes 8-70 ms, more than the rest of making an instance; the closed loop
-and the bench make several instances of the same files per process. What running it needs
-is unpacked: all but its C sources and its documentation (``sources/``, ``documentation/``:
-of a native FMU's 92 files, 80; creating them was most of the time). The cache
-key is the file's resolved path, size and modification time [ns]: a rebuilt FMU at the same
-path gets a fresh folder, and the old folder is removed once no instance uses it.
+and the bench make several instances of the same files per process. Only what running it
+needs is unpacked: its model description, ``resources/`` and the binaries of the platforms
+asked for (default: this process's; a win64 host under wine asks for win64's), not its C
+sources, documentation, ``extra/`` or other platforms' binaries (of a native FMU's 103
+files, 4: a fifth of the bytes of all but sources and documentation). A platform asked for
+later is added to the same folder. The cache key is the file's resolved path, size and
+modification time [ns]: a rebuilt FMU at the same path gets a fresh folder, and the old folder is removed once no instance uses it.
 
 - :func:`acquire` gives an :class:`Unpacked` (folder and model description) and counts a
   user; :func:`release` ends the use. The archive is inspected
@@ -33,21 +35,24 @@ from pathlib import Path
 from sma_fmu.files.archives import require_safe_archive, safe_extract
 from sma_fmu.fmi.driving.description import described
 
-__all__ = ["Unpacked", "acquire", "release", "folders", "remove_stale", "UNPACK_EACH_VARIABLE"]
+__all__ = ["Unpacked", "WIN64", "acquire", "release", "folders", "remove_stale",
+           "UNPACK_EACH_VARIABLE"]
 
 UNPACK_EACH_VARIABLE = "SMA_FMU_UNPACK_EACH"
 _PREFIX = "sma_fmu_unpacked_"
-_NOT_RUN = ("sources/", "documentation/")   # what no host reads to run an FMU
+_RUN = ("resources/",)   # with the model description and binaries/<platform>/: what a host reads
+WIN64 = ("win64", "x86_64-windows")   # the binaries/ folders (FMI 2.0, 3.0) of a win64 host
 
 
 class Unpacked:
     """One unpacked FMU: ``folder`` (str), ``description`` (fmpy's ModelDescription, shared:
     read only) and the number of instances using it."""
 
-    __slots__ = ("folder", "description", "key", "pid", "users", "cached")
+    __slots__ = ("folder", "description", "key", "pid", "users", "cached", "platforms")
 
-    def __init__(self, folder, description, key, cached):
+    def __init__(self, folder, description, key, cached, platforms):
         self.folder, self.description, self.key = folder, description, key
+        self.platforms = set(platforms)   # the binaries/ folders unpacked
         self.pid = os.getpid()  # the process that made the folder, the only one to remove it
         self.users = 0
         self.cached = cached    # False: replaced by a newer file, or SMA_FMU_UNPACK_EACH
@@ -142,37 +147,57 @@ def remove_stale(folder=None):
     return removed
 
 
-def _unpack(path, key, cached):
+def _platforms(platforms):
+    """The binaries/ folder names ``platforms`` (None: this process's, FMI 2.0 and 3.0 names)."""
+    if platforms is None:
+        import fmpy
+        return (fmpy.platform, fmpy.platform_tuple)
+    return tuple(platforms)
+
+
+def _binaries(platforms):
+    """Whether to unpack a member: the binaries of ``platforms`` only."""
+    folders = tuple(f"binaries/{platform}/" for platform in platforms)
+    return lambda name: name.startswith(folders)
+
+
+def _unpack(path, key, cached, platforms):
     if _SWEPT_PID[0] != os.getpid():   # once per process: what killed ones left behind
         _SWEPT_PID[0] = os.getpid()
         remove_stale()
     folder = tempfile.mkdtemp(prefix=f"{_PREFIX}{os.getpid()}_")
+    binaries = _binaries(platforms)
     try:
         # the archive inspected once, before fmpy reads anything of it
-        safe_extract(path, folder, lambda name: not name.startswith(_NOT_RUN))
+        safe_extract(path, folder, lambda name: (name == "modelDescription.xml"
+                                                 or name.startswith(_RUN) or binaries(name)))
         description = described(key)   # read once per file version
     except BaseException:
         shutil.rmtree(folder, ignore_errors=True)
         raise
-    unpacked = Unpacked(folder, description, key, cached)
+    unpacked = Unpacked(folder, description, key, cached, platforms)
     _OWNED.append(unpacked)
     _register_child_exit()
     return unpacked
 
 
-def acquire(path):
+def acquire(path, platforms=None):
     """The :class:`Unpacked` FMU file ``path``, unpacked now or earlier; counts one user.
+    ``platforms``: the binaries/ folders its host loads (None: this process's platform;
+    :data:`WIN64` for a win64 host under wine).
 
     Raises :class:`~sma_fmu.files.archives.UnsafeArchiveError` for an unsafe or unreadable
     archive, :class:`~sma_fmu.fmi.driving.description.FmuFileError` for a zip that is no usable FMU.
     """
-    path = str(path)
+    path, platforms = str(path), _platforms(platforms)
     key = _key(path)
     each = os.environ.get(UNPACK_EACH_VARIABLE, "") not in ("", "0")
     with _LOCK:
         unpacked = None if each else _CACHE.get(key)
+        if unpacked is not None and not unpacked.platforms.issuperset(platforms):
+            _add_platforms(unpacked, path, platforms)
         if unpacked is None:
-            unpacked = _unpack(path, key, cached=not each)
+            unpacked = _unpack(path, key, cached=not each, platforms=platforms)
             if not each:
                 if _key(path) != key:   # changed while unpacking: use once, cache nothing
                     unpacked.cached = False
@@ -181,6 +206,14 @@ def acquire(path):
                     _CACHE[key] = unpacked
         unpacked.users += 1
         return unpacked
+
+
+def _add_platforms(unpacked, path, platforms):
+    """Unpack the binaries of ``platforms`` into the folder of ``unpacked`` too (call with
+    the lock held; the cache key just matched the file: the same version)."""
+    missing = [p for p in platforms if p not in unpacked.platforms]
+    safe_extract(path, unpacked.folder, _binaries(missing))
+    unpacked.platforms.update(missing)
 
 
 def _retire_older(key):
