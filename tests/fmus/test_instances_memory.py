@@ -10,13 +10,14 @@ the front takes pythonfmu's sys.path entry off again.
 
 The stated bound, after 400 warm-up instances, over 400 more: no more mappings of FMU
 binaries, no more sys.path entries, at most 1.5 Python objects and 5 KiB of resident
-memory per instance (2 MiB in all; before: 69 MiB x 2). Measured when this test was
-written: about 1.4 KiB per instance. Measured now (this probe, by hand): 3.7 KiB for the
-plant and 4.4 KiB for the compensator; over 200 after 200 warm-up instances, the bound
-this test had, 5.1-7.7 KiB, also for FMUs built before the latest changes. The first
-instances take more each (the allocators' pools, the front's table of freed instances),
-and the growth per instance falls the longer the warm-up; what has grown since the test
-was written is not explained yet. What is left is pythonfmu 0.7.0's: one
+memory per instance (2 MiB in all; before: 69 MiB x 2). Measured now (this probe, by
+hand): 3.7 KiB for the plant and 4.4 KiB for the compensator. The first instances take
+more each, once: the allocators' pools, the front's table of freed instances, and Python's
+table of interned strings, which pathlib fills with each instance's folder name and which
+grew once by 939 KiB between the 200th and the 400th instance (tracemalloc); a 200-instance
+warm-up, which this test had, caught that growth in its measurement (5.1-7.7 KiB per
+instance). After it, the Python-level growth is 1.05-1.26 KiB per instance (tracemalloc,
+blocks of 200 up to 1,200 instances), nearly all of it made in fmi2Instantiate. What is left is pythonfmu 0.7.0's: one
 object per instance, the list of the slave class's bases that findClass never frees, with
 their names.
 Run by hand: ``python tests/support/instance_memory_probe.py FMU --warm 200 --instances 200``.
