@@ -58,13 +58,16 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
     putchar('\n');
 }
 
-/* hex text -> malloc'd bytes (NUL-terminated); "-" -> NULL, "_" -> "". */
+/* hex text -> malloc'd bytes (NUL-terminated); "-" -> NULL, "_" -> "". Two digits at a time
+ * through strtol: sscanf per byte measures the rest of the string each call, quadratic in a
+ * long string. */
 static char* unhex(const char* hex, size_t* length)
 {
     if (!strcmp(hex, "-")) { if (length) *length = 0; return NULL; }
     size_t n = strcmp(hex, "_") ? strlen(hex) / 2 : 0;
     char* out = calloc(n + 1, 1);
-    for (size_t i = 0; i < n; ++i) sscanf(hex + 2 * i, "%2hhx", (unsigned char*)&out[i]);
+    for (size_t i = 0; out && i < n; ++i)
+        out[i] = (char)strtol((const char[]){hex[2 * i], hex[2 * i + 1], '\0'}, NULL, 16);
     if (length) *length = n;
     return out;
 }
