@@ -209,3 +209,14 @@ def test_bound_command_errors_are_one_line(tmp_path, capsys, argv, message):
     err = capsys.readouterr().err
     assert err.startswith("sma-fmu: error: ") and message in err and len(err.splitlines()) == 1
     assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("value,bound,expected", [
+    (1.0, 0.5, 2.0), (0.3, 0.3, 1.0), (1.0, 0.0, None),
+    (1.0, 1e-14, None),   # a benchmark at rounding-error size: no ratio of 1e14
+    (0.0, 0.2, 0.0)])
+def test_a_ratio_to_a_bound_of_rounding_size_is_not_printed(value, bound, expected):
+    from sma_fmu.analysis.bound_report import _ratio, _number
+
+    assert _ratio(value, bound) == expected
+    assert _number(_ratio(value, bound), 1) == ("n/a" if expected is None else f"{expected:.1f}")
