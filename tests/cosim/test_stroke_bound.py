@@ -74,7 +74,9 @@ def test_sma_fmu_bound_reports_the_stroke_rmse_beside_its_bound(tmp_path):
     stroke = rows[0]["stroke"]
     run = scenario_metrics(run_library(scenario).data, scenario)["stroke"]
     assert stroke["rmse_um"] == run["rmse_um"]
-    assert stroke["rmse_over_achievable"] == pytest.approx(
-        run["rmse_um"] / stroke["achievable_um"])
+    # the benchmark (no power cap) tracks this reachable step to rounding error, so the
+    # report gives no ratio to it (n/a), where it once printed about 5e13
+    assert 0.0 <= stroke["achievable_um"] < 1e-9 * run["rmse_um"]
+    assert stroke["rmse_over_achievable"] is None
     table = (tmp_path / "bound" / "bound.md").read_text()
     assert "| stroke | pi+ff-adaptive | " in table and f"{run['rmse_um']:.1f}" in table
