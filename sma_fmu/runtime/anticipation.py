@@ -10,8 +10,12 @@ the reference's own past samples, with no preview of the future: from the last t
     R' = (R_k - R_k-2) / (2 h),    R'' = (R_k - 2 R_k-1 + R_k-2) / h^2
 
 where the reference falls towards a minimum (R' < 0 < R'') that, at this curvature, it
-reaches within the anticipation time L (-R'/R'' < L), the compensator aims at the parabola's
-value L ahead, R_k + R' L + R'' L^2 / 2, instead of R_k. Once the reference has turned, the
+reaches within the anticipation time L but not within one sample (h <= -R'/R'' < L), the
+compensator aims at the parabola's value L ahead, R_k + R' L + R'' L^2 / 2, instead of R_k.
+The one-sample floor tells a turn from a jump: after a step, a kink or a jump (a stroke
+reference mapped onto the other branch jumps where it turns) the three samples give
+-R'/R'' = h/2, and a parabola through them would aim thousands of ohms away
+(R_k - (L^2/(2 h^2) - L/(2 h)) dR for a step dR: 11,000 ohm per ohm at L = 0.15 s, h = 1 ms). Once the reference has turned, the
 aim stays at the last anticipated value until R_ref catches up with it (no step back, which
 would read as heating). **choice**: the lower turn only: at the upper turn the wire heats,
 as fast as the driver allows, and anticipating it made tracking worse on the paper's
@@ -32,13 +36,13 @@ class TurnAnticipation:
         self.held = None        # the last anticipated aim [ohm], held after the turn
 
     def _ahead(self, reference, step_size):
-        """R_k + R' L + R'' L^2 / 2 [ohm] near a lower turn within L, else R_k."""
+        """R_k + R' L + R'' L^2 / 2 [ohm] near a lower turn between h and L ahead, else R_k."""
         earlier, previous, lead = self.earlier, self.previous, self.lead
         if earlier is None:
             return reference
         slope = (reference - earlier) / (2.0 * step_size)
         curvature = (reference - 2.0 * previous + earlier) / (step_size * step_size)
-        if slope < 0.0 < curvature and -slope < curvature * lead:
+        if slope < 0.0 < curvature and step_size * curvature <= -slope < curvature * lead:
             return reference + slope * lead + 0.5 * curvature * lead * lead
         return reference
 

@@ -3,7 +3,8 @@ equals the Python runtime's, step by step and bit for bit.
 
 Long random R_ref/load walks (nested reversals, holds, saturation at both ends, load changes
 also far above the validity limit, an unconnected start, varied steps, a full minor-loop
-memory) through both inverses, without and with a power cap; mid-walk the saved state (the
+memory) through both inverses, without and with a power cap, without and with the
+anticipation of the lower turn (the walk's holds are steps it must not take for turns); mid-walk the saved state (the
 compensator's and its model wire's) goes through C and through Python's state() into C.
 Bad arguments and bad states are refused by both with the same message and change nothing.
 """
@@ -23,20 +24,20 @@ def lib(tmp_path_factory):
     return load_library(tmp_path_factory.mktemp("c_shaping"))
 
 
-CASES = [  # (seed, inverse, adapt_to_load, power cap [W] or None, memory depth)
-    (21, "major", True, None, 64),
-    (22, "minor-loop", True, None, 64),
-    (23, "minor-loop", True, 10.0, 6),
-    (24, "major", False, 3.0, 64),
-    (25, "minor-loop", False, None, 4),
-    (26, "major", True, 0.5, 8),
+CASES = [  # (seed, inverse, adapt_to_load, power cap [W] or None, memory depth, anticipation [s])
+    (21, "major", True, None, 64, 0.0),
+    (22, "minor-loop", True, None, 64, 0.15),
+    (23, "minor-loop", True, 10.0, 6, 0.0),
+    (24, "major", False, 3.0, 64, 0.3),
+    (25, "minor-loop", False, None, 4, 0.0),
+    (26, "major", True, 0.5, 8, 0.0),
 ]
 STEPS = 6000
 
 
-def pair(lib, params, inverse, adapt, cap):
+def pair(lib, params, inverse, adapt, cap, lead=0.0):
     keywords = {"adapt_to_load": adapt, "inverse": inverse, "shaping": "reachable",
-                "power_cap": cap}
+                "power_cap": cap, "anticipation": lead}
     cparams = CParameters(lib, params)
     return (FeedforwardStepper(params, **keywords), CStepper(lib, cparams, params, **keywords),
             cparams, keywords)
@@ -50,15 +51,16 @@ def compare(python, c, sample):
     return expected
 
 
-@pytest.mark.parametrize("seed, inverse, adapt, cap, depth", CASES)
+@pytest.mark.parametrize("seed, inverse, adapt, cap, depth, lead", CASES)
 def test_the_shaped_c_compensator_equals_the_python_one(lib, params, seed, inverse, adapt, cap,
-                                                        depth):
+                                                        depth, lead):
     params = params.replace(memory_depth=depth)
     rng = random.Random(seed)
-    python, c, cparams, keywords = pair(lib, params, inverse, adapt, cap)
+    python, c, cparams, keywords = pair(lib, params, inverse, adapt, cap, lead)
     walk = reference_walk(rng, params, STEPS)
     assert c.initial_outputs(*walk[0][:2]) == tuple(python.initial_outputs(*walk[0][:2]))
-    seen = {"moved": 0, "capped": 0, "passive": 0, "deepest": 0, "load warnings": 0}
+    seen = {"moved": 0, "capped": 0, "passive": 0, "deepest": 0, "load warnings": 0,
+            "anticipated": 0}
     restart = rng.randrange(STEPS // 3, 2 * STEPS // 3)
     others = []
     for index, sample in enumerate(walk):
@@ -70,6 +72,7 @@ def test_the_shaped_c_compensator_equals_the_python_one(lib, params, seed, inver
         seen["passive"] += outputs[0] == 0.0 and sample[0] > 0.0
         seen["deepest"] = max(seen["deepest"], len(python._shaper.model.reversals))
         seen["load warnings"] += bool(python.warning and "load" in python.warning)
+        seen["anticipated"] += bool(lead) and python._anticipation.held is not None
         if index % 97 == 0:
             assert same_doubles(c.state(), doubles_of(python.state())), index
         if index == restart:
@@ -85,6 +88,7 @@ def test_the_shaped_c_compensator_equals_the_python_one(lib, params, seed, inver
     print(f"seed {seed} {inverse} cap {cap}: {seen}")
     assert seen["moved"] > 0 and seen["passive"] > 0 and seen["load warnings"] > 0
     assert cap is None or seen["capped"] > 0
+    assert (seen["anticipated"] > 0) == (lead > 0)
     if inverse == "minor-loop":   # a small memory fills; the model's stack is shallower
         assert seen["deepest"] == depth if depth <= 6 else seen["deepest"] > 2
 

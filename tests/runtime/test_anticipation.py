@@ -54,6 +54,22 @@ def test_no_anticipation_at_the_upper_turn_nor_on_ramps():
     assert [block.step(r, H) for r in ramp] == ramp      # a kink, no curvature before it
 
 
+def test_steps_and_jumps_are_not_turns():
+    """A step down, and a cosine that jumps down where it turns (a stroke reference mapped
+    onto the other branch there), give three samples with -R'/R'' = h/2: no parabola. The
+    aims stay inside the samples' range (a parabola through a 0.4-ohm jump aims thousands
+    of ohms away) and a step is passed through as it is."""
+    block = TurnAnticipation(0.15)
+    step = [50.0] * 100 + [45.0] * 100
+    assert [block.step(r, H) for r in step] == step
+    times = np.arange(0.5, 1.5, H)
+    jumped = _cosine(times) - 0.4 * (times > 1.0)         # the turn at t = 1 s, then 0.4 ohm down
+    block = TurnAnticipation(0.15)
+    aims = np.array([block.step(float(r), H) for r in jumped])
+    assert np.any(aims != jumped)                        # the smooth descent is anticipated
+    assert jumped.min() <= aims.min() and aims.max() <= jumped.max()
+
+
 def test_after_the_turn_the_aim_is_held_until_the_reference_catches_up():
     """No step back after the turn: the aims never fall from the start of the window on, so
     the compensator never reads the exit as heating."""

@@ -37,10 +37,12 @@ void *params_new(const double *values, char *error) {
 void params_free(void *p) { free(p); }
 
 void *ff_new(const void *params, double alpha, double beta, double model_load, int adapt,
-             const char *inverse, const char *shaping, double power_cap, char *error) {
+             const char *inverse, const char *shaping, double power_cap, double lead,
+             char *error) {
     SmaMessage m; FeedforwardStepper *s = malloc(sizeof *s);
     if (feedforward_stepper_init(s, params, alpha, beta, model_load, adapt, inverse, shaping,
-                                 power_cap, &m)) {
+                                 power_cap, &m)
+        || feedforward_stepper_set_anticipation(s, lead, &m)) {
         copy_error(error, &m); feedforward_stepper_free(s); free(s); return NULL;
     }
     return s;
@@ -91,7 +93,7 @@ D, P, I, S, C = (ctypes.c_double, ctypes.c_void_p, ctypes.c_int, ctypes.c_size_t
 DP, IP = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int)
 SIGNATURES = {
     "params_new": (P, [DP, C]), "params_free": (None, [P]),
-    "ff_new": (P, [P, D, D, D, I, C, C, D, C]), "ff_free": (None, [P]),
+    "ff_new": (P, [P, D, D, D, I, C, C, D, D, C]), "ff_free": (None, [P]),
     "ff_step": (I, [P, D, D, D, DP, IP, C, C]), "ff_initial": (I, [P, D, D, DP, IP, C]),
     "ff_state_size": (S, [P]), "ff_state_write": (None, [P, DP]),
     "ff_state_read": (I, [P, DP, S, C]), "band": (I, [P, D, DP, C]),
@@ -120,7 +122,8 @@ class CStepper(StateDoubles):
     STATE_CALLS = ("ff_state_size", "ff_state_write", "ff_state_read")
 
     def __init__(self, lib, cparams, params, alpha=None, beta=None, model_load=None,
-                 adapt_to_load=True, inverse="major", shaping="none", power_cap=None):
+                 adapt_to_load=True, inverse="major", shaping="none", power_cap=None,
+                 anticipation=0.0):
         self.lib, self.cparams = lib, cparams   # cparams outlives the stepper
         error = ctypes.create_string_buffer(512)
         self.pointer = lib.ff_new(
@@ -129,7 +132,7 @@ class CStepper(StateDoubles):
             params.model_load if model_load is None else model_load, int(adapt_to_load),
             None if inverse is None else inverse.encode(),
             None if shaping is None else shaping.encode(),
-            math.nan if power_cap is None else power_cap, error)
+            math.nan if power_cap is None else power_cap, anticipation, error)
         if not self.pointer:
             raise ValueError(error.value.decode())
         self._out, self._saturated = (ctypes.c_double * 2)(), ctypes.c_int()
@@ -159,8 +162,9 @@ class CStepper(StateDoubles):
 
 
 def doubles_of(state):
-    """Python's state() dict in the C layout (feedforward.h): None as NaN; a shaped
-    compensator's model wire after its own doubles (plant.h's layout)."""
+    """Python's state() dict in the C layout (feedforward.h): None as NaN; the
+    anticipation's three after its own doubles; a shaped compensator's model wire after
+    them (plant.h's layout)."""
     def number(value):
         return math.nan if value is None else float(value)
     own = with_reversals([
@@ -168,6 +172,8 @@ def doubles_of(state):
         number(state["previous_temperature"]), number(state["previous_fraction"]),
         number(state["filter"]["previous_input"]), number(state["filter"]["previous_output"])],
         state["reversals"])
+    if "anticipation" in state:
+        own += [number(state["anticipation"][key]) for key in ("earlier", "previous", "held")]
     if "model" not in state:
         return own
     model = state["model"]

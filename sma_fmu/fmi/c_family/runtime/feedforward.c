@@ -108,7 +108,8 @@ static double anticipated_aim(const FeedforwardStepper *self, double reference,
     if (earlier == earlier) {
         slope = (reference - earlier) / (2.0 * step_size);
         curvature = (reference - 2.0 * previous + earlier) / (step_size * step_size);
-        if (slope < 0.0 && 0.0 < curvature && -slope < curvature * lead) {
+        if (slope < 0.0 && 0.0 < curvature && step_size * curvature <= -slope
+            && -slope < curvature * lead) {
             aim = reference + slope * lead + 0.5 * curvature * lead * lead;
         }
     }
