@@ -14,10 +14,12 @@ to measure it, a third of a comparison's time): the run figure's margins are fix
 values ``tight_layout`` found for every shipped scenario: its labels and legends are the
 same text for each run); the comparison's are too, but for its right margin, which makes
 room for the widest of its outside legends (they hold the runs' names), measured alone
-(:func:`_legend_margin`). **The run figure is made once** (one for runs with the
-feedforward's lines, one without) and drawn again for each run with its data: making the
-axes and their ticks was half of its time, and a kept figure draws the same PNG bytes as
-a new one. The comparison's axes are kept too, emptied of the last comparison's artists.
+(:func:`_legend_margin`). **The run figure is made once** (for runs with the
+feedforward's lines and without: a run without them leaves those lines empty and out of
+the legends) and drawn again for each run with its data: making the axes and their ticks
+was half of its time, a second kind's first drawing (its ticks made, its texts measured)
+a third more than its later ones, and a kept figure draws the same PNG bytes as a new
+one. The comparison's axes are kept too, emptied of the last comparison's artists.
 Each thread keeps figures of its own. **A kept figure keeps its Agg canvas, at the PNG's
 dpi**: savefig otherwise makes a new canvas and renderer for each PNG, and matplotlib's
 cache of text sizes is per renderer, so every figure measured its texts again (the same
@@ -43,6 +45,7 @@ _DPI = 110           # [dots per inch] the PNGs' resolution: 1100 px a 10-inch f
 # zlib level 1 instead of Pillow's 6: a figure's PNG 35 % faster to write, 5 % larger
 _PNG = {"compress_level": 1}
 
+_FEEDFORWARD_LINES = ("T_ref", "P_ff")   # the run figure's lines of the feedforward only
 _COLOURS = {"pi": "tab:red", "pi+ff-fixed": "tab:orange", "pi+ff-adaptive": "tab:green"}
 _EXTRA_COLOURS = ("tab:blue", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
 
@@ -126,10 +129,10 @@ def _mark(axis, data, metrics_start, label=False):
 class _RunFigure:
     """The run figure's axes and lines, made once and drawn again for each run with its
     data (:func:`plot_run`): making the axes and their ticks was half of a figure's time.
-    One per kind (with or without the feedforward's lines, T_ref and P_ff; with or without a
-    stroke reference's curve, its panel taller)."""
+    One per kind (with or without a stroke reference's curve, its panel taller); a run
+    without a feedforward leaves its lines (T_ref, P_ff) empty and out of the legends."""
 
-    def __init__(self, feedforward, stroke_reference=False):
+    def __init__(self, stroke_reference=False):
         self.figure = _agg_figure(figsize=(10, 10))
         self.axes = self.figure.subplots(4, 1, sharex=True, gridspec_kw={
             "height_ratios": [3, 2, 2, 2.6 if stroke_reference else 1.4]})
@@ -150,8 +153,6 @@ class _RunFigure:
             "stroke": (self.stroke, dict(color="tab:green", label="stroke x_0 - x", **thin), False)}
         if not stroke_reference:
             del self.lines["stroke_reference"]
-        if not feedforward:
-            del self.lines["T_ref"], self.lines["P_ff"]
         self.lines = {name: (axis.plot([], [], **style)[0], early)
                       for name, (axis, style, early) in self.lines.items()}
         self.room = temperature.axhline(0.0, color="tab:blue", lw=0.8, ls="-.", label="T_room")
@@ -170,7 +171,14 @@ class _RunFigure:
         """Draw the run ``data`` of ``scenario`` and write the PNG at ``path``."""
         resistance, temperature, power, load = self.axes
         t = data["t"]
+        feedforward = bool(scenario.controller.feedforward)
         for name, (line, early) in self.lines.items():
+            if name in _FEEDFORWARD_LINES:   # without a feedforward: empty, out of legends ("_")
+                label = line.get_label().lstrip("_")
+                line.set_label(label if feedforward else f"_{label}")
+                if not feedforward:
+                    line.set_data([], [])
+                    continue
             if name == "stroke_reference":
                 values = 1e3 * np.array([scenario.reference.stroke(time) for time in t.tolist()])
             else:
@@ -214,10 +222,9 @@ def plot_run(data, scenario, path):
     """Resistance, temperature, power (total, feedforward, feedback), load and stroke (with a
     stroke reference's curve, its panel taller); PNG at ``path``. The figure is kept for the
     next run of the same kind (:class:`_RunFigure`)."""
-    feedforward = bool(scenario.controller.feedforward)
     stroke_reference = getattr(scenario.reference, "quantity", None) == "stroke"
-    _kept(f"run_{feedforward}" + ("_stroke" if stroke_reference else ""),
-          lambda: _RunFigure(feedforward, stroke_reference)).draw(data, scenario, path)
+    _kept("run" + ("_stroke" if stroke_reference else ""),
+          lambda: _RunFigure(stroke_reference)).draw(data, scenario, path)
 
 
 def rolling_rms(values, window):
