@@ -14,11 +14,16 @@ to measure it, a third of a comparison's time): the run figure's margins are fix
 values ``tight_layout`` found for every shipped scenario: its labels and legends are the
 same text for each run); the comparison's are too, but for its right margin, which makes
 room for the widest of its outside legends (they hold the runs' names), measured alone
-(:func:`_legend_margin`). **The run figure is made once** (one for runs with the
-feedforward's lines, one without) and drawn again for each run with its data: making the
-axes and their ticks was half of its time, and a kept figure draws the same PNG bytes as
-a new one. The comparison's axes are kept too, emptied of the last comparison's artists.
-Each thread keeps figures of its own.
+(:func:`_legend_margin`). **The run figure is made once** (for runs with the
+feedforward's lines and without: a run without them leaves those lines empty and out of
+the legends) and drawn again for each run with its data: making the axes and their ticks
+was half of its time, a second kind's first drawing (its ticks made, its texts measured)
+a third more than its later ones, and a kept figure draws the same PNG bytes as a new
+one. The comparison's axes are kept too, emptied of the last comparison's artists.
+Each thread keeps figures of its own. **A kept figure keeps its Agg canvas, at the PNG's
+dpi**: savefig otherwise makes a new canvas and renderer for each PNG, and matplotlib's
+cache of text sizes is per renderer, so every figure measured its texts again (the same
+tick labels and legend entries each run): 15 % of a figure's time.
 """
 import threading
 
@@ -36,9 +41,11 @@ _RUN_MARGINS = {"left": 0.08, "right": 0.782, "top": 0.964, "bottom": 0.059, "hs
 _COMPARISON_MARGINS = {"left": 0.063, "right": 0.817, "top": 0.964, "bottom": 0.059,
                        "wspace": 0.18, "hspace": 0.321}
 _LEGEND_PAD = 1.08   # [font sizes] beside an outside legend, tight_layout's pad
+_DPI = 110           # [dots per inch] the PNGs' resolution: 1100 px a 10-inch figure
 # zlib level 1 instead of Pillow's 6: a figure's PNG 35 % faster to write, 5 % larger
 _PNG = {"compress_level": 1}
 
+_FEEDFORWARD_LINES = ("T_ref", "P_ff")   # the run figure's lines of the feedforward only
 _COLOURS = {"pi": "tab:red", "pi+ff-fixed": "tab:orange", "pi+ff-adaptive": "tab:green"}
 _EXTRA_COLOURS = ("tab:blue", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan")
 
@@ -67,6 +74,21 @@ def envelope(x, y, spans=ENVELOPE_SPANS):
     rows = np.arange(spans)[:, None]
     return (np.concatenate([xs[rows, order].ravel(), x[whole:]]),
             np.concatenate([ys[rows, order].ravel(), y[whole:]]))
+
+
+def _agg_figure(figsize):
+    """A :class:`Figure` of ``figsize`` [inches] at the PNGs' dpi, on an Agg canvas of its
+    own: savefig draws on that canvas and keeps its renderer, and with it matplotlib's
+    cache of text sizes, from one PNG to the next."""
+    figure = Figure(figsize=figsize, dpi=_DPI)
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _agg_canvas(figure):
+    """``figure``'s Agg canvas (one made for it if it has none)."""
+    canvas = figure.canvas
+    return canvas if isinstance(canvas, FigureCanvasAgg) else FigureCanvasAgg(figure)
 
 
 def _line(axis, x, y, **style):
@@ -107,11 +129,11 @@ def _mark(axis, data, metrics_start, label=False):
 class _RunFigure:
     """The run figure's axes and lines, made once and drawn again for each run with its
     data (:func:`plot_run`): making the axes and their ticks was half of a figure's time.
-    One per kind (with or without the feedforward's lines, T_ref and P_ff; with or without a
-    stroke reference's curve, its panel taller)."""
+    One per kind (with or without a stroke reference's curve, its panel taller); a run
+    without a feedforward leaves its lines (T_ref, P_ff) empty and out of the legends."""
 
-    def __init__(self, feedforward, stroke_reference=False):
-        self.figure = Figure(figsize=(10, 10))
+    def __init__(self, stroke_reference=False):
+        self.figure = _agg_figure(figsize=(10, 10))
         self.axes = self.figure.subplots(4, 1, sharex=True, gridspec_kw={
             "height_ratios": [3, 2, 2, 2.6 if stroke_reference else 1.4]})
         resistance, temperature, power, load = self.axes
@@ -131,8 +153,6 @@ class _RunFigure:
             "stroke": (self.stroke, dict(color="tab:green", label="stroke x_0 - x", **thin), False)}
         if not stroke_reference:
             del self.lines["stroke_reference"]
-        if not feedforward:
-            del self.lines["T_ref"], self.lines["P_ff"]
         self.lines = {name: (axis.plot([], [], **style)[0], early)
                       for name, (axis, style, early) in self.lines.items()}
         self.room = temperature.axhline(0.0, color="tab:blue", lw=0.8, ls="-.", label="T_room")
@@ -151,7 +171,14 @@ class _RunFigure:
         """Draw the run ``data`` of ``scenario`` and write the PNG at ``path``."""
         resistance, temperature, power, load = self.axes
         t = data["t"]
+        feedforward = bool(scenario.controller.feedforward)
         for name, (line, early) in self.lines.items():
+            if name in _FEEDFORWARD_LINES:   # without a feedforward: empty, out of legends ("_")
+                label = line.get_label().lstrip("_")
+                line.set_label(label if feedforward else f"_{label}")
+                if not feedforward:
+                    line.set_data([], [])
+                    continue
             if name == "stroke_reference":
                 values = 1e3 * np.array([scenario.reference.stroke(time) for time in t.tolist()])
             else:
@@ -176,7 +203,7 @@ class _RunFigure:
                     bbox_to_anchor=(1.08, 1.0), fontsize=8, borderaxespad=0)
         _title(resistance, f"{scenario.name}: {scenario.controller.kind}, "
                            f"{scenario.hysteresis_mode} hysteresis")
-        self.figure.savefig(path, dpi=110, pil_kwargs=_PNG)
+        self.figure.savefig(path, dpi=_DPI, pil_kwargs=_PNG)
 
 
 _KEPT = threading.local()   # each thread's kept figures: one figure is never drawn by two at once
@@ -195,10 +222,9 @@ def plot_run(data, scenario, path):
     """Resistance, temperature, power (total, feedforward, feedback), load and stroke (with a
     stroke reference's curve, its panel taller); PNG at ``path``. The figure is kept for the
     next run of the same kind (:class:`_RunFigure`)."""
-    feedforward = bool(scenario.controller.feedforward)
     stroke_reference = getattr(scenario.reference, "quantity", None) == "stroke"
-    _kept(f"run_{feedforward}" + ("_stroke" if stroke_reference else ""),
-          lambda: _RunFigure(feedforward, stroke_reference)).draw(data, scenario, path)
+    _kept("run" + ("_stroke" if stroke_reference else ""),
+          lambda: _RunFigure(stroke_reference)).draw(data, scenario, path)
 
 
 def rolling_rms(values, window):
@@ -223,7 +249,7 @@ def _legend_margin(figure, legends, left, widest):
     """The right margin (a fraction of the figure) that leaves room for ``legends``, placed
     just outside their axes' right edge (``bbox_to_anchor`` (1.01, 1)): ``widest`` at most.
     Measures the legends alone, not the figure."""
-    renderer = FigureCanvasAgg(figure).get_renderer()   # the canvas savefig draws PNGs on
+    renderer = _agg_canvas(figure).get_renderer()   # the canvas savefig draws PNGs on
     width = figure.bbox.width
     room = max(legend.get_window_extent(renderer).width for legend in legends)
     pad = _LEGEND_PAD * legends[0].prop.get_size_in_points() * figure.dpi / 72.0
@@ -233,7 +259,7 @@ def _legend_margin(figure, legends, left, widest):
 
 def _new_comparison_axes():
     """(figure, its four axes: overview, zoomed, zoomed error, RMS) for a comparison."""
-    figure = Figure(figsize=(12, 10))
+    figure = _agg_figure(figsize=(12, 10))
     grid = figure.add_gridspec(3, 2, height_ratios=[1.1, 1.2, 1.0])
     overview = figure.add_subplot(grid[0, :])
     zoomed = figure.add_subplot(grid[1, 0])
@@ -308,4 +334,4 @@ def plot_comparison(runs, scenario, title, path):
     margins = dict(_COMPARISON_MARGINS)
     margins["right"] = _legend_margin(figure, outside, margins["left"], margins["right"])
     figure.subplots_adjust(**margins)
-    figure.savefig(path, dpi=110, pil_kwargs=_PNG)
+    figure.savefig(path, dpi=_DPI, pil_kwargs=_PNG)

@@ -24,13 +24,14 @@ def _run(name, stop_time_s):
 
 def test_a_kept_run_figure_draws_each_run_as_a_new_figure(tmp_path):
     """The same PNG bytes, whatever the kept figure drew before (other limits, load
-    changes, metrics window, feedforward lines, room temperature)."""
+    changes, metrics window, room temperature, a run with the feedforward's lines before
+    one without them and after it)."""
     runs = [_run("load-step-pi+ff-adaptive", 12.0), _run("heavy-pi", 4.0),
             _run("heavy-pi+ff-fixed", 1.5), _run("load-step-pi+ff-adaptive", 21.0)]
     vars(plots._KEPT).clear()
     for index, (data, scenario) in enumerate(runs):
         plots.plot_run(data, scenario, tmp_path / f"kept-{index}.png")
-    assert sorted(vars(plots._KEPT)) == ["run_False", "run_True"]   # with the feedforward's lines, without
+    assert sorted(vars(plots._KEPT)) == ["run"]   # one figure, with the feedforward's lines or without
     for index, (data, scenario) in enumerate(runs):
         vars(plots._KEPT).clear()
         plots.plot_run(data, scenario, tmp_path / f"new-{index}.png")
@@ -78,15 +79,33 @@ def test_each_thread_keeps_figures_of_its_own(tmp_path):
 
     data, scenario = _run("heavy-pi", 2.0)
     plots.plot_run(data, scenario, tmp_path / "here.png")
-    mine = plots._KEPT.run_False
+    mine = plots._KEPT.run
     theirs = []
 
     def draw():
         plots.plot_run(data, scenario, tmp_path / "there.png")
-        theirs.append(plots._KEPT.run_False)
+        theirs.append(plots._KEPT.run)
 
     thread = threading.Thread(target=draw)
     thread.start()
     thread.join()
-    assert theirs and theirs[0] is not mine and plots._KEPT.run_False is mine
+    assert theirs and theirs[0] is not mine and plots._KEPT.run is mine
     assert (tmp_path / "here.png").read_bytes() == (tmp_path / "there.png").read_bytes()
+
+
+def test_the_feedforward_lines_show_only_for_a_run_with_a_feedforward(tmp_path):
+    """One kept figure draws runs with and without a feedforward: T_ref and P_ff are drawn
+    and in the legends for the one, empty and out of the legends for the other."""
+    vars(plots._KEPT).clear()
+    runs = (("heavy-pi+ff-fixed", True), ("heavy-pi", False), ("heavy-pi+ff-fixed", True))
+    for name, feedforward in runs:
+        data, scenario = _run(name, 2.0)
+        plots.plot_run(data, scenario, tmp_path / f"{name}.png")
+        axes = plots._KEPT.run.axes
+        legends = {text.get_text() for axis in axes for text in axis.get_legend().get_texts()}
+        for label in ("T_ref (inverse model)", "P_ff (feedforward)"):
+            assert (label in legends) == feedforward, (name, label)
+            line = next(line for axis in axes for line in axis.lines
+                        if line.get_label().lstrip("_") == label)
+            assert (len(line.get_xdata()) > 0) == feedforward, (name, label)
+        assert {"R", "T (wire)", "P applied", "P_fb (PI feedback)", "load"} <= legends
