@@ -28,11 +28,11 @@ CASES = {
     "paper": ("major inverse + phase-lag filter (paper)", "load-step-bench-pi+ff-adaptive", None),
     "minor_loop": ("minor-loop inverse + phase-lag filter",
                    "load-step-continuous-bench-pi+ff-adaptive-minor-loop", None),
-    "shaped": ("shaped, major inverse, no anticipation",
+    "shaped": ("shaped (major inverse), no anticipation",
                "load-step-bench-pi+ff-adaptive-reachable", 0.0),
-    "anticipating": ("shaped, major inverse, anticipation 0.15 s",
+    "anticipating": ("shaped (major), anticipation 0.15 s",
                      "load-step-bench-pi+ff-adaptive-reachable", None),
-    "anticipating_minor": ("shaped, minor-loop inverse, anticipation 0.15 s",
+    "anticipating_minor": ("shaped (minor-loop), anticipation 0.15 s",
                            "load-step-continuous-bench-pi+ff-adaptive-reachable", None)}
 START_S = 8.0     # the samples start here [s] ...
 STEPS = 4000      # ... and run this many steps (8-12 s: the load steps at 10 s)

@@ -8,13 +8,10 @@ include path (a timing program's shared header), into a cache folder under a key
 input, so each is compiled once per source and compiler.
 """
 import hashlib
-import os
-import shlex
-import subprocess
 import tempfile
 from pathlib import Path
 
-from sma_fmu.fmi.hosts import CHostError, c_compiler
+from sma_fmu.fmi.hosts import build_once, c_compiler
 from sma_fmu.fmi.packaging.parameter_table import generated_folder
 
 __all__ = ["RUNTIME", "runtime_program"]
@@ -31,26 +28,14 @@ def runtime_program(source, cache=None, headers=()):
     source = Path(source)
     compiler, generated = c_compiler(), generated_folder()
     inputs = [source, *(source.parent / name for name in headers),
-              *sorted(RUNTIME.glob("*.[ch]")), *sorted(generated.iterdir())]
+              *sorted(RUNTIME.glob("*.[ch]")),
+              *sorted(p for p in generated.iterdir() if not p.name.startswith("."))]
     digest = hashlib.sha256("\0".join([*compiler, *_FLAGS]).encode())
     for path in inputs:
         digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
-    folder = Path(cache or tempfile.gettempdir()) / f"sma-fmu-{source.stem}-{digest.hexdigest()[:12]}"
-    executable = folder / source.stem
-    if executable.is_file():
-        return executable
-    folder.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=folder) as stage:
-        built = Path(stage) / source.stem
-        command = [*compiler, *_FLAGS, f"-I{source.parent}", f"-I{RUNTIME}", f"-I{generated}",
-                   "-o", str(built), str(source), *map(str, sorted(RUNTIME.glob("*.c"))), "-lm"]
-        try:
-            result = subprocess.run(command, capture_output=True, text=True, timeout=600)
-        except (OSError, subprocess.SubprocessError) as error:
-            raise CHostError(f"C compiler {shlex.join(compiler)!r} could not run to build "
-                             f"{source.name} ({error}): install gcc or set CC") from None
-        if result.returncode != 0:
-            raise CHostError(f"C compiler {shlex.join(compiler)!r} could not build "
-                             f"{source.name}: {result.stderr.strip()}")
-        os.replace(built, executable)   # atomic: a parallel build never sees half a file
-    return executable
+    executable = (Path(cache or tempfile.gettempdir())
+                  / f"sma-fmu-{source.stem}-{digest.hexdigest()[:12]}" / source.stem)
+    return build_once(executable, lambda built: [
+        *compiler, *_FLAGS, f"-I{source.parent}", f"-I{RUNTIME}", f"-I{generated}", "-o",
+        str(built), str(source), *map(str, sorted(RUNTIME.glob("*.c"))), "-lm"], compiler,
+        timeout=600)
