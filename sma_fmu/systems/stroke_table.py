@@ -61,11 +61,14 @@ def stroke_table_input(scenario):
     numbers = [math.nan if getattr(params, spec.name) is None else float(getattr(params, spec.name))
                for spec in PARAMETER_SPECS]
     numbers += [reference.map.start_length, list(REFERENCE_KINDS).index(signal.kind)]
-    settings = signal._s   # the settings under the kinds' own keys (in mm)
+    def setting(key):   # the kinds' own keys (..._ohm) in the signal's unit (..._mm)
+        unit_key = key[:-3] + signal.unit if key.endswith("_ohm") else key
+        return signal.settings.get(unit_key, 0.0)   # phase_deg: 0 unless given
+
     if signal.kind == "table":
-        numbers += _array(settings["times_s"]) + _array(settings["values_ohm"])
+        numbers += _array(setting("times_s")) + _array(setting("values_ohm"))
     else:
-        numbers += [settings.get(key, 0.0) for key in _SETTINGS[signal.kind]]
+        numbers += [setting(key) for key in _SETTINGS[signal.kind]]
     numbers += _array(load.times) + _array(load.values) + [scenario.step_s, scenario.steps]
     return " ".join(map(repr, map(float, numbers)))
 
