@@ -7,6 +7,8 @@ cost per step, and the C master against the library on the bench scenarios.
   PI without and with its sensor (the SmaPiController FMU's step), the linear driver under a
   current limit, the PWM driver without and with a limited on-power. CPU time, the median of
   the passes: on a shared machine it counts this process's work only.
+- The feedforward compensators' cost per step, Python and C: the paper's beside the minor-loop
+  inverse and the shaped one with and without anticipation (:mod:`.compensator`).
 - :data:`SCENARIOS` through the C master over the native FMUs against the library path,
   recording included (:func:`~sma_fmu.bench.c_master.c_master_times`), against the C
   master's target (0.25).
@@ -19,6 +21,7 @@ from importlib import resources
 from pathlib import Path
 
 from sma_fmu.bench.c_master import TARGET, c_master_times
+from sma_fmu.bench.compensator import CASES, compensator_costs
 from sma_fmu.bench.inverse import timing_program
 from sma_fmu.runtime.drive_limit import DriveLimit, LinearDriver
 from sma_fmu.runtime.measurement import ResistanceSensor, SensedPIController
@@ -100,14 +103,16 @@ def run_hardware_bench(out_dir, runs=5, native_dir=None, progress=print):
     with staged_folder(out_dir) as stage, tempfile.TemporaryDirectory() as work:
         progress("each block per step, Python and C ...")
         costs = {"python_ns": python_costs(max(runs, 3)), "c_ns": c_costs(work, max(runs, 3))}
+        progress("the compensators per step, Python and C ...")
+        compensators = compensator_costs(work, max(runs, 3))
         if native_dir is None:
             from sma_fmu.fmi.packaging.c_family_build import build_native_fmus
             progress("building the native FMUs ...")
             native_dir = Path(build_native_fmus(stage / "native-fmus")["SmaActuator"]).parent
         progress(f"C master against the library on the bench scenarios ({runs} alternating runs) ...")
         times = c_master_times(native_dir, runs, Path(work) / "runs", SCENARIOS, ("parquet",))
-        results = {"hardware": {"per_step": costs, "c_master": times, "target": TARGET,
-                                "steps_per_pass": STEPS}}
+        results = {"hardware": {"per_step": costs, "compensator_per_step": compensators,
+                                "c_master": times, "target": TARGET, "steps_per_pass": STEPS}}
         (stage / "benchmark.json").write_text(json_text(results), encoding="utf-8")
     return results
 
@@ -118,6 +123,11 @@ def hardware_lines(results):
     python, c = section["per_step"]["python_ns"], section["per_step"]["c_ns"]
     lines = [f"{'block, per step [CPU ns]':<46}{'Python':>10}{'C':>10}"]
     lines += [f"{text:<46}{python[name]:>10.1f}{c[name]:>10.2f}" for name, text in BLOCKS.items()]
+    compensators = section.get("compensator_per_step")
+    if compensators:
+        lines += ["", f"{'compensator, per step [CPU ns]':<46}{'Python':>10}{'C':>10}"]
+        lines += [f"{CASES[case][0]:<46}{row['python_ns']:>10.1f}{row['c_ns']:>10.2f}"
+                  for case, row in compensators.items()]
     lines += ["", "C master (--master c) / library on the bench scenarios, recording included"]
     for name, row in section["c_master"].items():
         verdict = "meets" if row["ratio"] <= section["target"] else "MISSES"

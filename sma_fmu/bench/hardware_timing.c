@@ -8,22 +8,14 @@
  * compiler from dropping the work). A refusal prints it on stderr, exit 1.
  */
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
-#include <stdio.h>
-#include <time.h>
+#define TIMING_PROGRAM "hardware_timing"
+#include "timing_input.h"
 
 #include "drive_limit.h"
 #include "measurement.h"
 #include "noise.h"
 #include "pi_control.h"
 #include "pwm.h"
-
-/* This process's CPU time [s] (the machine may be shared). */
-static double seconds_now(void)
-{
-    struct timespec now;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
-    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
-}
 
 static double wire(long k)   /* a resistance that moves a little every step [ohm] */
 {

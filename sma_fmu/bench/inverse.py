@@ -22,7 +22,6 @@ import statistics
 import subprocess
 import tempfile
 import time
-from importlib import resources
 from pathlib import Path
 
 from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
@@ -72,23 +71,11 @@ def python_inverse_ns(constants, targets, margin, passes):
 
 
 def timing_program(folder, name="inverse_timing"):
-    """Compile the bench's ``<name>.c`` with the C runtime's sources into ``folder``; its path."""
-    from sma_fmu.fmi.hosts import c_compiler
-    from sma_fmu.fmi.packaging.parameter_table import generated_folder
-    import sma_fmu.fmi.c_family as c_family
-    runtime = Path(c_family.__file__).parent / "runtime"
-    sources = [str(path) for path in sorted(runtime.glob("*.c"))]
-    program = Path(folder) / name
-    source = Path(folder) / f"{name}.c"
-    source.write_bytes((resources.files("sma_fmu.bench") / f"{name}.c").read_bytes())
-    shared = Path(folder) / "timing_input.h"   # what the timing programs share
-    shared.write_bytes((resources.files("sma_fmu.bench") / "timing_input.h").read_bytes())
-    command = [*c_compiler(), "-std=c99", "-O2", "-ffp-contract=off", f"-I{runtime}",
-               f"-I{generated_folder()}", "-o", str(program), str(source), *sources, "-lm"]
-    result = subprocess.run(command, capture_output=True, text=True)
-    if result.returncode != 0:
-        raise RuntimeError(f"the timing program {name} did not compile:\n{result.stderr}")
-    return program
+    """The bench's ``<name>.c`` compiled with the C runtime's sources (and the timing programs'
+    shared header), kept in ``folder``; its path."""
+    from sma_fmu.fmi.packaging.runtime_program import runtime_program
+
+    return runtime_program(Path(__file__).parent / f"{name}.c", folder, ("timing_input.h",))
 
 
 def c_inverse_ns(program, params, load, direction, targets, passes=C_PASSES):

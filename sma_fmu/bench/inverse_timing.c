@@ -11,45 +11,25 @@
  */
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
 #define TIMING_PROGRAM "inverse_timing"
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
-
 #include "timing_input.h"
 
 #include "constant_load.h"
-#include "parameters.h"
 #include "sensing.h"
 
 int main(void)
 {
-    static double values[PARAM_COUNT];
     WireParameters params;
     BranchConstants constants;
     SensedTemperature sensed;
     SmaMessage message;
     double load, direction, passes, count, *targets, start, sum;
-    long i, pass, k;
-    for (i = 0; i < PARAM_COUNT; i++) {
-        if (read_double(&values[i])) {
-            return 1;
-        }
-    }
-    if (read_double(&load) || read_double(&direction) || read_double(&passes)
-        || read_double(&count) || count < 1.0 || count > 1e7) {
+    long pass, k;
+    if (read_wire(&params) || read_double(&load) || read_double(&direction)
+        || read_double(&passes) || read_double(&count) || count < 1.0 || count > 1e7
+        || read_doubles(2 * (long)count, &targets)) {
         return 1;
     }
-    targets = malloc(2 * (size_t)count * sizeof *targets);
-    if (targets == NULL) {
-        return 1;
-    }
-    for (k = 0; k < 2 * (long)count; k++) {
-        if (read_double(&targets[k])) {
-            return 1;
-        }
-    }
-    if (wire_parameters_from_values(&params, values, &message)
-        || branch_constants(load, direction > 0.0 ? 1 : -1, &params, &constants, &message)) {
+    if (branch_constants(load, direction > 0.0 ? 1 : -1, &params, &constants, &message)) {
         fprintf(stderr, "%s\n", message.text);
         return 1;
     }

@@ -10,14 +10,17 @@ costs per step in the Python runtime (:mod:`sma_fmu.runtime.stroke`).
   mapped R_ref given as a table (what the mapping adds to a whole run), wall time;
 - with native FMUs (``--fmus``): the same scenarios through the C master against the library
   path (:func:`~sma_fmu.bench.c_master.c_master_times`, recording included; the C master's
-  wall includes the master's mapping of the stroke into the signals FMU's table).
+  wall includes its mapping of the stroke into the signals FMU's table, done in C:
+  :mod:`sma_fmu.systems.stroke_table`).
 
 CPU time per step, the median of the passes (a shared machine's other work is not counted);
 the moving strokes in C too (``stroke_timing.c`` compiled with the C family's sources: the
-C runtime's stroke map, bit-equal to Python's).
+C runtime's stroke map, bit-equal to Python's), and the profile's R_ref(t) as the C master's
+stroke table computes it (the whole program's CPU per step).
 """
 import dataclasses
 import math
+import resource
 import shutil
 import statistics
 import subprocess
@@ -33,9 +36,10 @@ from sma_fmu.bench.inverse import timing_program
 from sma_fmu.runtime import stroke as stroke_module
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.stroke import StrokeMap, start_length
+from sma_fmu.systems.stroke_table import stroke_table_input, stroke_table_program
 from sma_fmu.wire.parameter_file import load_parameter_set
 
-__all__ = ["SCENARIOS", "STEPS", "map_costs", "c_map_ns", "c_map_costs", "scenario_walls",
+__all__ = ["SCENARIOS", "STEPS", "map_costs", "c_map_ns", "c_table_ns", "c_map_costs", "scenario_walls",
            "run_stroke_bench", "stroke_lines"]
 
 SCENARIOS = ("flexinol-stroke-load-step-pi+ff-adaptive", "flexinol-stroke-profile-pi+ff-adaptive")
@@ -102,14 +106,32 @@ def c_map_ns(program, stroke_map, load, direction, strokes, passes):
     return statistics.median(float(line.split()[0]) for line in result.stdout.splitlines())
 
 
+def c_table_ns(program, scenario, passes):
+    """Median CPU time [ns per step] of the C master's stroke table of ``scenario`` (``program``:
+    :func:`~sma_fmu.systems.stroke_table.stroke_table_program`): the whole process's CPU (its
+    start and reading its input included) over the run's steps."""
+    text, costs = stroke_table_input(scenario).encode("ascii"), []
+    for _ in range(passes):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([str(program)], input=text, capture_output=True, check=True)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        costs.append(cpu / (scenario.steps + 1) * 1e9)
+    return statistics.median(costs)
+
+
 def c_map_costs(passes):
-    """{case: C CPU ns per mapping} of the two moving-stroke cases of :func:`map_costs`."""
+    """{case: C CPU ns per mapping} of the two moving-stroke cases of :func:`map_costs` and
+    the 0.5 Hz profile's R_ref(t) as the C master maps it (:func:`c_table_ns`)."""
     reference = load_parameter_set().params
     flexinol = load_parameter_set(shipped_file("models", "flexinol_fit.toml")).params
     strokes = [7e-3 + 16e-3 * k / STEPS for k in range(STEPS)]
+    profile = load_scenario(shipped_file("scenarios", f"{SCENARIOS[1]}.toml"))
     with tempfile.TemporaryDirectory() as folder:
         program = timing_program(folder, "stroke_timing")
         return {
+            "R_ref(t) of the 0.5 Hz profile (trend + map)": c_table_ns(
+                stroke_table_program(folder), profile, passes),
             "moving stroke, reference wire (closed form)": c_map_ns(
                 program, StrokeMap(reference, start_length(reference, None, 0.05)), 0.05, 1,
                 [s - 2e-3 for s in strokes], passes),
@@ -187,7 +209,7 @@ def stroke_lines(results):
         lines.append(f"  {name:<48} {walls['stroke']:>7.2f} / {walls['mapped_beforehand']:.2f}")
     if "c_master" in results:
         lines.append("C master / library path, wall [s] (median, csv recorded; the C master's "
-                     "includes mapping the stroke)")
+                     "includes mapping the stroke, in C)")
         for name, times in results["c_master"].items():
             lines.append(f"  {name:<48} {times['c_s']:>7.2f} / {times['library_s']:.2f}  "
                          f"ratio {times['ratio']:.3f} ({times['min']:.3f}-{times['max']:.3f})")

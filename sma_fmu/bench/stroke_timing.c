@@ -11,45 +11,21 @@
  */
 #define _POSIX_C_SOURCE 199309L   /* clock_gettime under -std=c99 */
 #define TIMING_PROGRAM "stroke_timing"
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
-
 #include "timing_input.h"
 
-#include "parameters.h"
 #include "stroke.h"
 
 int main(void)
 {
-    static double values[PARAM_COUNT];
     static StrokeMap map;
     WireParameters params;
     StrokeTarget target;
     SmaMessage message;
     double start_length, load, direction, passes, count, *strokes, start, sum;
-    long i, pass, k;
-    for (i = 0; i < PARAM_COUNT; i++) {
-        if (read_double(&values[i])) {
-            return 1;
-        }
-    }
-    if (read_double(&start_length) || read_double(&load) || read_double(&direction)
-        || read_double(&passes) || read_double(&count)) {
-        return 1;
-    }
-    strokes = malloc(sizeof(double) * (size_t)count);
-    if (!strokes) {
-        fprintf(stderr, "stroke_timing: out of memory\n");
-        return 1;
-    }
-    for (k = 0; k < (long)count; k++) {
-        if (read_double(&strokes[k])) {
-            return 1;
-        }
-    }
-    if (wire_parameters_from_values(&params, values, &message)) {
-        fprintf(stderr, "stroke_timing: %s\n", message.text);
+    long pass, k;
+    if (read_wire(&params) || read_double(&start_length) || read_double(&load)
+        || read_double(&direction) || read_double(&passes) || read_double(&count)
+        || count < 1.0 || count > 1e7 || read_doubles((long)count, &strokes)) {
         return 1;
     }
     for (pass = 0; pass < (long)passes; pass++) {

@@ -47,7 +47,7 @@ from .plant import PlantStepper, branch_length
 from .sensing import temperature_of_fractions
 from .two_stage_root import ROOT_CAP, ROOT_TOLERANCE_K
 
-__all__ = ["StrokeTarget", "StrokeMap", "StrokeReference", "start_length"]
+__all__ = ["StrokeTarget", "StrokeMap", "StrokeReference", "step_table", "start_length"]
 
 StrokeTarget = namedtuple("StrokeTarget", ["R_ref", "stroke", "temperature", "clamped"])
 StrokeTarget.__doc__ = """Where the wire gives a stroke on a branch at one load.
@@ -56,6 +56,16 @@ R_ref : the resistance there [ohm]; stroke : the stroke it gives [m] (the asked 
 clamped); temperature : the branch's temperature there [degC]; clamped : the asked stroke
 lay beyond the reach at that load (see the module docstring).
 """
+
+
+def step_table(step_s, values):
+    """``values`` [ohm] at t_k = k ``step_s`` [s], k = 0, 1, ..., as a ``[reference]`` table:
+    the knots inside a run of equal values left out (a table interpolates them back)."""
+    last = len(values) - 1
+    kept = [k for k in range(last + 1)
+            if k in (0, last) or not values[k - 1] == values[k] == values[k + 1]]
+    return {"kind": "table", "times_s": [k * step_s for k in kept],
+            "values_ohm": [values[k] for k in kept]}
 
 
 def start_length(params, T_start, load):
@@ -176,12 +186,7 @@ class StrokeReference:
         ohm: what a signals source without a stroke map (the FMUs') is given. A table gives
         its knots exactly at those times, so it samples the same R_ref as this map; knots
         inside a run of equal values are left out (a held stroke and load: a few knots)."""
-        times = [k * step_s for k in range(steps + 1)]
-        values = [self.value(t) for t in times]
-        kept = [k for k in range(len(values))
-                if k in (0, steps) or not values[k - 1] == values[k] == values[k + 1]]
-        return {"kind": "table", "times_s": [times[k] for k in kept],
-                "values_ohm": [values[k] for k in kept]}
+        return step_table(step_s, [self.value(k * step_s) for k in range(steps + 1)])
 
     def stroke(self, t):
         """The stroke reference [m] at ``t`` [s]."""

@@ -22,7 +22,7 @@ def identifier(name):
     return text if text[:1].isalpha() else f"sma_{text}"
 
 
-def closed_loop(scenario, fmu_dir):
+def closed_loop(scenario, fmu_dir, reference_text=None):
     """The :class:`~sma_fmu.fmi.loop.system.LoopSystem` of ``scenario`` with the FMUs built in
-    ``fmu_dir``."""
-    return loop_system(scenario, default_fmu_paths(fmu_dir))
+    ``fmu_dir`` (``reference_text``: the signals' reference, when the caller made it)."""
+    return loop_system(scenario, default_fmu_paths(fmu_dir), reference_text=reference_text)

@@ -13,8 +13,9 @@ def test_the_stroke_bench_measures_every_case_and_counts_the_rounds():
 
 
 @needs("gcc")
-def test_the_stroke_bench_times_the_c_map_of_both_wires():
+def test_the_stroke_bench_times_the_c_map_of_both_wires_and_the_c_masters_table():
     costs = c_map_costs(1)
     assert set(costs) == {"moving stroke, reference wire (closed form)",
-                          "moving stroke, Flexinol fit (secant on T)"}
+                          "moving stroke, Flexinol fit (secant on T)",
+                          "R_ref(t) of the 0.5 Hz profile (trend + map)"}
     assert all(ns > 0.0 for ns in costs.values())

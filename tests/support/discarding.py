@@ -50,8 +50,8 @@ def discards(monkeypatch):
 
     settings = system.component_settings
 
-    def component_settings(scenario, name):
-        values = settings(scenario, name)
+    def component_settings(scenario, name, *rest):
+        values = settings(scenario, name, *rest)
         if name == "signals" and scenario.name == "discard":
             load = with_discard(scenario).load
             values = {**values, "load_profile": table_text(load.as_table())}

@@ -30,7 +30,7 @@ from sma_fmu.console.interrupts import run_child
 from sma_fmu.fmi.c_common import FMI_HEADERS, include_flags
 
 __all__ = ["CHostError", "HOST_PROGRAMS", "SHARED_HEADER", "PREBUILT_HOSTS", "c_compiler",
-           "windows_compiler", "compile_host", "prebuilt_host", "write_prebuilt_hosts"]
+           "windows_compiler", "compile_host", "build_once", "prebuilt_host", "write_prebuilt_hosts"]
 
 HOST_PROGRAMS = ("fmi_host", "cosim_host", "loop_host")
 SHARED_HEADER = "host_platform.h"   # loading a binary, the platform shim (fmi_host, loop_host)
@@ -98,26 +98,33 @@ def compile_host(name, cache=None, windows=False):
             return prebuilt
     link = _link_flags(name, windows)
     key = hashlib.sha256(_inputs(name) + "\0".join([*compiler, *_FLAGS, *link]).encode()).hexdigest()[:12]
-    folder = Path(cache or tempfile.gettempdir()) / f"sma-fmu-{name}-{key}"
-    executable = folder / (f"{name}.exe" if windows else name)
+    hint = "install gcc-mingw-w64-x86-64 or set SMA_FMU_WIN64_CC" if windows else "install gcc or set CC"
+    return build_once(
+        Path(cache or tempfile.gettempdir()) / f"sma-fmu-{name}-{key}" / (f"{name}.exe" if windows else name),
+        lambda built: [*compiler, *_FLAGS, *include_flags(HOSTS), "-o", str(built),
+                       str(HOSTS / f"{name}.c"), *link], compiler, hint)
+
+
+def build_once(executable, command, compiler, hint="install gcc or set CC", timeout=300):
+    """``executable`` (a Path in a folder named by a key of its inputs) if it exists, else
+    built by ``command(path)`` (the compiler's command line writing ``path``) into a stage
+    beside it and moved into place at once, so a parallel build never sees half a file.
+    Raises :class:`CHostError` naming ``compiler`` (with ``hint`` when it cannot run, the
+    compiler's message when it fails)."""
     if executable.is_file():
         return executable
-    folder.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=folder) as stage:
+    executable.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=executable.parent) as stage:
         built = Path(stage) / executable.name
-        command = [*compiler, *_FLAGS, *include_flags(HOSTS), "-o", str(built),
-                   str(HOSTS / f"{name}.c"), *link]
         try:
-            result = run_child(command, text=True, timeout=300)
+            result = run_child(command(built), text=True, timeout=timeout)
         except (OSError, subprocess.SubprocessError) as error:
-            hint = ("install gcc-mingw-w64-x86-64 or set SMA_FMU_WIN64_CC" if windows
-                    else "install gcc or set CC")
             raise CHostError(f"C compiler {shlex.join(compiler)!r} could not run to build "
-                             f"{name} ({error}): {hint}") from None
+                             f"{executable.stem} ({error}): {hint}") from None
         if result.returncode != 0:
-            raise CHostError(f"C compiler {shlex.join(compiler)!r} could not build {name}: "
-                             f"{result.stderr.strip()}")
-        os.replace(built, executable)  # atomic: a parallel build never sees half a file
+            raise CHostError(f"C compiler {shlex.join(compiler)!r} could not build "
+                             f"{executable.stem}: {result.stderr.strip()}")
+        os.replace(built, executable)
     return executable
 
 

@@ -118,7 +118,7 @@ def _built_wire(version):
     return built_wire(version[0])
 
 
-def _component(scenario, name, path, starts, sources):
+def _component(scenario, name, path, starts, sources, reference_text):
     variables, version = _read_fmu(_version(path))
     wire = wire_of(scenario, name)
     values = {}
@@ -128,16 +128,17 @@ def _component(scenario, name, path, starts, sources):
         if refused:
             raise mismatch_error(path, model, refused, sources[name].record(),
                                  _built_wire(_version(path)))
-    values.update(component_settings(scenario, name))
+    values.update(component_settings(scenario, name, reference_text))
     return Component(name, COMPONENT_MODELS[name], path, values, dict(variables), version,
                      starts.get(name, {}))
 
 
-def loop_system(scenario, fmu_files, only=None):
+def loop_system(scenario, fmu_files, only=None, reference_text=None):
     """The :class:`LoopSystem` of ``scenario`` with the FMU files ``fmu_files`` ({model:
     path}). ``only``: the names of the components to take (default: the whole loop); a
     master that runs the rest of the loop itself (the fmpy master: the PI and the signals)
-    gets those components and the connections and outputs among them."""
+    gets those components and the connections and outputs among them. ``reference_text``:
+    the signals' reference as the caller made it (see :func:`~.values.component_settings`)."""
     feedforward, driver = scenario.controller.feedforward, scenario.drive.driver
     names = [name for name in loop_components(feedforward, driver) if only is None or name in only]
     paths = built_fmus(fmu_files, [COMPONENT_MODELS[name] for name in names])
@@ -147,7 +148,8 @@ def loop_system(scenario, fmu_files, only=None):
     model = WireSource((scenario.compensator_parameter_set or scenario.parameter_set).path,
                        wire_digest(scenario.compensator_params))
     sources = {"plant": wire, "compensator": model}
-    components = tuple(_component(scenario, name, paths[COMPONENT_MODELS[name]], starts, sources)
+    components = tuple(_component(scenario, name, paths[COMPONENT_MODELS[name]], starts, sources,
+                                  reference_text)
                        for name in names)
     outputs = {column: source for column, source in loop_outputs(feedforward).items()
                if source[0] in names}

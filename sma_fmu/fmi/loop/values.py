@@ -32,11 +32,14 @@ def _gains(controller, component):
             if gain.component == component}
 
 
-def component_settings(scenario, name):
-    """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters."""
+def component_settings(scenario, name, reference_text=None):
+    """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters.
+    ``reference_text``: the signals' ``reference`` text when the caller made it already (the
+    C master maps a stroke reference in C, :mod:`sma_fmu.systems.stroke_table`)."""
     c, drive = scenario.controller, scenario.drive
     if name == "signals":
-        return {"reference": table_text(_reference_table(scenario)),
+        return {"reference": reference_text if reference_text is not None
+                else table_text(_reference_table(scenario)),
                 "load_profile": table_text(scenario.load.as_table())}
     if name == "compensator":
         return {**_gains(c, name), "adapt_to_load": c.adapt_to_load,

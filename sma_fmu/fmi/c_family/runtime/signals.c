@@ -226,6 +226,55 @@ int reference_signal_value(const ReferenceSignal *s, double t, double *value,
     }
 }
 
+/* bisect.bisect_left(times, t) */
+static size_t bisect_left(const double *times, size_t count, double t)
+{
+    size_t low = 0, high = count;
+    while (low < high) {
+        size_t middle = (low + high) / 2;
+        if (times[middle] < t) {
+            low = middle + 1;
+        } else {
+            high = middle;
+        }
+    }
+    return low;
+}
+
+int reference_signal_trend(const ReferenceSignal *s, double t)
+{
+    double change = 0.0, angle, slope, curvature;
+    size_t last, i;
+    switch (s->kind) {
+    case REFERENCE_STEP:
+        change = t >= s->time_s ? s->final_ohm - s->initial_ohm : 0.0;
+        break;
+    case REFERENCE_RAMP:
+        change = t > s->start_time_s ? s->end_ohm - s->start_ohm : 0.0;
+        break;
+    case REFERENCE_SINE:
+    case REFERENCE_COSINE:
+        angle = 2.0 * PI * s->frequency_hz * t + s->phase_deg * (PI / 180.0);
+        slope = s->kind == REFERENCE_SINE ? cos(angle) : -sin(angle);
+        curvature = s->kind == REFERENCE_SINE ? -sin(angle) : -cos(angle);
+        /* at a turn (slope 0) the curvature says where it came from: a maximum, rising */
+        change = s->amplitude_ohm * s->frequency_hz * (slope != 0.0 ? slope : -curvature);
+        break;
+    case REFERENCE_TABLE:
+        last = bisect_left(s->times_s, s->count, t);   /* knots before t */
+        for (i = (last < s->count - 1 ? last : s->count - 1); i-- > 0;) {
+            change = s->values_ohm[i + 1] - s->values_ohm[i];
+            if (change != 0.0) {
+                break;
+            }
+        }
+        break;
+    default:
+        break;
+    }
+    return change < 0.0 ? -1 : 1;
+}
+
 void reference_signal_free(ReferenceSignal *signal)
 {
     free(signal->times_s);

@@ -52,6 +52,9 @@ void reference_signal_bounds(const ReferenceSignal *signal, double *lowest, doub
  * ("math domain error"); a NaN result is passed on as in Python. */
 int reference_signal_value(const ReferenceSignal *signal, double t, double *value,
                            SmaMessage *message);
+/* +1 or -1: the sign of the change the reference last made at or before t [s] (its slope
+ * where it moves; +1 while it never moved); ReferenceSignal.trend. */
+int reference_signal_trend(const ReferenceSignal *signal, double t);
 void reference_signal_free(ReferenceSignal *signal);
 
 /* Load [kg] at t [s]; a switching time within `tolerance` [s] counts as reached (before
