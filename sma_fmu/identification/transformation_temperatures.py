@@ -8,7 +8,9 @@ On one heating or cooling branch:
    15 % on a steep branch with fewer than two samples there).
 2. Baselines: straight lines (least squares) through the samples colder than
    T50 - 2.5 |T75 - T25| (martensite, "cold") and hotter than T50 + 2.5 |T75 - T25|
-   (austenite, "hot"); they keep the slope of the data (thermal expansion, creep).
+   (austenite, "hot"); they keep the slope of the data (thermal expansion, creep). Where
+   those samples span under a tenth of |T75 - T25| (bunched at a turn) the line is flat
+   at their median strain: a slope from them would be noise.
 3. Transformation tangent: the tangent at the branch's steepest point (ASTM F2082 / E3097
    practice, and what ASMADA does): a logistic step plus a straight line (scipy's
    ``curve_fit``) is fitted to the branch, and the tangent is taken at the logistic's
@@ -43,6 +45,7 @@ __all__ = ["branch_tangents", "branch_tangents_or_reason", "cycle_numbers", "QUA
 BAND = (0.4, 0.6)
 TAIL_WIDTHS = 2.5
 MIN_BASELINE_POINTS = 5
+SHORT_BASELINE = 0.1   # a baseline spanning under this share of T25-T75 is taken flat
 QUANTITIES = (("A_s", "degC"), ("A_f", "degC"), ("M_s", "degC"), ("M_f", "degC"),
               ("thermal_hysteresis", "K"), ("actuation_strain", "%"), ("residual_strain", "%"))
 
@@ -61,6 +64,16 @@ def _line(x, y):
     """(intercept, slope) of y = a + b x, least squares."""
     slope, intercept = np.polyfit(x, y, 1)
     return float(intercept), float(slope)
+
+
+def _baseline(t, e, width):
+    """(intercept, slope) of a baseline: the least-squares line, or flat at the median strain
+    where its samples span under SHORT_BASELINE of the transformation's quartile ``width``
+    [K] (a few samples bunched at a turn: a slope from them is noise, and extrapolated to
+    the branch's coldest point or to the tangent it can give any strain)."""
+    if np.ptp(t) < SHORT_BASELINE * width:
+        return float(np.median(e)), 0.0
+    return _line(t, e)
 
 
 def _meet(tangent, line):
@@ -130,7 +143,8 @@ def branch_tangents_or_reason(temperature, strain, direction, band=BAND, tail=TA
         return None, ("transformation already under way at the branch's coldest point (no "
                       "martensite baseline)" if heating else
                       "transformation not finished before the turn (no martensite baseline)")
-    cold, hot = _line(t[cold_rows], e[cold_rows]), _line(t[hot_rows], e[hot_rows])
+    cold = _baseline(t[cold_rows], e[cold_rows], width)
+    hot = _baseline(t[hot_rows], e[hot_rows], width)
     low_line = hot[0] + hot[1] * t
     with np.errstate(divide="ignore", invalid="ignore"):   # baselines that cross
         progress = (e - low_line) / (cold[0] + cold[1] * t - low_line)

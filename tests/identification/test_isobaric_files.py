@@ -157,3 +157,27 @@ def test_synth_several_loads_writes_a_folder(tmp_path, capsys):
     assert names == ["isobaric-0.1kg.csv", "isobaric-0.2kg.csv"] and (out / MARKER).is_file()
     data = read_isobaric(out / names[1])
     assert data.load == 0.2 and data.time is None and data.columns["strain"] == ("strain", "fraction")
+
+
+def test_one_wild_residual_strain_is_marked_at_the_panel_s_edge_not_scaling_it():
+    """The stabilisation figure's residual-strain panel: 99 cycles near zero and one at
+    3.7 % keep their scale, and the wild one is named at the edge; a training drift of the
+    first cycles (a few times the others) stays on the axis, unmarked."""
+    from matplotlib.figure import Figure
+    from sma_fmu.identification.isobaric.figures import _mark_beyond
+    rng = np.random.default_rng(1)
+    cycles = list(range(2, 101))
+    data = list(rng.normal(0.003, 0.005, len(cycles)))
+    model = list(rng.normal(0.003, 0.005, len(cycles)))
+    data[14] = 3.69
+    axis = Figure().subplots()
+    axis.plot(cycles, data), axis.plot(cycles, model)
+    _mark_beyond(axis, cycles, data + model)
+    low, high = axis.get_ylim()
+    assert high < 0.2 and low < min(model) and high > sorted(data)[-2]
+    assert [t.get_text() for t in axis.texts] == ["cycle 16: 3.69 %"]
+    drift = [0.07, 0.05] + data[2:14] + [0.004] + data[15:]
+    axis = Figure().subplots()
+    axis.plot(cycles, drift)
+    _mark_beyond(axis, cycles, drift + model)
+    assert not axis.texts and axis.get_ylim()[1] >= 0.07

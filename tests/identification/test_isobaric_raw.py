@@ -55,13 +55,6 @@ def test_the_load_it_is_told_moves_only_the_centres_offset(fits):
     assert centres[1.0][0] - centres[1.0][1] < (100.0 - 60.0) * 1.0 - 10.0
 
 
-@pytest.mark.xfail(strict=True, reason="the data's heating half-strain temperature on the "
-                   "thermocouple smoothed over the square root of a branch (its latent-heat "
-                   "stall no longer smeared) is 120.2 degC; the model's 123.7, 3.5 K off on "
-                   "this slice (3.1 K on the whole file): heating crosses its core at 3.5 K per "
-                   "sample, and the fitted wire temperature bends through it; neither a share "
-                   "per direction nor a third stage fixed it on this slice "
-                   "(docs/identification.md, a raw lab file)")
 def test_the_model_s_half_strain_temperatures_are_the_data_s(fits):
     for load, (data, fit) in fits.items():
         row, = half_strain_table([data], fit)["per_file"]

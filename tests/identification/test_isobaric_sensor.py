@@ -81,20 +81,47 @@ def test_at_one_rate_the_lag_is_held_at_zero_and_the_report_says_what_it_would_d
     assert width - true_width == pytest.approx(narrowing * PROGRAMME["lag_s"], rel=0.25)
 
 
+def _beyond_bound(f, fit):
+    """Per sample: |fitted profile - thermocouple profile| over the stated bound there
+    (PROFILE_BOUND standard errors of the thermocouple profile, or its tolerance; both
+    curves are linear between the joint profile's knots, so is the bound)."""
+    bound = f.profile.basis @ (PROFILE_BOUND * f.tc_error[f.profile.knots])
+    return np.abs(fit.measured_profiles[0] - f.thermocouple.values) / bound
+
+
 def test_the_fitted_temperature_stays_within_its_bound_of_the_thermocouple(tmp_path, params):
-    """Every knot of the joint profile within PROFILE_BOUND standard errors (or the
-    thermocouple tolerance) of the temperature's own least-squares fit."""
-    from sma_fmu.identification.isobaric.profile import pointwise_error
+    """Every sample of the joint profile within PROFILE_BOUND standard errors (or the
+    thermocouple tolerance) of the thermocouple profile."""
     data, _ = _file(tmp_path, params, rates=(12.0,), lag_s=0.0, cycles=4, points=2000)
     f = prepare(data, 0)
     fit = fit_isobaric([data], params, lag="none", widths="shared")
-    knots = f.profile.knots
-    own = f.profile.factor.solve(f.profile.basis.T @ data.temperature)
-    allowed = np.maximum(PROFILE_BOUND * pointwise_error(f.profile)[knots], PROFILE_TOLERANCE_K)
-    moved = np.abs(fit.measured_profiles[0][knots] - own)
-    assert np.all(moved <= allowed + 1e-9)
+    assert np.all(_beyond_bound(f, fit) <= 1.0 + 1e-9)
+    moved = np.abs(fit.measured_profiles[0] - f.thermocouple.values)
     assert moved.max() > 0.1      # it moved: the bound is not a freeze
+    assert np.all(f.tc_error >= PROFILE_TOLERANCE_K / PROFILE_BOUND)
     assert fit.residual_rms["temperature_K"] <= 1.5 * fit.noise["temperature_K"]
+
+
+def test_a_model_that_lacks_a_shape_cannot_bend_the_temperature_beyond_its_bound(tmp_path,
+                                                                                  params):
+    """A noisy thermocouple (3 K) and dense strain knots: a knot every few samples has a
+    standard error near the noise, so bounds held knot by knot would let a run of knots move
+    together by 5 sigma each. Truth with a wide second stage, fitted with one stage: the
+    profile would flatten the branch ends by over 10 K to hide the missing tail. Held to the
+    thermocouple profile, whose knots the temperature alone chose, it cannot, and the misfit
+    shows in the strain."""
+    truth = params.replace(w2=0.3, a2_h=140.0, a2_c=40.0, b2_h=100.0, b2_c=60.0, nu2_h=15.0,
+                           nu2_c=15.0)
+    columns, _ = isobaric_table(truth, LOAD, IsobaricProgramme(**dict(
+        PROGRAMME, rates=(12.0,), rate=12.0, lag_s=0.0, cycles=4, points=2000, noise_K=3.0)))
+    path = tmp_path / "two_stages.csv"
+    path.write_text(isobaric_text(columns, [f"load: {LOAD} kg"]), encoding="utf-8")
+    data = read_isobaric(path)
+    f = prepare(data, 0)
+    fit = fit_isobaric([data], params, lag="none", stages=1, widths="shared")
+    assert fit.converged, fit.message
+    assert np.all(_beyond_bound(f, fit) <= 1.0 + 1e-9)
+    assert fit.residual_rms["strain"] > 2.0 * fit.noise["strain"]   # the misfit shows
 
 
 def test_the_fit_shows_its_evaluations_on_a_progress_bar(tmp_path, params):

@@ -72,3 +72,22 @@ def test_asmada_s_raw_file_gives_asmada_s_medians(params):
     medians = {k: float(np.median(v)) for k, v in found.items()}
     for key, value in asmada.items():
         assert medians[key] == pytest.approx(value, abs=2.0), medians
+
+
+def test_a_baseline_of_a_few_samples_bunched_at_the_turn_gives_no_wild_slope():
+    """A cooling branch whose martensite side holds only six samples within 0.1 K (a
+    temperature that stalls at the turn), strain noise 1e-4: a line through them has a slope
+    of order 1e-4 / 0.1 K (5e-4/K here, 50 times the plateau's), which extrapolated to the
+    tangent moved M_f 6.5 K (and the residual strain by that slope times the distance).
+    Flat instead, M_f is the closed form's centre - 2/rate within 1 K (the plateau's 1e-5/K
+    slope over the bunch is below the noise)."""
+    centre, rate = 97.0, 0.15          # cold-side cut at T50 - 2.5 |T25 - T75| = 60.4 degC;
+    # the ramp stops short of it, the bunch lies beyond
+    ramp = np.linspace(220.0, 66.0, 300)
+    bunch = np.linspace(60.0, 59.9, 6)
+    t = np.concatenate([ramp, bunch])
+    clean = COLD + (HOT - COLD) / (1.0 + np.exp(-rate * (t - centre))) + EXPANSION * (t - centre)
+    noise = np.random.default_rng(7).normal(0.0, 1e-4, t.size)
+    found = branch_tangents(t, clean + noise, COOLING)
+    assert found["finish"] == pytest.approx(centre - 2.0 / rate, abs=1.0)
+    assert found["cold"][1] == 0.0

@@ -10,7 +10,8 @@
   ``TEMPERATURE_CYCLES`` cycles.
 - ``fit_isobaric_stabilisation.png``: per-cycle A_s, A_f, M_s, M_f and residual strain
   against cycle number, data (markers) and model (markers joined by lines): the
-  stabilisation plot labs use; outlier cycles shaded grey. With one cycle it shows that
+  stabilisation plot labs use; outlier cycles shaded grey; a residual strain far outside the
+  other cycles' is marked at the panel's edge with its value. With one cycle it shows that
   cycle's values, and a quantity no cycle has is said so in its panel.
 - ``fit_isobaric_residuals.png``: strain and temperature residuals against sample or time,
   with their noise estimates.
@@ -184,6 +185,9 @@ def _no_values(axis, rows, sources):
               wrap=True)
 
 
+BEYOND_SPREADS = 5.0   # a residual strain this many 5-95 % spreads out is marked at the edge
+
+
 def _stabilisation(files, rows, outliers=()):
     figure = Figure(figsize=(9.0, 7.6 * len(files)))
     axes = figure.subplots(2 * len(files), 1, squeeze=False)[:, 0]
@@ -223,13 +227,40 @@ def _stabilisation(files, rows, outliers=()):
                     label="data (wire temperature)")
         bottom.plot(cycle, [r["model"] for r in these], "-s", ms=7, mfc="none", zorder=3,
                     color="tab:green", label="model")
+        _mark_beyond(bottom, cycle, [r["data_wire"] for r in these] + [r["model"] for r in these])
         if any(np.isfinite(r[s]) for r in these for s in ("data_wire", "model")):
             bottom.legend(fontsize=7)
         else:
             _no_values(bottom, these, ("data_wire", "model"))
-        bottom.set(title="residual strain left by each cycle (outlier cycles not drawn)",
+        bottom.set(title="residual strain left by each cycle (outlier cycles not drawn; red: beyond "
+                         "the axis, at its edge)",
                    xlabel="cycle", ylabel="residual strain [%]")
     return figure
+
+
+def _mark_beyond(axis, cycles, values):
+    """Limit the axis to the bulk of ``values`` (data then model, per cycle) when a few lie
+    more than BEYOND_SPREADS times the 5-95 % spread outside it, and mark those at the edge
+    with their cycle and value, so one wild cycle neither flattens the others nor
+    disappears (a training drift of the first cycles stays on the axis)."""
+    v = np.asarray(values, dtype=float)
+    finite = v[np.isfinite(v)]
+    if finite.size < 4:
+        return
+    low, high = np.percentile(finite, [5, 95])
+    pad = BEYOND_SPREADS * max(high - low, 1e-6)
+    low, high = low - pad, high + pad
+    cycle = np.tile(np.asarray(cycles), 2)
+    beyond = np.isfinite(v) & ((v < low) | (v > high))
+    if not beyond.any():
+        return
+    axis.set_ylim(low, high)
+    for n, (c, value) in enumerate(zip(cycle[beyond], v[beyond])):
+        edge, marker = (high, "^") if value > high else (low, "v")
+        axis.plot([c], [edge], marker, ms=8, color="tab:red", clip_on=False, zorder=4)
+        step = 9 * (n % 4) + 10
+        axis.annotate(f"cycle {c}: {value:.3g} %", (c, edge), fontsize=7, color="tab:red",
+                      xytext=(4, -step if value > high else step - 6), textcoords="offset points")
 
 
 def _left_out(data, fit, k):

@@ -106,8 +106,9 @@ def prepare(data, index, residual="per-cycle"):
     thermocouple = temperature_profile(data.temperature, data.branches, data.time, window)
     profile = temperature_profile(data.temperature, data.branches, data.time, window,
                                   strain=data.strain)
-    # the first fit's temperature uncertainty: the profile's own, or the share of the
-    # thermocouple tolerance the joint fit's knot bound stands for, where that is larger
+    # the thermocouple profile's standard error, or the share of the thermocouple tolerance
+    # the joint fit's knot bound stands for, where that is larger: the first fit's
+    # temperature uncertainty, and PROFILE_BOUND of it the joint fit's knot bound
     error = np.maximum(pointwise_error(thermocouple), PROFILE_TOLERANCE_K / PROFILE_BOUND)
     return PreparedFile(index, data, profile, thermocouple, error, step, spread, sigma,
                         residual == "per-cycle")

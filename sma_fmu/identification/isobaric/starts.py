@@ -6,16 +6,20 @@ files, the levels from the strain. A second stage starts as a broader copy of th
 (same centres, a third of the domain size) holding a fifth of the transformation.
 
 The temperature profile's knots are bounded: each stays within PROFILE_BOUND standard errors
-of the measured temperature's own least-squares fit at that knot (the standard error from the
-thermocouple noise, :func:`~.profile.pointwise_error`), or within PROFILE_TOLERANCE_K where
-that is wider (a filtered file's noise estimate is the filter's remains, and no thermocouple
-is that exact: 2.5 K is the class-2 tolerance of IEC 60584, the usual grade of a lab's
-thermocouple). Inside that band the
-temperature residual weighs every move; beyond it a move cannot be thermocouple noise (5
-sigma: about one knot in a million by chance), so a wire temperature the strain would want
-further away is the model not following the data, and shows as strain residual instead of a
-profile bent by tens of kelvin (on the shared raw file, 40 K at the bottom turns without the
-bound).
+of the thermocouple profile at that knot (the measured temperature's own least-squares fit on
+the knots Akaike's criterion chose from it alone; the standard error from the thermocouple
+noise, :func:`~.profile.pointwise_error`), or within PROFILE_TOLERANCE_K where that is wider
+(a filtered file's noise estimate is the filter's remains, and no thermocouple is that exact:
+2.5 K is the class-2 tolerance of IEC 60584, the usual grade of a lab's thermocouple). Inside
+that band the temperature residual weighs every move; beyond it a move cannot be thermocouple
+noise (5 sigma: about one knot in a million by chance), so a wire temperature the strain would
+want further away is the model not following the data, and shows as strain residual instead
+of a profile bent by tens of kelvin (on the shared raw file, 40 K at the bottom turns without
+the bound). The band is not taken from the temperature's fit on the joint profile's own knots:
+with a knot wherever the strain is steep, a few samples apart, each such knot's standard error
+is near the noise itself, and a run of them moved together by up to 5 sigma each (the raw
+file's cooling ends, 4 K of noise: the wire 6 to 10 K above the thermocouple over the last 20
+samples of cycles 2 to 26).
 """
 import math
 
@@ -23,7 +27,7 @@ import numpy as np
 
 from sma_fmu.identification.isobaric.jacobian import file_model
 from sma_fmu.identification.isobaric.lag import lagged
-from sma_fmu.identification.isobaric.profile import pointwise_error, wire_rows
+from sma_fmu.identification.isobaric.profile import wire_rows
 from sma_fmu.identification.isobaric.terms import stress_MPa
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constant_load import residual_f_fraction
@@ -116,15 +120,14 @@ def starts(files, layout, base, lag_fraction=0.01):
     centres = {HEATING: [], COOLING: []}
     widths, spans, r_levels = [], [], []
     for f in files:
-        # the knots stay within PROFILE_BOUND standard errors of the temperature's own fit
-        # on them; they start on the thermocouple profile (whose knots they include)
+        # the knots stay within PROFILE_BOUND standard errors of the thermocouple profile
+        # (the temperature's own fit, its knots chosen by AIC) and start on it
         knots = layout.knots[f.index]
-        own = f.profile.factor.solve(f.profile.basis.T @ f.data.temperature)
-        error = np.maximum(PROFILE_BOUND * pointwise_error(f.profile)[f.profile.knots],
-                           PROFILE_TOLERANCE_K)
+        own = f.thermocouple.values[f.profile.knots]
+        error = PROFILE_BOUND * f.tc_error[f.profile.knots]
         lower[knots] = np.maximum(own - error, -KELVIN_OFFSET + 1.0)
         upper[knots] = own + error
-        vector[knots] = np.clip(f.thermocouple.values[f.profile.knots], lower[knots], upper[knots])
+        vector[knots] = own
         profile = f.thermocouple.values
         if layout.lags[f.index] is not None:
             period = f.data.splitting.period_samples * f.step if f.data.splitting else 100 * f.step
