@@ -175,9 +175,10 @@ class FeedforwardStepper:
             model = self._shaper.model
             points, last = model.reversals, model.direction
             temperature, fraction = model.temperature, model.xi_MF
-        if not self._minor_loops:
-            return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin), \
-                points, xi_mf
+        if not self._minor_loops:   # the search starts at the last T on the same branch
+            near = temperature if direction == last else None
+            return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin,
+                                            near), points, xi_mf
         if direction != last and temperature is not None:
             points = list(points)
             push_reversal(points, temperature, fraction, params.memory_depth)
