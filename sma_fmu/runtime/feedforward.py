@@ -63,7 +63,7 @@ from .sensing import invert_on_stack, mixed_fractions_of_resistance, temperature
 from .shaping import ReachableShaping, require_power_cap, require_shaping
 from .state_entries import (StateError, check_format, read_direction, read_entries,
                             read_optional_number, read_temperature)
-from .validity import data_range_warning, validity_warning
+from .validity import data_box, data_range_warning, validity_warning
 
 __all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStepper",
            "STATE_FORMAT"]
@@ -156,6 +156,7 @@ class FeedforwardStepper:
         self._unconnected_warned = False  # the no-reference-yet warning was given
         self._bounded_before = False      # the last step's T_ref was bounded to T_max
         self._data_unwarned = params.data_range   # the data-range warning is still to come
+        self._data_box = data_box(params)    # its bounds, missing ones infinite
 
     def _invert(self, reference, load, direction):
         """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
@@ -174,9 +175,10 @@ class FeedforwardStepper:
             model = self._shaper.model
             points, last = model.reversals, model.direction
             temperature, fraction = model.temperature, model.xi_MF
-        if not self._minor_loops:
-            return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin), \
-                points, xi_mf
+        if not self._minor_loops:   # the search starts at the last T on the same branch
+            near = temperature if direction == last else None
+            return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin,
+                                            near), points, xi_mf
         if direction != last and temperature is not None:
             points = list(points)
             push_reversal(points, temperature, fraction, params.memory_depth)
@@ -281,8 +283,11 @@ class FeedforwardStepper:
                      f"{self.params.T_max:g} degC (R_ref = {reference:.6g} ohm, load = {load:.6g} "
                      f"kg): bounded to T_max, saturated")
             warning = bound if warning is None else f"{warning}; {bound}"
-        outside = (data_range_warning(self.params, temperature, load, "T_ref")
-                   if self._data_unwarned else None)
+        outside = None
+        if self._data_unwarned:
+            t_low, t_high, load_low, load_high = self._data_box
+            if not (t_low <= temperature <= t_high and load_low <= load <= load_high):
+                outside = data_range_warning(self.params, temperature, load, "T_ref")
         if outside is not None:
             warning = outside if warning is None else f"{warning}; {outside}"
         if self._shaper is None:

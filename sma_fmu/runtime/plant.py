@@ -28,7 +28,7 @@ from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_po
 from .state_entries import (StateError, check_format, read_direction, read_entries, read_number,
                             read_temperature)
 from .thermal import step_decay, thermal_step
-from .validity import data_range_warning, validity_warning
+from .validity import data_box, data_range_warning, validity_warning
 
 __all__ = ["PlantOutputs", "PlantStepper", "STATE_FORMAT", "branch_length"]
 
@@ -95,6 +95,7 @@ class PlantStepper:
         self.outputs = self._evaluate(constants)
         self.warning = None
         self._data_unwarned = params.data_range   # the data-range warning is still to come
+        self._data_box = data_box(params)    # its bounds, missing ones infinite
         self._check_validity(-math.inf, -math.inf)
         if self._data_unwarned:
             self._check_data_range()
@@ -159,7 +160,9 @@ class PlantStepper:
         if after > params.T_max or load > params.load_max:
             self._check_validity(before, load_before)
         if self._data_unwarned:
-            self._check_data_range()
+            t_low, t_high, load_low, load_high = self._data_box
+            if not (t_low <= after <= t_high and load_low <= load <= load_high):
+                self._check_data_range()
         return self.outputs
 
     def _evaluate(self, constants):

@@ -5,7 +5,8 @@
 
 With a second stage (w2 > 0, :mod:`.constant_load`) no closed form exists: 1/T_K is found
 by a safeguarded Newton iteration on Lambda(1/T_K), bracketed by the two single-stage closed
-forms (:func:`~.two_stage_root.two_stage_inverse`).
+forms (:func:`~.two_stage_root.two_stage_inverse`); the compensator starts it from its last
+temperature on the same branch (``near``).
 
 Outside the transformation the resistance is saturated and carries no temperature
 information. There xi_MF is clamped into [delta, M - delta], delta = saturation_margin * M,
@@ -58,10 +59,13 @@ def _clamped(xi_mf, total, delta):
     return total - delta, delta, True
 
 
-def temperature_of_fractions(xi_mf, xi_p, constants, margin):
+def temperature_of_fractions(xi_mf, xi_p, constants, margin, near=None):
     """Invert a major branch: (xi_MF, xi_P) [1] -> :class:`SensedTemperature`.
 
-    ``margin`` is the relative clamp delta/M [1].
+    ``margin`` is the relative clamp delta/M [1]. ``near`` [degC], if given, is a temperature
+    close to the answer (a compensator's last one): a two-stage search starts there when it
+    lies inside the search's bracket. The answer is the same to the search's tolerance
+    (1e-12 K), not bit for bit.
     """
     delta = margin * constants.M
     saturated = False
@@ -70,7 +74,11 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin):
     exponent = math.log(xi_p / xi_mf)
     inverse_kelvin = constants.inv_centre_K - exponent / constants.energy_over_kB
     if constants.w2 != 0.0:
-        inverse_kelvin = two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants)
+        start = None   # 1/(near + 273.15), where that is a temperature above absolute zero
+        if near is not None and near + KELVIN_OFFSET > 0.0:
+            start = 1.0 / (near + KELVIN_OFFSET)
+        inverse_kelvin = two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants,
+                                           start)
     elif not inverse_kelvin > 0.0:
         raise ValueError(
             f"temperature-sensing inverse diverges at Lambda = {exponent!r}: dH(f)/k_B = "
@@ -166,7 +174,8 @@ def inverse_method(two_stage):
     words follow the code. ``two_stage``: the branch has a second stage (w2 > 0)."""
     if not two_stage:
         return "closed form, T_K = 1/(1/tau_K - k_B Lambda/dH(f))"
-    return (f"Newton's method on 1/T_K, safeguarded: started from the steeper stage's "
+    return (f"Newton's method on 1/T_K, safeguarded: started from the compensator's last "
+            f"temperature on the same branch, else from the steeper stage's "
             f"closed-form inverse, kept inside the bracket of the two stages' closed forms "
             f"(a step that would leave it halves it instead), stopped when the error left in "
             f"T is below {ROOT_TOLERANCE_K:g} K (about 3 evaluations; at most {ROOT_CAP} rounds)")

@@ -9,7 +9,9 @@ A wire fitted to data also gives the range those data covered (``validity.T_data
 ``stress_data_max``, optional): a run that leaves it is extrapolating the fit, and a stepper
 says so once, the first time (:func:`data_range_warning`); the model still computes.
 """
-__all__ = ["validity_warning", "data_range_warning", "DATA_RANGE_NOTE"]
+import math
+
+__all__ = ["validity_warning", "data_range_warning", "data_box", "DATA_RANGE_NOTE"]
 
 DATA_RANGE_NOTE = ("outside the range of the data the wire's parameters were fitted to "
                    "(warned once per instance)")
@@ -29,6 +31,17 @@ def validity_warning(params, temperature, temperature_before, load, load_before)
     if not messages:
         return None
     return "; ".join(messages) + ": outside the range the model's parameters describe"
+
+
+def data_box(params):
+    """(T_data_min, T_data_max [degC], load_data_min, load_data_max [kg]) of ``params``, a
+    bound not given as -inf or inf: a stepper compares with these at every step until it has
+    warned, and calls :func:`data_range_warning` only for a value outside (the call inside
+    the range cost ~0.1 us a step in Python)."""
+    def bound(value, missing):
+        return missing if value is None else value
+    return (bound(params.T_data_min, -math.inf), bound(params.T_data_max, math.inf),
+            bound(params.load_data_min, -math.inf), bound(params.load_data_max, math.inf))
 
 
 def data_range_warning(params, temperature, load, name="T"):

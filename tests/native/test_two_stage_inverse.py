@@ -10,7 +10,9 @@ invertible target and is skipped, and the test asserts that points near saturati
 (min(xi_MF, xi_P) < 1e-4 M) were inverted. The wires: the shape the isobaric fit of the
 Flexinol files gives (a sharp stage and a broad one of about equal share, centres close),
 two stages apart (w2 = 0.13), a broad small second stage (nu2 = 8, w2 = 0.02) and a second
-stage steeper than the first (so the search starts from stage 2's closed form).
+stage steeper than the first (so the search starts from stage 2's closed form). The same
+holds when the search starts from a given temperature (a compensator's last): near the
+answer, a transition away, beyond both stages.
 """
 import ctypes
 import math
@@ -50,11 +52,24 @@ int invert(const void *params, double load, int direction, double xi_mf, double 
     }
     *temperature = t.temperature; *saturated = t.saturated; return 0;
 }
+int invert_near(const void *params, double load, int direction, double xi_mf, double xi_p,
+                double near, double *temperature, int *saturated, char *error) {
+    SmaMessage m; BranchConstants b; SensedTemperature t; const WireParameters *p = params;
+    if (branch_constants(load, direction, p, &b, &m)
+        || temperature_near(xi_mf, xi_p, &b, p->saturation_margin, near, &t, &m)) {
+        copy_error(error, &m); return 1;
+    }
+    *temperature = t.temperature; *saturated = t.saturated; return 0;
+}
 """
 SIGNATURES = {**c_feedforward.SIGNATURES,
               "invert": (ctypes.c_int, [ctypes.c_void_p, ctypes.c_double, ctypes.c_int,
                                         ctypes.c_double, ctypes.c_double, c_feedforward.DP,
-                                        c_feedforward.IP, ctypes.c_char_p])}
+                                        c_feedforward.IP, ctypes.c_char_p]),
+              "invert_near": (ctypes.c_int, [ctypes.c_void_p, ctypes.c_double, ctypes.c_int,
+                                             ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                             c_feedforward.DP, c_feedforward.IP,
+                                             ctypes.c_char_p])}
 
 
 @pytest.fixture(scope="module")
@@ -97,6 +112,35 @@ def test_the_inverse_returns_the_forward_models_temperature(params, lib, wire):
     # near saturation: a quarter of the points on the three sharper wires; the broad stage
     # 2 of w2 = 0.02 reaches 1e-4 M only far out, about 1 % of its points
     assert inverted > POINTS // 2 and near_saturation > POINTS // 100, (inverted, near_saturation)
+
+
+# where a compensator's last temperature lies from the answer [K]: a step's change, a
+# transition's width, a jump to the other side of both stages; and no start (NaN, None)
+NEAR_OFFSETS = (1e-9, 0.03, -0.03, 2.0, -40.0, 300.0, math.nan)
+
+
+@pytest.mark.parametrize("wire", sorted(WIRES))
+def test_a_start_near_the_answer_returns_it_too(params, lib, wire):
+    """The search from a given start (the compensator's last T): the forward model's
+    temperature to 1e-12 K, and the C runtime's doubles."""
+    p = params.replace(**WIRES[wire])
+    cparams = c_feedforward.CParameters(lib, p)
+    temperature, saturated = ctypes.c_double(), ctypes.c_int()
+    error = ctypes.create_string_buffer(512)
+    worst, inverted, rng = 0.0, 0, random.Random(49)
+    for load, direction, T, constants, xi_mf, xi_p in random_points(p, 49):
+        offset = rng.choice(NEAR_OFFSETS)
+        near = None if math.isnan(offset) else T + offset * rng.uniform(0.5, 1.0)
+        sensed = temperature_of_fractions(xi_mf, xi_p, constants, p.saturation_margin, near)
+        assert lib.invert_near(cparams.pointer, load, direction, xi_mf, xi_p,
+                               math.nan if near is None else near, ctypes.byref(temperature),
+                               ctypes.byref(saturated), error) == 0
+        assert (temperature.value, bool(saturated.value)) == tuple(sensed)   # bit for bit
+        if not sensed.saturated:
+            inverted += 1
+            worst = max(worst, abs(sensed.temperature - T))
+    assert worst <= 1e-12, (wire, worst)
+    assert inverted > POINTS // 2, inverted
 
 
 def _batch_arrays(points):

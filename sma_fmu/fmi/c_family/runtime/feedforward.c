@@ -154,8 +154,9 @@ static int invert(FeedforwardStepper *self, double reference, double load, int d
         *stack = points;
         *kept = count;
         *fraction = xi_mf;
-        return temperature_of_fractions(xi_mf, xi_p, &constants, params->saturation_margin,
-                                        sensed, message);
+        /* the search starts at the last T on the same branch (NaN: none) */
+        return temperature_near(xi_mf, xi_p, &constants, params->saturation_margin,
+                                direction == last ? temperature : NAN, sensed, message);
     }
     if (direction != last && !sma_state_is_none(temperature)) {
         points[count].temperature = temperature;   /* push_reversal */

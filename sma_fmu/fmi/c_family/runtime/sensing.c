@@ -93,8 +93,9 @@ static void split_with_slope(const Stage *stage, double u, double *mf, double *p
     *q = *p / d;
 }
 
-int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *inverse_kelvin,
-                      const BranchConstants *constants, SmaMessage *message)
+int two_stage_inverse(double xi_mf, double xi_p, double exponent, double start,
+                      double *inverse_kelvin, const BranchConstants *constants,
+                      SmaMessage *message)
 {
     Stage first, second;
     double other, low, high, u, limit, mf, p, mf1, p1, q1, mf2, p2, q2, residual, slope;
@@ -124,13 +125,14 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *invers
                                    exponent, first.energy, second.energy);
         }
     }
-    if (first.energy >= second.energy) {
+    if (low < start && start < high) {   /* a caller's start (NaN: none) */
+        u = start;
+    } else if (first.energy >= second.energy) {
         u = newton_start(xi_mf, xi_p, &first, &second, *inverse_kelvin, low, high);
-        limit = ROOT_TOLERANCE_K / first.energy;
     } else {
         u = newton_start(xi_mf, xi_p, &second, &first, other, low, high);
-        limit = ROOT_TOLERANCE_K / second.energy;
     }
+    limit = ROOT_TOLERANCE_K / (first.energy >= second.energy ? first.energy : second.energy);
     for (i = 0; i < ROOT_CAP; i++) {
         split_with_slope(&first, u, &mf1, &p1, &q1);
         split_with_slope(&second, u, &mf2, &p2, &q2);
@@ -177,7 +179,13 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *invers
 int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *constants,
                              double margin, SensedTemperature *sensed, SmaMessage *message)
 {
-    double delta = margin * constants->M, exponent, inverse_kelvin;
+    return temperature_near(xi_mf, xi_p, constants, margin, NAN, sensed, message);
+}
+
+int temperature_near(double xi_mf, double xi_p, const BranchConstants *constants, double margin,
+                     double near, SensedTemperature *sensed, SmaMessage *message)
+{
+    double delta = margin * constants->M, exponent, inverse_kelvin, start;
     int saturated = 0;
     if (!(xi_mf >= delta && xi_p >= delta)) {
         clamped(&xi_mf, &xi_p, constants->M, delta);
@@ -186,7 +194,10 @@ int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *c
     exponent = log(xi_p / xi_mf);
     inverse_kelvin = constants->inv_centre_K - exponent / constants->energy_over_kB;
     if (constants->w2 != 0.0) {
-        if (two_stage_inverse(xi_mf, xi_p, exponent, &inverse_kelvin, constants, message)) {
+        /* 1/(near + 273.15) where that is a temperature above absolute zero, else none */
+        start = near + KELVIN_OFFSET > 0.0 ? 1.0 / (near + KELVIN_OFFSET) : NAN;
+        if (two_stage_inverse(xi_mf, xi_p, exponent, start, &inverse_kelvin, constants,
+                              message)) {
             return 1;
         }
     } else if (!(inverse_kelvin > 0.0)) {

@@ -39,14 +39,21 @@ void mixed_fractions_of_resistance(double resistance, const BranchConstants *con
 /* 1/T_K [1/K] where a two-stage branch has (xi_MF, xi_P): a safeguarded Newton iteration on
  * Lambda(1/T_K) = ln(xi_P/xi_MF) inside the bracket of stage 1's closed form
  * (*inverse_kelvin on entry) and stage 2's (from 0 where one is <= 0; refused when the
- * branch does not reach the target at any temperature), `exponent` = ln(xi_P/xi_MF);
+ * branch does not reach the target at any temperature), `exponent` = ln(xi_P/xi_MF), from
+ * `start` [1/K] where it lies inside the bracket (NaN: none, the search's own start);
  * runtime/two_stage_root.py's two_stage_inverse, the same operations. */
-int two_stage_inverse(double xi_mf, double xi_p, double exponent, double *inverse_kelvin,
-                      const BranchConstants *constants, SmaMessage *message);
+int two_stage_inverse(double xi_mf, double xi_p, double exponent, double start,
+                      double *inverse_kelvin, const BranchConstants *constants,
+                      SmaMessage *message);
 /* Invert a major branch: (xi_MF, xi_P) [1] -> *sensed; `margin` is delta/M [1]. Refuses
  * ("temperature-sensing inverse diverges at Lambda = ...") when 1/T_K would be <= 0. */
 int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *constants,
                              double margin, SensedTemperature *sensed, SmaMessage *message);
+/* temperature_of_fractions with `near` [degC], a temperature close to the answer (NaN: none;
+ * sensing.temperature_of_fractions's near): a two-stage search starts there when it lies
+ * inside the bracket. The same answer to the search's tolerance, not bit for bit. */
+int temperature_near(double xi_mf, double xi_p, const BranchConstants *constants, double margin,
+                     double near, SensedTemperature *sensed, SmaMessage *message);
 /* Invert the branch of the stack points[0 .. count) (count 0: the major branch of
  * `direction`) -> *sensed and *kept, how many points of the stack remain after the walk.
  * No argument checks (the compensator's hot path). */
