@@ -23,7 +23,7 @@ from collections import namedtuple
 
 from .checks import direction_sign, require_finite, require_nonnegative
 from .constants import BOLTZMANN, HEATING, KELVIN_OFFSET, STANDARD_GRAVITY
-from .model_terms import centre_load, stressed_lengths
+from .model_terms import centre_load, length_constants, stressed_lengths
 from .phases import PhaseFractions, resistance_of
 
 _exp = math.exp
@@ -31,15 +31,15 @@ _exp = math.exp
 __all__ = [
     "BranchConstants", "slope_load", "hysteresis_centre", "second_centre", "residual_f_fraction",
     "domain_energy", "branch_constants", "logistic_split", "branch_fractions",
-    "two_stage_fractions", "phase_fractions",
+    "two_stage_fractions", "with_second_stage", "phase_fractions",
     "constant_load_fractions", "constant_load_resistance", "require_temperature", "BranchCache",
 ]
 
 BranchConstants = namedtuple(
     "BranchConstants", ["M", "xi_F_min", "energy_over_kB", "inv_centre_K", "centre",
                         "w2", "M1", "M2", "energy2_over_kB", "inv_centre2_K", "centre2",
-                        "length_M", "length_F"],
-    defaults=(0.0, None, None, None, None, None, None, None))
+                        "length_M", "length_F", "stages", "strain"],
+    defaults=(0.0, None, None, None, None, None, None, None, None, None))
 BranchConstants.__doc__ = """Constants of one major branch at one load.
 
 M : 1 - xi_Fmin, the fraction that can transform [1]
@@ -51,6 +51,10 @@ w2 : share of M in the second stage [1] (0: one stage; the rest of the fields ar
 M1, M2 : M (1 - w2) and M w2 [1]; energy2_over_kB [K], inv_centre2_K [1/K], centre2 [degC]:
     the second stage's dH/k_B, 1/tau2_K and tau2
 length_M, length_F : l_M and l_F at this load and T_alpha [m] (None without strain terms)
+stages : (M1, energy_over_kB, inv_centre_K, M2, energy2_over_kB, inv_centre2_K) of a second
+    stage (:func:`with_second_stage`), one tuple for the per-step paths (a field lookup costs
+    what a short operation does in Python); None for one stage
+strain : the strain terms' length constants of :func:`~.model_terms.length_of` (None without)
 """
 
 
@@ -142,14 +146,23 @@ def branch_constants(load, direction, params):
                                   "second-stage centre a2_h + b2_h f" if heating
                                   else "second-stage centre a2_c + b2_c f")
         energy2 = domain_energy(load, params, terms.nu2_h if heating else terms.nu2_c)
-        constants = constants._replace(
-            w2=terms.w2, M1=total * (1.0 - terms.w2), M2=total * terms.w2,
-            energy2_over_kB=energy2 / BOLTZMANN, inv_centre2_K=1.0 / (centre2 + KELVIN_OFFSET),
-            centre2=centre2)
+        constants = with_second_stage(constants, terms.w2, total * (1.0 - terms.w2),
+                                      total * terms.w2, energy2 / BOLTZMANN,
+                                      1.0 / (centre2 + KELVIN_OFFSET), centre2)
     if terms.strain:
         length_m, length_f = stressed_lengths(load, params)
-        constants = constants._replace(length_M=length_m, length_F=length_f)
+        constants = constants._replace(length_M=length_m, length_F=length_f,
+                                       strain=length_constants(length_m, length_f, params))
     return constants
+
+
+def with_second_stage(constants, w2, M1, M2, energy2_over_kB, inv_centre2_K, centre2=None):
+    """``constants`` (:class:`BranchConstants`) with a second stage: share ``w2`` [1], the
+    stages' M1, M2 [1], dH2/k_B [K], 1/tau2_K [1/K] and tau2 [degC], and ``stages``."""
+    return constants._replace(
+        w2=w2, M1=M1, M2=M2, energy2_over_kB=energy2_over_kB, inv_centre2_K=inv_centre2_K,
+        centre2=centre2, stages=(M1, constants.energy_over_kB, constants.inv_centre_K, M2,
+                                 energy2_over_kB, inv_centre2_K))
 
 
 def logistic_split(total, exponent):
@@ -175,8 +188,8 @@ def two_stage_fractions(inverse_kelvin, constants):
     each stage split by :func:`logistic_split`, the halves added (stage 1 first). The splits
     are written out (the same operations): a plant calls this at every step, and the two
     calls cost a fifth of it in Python."""
-    total = constants.M1
-    exponent = constants.energy_over_kB * (constants.inv_centre_K - inverse_kelvin)
+    total, energy1, centre1, total2, energy2, centre2 = constants.stages
+    exponent = energy1 * (centre1 - inverse_kelvin)
     if exponent > 0.0:
         e = _exp(-exponent)
         d = 1.0 + e
@@ -185,15 +198,14 @@ def two_stage_fractions(inverse_kelvin, constants):
         e = _exp(exponent)
         d = 1.0 + e
         mf, p = total / d, total * e / d
-    total = constants.M2
-    exponent = constants.energy2_over_kB * (constants.inv_centre2_K - inverse_kelvin)
+    exponent = energy2 * (centre2 - inverse_kelvin)
     if exponent > 0.0:
         e = _exp(-exponent)
         d = 1.0 + e
-        return mf + total * e / d, p + total / d
+        return mf + total2 * e / d, p + total2 / d
     e = _exp(exponent)
     d = 1.0 + e
-    return mf + total / d, p + total * e / d
+    return mf + total2 / d, p + total2 * e / d
 
 
 def phase_fractions(xi_mf, xi_p, xi_f_min):

@@ -28,7 +28,8 @@ from collections import namedtuple
 from .constants import STANDARD_GRAVITY
 
 __all__ = ["ModelTerms", "TERM_DEFAULTS", "model_terms", "domain_widths", "stress_of_load",
-           "stress_ratio", "centre_load", "stressed_lengths", "wire_length", "DEFAULT_T_ALPHA",
+           "stress_ratio", "centre_load", "stressed_lengths", "wire_length", "length_constants",
+           "length_of", "DEFAULT_T_ALPHA",
            "DEFAULT_SPAN_STRESS"]
 
 DEFAULT_T_ALPHA = 20.0        # degC: where l_P, l_M, l_F are the given lengths
@@ -138,8 +139,24 @@ def stressed_lengths(load, params):
 def wire_length(temperature, xi_p, xi_m, xi_f, length_m, length_f, params):
     """x [m] at ``temperature`` [degC] of the fractions [1], with the stressed lengths
     ``length_m``, ``length_f`` [m] (:func:`stressed_lengths`) and thermal expansion."""
+    return length_of(temperature, xi_p, xi_m, xi_f,
+                     length_constants(length_m, length_f, params))
+
+
+def length_constants(length_m, length_f, params):
+    """(T_alpha [degC], alpha_MF, alpha_P [1/K], l_P, l_M, l_F [m]): what :func:`length_of`
+    needs, the stressed lengths ``length_m``, ``length_f`` [m] of one load included (a
+    plant keeps them with its branch instead of looking them up at every step)."""
     terms = params.terms
-    offset = temperature - terms.T_alpha
-    grow = 1.0 + terms.alpha_MF * offset
-    return (params.l_P * (1.0 + terms.alpha_P * offset) * xi_p
+    return terms.T_alpha, terms.alpha_MF, terms.alpha_P, params.l_P, length_m, length_f
+
+
+def length_of(temperature, xi_p, xi_m, xi_f, constants):
+    """x [m] at ``temperature`` [degC] of the fractions [1] with thermal expansion:
+    l_P (1 + alpha_P dT) xi_P + l_M g xi_M + l_F g xi_F, g = 1 + alpha_MF dT, dT = T - T_alpha,
+    ``constants`` from :func:`length_constants`."""
+    t_alpha, alpha_mf, alpha_p, length_p, length_m, length_f = constants
+    offset = temperature - t_alpha
+    grow = 1.0 + alpha_mf * offset
+    return (length_p * (1.0 + alpha_p * offset) * xi_p
             + length_m * grow * xi_m + length_f * grow * xi_f)

@@ -20,9 +20,9 @@ import math
 from collections import namedtuple
 
 from .checks import fast_finite, fast_nonnegative, fast_positive, require_mode, require_nonnegative
-from .constant_load import BranchCache, branch_fractions, require_temperature
-from .constants import COOLING, HEATING
-from .model_terms import wire_length
+from .constant_load import BranchCache, branch_fractions, require_temperature, two_stage_fractions
+from .constants import COOLING, HEATING, KELVIN_OFFSET
+from .model_terms import length_of
 from .minor_loops import (branch_of, fractions_on_branch, push_reversal, read_points,
                           wipe_out)
 from .state_entries import (StateError, check_format, read_direction, read_entries, read_number,
@@ -50,10 +50,9 @@ def branch_length(temperature, xi_p, xi_m, xi_f, constants, params):
     """Wire length x [m] of the fractions [1] at ``temperature`` [degC] on a branch with
     :class:`~.constant_load.BranchConstants` (the strain terms' stressed lengths and thermal
     expansion where the wire has them)."""
-    if constants.length_M is None:
+    if constants.strain is None:
         return params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f
-    return wire_length(temperature, xi_p, xi_m, xi_f, constants.length_M, constants.length_F,
-                       params)
+    return length_of(temperature, xi_p, xi_m, xi_f, constants.strain)
 
 
 class PlantStepper:
@@ -142,15 +141,17 @@ class PlantStepper:
                 push_reversal(points, before, self.xi_MF, params.memory_depth)
             if len(points) >= 2 and wipe_out(points, after, direction):
                 changed = True
-            if not points:
-                xi_mf, xi_p = branch_fractions(after, constants)
+            if not points:   # two stages: branch_fractions' own call, without the layer
+                xi_mf, xi_p = (branch_fractions(after, constants) if constants.stages is None
+                               else two_stage_fractions(1.0 / (after + KELVIN_OFFSET), constants))
             else:
                 if changed or constants is not self._branch_key:
                     self._branch = branch_of(points, len(points), constants, direction)
                     self._branch_key = constants
                 xi_mf, xi_p = fractions_on_branch(after, constants, direction, self._branch)
         else:
-            xi_mf, xi_p = branch_fractions(after, constants)
+            xi_mf, xi_p = (branch_fractions(after, constants) if constants.stages is None
+                           else two_stage_fractions(1.0 / (after + KELVIN_OFFSET), constants))
         load_before = self.load
         self.temperature, self.direction, self.load, self.power = (
             after, direction, load, power)
@@ -170,7 +171,9 @@ class PlantStepper:
         xi_p = self.xi_P
         xi_m = 0.5 * self.xi_MF
         xi_f = constants.xi_F_min + xi_m
-        length = branch_length(self.temperature, xi_p, xi_m, xi_f, constants, params)
+        strain = constants.strain   # branch_length, written out: it runs at every step
+        length = (params.l_P * xi_p + params.l_M * xi_m + params.l_F * xi_f if strain is None
+                  else length_of(self.temperature, xi_p, xi_m, xi_f, strain))
         # tuple.__new__ builds the namedtuple in C: a third of the cost of PlantOutputs(...)
         return _new_tuple(PlantOutputs, (
             params.R_P * xi_p + params.R_M * xi_m + params.R_F * xi_f,

@@ -75,8 +75,9 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin, near=None):
     inverse_kelvin = constants.inv_centre_K - exponent / constants.energy_over_kB
     if constants.w2 != 0.0:
         start = None   # 1/(near + 273.15), where that is a temperature above absolute zero
-        if near is not None and near + KELVIN_OFFSET > 0.0:
-            start = 1.0 / (near + KELVIN_OFFSET)
+        if near is not None:
+            start = near + KELVIN_OFFSET
+            start = 1.0 / start if start > 0.0 else None
         inverse_kelvin = two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants,
                                            start)
     elif not inverse_kelvin > 0.0:

@@ -51,11 +51,13 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants, start=No
     E_max) u^2: since |Lambda''| <= 2 E_max |Lambda'|, the step leaves an error of about
     E_max dx^2 in u, that many kelvin in T. At most :data:`ROOT_CAP` rounds.
     """
-    energy1, energy2 = constants.energy_over_kB, constants.energy2_over_kB
-    centre1, centre2 = constants.inv_centre_K, constants.inv_centre2_K
-    total1, total2 = constants.M1, constants.M2
+    total1, energy1, centre1, total2, energy2, centre2 = constants.stages
+    exp, log = _exp, _log   # locals: this runs at every compensator step
     other = centre2 - exponent / energy2
-    low, high = (inverse_kelvin, other) if inverse_kelvin <= other else (other, inverse_kelvin)
+    if inverse_kelvin <= other:
+        low, high = inverse_kelvin, other
+    else:
+        low, high = other, inverse_kelvin
     if not low > 0.0:
         low = 0.0
         mf, p = two_stage_fractions(0.0, constants)
@@ -76,23 +78,23 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants, start=No
                 energy2, centre2, total2, energy1, centre1, total1, other)
         z = energy_b * (centre_b - u)   # the broad stage at u_s, split as logistic_split does
         if z > 0.0:
-            e = _exp(-z)
+            e = exp(-z)
             d = 1.0 + e
             half = total_b * e / d      # the smaller half, MF
             left_mf, left_p = xi_mf - half, xi_p - total_b / d
         else:
-            e = _exp(z)
+            e = exp(z)
             d = 1.0 + e
             half = total_b * e / d      # the smaller half, P
             left_mf, left_p = xi_mf - total_b / d, xi_p - half
         if left_mf > 0.0 and left_p > 0.0:
-            target = centre_s - _log(left_p / left_mf) / steepest
+            target = centre_s - log(left_p / left_mf) / steepest
             u = u + (target - u) / (1.0 + energy_b * (half / d) / steepest * (
                 1.0 / left_p + 1.0 / left_mf))
         elif left_mf > 0.0:   # the broad stage alone holds more P: the steep one is all MF
-            u = centre_b - _log(xi_p / (xi_mf - total_s)) / energy_b if xi_mf > total_s else low
+            u = centre_b - log(xi_p / (xi_mf - total_s)) / energy_b if xi_mf > total_s else low
         else:                 # it holds more MF: the steep one is all P
-            u = centre_b - _log((xi_p - total_s) / xi_mf) / energy_b if xi_p > total_s else low
+            u = centre_b - log((xi_p - total_s) / xi_mf) / energy_b if xi_p > total_s else low
         if not low < u < high:
             u = 0.5 * (low + high)
     limit = ROOT_TOLERANCE_K / steepest
@@ -101,29 +103,29 @@ def two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants, start=No
         # function call per stage costs ~15 % of an inversion in Python
         z = energy1 * (centre1 - u)
         if z > 0.0:
-            e = _exp(-z)
+            e = exp(-z)
             d = 1.0 + e
             mf1, p1 = total1 * e / d, total1 / d
             q1 = mf1 / d
         else:
-            e = _exp(z)
+            e = exp(z)
             d = 1.0 + e
             mf1, p1 = total1 / d, total1 * e / d
             q1 = p1 / d
         z = energy2 * (centre2 - u)
         if z > 0.0:
-            e = _exp(-z)
+            e = exp(-z)
             d = 1.0 + e
             mf2, p2 = total2 * e / d, total2 / d
             q2 = mf2 / d
         else:
-            e = _exp(z)
+            e = exp(z)
             d = 1.0 + e
             mf2, p2 = total2 / d, total2 * e / d
             q2 = p2 / d
         mf, p = mf1 + mf2, p1 + p2
         if mf > 0.0 and p > 0.0:
-            residual = _log(p / mf) - exponent
+            residual = log(p / mf) - exponent
             slope = (energy1 * q1 + energy2 * q2) * (1.0 / mf + 1.0 / p)   # -Lambda'
         else:   # a fraction underflowed (extreme values): its sign only, then halve
             residual, slope = p - mf, 0.0

@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from sma_fmu.runtime.constant_load import BranchConstants
+from sma_fmu.runtime.constant_load import BranchConstants, with_second_stage
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
 from sma_fmu.runtime.minor_loops import DENOMINATOR_FLOOR, push_reversal
 from sma_fmu.runtime.sensing import invert_on_stack
@@ -277,10 +277,10 @@ class MinorLoopMemory:
         if not self.two_stage[column]:
             return constants
         heating = sample["heating"]
-        return constants._replace(
-            w2=1.0, M1=sample["M1"], M2=sample["M2"],
-            energy2_over_kB=sample["energy2_heating" if heating else "energy2_cooling"],
-            inv_centre2_K=sample["inv2_heating" if heating else "inv2_cooling"])
+        return with_second_stage(
+            constants, 1.0, sample["M1"], sample["M2"],
+            sample["energy2_heating" if heating else "energy2_cooling"],
+            sample["inv2_heating" if heating else "inv2_cooling"])
 
     def _assumed(self, column, points, sample):
         """(T_ref, xi_MF) the compensator assumed at a sample that was no event (its stack

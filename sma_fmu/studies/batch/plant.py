@@ -37,7 +37,7 @@ runs without: alpha = 0, the given lengths).
 """
 import numpy as np
 
-from sma_fmu.runtime.constant_load import BranchConstants
+from sma_fmu.runtime.constant_load import BranchConstants, with_second_stage
 from sma_fmu.runtime.constants import COOLING, HEATING, KELVIN_OFFSET
 from sma_fmu.runtime.minor_loops import (DENOMINATOR_FLOOR, ReversalPoint, branch_of, push_reversal,
                                          wipe_out)
@@ -296,10 +296,9 @@ class BatchPlant(PlantTerms):
             float(self.M[run]), None, -float(self.minus_energy[run]),
             float(self.inv_heating[run] if heating else self.inv_cooling[run]), None)
         if self.M2[run] != 0.0:                         # a second stage (w2 > 0)
-            constants = constants._replace(
-                w2=1.0, M1=float(self.M1[run]), M2=float(self.M2[run]),
-                energy2_over_kB=-float(self.minus_energy2[run]),
-                inv_centre2_K=float(self.inverse2[run]))
+            constants = with_second_stage(
+                constants, 1.0, float(self.M1[run]), float(self.M2[run]),
+                -float(self.minus_energy2[run]), float(self.inverse2[run]))
         branch = branch_of(points, c, constants, HEATING if heating else COOLING)
         self._value_B[run], self._ratio[run], self._major_B[run] = branch
 
