@@ -2,10 +2,14 @@
 (as fmpy's simulate_fmu does, and FmuInstance with SMA_FMU_UNPACK_EACH=1, which this probe
 sets unless ``--shared``), and measure the process before and after.
 
-    python tests/support/instance_memory_probe.py FMU [--warm 50] [--instances 200] [--fmpy] [--shared]
+    python tests/support/instance_memory_probe.py FMU [--warm 50] [--instances 200] [--blocks 1]
+        [--fmpy] [--shared]
 
 Prints one JSON object: resident memory growth per instance [KiB], growth of the mappings
-of FMU binaries, of sys.path, of sys.path_importer_cache and of Python objects. ``--fmpy``
+of FMU binaries, of sys.path, of sys.path_importer_cache and of Python objects. With
+``--blocks N`` the measured instances run in N equal blocks and the resident growth per
+instance of each block is reported too, with their median: a leak grows every block, a
+one-off step (an allocator's pool, a hash table doubling) only one. ``--fmpy``
 uses plain ``fmpy.simulate_fmu`` instead of :class:`~sma_fmu.fmi.driving.instance.FmuInstance`.
 Each instance is initialized, stepped, terminated and freed, and its folder removed.
 """
@@ -14,6 +18,7 @@ import gc
 import json
 import os
 import re
+import statistics
 import sys
 
 
@@ -30,6 +35,7 @@ def main(argv=None):
     parser.add_argument("fmu")
     parser.add_argument("--warm", type=int, default=50, help="instances before the first measurement")
     parser.add_argument("--instances", type=int, default=200, help="instances measured")
+    parser.add_argument("--blocks", type=int, default=1, help="blocks the measured instances run in")
     parser.add_argument("--fmpy", action="store_true", help="plain fmpy.simulate_fmu")
     parser.add_argument("--shared", action="store_true",
                         help="FmuInstance's instances share one unpacked folder (its default)")
@@ -52,14 +58,23 @@ def main(argv=None):
         one(k)
     gc.collect()
     before = _state()
-    for k in range(args.instances):
-        one(k)
-    gc.collect()
-    after = _state()
+    size = args.instances // args.blocks
+    blocks, last = [], before
+    for block in range(args.blocks):
+        for k in range(block * size, (block + 1) * size):
+            one(k)
+        gc.collect()
+        state = _state()
+        blocks.append(round((state["rss_kib"] - last["rss_kib"]) / size, 2))
+        last = state
+    after = last
     growth = {key: after[key] - before[key] for key in before}
-    print(json.dumps({"instances": args.instances, "before": before, "after": after,
-                      "rss_kib_per_instance": round(growth["rss_kib"] / args.instances, 2),
-                      "objects_per_instance": round(growth["objects"] / args.instances, 2),
+    measured = size * args.blocks
+    print(json.dumps({"instances": measured, "before": before, "after": after,
+                      "rss_kib_per_instance": round(growth["rss_kib"] / measured, 2),
+                      "rss_kib_per_instance_blocks": blocks,
+                      "rss_kib_per_instance_median": statistics.median(blocks),
+                      "objects_per_instance": round(growth["objects"] / measured, 2),
                       "growth": growth}))
 
 
