@@ -10,7 +10,7 @@ to R_ref through the model.
 import bisect
 import math
 
-__all__ = ["REFERENCE_KINDS", "MAX_REFERENCE_OHM", "MAX_STROKE_MM", "QUANTITIES", "ReferenceSignal", "LoadProfile", "reference_from_table",
+__all__ = ["REFERENCE_KINDS", "unit_key", "MAX_REFERENCE_OHM", "MAX_STROKE_MM", "QUANTITIES", "ReferenceSignal", "LoadProfile", "reference_from_table",
            "load_from_table"]
 
 MAX_REFERENCE_OHM = 1e6  # a wire's resistance is ohms to kilo-ohms; beyond this is a typo
@@ -47,7 +47,7 @@ def _increasing(times, key):
         raise ValueError(f"{key} must be strictly increasing, got {times!r}")
 
 
-def _unit_key(key, unit):
+def unit_key(key, unit):
     """``key`` of :data:`REFERENCE_KINDS` (unit ohm) with its unit suffix for ``unit``."""
     return key[:-3] + unit if key.endswith("_ohm") else key
 
@@ -185,7 +185,7 @@ def reference_from_table(table):
         raise ValueError(f"quantity must be one of {', '.join(QUANTITIES)}, got {quantity!r}")
     unit = QUANTITIES[quantity]
     required, optional = REFERENCE_KINDS[kind]
-    required = tuple(_unit_key(key, unit) for key in required)
+    required = tuple(unit_key(key, unit) for key in required)
     unknown = sorted(set(table) - set(required) - set(optional) - {"kind", "quantity"})
     if unknown:
         raise ValueError(f"unknown key(s) {', '.join(unknown)} for kind {kind!r}; expected "
@@ -199,7 +199,7 @@ def reference_from_table(table):
             continue
         settings[key] = _numbers(table, key) if key.startswith(("times", "values")) else _number(table, key)
     if kind == "table":
-        values = _unit_key("values_ohm", unit)
+        values = unit_key("values_ohm", unit)
         if len(settings["times_s"]) != len(settings[values]):
             raise ValueError(f"times_s and {values} must have the same length")
         _increasing(settings["times_s"], "times_s")

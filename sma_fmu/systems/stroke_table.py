@@ -19,17 +19,12 @@ from pathlib import Path
 from sma_fmu.fmi.packaging.runtime_program import runtime_program
 from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.scenario_signals import table_text
-from sma_fmu.runtime.signals import REFERENCE_KINDS
+from sma_fmu.runtime.signals import REFERENCE_KINDS, unit_key
 from sma_fmu.runtime.stroke import step_table
 
 __all__ = ["SOURCE", "is_stroke", "stroke_table_program", "stroke_table_input", "stroke_table_text"]
 
 SOURCE = Path(__file__).parent / "stroke_table.c"
-# the settings stroke_table.c reads after each kind, in its order (the kinds' own keys)
-_SETTINGS = {"constant": ("value_ohm",), "step": ("initial_ohm", "final_ohm", "time_s"),
-             "ramp": ("start_ohm", "end_ohm", "start_time_s", "end_time_s"),
-             "sine": ("offset_ohm", "amplitude_ohm", "frequency_hz", "phase_deg"),
-             "cosine": ("offset_ohm", "amplitude_ohm", "frequency_hz", "phase_deg")}
 
 
 _PROGRAMS = {}   # the program's executable, by cache folder and compiler settings
@@ -61,14 +56,15 @@ def stroke_table_input(scenario):
     numbers = [math.nan if getattr(params, spec.name) is None else float(getattr(params, spec.name))
                for spec in PARAMETER_SPECS]
     numbers += [reference.map.start_length, list(REFERENCE_KINDS).index(signal.kind)]
+    required, optional = REFERENCE_KINDS[signal.kind]   # stroke_table.c reads them in this order
+
     def setting(key):   # the kinds' own keys (..._ohm) in the signal's unit (..._mm)
-        unit_key = key[:-3] + signal.unit if key.endswith("_ohm") else key
-        return signal.settings.get(unit_key, 0.0)   # phase_deg: 0 unless given
+        return signal.settings.get(unit_key(key, signal.unit), optional.get(key))
 
     if signal.kind == "table":
         numbers += _array(setting("times_s")) + _array(setting("values_ohm"))
     else:
-        numbers += [setting(key) for key in _SETTINGS[signal.kind]]
+        numbers += [setting(key) for key in required + tuple(optional)]
     numbers += _array(load.times) + _array(load.values) + [scenario.step_s, scenario.steps]
     return " ".join(map(repr, map(float, numbers)))
 
