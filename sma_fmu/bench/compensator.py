@@ -15,9 +15,9 @@ import subprocess
 import time
 
 from sma_fmu.bench.inverse import timing_program
+from sma_fmu.fmi.packaging.runtime_program import wire_numbers
 from sma_fmu.cosim.scenario import load_scenario, resolve_scenarios
 from sma_fmu.runtime.feedforward import FeedforwardStepper
-from sma_fmu.runtime.parameters import PARAMETER_SPECS
 
 __all__ = ["CASES", "START_S", "STEPS", "compensator_samples", "python_compensator_ns",
            "python_compensator_sum", "c_compensator_passes", "c_compensator_ns",
@@ -90,9 +90,7 @@ def c_compensator_passes(program, case, passes, steps=STEPS):
     runtime (``program``: compensator_timing)."""
     scenario, s = _settings(case)
     params = scenario.compensator_params
-    numbers = [math.nan if getattr(params, spec.name) is None else float(getattr(params, spec.name))
-               for spec in PARAMETER_SPECS]
-    numbers += [s["alpha"], s["beta"], s["model_load"], float(s["adapt_to_load"])]
+    numbers = wire_numbers(params) + [s["alpha"], s["beta"], s["model_load"], float(s["adapt_to_load"])]
     words = [s["inverse"], s["shaping"]]
     samples = compensator_samples(scenario, steps=steps)
     tail = [math.nan if s["power_cap"] is None else s["power_cap"], s["anticipation"],

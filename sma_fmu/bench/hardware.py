@@ -17,7 +17,6 @@ import statistics
 import subprocess
 import tempfile
 import time
-from importlib import resources
 from pathlib import Path
 
 from sma_fmu.bench.c_master import TARGET, c_master_times

@@ -16,7 +16,6 @@ the case this measures), else the reference wire with a broad second stage of th
 Flexinol fit gives (:data:`SECOND_STAGE`).
 """
 import dataclasses
-import math
 import os
 import statistics
 import subprocess
@@ -24,8 +23,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from sma_fmu.fmi.packaging.runtime_program import runtime_program, wire_numbers
 from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
-from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.sensing import temperature_of_fractions
 
 __all__ = ["SCENARIO", "FMUS", "SECOND_STAGE", "default_two_stage", "TARGETS", "inverse_targets",
@@ -73,16 +72,12 @@ def python_inverse_ns(constants, targets, margin, passes):
 def timing_program(folder, name="inverse_timing"):
     """The bench's ``<name>.c`` compiled with the C runtime's sources (and the timing programs'
     shared header), kept in ``folder``; its path."""
-    from sma_fmu.fmi.packaging.runtime_program import runtime_program
-
     return runtime_program(Path(__file__).parent / f"{name}.c", folder, ("timing_input.h",))
 
 
 def c_inverse_ns(program, params, load, direction, targets, passes=C_PASSES):
     """Median CPU time [ns] of one C inversion (``program`` from :func:`timing_program`)."""
-    values = [getattr(params, spec.name) for spec in PARAMETER_SPECS]
-    numbers = [math.nan if v is None else float(v) for v in values]
-    numbers += [load, direction, passes, len(targets)] + [v for pair in targets for v in pair]
+    numbers = wire_numbers(params) + [load, direction, passes, len(targets)] + [v for pair in targets for v in pair]
     result = subprocess.run([str(program)], input=" ".join(map(repr, numbers)),
                             capture_output=True, text=True)
     if result.returncode != 0:

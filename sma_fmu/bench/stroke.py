@@ -19,7 +19,6 @@ C runtime's stroke map, bit-equal to Python's), and the profile's R_ref(t) as th
 stroke table computes it (the whole program's CPU per step).
 """
 import dataclasses
-import math
 import resource
 import shutil
 import statistics
@@ -33,8 +32,8 @@ from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.bench.inverse import timing_program
+from sma_fmu.fmi.packaging.runtime_program import wire_numbers
 from sma_fmu.runtime import stroke as stroke_module
-from sma_fmu.runtime.parameters import PARAMETER_SPECS
 from sma_fmu.runtime.stroke import StrokeMap, start_length
 from sma_fmu.systems.stroke_table import stroke_table_input, stroke_table_program
 from sma_fmu.wire.parameter_file import load_parameter_set
@@ -96,9 +95,7 @@ def map_costs(passes):
 
 def c_map_ns(program, stroke_map, load, direction, strokes, passes):
     """Median CPU time [ns] of one C mapping (``program``: stroke_timing) of ``strokes`` [m]."""
-    values = [getattr(stroke_map.params, spec.name) for spec in PARAMETER_SPECS]
-    numbers = [math.nan if v is None else float(v) for v in values]
-    numbers += [stroke_map.start_length, load, direction, passes, len(strokes), *strokes]
+    numbers = wire_numbers(stroke_map.params) + [stroke_map.start_length, load, direction, passes, len(strokes), *strokes]
     result = subprocess.run([str(program)], input=" ".join(map(repr, numbers)),
                             capture_output=True, text=True)
     if result.returncode != 0:

@@ -11,13 +11,11 @@ character; the C master uses it. The program is compiled once per source and com
 (:func:`~sma_fmu.fmi.packaging.runtime_program.runtime_program`).
 """
 import array
-import math
 import os
 import subprocess
 from pathlib import Path
 
-from sma_fmu.fmi.packaging.runtime_program import runtime_program
-from sma_fmu.runtime.parameters import PARAMETER_SPECS
+from sma_fmu.fmi.packaging.runtime_program import runtime_program, wire_numbers
 from sma_fmu.runtime.scenario_signals import table_text
 from sma_fmu.runtime.signals import REFERENCE_KINDS, unit_key
 from sma_fmu.runtime.stroke import step_table
@@ -53,9 +51,7 @@ def stroke_table_input(scenario):
     """The numbers ``stroke_table.c`` reads for ``scenario`` (a stroke reference), as text."""
     reference = scenario.reference
     params, signal, load = reference.map.params, reference.signal, reference.load
-    numbers = [math.nan if getattr(params, spec.name) is None else float(getattr(params, spec.name))
-               for spec in PARAMETER_SPECS]
-    numbers += [reference.map.start_length, list(REFERENCE_KINDS).index(signal.kind)]
+    numbers = wire_numbers(params) + [reference.map.start_length, list(REFERENCE_KINDS).index(signal.kind)]
     required, optional = REFERENCE_KINDS[signal.kind]   # stroke_table.c reads them in this order
 
     def setting(key):   # the kinds' own keys (..._ohm) in the signal's unit (..._mm)

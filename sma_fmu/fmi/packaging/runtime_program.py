@@ -8,13 +8,15 @@ include path (a timing program's shared header), into a cache folder under a key
 input, so each is compiled once per source and compiler.
 """
 import hashlib
+import math
 import tempfile
 from pathlib import Path
 
 from sma_fmu.fmi.hosts import build_once, c_compiler
 from sma_fmu.fmi.packaging.parameter_table import generated_folder
+from sma_fmu.runtime.parameters import PARAMETER_SPECS
 
-__all__ = ["RUNTIME", "runtime_program"]
+__all__ = ["RUNTIME", "runtime_program", "wire_numbers"]
 
 RUNTIME = Path(__file__).parents[1] / "c_family" / "runtime"   # the C runtime's sources
 _FLAGS = ["-std=c99", "-O2", "-ffp-contract=off"]
@@ -39,3 +41,10 @@ def runtime_program(source, cache=None, headers=()):
         *compiler, *_FLAGS, f"-I{source.parent}", f"-I{RUNTIME}", f"-I{generated}", "-o",
         str(built), str(source), *map(str, sorted(RUNTIME.glob("*.c"))), "-lm"], compiler,
         timeout=600)
+
+
+def wire_numbers(params):
+    """The wire's values in PARAMETER_SPECS order as floats, NaN for a value not given: what
+    every runtime program reads first (``wire_parameters_from_values``)."""
+    return [math.nan if value is None else float(value)
+            for value in (getattr(params, spec.name) for spec in PARAMETER_SPECS)]
