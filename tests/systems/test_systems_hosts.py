@@ -11,6 +11,7 @@ import dataclasses
 import io
 import json
 import math
+import os
 import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
@@ -168,6 +169,24 @@ def test_every_host_fails_on_a_feedforward_system_without_its_compensator(fmu_di
             run()
 
 
+def test_ecos_leaves_no_copy_of_the_ssp_behind(fmu_dir, tmp_path, monkeypatch):
+    """Ecos unpacks each SSP under TMPDIR and never removes it (2.9 MB a run): the run gives
+    it a folder of its own, gone afterwards, and TMPDIR as it was; a failed run too."""
+    from sma_fmu.systems import hosts
+    from sma_fmu.fmi.loop.wiring import loop_outputs
+
+    system = closed_loop(short("heavy-pi", stop_time_s=0.01, load=None), fmu_dir)
+    ssp = write_ssp(system, tmp_path / "pi.ssp")
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
+    monkeypatch.setenv("TMPDIR", str(temporary))
+    samples = hosts.run_ssp_ecos(ssp, 1e-3, 10, loop_outputs(feedforward=False))
+    assert len(samples["R"]) == 11
+    with pytest.raises(hosts.HostError):
+        hosts.run_ssp_ecos(ssp, 1e-3, 10, loop_outputs(feedforward=True))
+    assert list(temporary.iterdir()) == [] and os.environ["TMPDIR"] == str(temporary)
+
+
 def test_fmpy_simulate_ssp_runs_the_loop_from_zero_inputs(adaptive, fmu_dir):
     """As docs/systems.md says: fmpy's simulate_ssp feeds 0.0 into every input at t = 0;
     the compensator takes R_ref = 0 ohm as no reference yet, with one warning."""
@@ -227,7 +246,7 @@ def test_run_paths_write_the_usual_results(fmu_dir, tmp_path):
     for path, coupling in (("ssp", "jacobi"), ("container", "gauss-seidel")):
         out = tmp_path / path
         assert main(["run", str(scenario_file), "--path", path, "--fmus", str(fmu_dir),
-                     "--out", str(out)]) == 0
+                     "--figures", "--out", str(out)]) == 0
         folder = out / "short-fixed"
         assert {p.name for p in folder.iterdir()} == {"timeseries.csv", "metrics.json", "figure.png"}
         library = scenario_metrics(run_library(scenario, coupling).data, scenario)
