@@ -79,7 +79,7 @@ _HOUR_RUN = """
 import json, re, resource, sys
 from sma_fmu.systems.runner import run_scenarios
 run_scenarios([sys.argv[1]], sys.argv[2], "fmu", sys.argv[3], progress=lambda _: None,
-              fmt=sys.argv[4], master="c")
+              fmt=sys.argv[4], master="c", figures=True)   # the heavier case
 try:
     with open("/proc/self/status") as status:
         print(json.dumps(int(re.search(r"VmHWM:\\s*(\\d+) kB", status.read()).group(1))))

@@ -3,7 +3,7 @@
 - :func:`run_command_times`: ``sma-fmu run paper --fmus DIR --master c`` against ``sma-fmu
   run paper --path library``, each the whole command in a process of its own (start-up,
   imports, unpacking, loading, runs, metrics, reports and figures, until its files are
-  closed), alternating, with figures (the default) and with ``--no-figures``; the output
+  closed), alternating, as it is by default (no figures) and with ``--figures``; the output
   files compared (the same names, the same time series); and from each run's
   ``summary.json`` the run table's "wall s" of every scenario, C master over library.
 - :func:`sweep_throughput`: the shipped gain grid on two Dask worker processes, each
@@ -69,7 +69,7 @@ def _summary(values):
 
 
 def run_command_times(native_dir, runs, folder, scenarios=("paper",)):
-    """{"figures"|"no figures": {c_s, library_s, c_cpu_s, library_cpu_s (medians), ratio
+    """{"default, no figures"|"--figures": {c_s, library_s, c_cpu_s, library_cpu_s (medians), ratio
     (median of the per-pair ratios, min, max), same_outputs, walls}} over ``runs``
     alternating whole commands, after one of each to warm the file cache; walls: {scenario:
     ratio of the run table's wall s (median over the runs)}."""
@@ -77,7 +77,7 @@ def run_command_times(native_dir, runs, folder, scenarios=("paper",)):
     commands = {"c": ["run", *scenarios, "--fmus", str(native_dir), "--master", "c"],
                 "library": ["run", *scenarios, "--path", "library"]}
     results = {}
-    for label, flags in (("figures", []), ("no figures", ["--no-figures"])):
+    for label, flags in (("default, no figures", []), ("--figures", ["--figures"])):
         for path, arguments in commands.items():   # warm-up
             _command([*arguments, *flags], folder / f"warm-{path}")
         measured = {path: [] for path in commands}
@@ -85,7 +85,7 @@ def run_command_times(native_dir, runs, folder, scenarios=("paper",)):
         for index in range(runs):
             outs = {}
             for path, arguments in commands.items():
-                outs[path] = folder / f"{label.replace(' ', '-')}-{path}-{index}"
+                outs[path] = folder / f"{'figures' if flags else 'default'}-{path}-{index}"
                 measured[path].append(_command([*arguments, *flags], outs[path]))
             same = same and _same_outputs(outs["c"], outs["library"])
             c_walls, library_walls = _walls(outs["c"]), _walls(outs["library"])

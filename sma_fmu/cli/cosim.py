@@ -18,14 +18,15 @@ def _run(args):
     from sma_fmu.systems.runner import timed_run
     timed_run(paths, args.out, args.path, args.fmus, progress=echo,
               output_interval_s=args.output_interval, fmt=args.format, master=args.master,
-              events=args.events, timeout_s=args.timeout, figures=not args.no_figures)
+              events=args.events, timeout_s=args.timeout, figures=args.figures)
     return 0
 
 
 def register(commands):
     """Add ``run`` to the ``commands`` subparsers."""
     run = commands.add_parser(
-        "run", help="run scenarios (names, files, 'paper' or --all): CSV, metrics, figures")
+        "run", help="run scenarios (names, files, 'paper' or --all): CSV, metrics, reports; "
+             "figures with --figures")
     add_scenario_arguments(run)
     run.add_argument("--out", type=Path, default=Path("results"), metavar="DIR", help="output folder")
     run.add_argument("--path", choices=("fmu", "library", "ssp", "container"), default="fmu",
@@ -48,8 +49,11 @@ def register(commands):
                           "every step); the metrics always use every step")
     run.add_argument("--format", choices=("csv", "parquet"), default="csv",  # recording.FORMATS
                      help="time-series file: timeseries.csv (default) or timeseries.parquet")
-    run.add_argument("--no-figures", action="store_true",
-                     help="write no figures (figure.png, comparison-*.png): the time series, "
-                          "metrics and reports only, without the time figures take")
+    figures = run.add_mutually_exclusive_group()
+    figures.add_argument("--figures", action="store_true",
+                         help="also draw the figures (NAME/figure.png, comparison-GROUP.png); "
+                              "without it, the time series, metrics and reports only")
+    figures.add_argument("--no-figures", action="store_true",
+                         help="no figures (the default; kept for scripts that say so)")
     add_quiet_argument(run)
     run.set_defaults(handler=_run)

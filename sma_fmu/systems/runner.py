@@ -1,12 +1,13 @@
 """Run scenarios and write their results: CSV, metrics JSON, figures, comparison table.
 
-For each scenario ``NAME`` in ``out_dir``: ``NAME/timeseries.csv`` (or ``.parquet``),
-``NAME/metrics.json`` and ``NAME/figure.png``, written while the run goes. Scenarios with the same file name from different folders get
+For each scenario ``NAME`` in ``out_dir``: ``NAME/timeseries.csv`` (or ``.parquet``) and
+``NAME/metrics.json``, written while the run goes, and with ``figures=True`` ``NAME/figure.png``. Scenarios with the same file name from different folders get
 ``FOLDER-NAME`` instead, so none overwrites another. For each group of scenarios (see
-:attr:`~sma_fmu.cosim.scenario.Scenario.group`): ``comparison-GROUP.png``. Over the whole
+:attr:`~sma_fmu.cosim.scenario.Scenario.group`), with figures: ``comparison-GROUP.png``. Over the whole
 run: ``comparison.md``, which ranks the runs by RMSE in each group, and ``summary.json``.
 Everything is written into a temporary folder and moved into ``out_dir`` at the end.
-``figures=False`` (``--no-figures``) writes no PNG (and never imports matplotlib).
+Figures are drawn only when asked (``figures=True``, ``--figures``): without them no PNG is
+written and matplotlib is never imported, so a run costs what its loop costs (docs/scenarios.md).
 
 The C master (``master="c"``) is one :class:`~sma_fmu.systems.c_master.CMaster` for all the
 scenarios: one host process, each FMU unpacked and loaded once; what that start-up cost is
@@ -88,7 +89,7 @@ def comparison_labels(scenarios, names):
 
 def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=print,
                   output_interval_s=None, fmt="csv", master="fmpy", events=False,
-                  timeout_s=None, figures=True):
+                  timeout_s=None, figures=False):
     """Run scenario files through ``path`` (a key of :data:`PATHS`); write results; return rows.
 
     All files are read and checked before the first run, so a bad file costs no time, and
@@ -102,7 +103,8 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     only): the longest the C master may send nothing before the run fails (None:
     :data:`~sma_fmu.systems.c_master.DEFAULT_TIMEOUT_S`). Each run streams into its files
     (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
-    ``figures``: write the figures (``--no-figures``: False). A scenario with a stroke
+    ``figures``: also write the figures (the command line's ``--figures``; without
+    them matplotlib is never imported). A scenario with a stroke
     reference runs on the library and FMU paths only (the master maps the stroke to an R_ref
     table for the signals FMU), not with ``events``: ValueError before any run.
     """
@@ -197,11 +199,12 @@ def _record_run(scenario, run, fmu_dir, folder, every, fmt):
 
 
 def timed_run(paths, out_dir, path, fmu_dir, progress=print, output_interval_s=None, fmt="csv",
-              master="fmpy", events=False, timeout_s=None, figures=True):
+              master="fmpy", events=False, timeout_s=None, figures=False):
     """:func:`run_scenarios`, then print the summary table; returns the rows."""
     start = time.perf_counter()
     rows = run_scenarios(paths, out_dir, path, fmu_dir, progress, output_interval_s, fmt, master,
                          events, timeout_s, figures)
     progress(summary_table(rows))
-    progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)")
+    progress(f"results in {out_dir}/ ({time.perf_counter() - start:.1f} s)"
+             + ("" if figures else "; no figures: --figures draws them"))
     return rows

@@ -25,15 +25,15 @@ def test_whole_run_commands_write_the_same_files(native_dir, tmp_path):
     from sma_fmu.bench.c_master_commands import COMMAND_TARGET, command_lines, run_command_times
 
     times = run_command_times(native_dir, 1, tmp_path, scenarios=("heavy-pi", "heavy-pi+ff-fixed"))
-    assert set(times) == {"figures", "no figures"}
+    assert set(times) == {"default, no figures", "--figures"}
     for label, row in times.items():
         assert row["same_outputs"] and row["runs"] == 1 and row["c_s"] > 0 and row["library_s"] > 0
         assert set(row["walls"]) == {"heavy-pi", "heavy-pi+ff-fixed"}
         assert row["ratio"]["median"] == pytest.approx(row["c_s"] / row["library_s"], rel=0.01)
     for path in ("c", "library"):
         assert (tmp_path / f"figures-{path}-0" / "heavy-pi" / "figure.png").is_file()
-        assert (tmp_path / f"no-figures-{path}-0" / "heavy-pi" / "metrics.json").is_file()
-        assert not list((tmp_path / f"no-figures-{path}-0").rglob("*.png"))
+        plain = tmp_path / f"default-{path}-0"
+        assert (plain / "heavy-pi" / "metrics.json").is_file() and not list(plain.rglob("*.png"))
     lines = command_lines(times)
     assert f"target <= {COMMAND_TARGET:g}" in lines[0] and "the same output files: yes" in lines[0]
     assert any(line.strip().startswith("run table's wall s, heavy-pi:") for line in lines)

@@ -9,7 +9,7 @@ from sma_fmu.cosim.loop import COLUMNS
 
 
 def test_run_paper_library_path_writes_everything(tmp_path, capsys):
-    assert main(["run", "paper", "--path", "library", "--out", str(tmp_path)]) == 0
+    assert main(["run", "paper", "--path", "library", "--figures", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "[6/6] heavy-pi+ff-adaptive" in out and "RMSE" in out
     for name in ("load-step-pi", "heavy-pi+ff-adaptive"):

@@ -161,21 +161,24 @@ def test_the_runner_keeps_one_host_for_all_its_scenarios(native_dir, started, tm
         assert (tmp_path / "c" / name / "timeseries.csv").stat().st_size > 1_000_000
 
 
-def test_no_figures_writes_every_other_file_alike(native_dir, tmp_path):
+def test_figures_are_drawn_on_demand_and_every_other_file_is_alike(native_dir, tmp_path):
+    """Without --figures (the default) or with --no-figures: every file --figures writes
+    but the PNGs, byte for byte."""
     from sma_fmu.cli import main
 
     files = {}
-    for flag in ([], ["--no-figures"]):
-        out = tmp_path / ("without" if flag else "with")
+    for flag in ("--figures", None, "--no-figures"):
+        out = tmp_path / str(flag)
         assert main(["run", "heavy-pi", "heavy-pi+ff-fixed", "--fmus", str(native_dir), "--master",
-                     "c", "--out", str(out), *flag]) == 0
-        files[bool(flag)] = {p.relative_to(out): p for p in out.rglob("*") if p.is_file()}
-    pictures = {name for name in files[False] if name.suffix == ".png"}
+                     "c", "--out", str(out), *([flag] if flag else [])]) == 0
+        files[flag] = {p.relative_to(out): p for p in out.rglob("*") if p.is_file()}
+    pictures = {name for name in files["--figures"] if name.suffix == ".png"}
     assert {name.as_posix() for name in pictures} == {
         "heavy-pi/figure.png", "heavy-pi+ff-fixed/figure.png", "comparison-heavy.png"}
-    assert set(files[True]) == set(files[False]) - pictures
-    for name in ("heavy-pi/timeseries.csv", "heavy-pi+ff-fixed/timeseries.csv", "comparison.md"):
-        assert files[False][Path(name)].read_bytes() == files[True][Path(name)].read_bytes()
+    for flag in (None, "--no-figures"):
+        assert set(files[flag]) == set(files["--figures"]) - pictures
+        for name in ("heavy-pi/timeseries.csv", "heavy-pi+ff-fixed/timeseries.csv", "comparison.md"):
+            assert files[flag][Path(name)].read_bytes() == files["--figures"][Path(name)].read_bytes()
 
 
 def test_a_sweep_task_keeps_the_workers_master(native_dir, started, tmp_path, monkeypatch):

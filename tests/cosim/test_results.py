@@ -62,7 +62,8 @@ def test_two_settings_of_one_controller_are_compared_by_name(tmp_path, capsys):
     slow = _copy(tmp_path, "heavy-pi", changes)
     fast = slow.with_name("heavy-pi-fast.toml")
     fast.write_text(slow.read_text().replace("[controller]\n", "[controller]\nKp_W_per_ohm = 1.2\n"))
-    assert main(["run", str(slow), str(fast), "--path", "library", "--out", str(tmp_path / "o")]) == 0
+    assert main(["run", str(slow), str(fast), "--path", "library", "--figures",
+                 "--out", str(tmp_path / "o")]) == 0
     comparison = (tmp_path / "o" / "comparison.md").read_text()
     # two runs of kind pi: labelled by their scenario names
     assert "| heavy-pi | pi |" in comparison and "| heavy-pi-fast | pi |" in comparison

@@ -80,7 +80,8 @@ def test_the_main_job_runs_without_any_optional_package(tmp_path):
                     raise ModuleNotFoundError(f"blocked: {{name}}", name=name)
         sys.meta_path.insert(0, Blocked())
         from sma_fmu.cli import main
-        status = main(["run", "heavy-pi", "--path", "library", "--out", {str(tmp_path / 'out')!r}])
+        status = main(["run", "heavy-pi", "--path", "library", "--figures",
+                       "--out", {str(tmp_path / 'out')!r}])
         print("imported:", sorted(m for m in sys.modules if m.split(".")[0] in {OPTIONAL!r}))
         sys.exit(status)
     """)
