@@ -202,9 +202,11 @@ def test_fmpy_simulate_ssp_runs_the_loop_from_zero_inputs(adaptive, fmu_dir):
         assert [status for status, _ in fmu.messages if status != "ok"] == ["warning"]
 
 
-def test_container_and_ssp_run_in_the_c_host(adaptive):
-    """A C program on libcosim's C API, with nothing preloaded (the FMUs load libpython)."""
+def test_container_and_ssp_run_in_the_c_host(adaptive, tmp_path, monkeypatch):
+    """A C program on libcosim's C API, with nothing preloaded (the FMUs load libpython);
+    it destroys what it made, so libcosim's unpacked copies (TMPDIR/libcosim_*) go too."""
     scenario, artifacts = adaptive
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
     n = scenario.steps
     last = {coupling: run_library(scenario, coupling).data[-1] for coupling in ("gauss-seidel", "jacobi")}
     container = run_c_host("fmu", artifacts["container"], scenario.step_s, n)
@@ -215,6 +217,7 @@ def test_container_and_ssp_run_in_the_c_host(adaptive):
     assert system["plant.R"] == pytest.approx(last["jacobi"]["R"], abs=TOLERANCE)
     assert system["plant.T"] == pytest.approx(last["jacobi"]["T"], abs=TOLERANCE)
     assert system["signals.R_ref"] == pytest.approx(last["jacobi"]["R_ref"], abs=TOLERANCE)
+    assert not list(tmp_path.glob("libcosim_*"))
 
 
 def test_container_declares_the_units_of_its_outputs(adaptive):

@@ -75,6 +75,8 @@ int cosim_observer_slave_get_boolean(cosim_observer* observer, cosim_slave_index
                                      const cosim_value_reference variables[], size_t nv,
                                      bool values[]);
 int cosim_execution_destroy(cosim_execution* execution);
+int cosim_local_slave_destroy(cosim_slave* slave);
+int cosim_observer_destroy(cosim_observer* observer);
 
 static const char usage[] = "usage: cosim_host [--timing] fmu|ssp FILE STEP_S STEPS [NAME=VALUE...]\n";
 
@@ -84,15 +86,20 @@ static int fail(const char* what)
     return 1;
 }
 
-/* The execution of an SSP, or of an FMU alone (its slave index in *fmu_index); NULL on failure. */
+/* The execution of an SSP, or of an FMU alone (its slave in *slave, its index in *fmu_index);
+   NULL on failure. The caller destroys the slave after the execution: libcosim unpacks the FMU
+   into a libcosim_<uuid> temporary folder that goes only when both are destroyed. */
 static cosim_execution* load(const char* kind, const char* path, cosim_duration step,
-                             cosim_slave_index* fmu_index)
+                             cosim_slave** slave, cosim_slave_index* fmu_index)
 {
     if (strcmp(kind, "ssp") == 0) return cosim_ssp_fixed_step_execution_create(path, true, 0, step);
     cosim_execution* execution = cosim_execution_create(0, step);
     if (!execution) return NULL;
-    cosim_slave* slave = cosim_local_slave_create(path, "fmu");
-    if (!slave || (*fmu_index = cosim_execution_add_slave(execution, slave)) < 0) return NULL;
+    *slave = cosim_local_slave_create(path, "fmu");
+    if (!*slave || (*fmu_index = cosim_execution_add_slave(execution, *slave)) < 0) {
+        cosim_execution_destroy(execution);
+        return NULL;
+    }
     return execution;
 }
 
@@ -223,6 +230,33 @@ static int print_outputs(cosim_execution* execution, cosim_observer* observer,
     return 0;
 }
 
+/* Set the start values, step, print every slave's outputs; 0 or the failure's status. The
+   observer it adds is left in *observer for the caller to destroy. */
+static int run_and_print(cosim_execution* execution, cosim_slave_index fmu_index, char** values,
+                         int nvalues, bool timing, long steps, cosim_observer** observer)
+{
+    int status = set_start_values(execution, fmu_index, values, nvalues);
+    if (status != 0) return status;
+    *observer = cosim_last_value_observer_create();
+    if (!*observer || cosim_execution_add_observer(execution, *observer) != 0)
+        return fail("cosim_execution_add_observer");
+    if (timing) {
+        if (timed_steps(execution, steps) != 0) return 1;
+    } else if (cosim_execution_step(execution, (size_t)steps) != 0) {
+        return fail("cosim_execution_step");
+    }
+    int count = cosim_execution_get_num_slaves(execution);
+    slave_info* slaves = calloc((size_t)count + 1, sizeof *slaves);
+    if (!slaves) return fail("calloc");
+    status = cosim_execution_get_slave_infos(execution, slaves, (size_t)count) != 0
+                 ? fail("cosim_execution_get_slave_infos") : 0;
+    for (int i = 0; i < count && status == 0; ++i) {
+        status = print_outputs(execution, *observer, &slaves[i]) != 0 ? 1 : 0;
+    }
+    free(slaves);
+    return status;
+}
+
 int main(int argc, char** argv)
 {
     const bool timing = argc > 1 && strcmp(argv[1], "--timing") == 0;
@@ -245,28 +279,18 @@ int main(int argc, char** argv)
     }
     cosim_log_set_output_level(LOG_WARNING);
     cosim_slave_index fmu_index = 0;
-    cosim_execution* execution = load(args[1], args[2], (cosim_duration)(step * 1e9 + 0.5), &fmu_index);
-    if (!execution) return fail("loading the system");
-    int status = set_start_values(execution, fmu_index, args + 5, nargs - 5);
-    if (status != 0) return status;
-    cosim_observer* observer = cosim_last_value_observer_create();
-    if (!observer || cosim_execution_add_observer(execution, observer) != 0)
-        return fail("cosim_execution_add_observer");
-    if (timing) {
-        if (timed_steps(execution, steps) != 0) return 1;
-    } else if (cosim_execution_step(execution, (size_t)steps) != 0) {
-        return fail("cosim_execution_step");
+    cosim_slave* slave = NULL;
+    cosim_execution* execution = load(args[1], args[2], (cosim_duration)(step * 1e9 + 0.5), &slave,
+                                      &fmu_index);
+    if (!execution) {
+        int failed = fail("loading the system");
+        cosim_local_slave_destroy(slave);
+        return failed;
     }
-
-    int count = cosim_execution_get_num_slaves(execution);
-    slave_info* slaves = calloc((size_t)count + 1, sizeof *slaves);
-    if (!slaves) return fail("calloc");
-    if (cosim_execution_get_slave_infos(execution, slaves, (size_t)count) != 0)
-        return fail("cosim_execution_get_slave_infos");
-    for (int i = 0; i < count; ++i) {
-        if (print_outputs(execution, observer, &slaves[i]) != 0) return 1;
-    }
-    free(slaves);
-    cosim_execution_destroy(execution);
-    return 0;
+    cosim_observer* observer = NULL;
+    int status = run_and_print(execution, fmu_index, args + 5, nargs - 5, timing, steps, &observer);
+    cosim_execution_destroy(execution);   /* then what it used: its temporary folders go */
+    cosim_observer_destroy(observer);
+    cosim_local_slave_destroy(slave);
+    return status;
 }
