@@ -21,16 +21,19 @@ _PHASES = ("austenite end", "transformation", "martensite end")
 
 
 def _part(residual, rows, noise, total):
+    """rows, RMS [1], RMS/noise, share of ``total``; RMS and ratio None for a part without
+    rows (a file with no martensite end, say), the share 0."""
     squares = float(np.sum(residual[rows] ** 2))
-    rms = float(np.sqrt(squares / rows.sum())) if rows.any() else float("nan")
-    return {"rows": int(rows.sum()), "rms": rms, "ratio": rms / noise,
-            "share": squares / total if total > 0 else float("nan")}
+    rms = float(np.sqrt(squares / rows.sum())) if rows.any() else None
+    return {"rows": int(rows.sum()), "rms": rms, "ratio": None if rms is None else rms / noise,
+            "share": squares / total if total > 0 else 0.0}
 
 
 def strain_parts(prepared, layout, x):
     """Per file: {"parts": [{"direction", "phase", "rows", "rms" [1], "ratio", "share"}],
     "cycles": [{"cycle", "rows", "rms", "ratio", "share"}]} of the strain residual at the
-    solution ``x`` (rows of left-out cycles excluded, as in the residual RMS)."""
+    solution ``x`` (rows of left-out cycles excluded, as in the residual RMS; a part without
+    rows has RMS and ratio None and share 0)."""
     params = layout.params(x)
     out = []
     for f in prepared:
