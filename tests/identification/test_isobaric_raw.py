@@ -14,7 +14,7 @@ import pytest
 from sma_fmu.cli import main
 from sma_fmu.identification.isobaric import runner
 from sma_fmu.identification.isobaric.cycles import parse_cycles
-from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.files import noise_level, read_isobaric
 from sma_fmu.identification.isobaric.fit import fit_isobaric, prepare
 from sma_fmu.identification.isobaric.outcome import check_inside
 from sma_fmu.identification.isobaric.summary import half_strain_table
@@ -96,3 +96,34 @@ def test_a_transformation_outside_the_data_is_refused_naming_it(params):
         check_inside(far, [prepare(data, 0)])
     assert "isobaric_100cycles.csv" in str(error.value) and "600 degC" in str(error.value)
     check_inside(params.replace(a_h=110.0, a_c=95.0), [prepare(data, 0)])   # inside: no error
+
+
+def test_the_strain_residual_is_split_where_it_sits(fits):
+    """The parts are the verdict's residual: their rows and squares add up to its RMS, and
+    their shares to 1; on this file the ends of the branches (the austenite and martensite
+    ends, where no transformation moves the strain) hold more of the squares than of the
+    rows, so the misfit is a shape the model lacks there, not the transformation."""
+    for load, (data, fit) in fits.items():
+        entry, = fit.strain_parts
+        parts = [p for p in entry["parts"] if p["rows"]]
+        rows = sum(p["rows"] for p in parts)
+        squares = sum(p["rows"] * p["rms"] ** 2 for p in parts)
+        assert np.isclose(np.sqrt(squares / rows), fit.residual_rms["strain"], rtol=1e-9)
+        assert np.isclose(sum(p["share"] for p in parts), 1.0)
+        assert np.isclose(sum(c["share"] for c in entry["cycles"]), 1.0)
+        left_out = {c["cycle"] for c in fit.outlier_cycles}
+        assert {c["cycle"] for c in entry["cycles"]} == {b.cycle for b in data.branches} - left_out
+        ends = [p for p in parts if p["phase"] != "transformation"]
+        assert sum(p["share"] for p in ends) > sum(p["rows"] for p in ends) / rows, load
+
+
+def test_the_strain_noise_estimate_agrees_with_a_second_one():
+    """The fit's strain noise (median absolute second difference) against the README's
+    3.5e-5 and against the median absolute third difference, which a quadratic trend over
+    three samples does not reach: a residual ratio is not made small by a large estimate."""
+    data = read_isobaric(_raw(), 0.1, 0.8, 1.5e-4)
+    estimate = noise_level(data.strain)
+    third = np.diff(data.strain, 3)
+    second = 1.4826 * np.median(np.abs(third - np.median(third))) / np.sqrt(20.0)
+    assert abs(estimate / 3.5e-5 - 1.0) < 0.1, estimate
+    assert abs(estimate / second - 1.0) < 0.15, (estimate, second)

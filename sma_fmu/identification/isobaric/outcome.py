@@ -8,6 +8,7 @@ import numpy as np
 from sma_fmu.identification.isobaric.covariance import (named, named_values,
                                                         reported_covariance, wire_covariance)
 from sma_fmu.identification.isobaric.jacobian import file_model, file_state
+from sma_fmu.identification.isobaric.residual_parts import strain_parts
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constant_load import hysteresis_centre
@@ -63,6 +64,7 @@ class IsobaricFit:
     lag_option: str = "fit"   # "fit" or "none", as used
     first_fit: dict = None    # the first fit (profile held): cost, evaluations, message
     sensor: list = None       # per file: {"narrowing": K per unit of lag, "unit": s or samples}
+    strain_parts: list = None  # per file: the strain residual by direction, phase and cycle
 
 
 def verdict(rms, noise):
@@ -186,4 +188,5 @@ def outcome(prepared, layout, solution, jacobian, order, first, on_bound, **extr
         noise=noise, verdict=verdict(rms, noise), variance_factor=factor, dof=dof,
         profile_unknowns=n - k, knots_per_branch=[f.profile.knots_per_branch for f in prepared],
         converged=bool(solution.status > 0), message=str(solution.message), on_bound=on_bound,
-        file_rms=file_rms, undetermined=undetermined, **extra)
+        file_rms=file_rms, undetermined=undetermined,
+        strain_parts=strain_parts(prepared, layout, solution.x), **extra)

@@ -109,8 +109,9 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
                                                         "cc_share_c")
                                           if n not in fit.wire_names]
     per_file = []
-    for data, offsets, sigma, lag, knots, rms_of_file in zip(
-            files, fit.offsets, fit.sigma, fit.lags, fit.knots_per_branch, fit.file_rms):
+    for data, offsets, sigma, lag, knots, rms_of_file, parts in zip(
+            files, fit.offsets, fit.sigma, fit.lags, fit.knots_per_branch, fit.file_rms,
+            fit.strain_parts):
         per_file.append({
             "file": str(data.path), "load_kg": data.load,
             "cycles_found": splitting_note(data.splitting, data.branches, data.time is not None),
@@ -128,6 +129,7 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
             "cycles": len({b.cycle for b in data.branches if b.complete}),
             "noise_estimates": sigma,
             "residual_rms": rms_of_file,
+            "strain_residual_parts": parts,
             "strain_offsets_per_level": offsets,
             "residual_strain_per_cycle": list(np.diff(offsets)) if residual == "per-cycle" else []})
     widths = {}

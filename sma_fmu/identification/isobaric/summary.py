@@ -6,6 +6,7 @@ import numpy as np
 
 from sma_fmu.identification.isobaric.halfway import (half_strain_temperature, stress_slope,
                                                      transformation_strain)
+from sma_fmu.identification.isobaric.residual_parts import parts_line
 from sma_fmu.identification.isobaric.synthetic import stress_of_load
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.runtime.constants import COOLING, HEATING
@@ -85,6 +86,9 @@ def format_isobaric_report(report):
              + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
                 if rms["resistance_ohm"] else ""),
              report["verdict"]]
+    if "strain residual" in report["verdict"]:     # not explained: say where it sits
+        lines += [parts_line(Path(entry["file"]).name, entry["strain_residual_parts"])
+                  for entry in report["files"] if entry.get("strain_residual_parts")]
     law = report.get("centre_law") or {"option": "linear"}
     for note in (report.get("lag_choice", {}).get("note"), report.get("stage_note"),
                  *report.get("slopes_not_fitted", []),
