@@ -59,18 +59,20 @@ from .constant_load import BranchCache
 from .constants import COOLING, HEATING
 from .minor_loops import push_reversal, read_points
 from .phase_lag import PhaseLagFilter
-from .sensing import invert_on_stack, mixed_fractions_of_resistance, temperature_of_fractions
+from .sensing import (invert_on_stack, mixed_fractions_of_resistance, temperature_of_fractions,
+                      temperature_with_tangent)
 from .shaping import ReachableShaping, require_power_cap, require_shaping
 from .state_entries import (StateError, check_format, read_direction, read_entries,
-                            read_optional_number, read_temperature)
+                            read_optional_number, read_temperature, require_pair)
 from .validity import data_box, data_range_warning, validity_warning
 
 __all__ = ["INVERSES", "require_inverse", "FeedforwardOutputs", "FeedforwardStepper",
            "STATE_FORMAT"]
 
-STATE_FORMAT = "sma-fmu compensator state 2: reversal stack"   # what state() writes
+STATE_FORMAT = "sma-fmu compensator state 3: reversal stack, search tangent"   # state() writes it
 _STATE_ENTRIES = ("format", "direction", "previous_reference", "reversals",
-                  "previous_temperature", "previous_fraction", "filter")
+                  "previous_temperature", "previous_fraction", "previous_exponent",
+                  "previous_slope", "filter")
 
 INVERSES = ("major", "minor-loop")
 
@@ -150,6 +152,7 @@ class FeedforwardStepper:
         self.reversals = []               # minor-loop memory: ReversalPoint(T [degC], xi_MF [1])
         self.previous_temperature = None  # T_ref,k-1 [degC] (minor-loop inverse only)
         self.previous_fraction = None     # xi_MF,k-1 [1] the compensator assumed
+        self.previous_line = None         # (Lambda [1], -Lambda' [K]) at T_ref,k-1 (two stages)
         self._branches = BranchCache(params)
         self.warning = None               # validity warning of the last step (the load)
         self._load_before = -math.inf     # load of the last step [kg]
@@ -159,11 +162,14 @@ class FeedforwardStepper:
         self._data_box = data_box(params)    # its bounds, missing ones infinite
 
     def _invert(self, reference, load, direction):
-        """(SensedTemperature, stack, xi_MF assumed) for one sample; no state change.
+        """(SensedTemperature, stack, xi_MF assumed, tangent line) for one sample; no state
+        change.
 
-        The memory is the compensator's (the last d_ref, T_ref and xi_MF, its stack) or,
-        shaped, the model wire's (its direction, temperature, xi_MF and stack). The stack
-        returned is that list itself when it is unchanged, else a copy.
+        The memory is the compensator's (the last d_ref, T_ref and xi_MF, its stack, the
+        two-stage search's tangent there) or, shaped, the model wire's (its direction,
+        temperature, xi_MF and stack; no tangent: the model's temperature is not the last
+        root). The stack returned is that list itself when it is unchanged, else a copy; the
+        line is the major inverse's (``temperature_with_tangent``), None for the minor loop.
         """
         params = self.params
         constants = self._branches.get(load if self.adapt_to_load else self.model_load, direction)
@@ -171,18 +177,21 @@ class FeedforwardStepper:
         if self._shaper is None:
             points, last = self.reversals, self.direction
             temperature, fraction = self.previous_temperature, self.previous_fraction
+            line = self.previous_line
         else:
             model = self._shaper.model
             points, last = model.reversals, model.direction
-            temperature, fraction = model.temperature, model.xi_MF
+            temperature, fraction, line = model.temperature, model.xi_MF, None
         if not self._minor_loops:   # the search starts at the last T on the same branch
-            near = temperature if direction == last else None
-            return temperature_of_fractions(xi_mf, xi_p, constants, params.saturation_margin,
-                                            near), points, xi_mf
+            near, line = (temperature, line) if direction == last else (None, None)
+            sensed, line = temperature_with_tangent(xi_mf, xi_p, constants,
+                                                    params.saturation_margin, near, line)
+            return sensed, points, xi_mf, line
         if direction != last and temperature is not None:
             points = list(points)
             push_reversal(points, temperature, fraction, params.memory_depth)
-        return invert_on_stack(xi_mf, xi_p, constants, direction, points, params.saturation_margin)
+        return invert_on_stack(xi_mf, xi_p, constants, direction, points,
+                               params.saturation_margin) + (None,)
 
     def _shaped_demand(self, reference, load, direction):
         """(way [+1/-1], SensedTemperature): where the shaped compensator's model wire moves
@@ -271,7 +280,7 @@ class FeedforwardStepper:
             reference = self._anticipation.aim(sample, step_size)
         direction = self._direction_for(reference)
         if self._shaper is None:
-            sensed, points, fraction = self._invert(reference, load, direction)
+            sensed, points, fraction, line = self._invert(reference, load, direction)
         else:
             way, sensed = self._shaped_demand(reference, load, direction)
         warning = (validity_warning(self.params, -math.inf, -math.inf, load, self._load_before)
@@ -295,6 +304,7 @@ class FeedforwardStepper:
             self.reversals = points
             self.previous_temperature = sensed.temperature
             self.previous_fraction = fraction
+            self.previous_line = line
         else:
             output, temperature, moved = self._shaper.step(
                 temperature, way, load if self.adapt_to_load else self.model_load, step_size)
@@ -320,13 +330,17 @@ class FeedforwardStepper:
         return (temperature - self.params.T_room) / self.params.K_th
 
     def state(self):
-        """JSON-ready hidden state (direction, last reference, reversal stack, filter; shaped,
-        also the model wire's state as ``model``)."""
+        """JSON-ready hidden state (direction, last reference, reversal stack, the two-stage
+        search's tangent at the last T_ref, filter; shaped, also the model wire's state as
+        ``model``)."""
+        line = self.previous_line
         state = {"format": STATE_FORMAT,
                  "direction": self.direction, "previous_reference": self.previous_reference,
                  "reversals": [list(point) for point in self.reversals],
                  "previous_temperature": self.previous_temperature,
                  "previous_fraction": self.previous_fraction,
+                 "previous_exponent": None if line is None else line[0],
+                 "previous_slope": None if line is None else line[1],
                  "filter": self.filter.state()}
         if self._shaper is not None:
             state["model"] = self._shaper.state()
@@ -338,9 +352,9 @@ class FeedforwardStepper:
         """Restore a state saved by :meth:`state`.
 
         Every entry is checked first (direction +1/-1; R_ref > 0; T_ref above absolute
-        zero; xi_MF in [0, 1]; the stack; the filter's memory; shaped, the model wire's
-        state as a plant's): a malformed state, or one of an earlier build, raises
-        ``ValueError`` naming the entry and changes nothing.
+        zero; xi_MF in [0, 1]; the tangent's Lambda finite, its slope > 0 K; the stack; the
+        filter's memory; shaped, the model wire's state as a plant's): a malformed state, or
+        one of an earlier build, raises ``ValueError`` naming the entry and changes nothing.
         """
         check_format(state, STATE_FORMAT, "compensator state")
         shaped = self._shaper is not None
@@ -351,9 +365,10 @@ class FeedforwardStepper:
         reference = read_optional_number(state, "previous_reference", 5e-324, unit="ohm")
         temperature = read_temperature(state, "previous_temperature", optional=True)
         fraction = read_optional_number(state, "previous_fraction", 0.0, 1.0)
-        if (temperature is None) != (fraction is None):
-            raise StateError("state entries previous_temperature and previous_fraction must "
-                             "both be numbers or both be null")
+        require_pair("previous_temperature", temperature, "previous_fraction", fraction)
+        exponent = read_optional_number(state, "previous_exponent")
+        slope = read_optional_number(state, "previous_slope", 5e-324, unit="K")
+        require_pair("previous_exponent", exponent, "previous_slope", slope)
         points = read_points(state["reversals"], self.params.memory_depth, "reversals")
         if shaped:   # checked on a new model wire, taken only when everything else is good
             model = ReachableShaping(self.params, self._minor_loops, self.power_cap,
@@ -378,4 +393,5 @@ class FeedforwardStepper:
             self._anticipation = anticipation
         self.direction, self.previous_reference = direction, reference
         self.previous_temperature, self.previous_fraction = temperature, fraction
+        self.previous_line = None if slope is None else (exponent, slope)
         self.reversals = points

@@ -6,7 +6,8 @@
 With a second stage (w2 > 0, :mod:`.constant_load`) no closed form exists: 1/T_K is found
 by a safeguarded Newton iteration on Lambda(1/T_K), bracketed by the two single-stage closed
 forms (:func:`~.two_stage_root.two_stage_inverse`); the compensator starts it from its last
-temperature on the same branch (``near``).
+temperature on the same branch (``near``), its first step along the tangent it kept there
+(``line``, :func:`temperature_with_tangent`).
 
 Outside the transformation the resistance is saturated and carries no temperature
 information. There xi_MF is clamped into [delta, M - delta], delta = saturation_margin * M,
@@ -34,7 +35,8 @@ from .reachable_band import band_of_branch
 from .two_stage_root import ROOT_CAP, ROOT_TOLERANCE_K, two_stage_inverse
 
 __all__ = ["SensedTemperature", "mixed_fractions_of_resistance", "temperature_of_fractions",
-           "temperature_on_stack", "invert_on_stack", "sense_temperature", "inverse_method"]
+           "temperature_with_tangent", "temperature_on_stack", "invert_on_stack",
+           "sense_temperature", "inverse_method"]
 
 SensedTemperature = namedtuple("SensedTemperature", ["temperature", "saturated"])
 SensedTemperature.__doc__ = "Sensed temperature [degC] and whether the resistance was saturated."
@@ -67,24 +69,40 @@ def temperature_of_fractions(xi_mf, xi_p, constants, margin, near=None):
     lies inside the search's bracket. The answer is the same to the search's tolerance
     (1e-12 K), not bit for bit.
     """
+    return temperature_with_tangent(xi_mf, xi_p, constants, margin, near)[0]
+
+
+def temperature_with_tangent(xi_mf, xi_p, constants, margin, near=None, line=None):
+    """:func:`temperature_of_fractions` that also returns Lambda's tangent at the answer:
+    (SensedTemperature, line), line = (Lambda [1], -dLambda/d(1/T_K) [K]) of a two-stage
+    search (None for one stage, or where the slope underflowed).
+
+    A compensator keeps the line with its temperature and passes both back at the next
+    step on the same branch (``near``, ``line``): the search's first step is then the
+    tangent's, without an evaluation (:func:`~.two_stage_root.two_stage_inverse`).
+    """
     delta = margin * constants.M
     saturated = False
     if not (xi_mf >= delta and xi_p >= delta):
         xi_mf, xi_p, saturated = _clamped(xi_mf, constants.M, delta)
     exponent = math.log(xi_p / xi_mf)
     inverse_kelvin = constants.inv_centre_K - exponent / constants.energy_over_kB
+    tangent = None
     if constants.w2 != 0.0:
         start = None   # 1/(near + 273.15), where that is a temperature above absolute zero
         if near is not None:
             start = near + KELVIN_OFFSET
             start = 1.0 / start if start > 0.0 else None
-        inverse_kelvin = two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin, constants,
-                                           start)
+        inverse_kelvin, slope = two_stage_inverse(xi_mf, xi_p, exponent, inverse_kelvin,
+                                                  constants, start, line)
+        if slope > 0.0:
+            tangent = (exponent, slope)
     elif not inverse_kelvin > 0.0:
         raise ValueError(
             f"temperature-sensing inverse diverges at Lambda = {exponent!r}: dH(f)/k_B = "
             f"{constants.energy_over_kB!r} K is too small for the hysteresis centre")
-    return _new_tuple(SensedTemperature, (1.0 / inverse_kelvin - KELVIN_OFFSET, saturated))
+    sensed = _new_tuple(SensedTemperature, (1.0 / inverse_kelvin - KELVIN_OFFSET, saturated))
+    return sensed, tangent
 
 
 def temperature_on_stack(xi_mf, xi_p, constants, direction, points, margin, count=None):
@@ -176,7 +194,9 @@ def inverse_method(two_stage):
     if not two_stage:
         return "closed form, T_K = 1/(1/tau_K - k_B Lambda/dH(f))"
     return (f"Newton's method on 1/T_K, safeguarded: started from the compensator's last "
-            f"temperature on the same branch, else from the steeper stage's "
+            f"temperature on the same branch, its first step along the tangent kept there, "
+            f"else from the steeper stage's "
             f"closed-form inverse, kept inside the bracket of the two stages' closed forms "
             f"(a step that would leave it halves it instead), stopped when the error left in "
-            f"T is below {ROOT_TOLERANCE_K:g} K (about 3 evaluations; at most {ROOT_CAP} rounds)")
+            f"T is below {ROOT_TOLERANCE_K:g} K (about 2 evaluations from the last temperature, "
+            f"3 without it; at most {ROOT_CAP} rounds)")

@@ -9,7 +9,7 @@ import math
 from .constants import KELVIN_OFFSET
 
 __all__ = ["StateError", "check_format", "read_entries", "read_number", "read_optional_number",
-           "read_temperature", "read_direction"]
+           "read_temperature", "read_direction", "require_pair"]
 
 
 class StateError(ValueError):
@@ -77,3 +77,11 @@ def read_direction(state, key="direction"):
     if isinstance(value, bool) or value not in (1, -1):
         raise StateError(f"state entry {key} must be 1 (heating) or -1 (cooling), got {value!r:.80}")
     return int(value)
+
+
+def require_pair(first_key, first, second_key, second):
+    """Refuse (StateError) a pair of entries read as optional numbers where one is None and
+    the other is not: they are one memory, filled together."""
+    if (first is None) != (second is None):
+        raise StateError(f"state entries {first_key} and {second_key} must both be numbers or "
+                         f"both be null")

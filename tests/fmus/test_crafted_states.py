@@ -84,10 +84,12 @@ def python_edited(blob, key, value, stepper):
 class Side:
     """One FMU of one family and FMI version, driven away from its start."""
 
-    def __init__(self, kind, path, variables, name):
+    def __init__(self, kind, path, variables, name, inputs=(("P_in", 1.0),)):
         self.kind, self.variables = kind, variables
         self.fmu = (Instance3 if kind == "c-fmi3" else Instance)(path, name)
-        assert self.fmu.start() == 0 and self.fmu.set("P_in", 1.0) == 0
+        assert self.fmu.start() == 0
+        for input_name, value in inputs:
+            assert self.fmu.set(input_name, value) == 0
         for k in range(20):
             assert self.fmu.step(k * 1e-3, 1e-3) == 0
         self.time = 20e-3
@@ -154,3 +156,33 @@ def test_the_same_bytes_with_a_recomputed_checksum_restore(side):
     assert blob == side.blob or side.kind == "python"
     assert side.restore(blob) == (0, 0)
     assert side.fmu.values() == after
+
+
+# the compensator's search tangent (previous_exponent [1], previous_slope [K]; C layout:
+# stepper doubles 6 and 7, feedforward.h): a bad slope, and a tangent without its slope
+TANGENT_EDITS = [("previous_slope", 7, -1.0,
+                  ["state entry previous_slope = -1", "must be finite and in [", "] K"]),
+                 ("previous_slope", 7, 0.0, ["state entry previous_slope = 0"]),
+                 ("previous_exponent", 6, 0.5,
+                  ["state entries previous_exponent and previous_slope must both be numbers or "
+                   "both be null"])]
+
+
+@pytest.fixture(params=["python", "c-fmi2", "c-fmi3"])
+def compensator_side(request, fmus, native_fmus, fmi3_fmus):
+    paths = {"python": fmus, "c-fmi2": native_fmus, "c-fmi3": fmi3_fmus}[request.param]
+    variables = read_model_description(str(native_fmus["SmaFeedforward"])).modelVariables
+    made = Side(request.param, paths["SmaFeedforward"], variables,
+                f"crafted-ff-{request.param}-{id(request)}", (("R_ref", 42.0), ("load", 0.25)))
+    yield made
+    made.fmu.close()
+
+
+@pytest.mark.parametrize("key,index,value,words", TANGENT_EDITS)
+def test_an_edited_search_tangent_is_refused_naming_it(compensator_side, key, index, value,
+                                                       words):
+    """The compensator's new entries are checked like the others, in both families and both
+    FMI versions (on the reference wire the tangent is null: one stage, no search)."""
+    side = compensator_side
+    blob = side.edited(key if side.kind == "python" else index, value, stepper=True)
+    _refused(side, blob, words)

@@ -66,6 +66,8 @@ def test_a_load_that_overflows_the_model_discards_the_step_naming_the_load(start
     ("SmaActuator", "xi_MF", -5.0, "xi_MF"),
     ("SmaActuator", "temperature", 1e308, "temperature"),
     ("SmaFeedforward", "previous_reference", "hot", "previous_reference must be a number"),
+    ("SmaFeedforward", "previous_slope", -1.0, "state entry previous_slope = -1.0 must be"),
+    ("SmaFeedforward", "previous_exponent", 0.5, "previous_exponent and previous_slope must"),
 ])
 def test_an_edited_saved_state_is_refused_naming_the_entry(started, name, entry, value, words):
     host, refs = started(name)

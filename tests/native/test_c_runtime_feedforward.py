@@ -276,6 +276,11 @@ def _bad_states(state):
     yield changed(previous_fraction=-0.1) + ("previous_fraction",)
     yield changed(previous_fraction=None) + ("previous_fraction",)
     yield changed(previous_temperature=None) + ("previous_temperature",)
+    yield changed(previous_exponent=math.inf, previous_slope=1e4) + ("previous_exponent",)
+    yield changed(previous_exponent=0.5, previous_slope=0.0) + ("previous_slope",)
+    yield changed(previous_exponent=0.5, previous_slope=-2e4) + ("previous_slope",)
+    yield changed(previous_exponent=0.5, previous_slope=math.inf) + ("previous_slope",)
+    yield changed(previous_exponent=0.5) + ("previous_exponent and previous_slope",)
     yield changed(reversals=state["reversals"] + [[-274.0, 0.5]]) + ("reversals[",)
     yield changed(reversals=[[point[0], 1.5]] + state["reversals"][1:]) + ("reversals[0]",)
     yield changed(reversals=[[math.inf, 0.5]]) + ("reversals[0]",)
@@ -300,8 +305,8 @@ def test_bad_states_are_refused_alike_and_change_nothing(lib, params):
         if not name.startswith("reversals"):   # the list-valued entries print differently
             assert normalized(got) == normalized(message)
         assert same_doubles(c.state(), saved) and python.state() == state
-    for doubles in (saved[:6], saved + [0.0], saved[:-1], saved[:6] + [0.5] + saved[7:],
-                    saved[:6] + [-1.0] + saved[7:]):
+    for doubles in (saved[:8], saved + [0.0], saved[:-1], saved[:8] + [0.5] + saved[9:],
+                    saved[:8] + [-1.0] + saved[9:]):
         assert "compensator state" in refusal(lambda: c.restore(doubles)) \
             or "reversals must be" in refusal(lambda: c.restore(doubles))
         assert same_doubles(c.state(), saved)

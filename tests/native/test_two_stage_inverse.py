@@ -12,7 +12,8 @@ Flexinol files gives (a sharp stage and a broad one of about equal share, centre
 two stages apart (w2 = 0.13), a broad small second stage (nu2 = 8, w2 = 0.02) and a second
 stage steeper than the first (so the search starts from stage 2's closed form). The same
 holds when the search starts from a given temperature (a compensator's last): near the
-answer, a transition away, beyond both stages.
+answer, a transition away, beyond both stages; with the tangent line kept there, or one whose
+slope is off by up to a factor 5.
 """
 import ctypes
 import math
@@ -23,7 +24,7 @@ import pytest
 
 from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
 from sma_fmu.runtime.constants import KELVIN_OFFSET
-from sma_fmu.runtime.sensing import temperature_of_fractions
+from sma_fmu.runtime.sensing import temperature_of_fractions, temperature_with_tangent
 from sma_fmu.studies.batch.branches import two_stage_inverse as batch_inverse
 
 import c_feedforward
@@ -53,13 +54,17 @@ int invert(const void *params, double load, int direction, double xi_mf, double 
     *temperature = t.temperature; *saturated = t.saturated; return 0;
 }
 int invert_near(const void *params, double load, int direction, double xi_mf, double xi_p,
-                double near, double *temperature, int *saturated, char *error) {
+                double near, double exponent, double slope, double *temperature,
+                int *saturated, double *tangent_exponent, double *tangent_slope, char *error) {
     SmaMessage m; BranchConstants b; SensedTemperature t; const WireParameters *p = params;
+    TangentLine line = {exponent, slope}, tangent;
     if (branch_constants(load, direction, p, &b, &m)
-        || temperature_near(xi_mf, xi_p, &b, p->saturation_margin, near, &t, &m)) {
+        || temperature_near(xi_mf, xi_p, &b, p->saturation_margin, near,
+                            isnan(slope) ? NULL : &line, &t, &tangent, &m)) {
         copy_error(error, &m); return 1;
     }
-    *temperature = t.temperature; *saturated = t.saturated; return 0;
+    *temperature = t.temperature; *saturated = t.saturated;
+    *tangent_exponent = tangent.exponent; *tangent_slope = tangent.slope; return 0;
 }
 """
 SIGNATURES = {**c_feedforward.SIGNATURES,
@@ -68,7 +73,9 @@ SIGNATURES = {**c_feedforward.SIGNATURES,
                                         c_feedforward.IP, ctypes.c_char_p]),
               "invert_near": (ctypes.c_int, [ctypes.c_void_p, ctypes.c_double, ctypes.c_int,
                                              ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                             ctypes.c_double, ctypes.c_double,
                                              c_feedforward.DP, c_feedforward.IP,
+                                             c_feedforward.DP, c_feedforward.DP,
                                              ctypes.c_char_p])}
 
 
@@ -119,28 +126,53 @@ def test_the_inverse_returns_the_forward_models_temperature(params, lib, wire):
 NEAR_OFFSETS = (1e-9, 0.03, -0.03, 2.0, -40.0, 300.0, math.nan)
 
 
+def _line_near(constants, p, near, rng):
+    """The tangent a compensator would keep at ``near`` [degC] on ``constants``' branch (its
+    last inversion's), that line's slope scaled by 0.2 ... 5 (a state edited within its
+    ranges: the search must still converge), or None."""
+    kind = rng.choice(("kept", "kept", "skewed", "none"))
+    if near is None or kind == "none":
+        return None
+    line = temperature_with_tangent(*branch_fractions(near, constants), constants,
+                                    p.saturation_margin)[1]
+    if line is None or kind == "kept":
+        return line
+    return line[0], line[1] * rng.uniform(0.2, 5.0)
+
+
 @pytest.mark.parametrize("wire", sorted(WIRES))
 def test_a_start_near_the_answer_returns_it_too(params, lib, wire):
-    """The search from a given start (the compensator's last T): the forward model's
-    temperature to 1e-12 K, and the C runtime's doubles."""
+    """The search from a given start (the compensator's last T) and its tangent line: the
+    forward model's temperature to 1e-12 K, and the C runtime's doubles, the line at the
+    answer included."""
     p = params.replace(**WIRES[wire])
     cparams = c_feedforward.CParameters(lib, p)
     temperature, saturated = ctypes.c_double(), ctypes.c_int()
+    exponent, slope = ctypes.c_double(), ctypes.c_double()
     error = ctypes.create_string_buffer(512)
-    worst, inverted, rng = 0.0, 0, random.Random(49)
+    worst, inverted, lines, rng = 0.0, 0, 0, random.Random(49)
     for load, direction, T, constants, xi_mf, xi_p in random_points(p, 49):
         offset = rng.choice(NEAR_OFFSETS)
         near = None if math.isnan(offset) else T + offset * rng.uniform(0.5, 1.0)
-        sensed = temperature_of_fractions(xi_mf, xi_p, constants, p.saturation_margin, near)
+        line = _line_near(constants, p, near, rng)
+        lines += line is not None
+        sensed, tangent = temperature_with_tangent(xi_mf, xi_p, constants, p.saturation_margin,
+                                                   near, line)
         assert lib.invert_near(cparams.pointer, load, direction, xi_mf, xi_p,
-                               math.nan if near is None else near, ctypes.byref(temperature),
-                               ctypes.byref(saturated), error) == 0
+                               math.nan if near is None else near,
+                               *((math.nan, math.nan) if line is None else line),
+                               ctypes.byref(temperature), ctypes.byref(saturated),
+                               ctypes.byref(exponent), ctypes.byref(slope), error) == 0
         assert (temperature.value, bool(saturated.value)) == tuple(sensed)   # bit for bit
+        if tangent is None:
+            assert math.isnan(exponent.value) and math.isnan(slope.value)
+        else:
+            assert (exponent.value, slope.value) == tangent and tangent[1] > 0.0
         if not sensed.saturated:
             inverted += 1
             worst = max(worst, abs(sensed.temperature - T))
     assert worst <= 1e-12, (wire, worst)
-    assert inverted > POINTS // 2, inverted
+    assert inverted > POINTS // 2 and lines > POINTS // 3, (inverted, lines)
 
 
 def _batch_arrays(points):

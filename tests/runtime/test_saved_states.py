@@ -1,13 +1,18 @@
 """Saved stepper states are read like inputs: a malformed entry is refused, naming it,
 and the stepper is left as it was (issue: edited saved states)."""
+import json
 import math
 
 import pytest
 
+from sma_fmu.files.package_data import shipped_file
+
+from sma_fmu.runtime import two_stage_root
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.pi_control import PIController
 from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.runtime.pwm import PwmDriver
+from sma_fmu.wire.parameter_file import load_parameter_set
 
 STEP = 1e-3
 
@@ -70,6 +75,11 @@ COMPENSATOR_EDITS = [
     ({"filter": {"previous_input": 1.0, "previous_output": None}}, "both be numbers or both"),
     ({"filter": {"previous_input": "x", "previous_output": 1.0}}, "previous_input"),
     ({"reversals": [[60.0, 0.5, 1.0]]}, r"reversals\[0\]"),
+    ({"previous_exponent": math.inf, "previous_slope": 1e4}, "previous_exponent"),
+    ({"previous_exponent": 0.5, "previous_slope": 0.0}, "previous_slope"),
+    ({"previous_exponent": 0.5, "previous_slope": -2e4}, "previous_slope"),
+    ({"previous_exponent": 0.5, "previous_slope": "steep"}, "previous_slope must be a number"),
+    ({"previous_exponent": 0.5, "previous_slope": None}, "previous_exponent and previous_slope"),
 ]
 
 
@@ -95,6 +105,45 @@ def test_control_blocks_refuse_edited_states(block, state, words):
     with pytest.raises(ValueError, match=words):
         instance.restore(state)
     assert instance.state() == before
+
+
+def _cosine(stepper, start, count):
+    """Step ``stepper`` through the heavy scenario's R_ref (0.25 kg) from step ``start``;
+    the outputs."""
+    return [stepper.step(41.85 + 6.05 * math.cos(math.pi * k * STEP), 0.25, STEP)
+            for k in range(start, start + count)]
+
+
+def test_a_two_stage_compensators_state_carries_the_search_tangent(monkeypatch):
+    """The Flexinol fit (two stages): the saved state holds the search's tangent at the last
+    T_ref, and a stepper restored from it (through JSON) takes the next step as the one that
+    saved it, to the bit, its state after it included. Restored without the tangent, the
+    next search starts at the last root instead: it lands within the search's tolerance
+    and needs more evaluations (counted as the exponentials the search takes, two each)."""
+    params = load_parameter_set(shipped_file("models", "flexinol_fit.toml")).params
+    running = FeedforwardStepper(params)
+    _cosine(running, 0, 700)
+    exponentials = [0]
+
+    def counted(x):
+        exponentials[0] += 1
+        return math.exp(x)
+    monkeypatch.setattr(two_stage_root, "_exp", counted)
+    largest, counts = 0.0, {"tangent": 0, "none": 0}
+    for k in range(700, 800):
+        saved = json.loads(json.dumps(running.state()))
+        assert saved["previous_exponent"] is not None and saved["previous_slope"] > 0.0
+        restored, untangent = FeedforwardStepper(params), FeedforwardStepper(params)
+        restored.restore(saved)
+        untangent.restore({**saved, "previous_exponent": None, "previous_slope": None})
+        expected = _cosine(running, k, 1)[0]
+        exponentials[0] = 0
+        assert _cosine(restored, k, 1)[0] == expected and restored.state() == running.state()
+        counts["tangent"] += exponentials[0]
+        exponentials[0] = 0
+        largest = max(largest, abs(_cosine(untangent, k, 1)[0].T_ref - expected.T_ref))
+        counts["none"] += exponentials[0]
+    assert largest <= 1e-12 and counts["tangent"] < counts["none"], (largest, counts)
 
 
 def test_load_beyond_the_validity_limit_warns_once_per_excursion(params):

@@ -170,7 +170,8 @@ def doubles_of(state):
     own = with_reversals([
         float(state["direction"]), number(state["previous_reference"]),
         number(state["previous_temperature"]), number(state["previous_fraction"]),
-        number(state["filter"]["previous_input"]), number(state["filter"]["previous_output"])],
+        number(state["filter"]["previous_input"]), number(state["filter"]["previous_output"]),
+        number(state["previous_exponent"]), number(state["previous_slope"])],
         state["reversals"])
     if "anticipation" in state:
         own += [number(state["anticipation"][key]) for key in ("earlier", "previous", "held")]

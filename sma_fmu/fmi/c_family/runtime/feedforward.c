@@ -71,6 +71,8 @@ int feedforward_stepper_init(FeedforwardStepper *self, const WireParameters *par
     self->previous_reference = SMA_STATE_NONE;
     self->previous_temperature = SMA_STATE_NONE;
     self->previous_fraction = SMA_STATE_NONE;
+    self->previous_line.exponent = SMA_STATE_NONE;
+    self->previous_line.slope = SMA_STATE_NONE;
     branch_cache_init(&self->branches);
     self->warning[0] = '\0';
     self->load_before = -HUGE_VAL;
@@ -128,7 +130,7 @@ static double anticipated_aim(const FeedforwardStepper *self, double reference,
  * compensator's or, shaped, the model wire's (its stack has the same free slot). */
 static int invert(FeedforwardStepper *self, double reference, double load, int direction,
                   SensedTemperature *sensed, ReversalPoint **stack, size_t *kept,
-                  double *fraction, SmaMessage *message)
+                  double *fraction, TangentLine *tangent, SmaMessage *message)
 {
     const WireParameters *params = &self->params;
     BranchConstants constants;
@@ -137,6 +139,9 @@ static int invert(FeedforwardStepper *self, double reference, double load, int d
     int last = self->direction;
     double xi_mf, xi_p, temperature = self->previous_temperature;
     double assumed = self->previous_fraction;
+    const TangentLine *line = sma_state_is_none(self->previous_line.slope)
+                              ? NULL : &self->previous_line;
+    tangent->exponent = tangent->slope = NAN;
     if (self->shaping == SHAPING_REACHABLE) {
         const PlantStepper *model = &self->shaper.model;
         points = model->reversals;
@@ -144,6 +149,7 @@ static int invert(FeedforwardStepper *self, double reference, double load, int d
         last = model->direction;
         temperature = model->temperature;
         assumed = model->xi_MF;
+        line = NULL;   /* the model's temperature is not the last root */
     }
     if (branch_cache_get(&self->branches, params, self->adapt_to_load ? load : self->model_load,
                          direction, &constants, message)) {
@@ -154,9 +160,12 @@ static int invert(FeedforwardStepper *self, double reference, double load, int d
         *stack = points;
         *kept = count;
         *fraction = xi_mf;
-        /* the search starts at the last T on the same branch (NaN: none) */
-        return temperature_near(xi_mf, xi_p, &constants, params->saturation_margin,
-                                direction == last ? temperature : NAN, sensed, message);
+        /* the search starts at the last T on the same branch (NaN: none), from its tangent */
+        return direction == last
+               ? temperature_near(xi_mf, xi_p, &constants, params->saturation_margin,
+                                  temperature, line, sensed, tangent, message)
+               : temperature_near(xi_mf, xi_p, &constants, params->saturation_margin,
+                                  NAN, NULL, sensed, tangent, message);
     }
     if (direction != last && !sma_state_is_none(temperature)) {
         points[count].temperature = temperature;   /* push_reversal */
@@ -186,16 +195,19 @@ static int shaped_demand(FeedforwardStepper *self, double reference, double load
     SensedTemperature major;
     ReversalPoint *stack;
     size_t kept;
+    TangentLine line;
     if (self->inverse != INVERSE_MINOR_LOOP) {
         *way = direction;
-        return invert(self, reference, load, direction, sensed, &stack, &kept, &fraction, message);
+        return invert(self, reference, load, direction, sensed, &stack, &kept, &fraction, &line,
+                      message);
     }
     if (branch_cache_get(&self->branches, params, used, HEATING, &constants, message)) {
         return 1;
     }
     mixed_fractions_of_resistance(reference, &constants, params, &target, &xi_p);
     *way = target < model->xi_MF ? HEATING : target > model->xi_MF ? COOLING : model->direction;
-    if (invert(self, reference, load, *way, sensed, &stack, &kept, &fraction, message)) {
+    if (invert(self, reference, load, *way, sensed, &stack, &kept, &fraction, &line,
+               message)) {
         return 1;
     }
     if (reachable_shaping_ahead(&self->shaper, sensed->temperature, *way)) {
@@ -264,6 +276,7 @@ int feedforward_stepper_initial_outputs(FeedforwardStepper *self, double referen
                                         SmaMessage *message)
 {
     SensedTemperature sensed;
+    TangentLine line;
     ReversalPoint *stack;
     size_t kept;
     double fraction;
@@ -286,7 +299,7 @@ int feedforward_stepper_initial_outputs(FeedforwardStepper *self, double referen
         ? shaped_demand(self, reference, load, direction_for(self, reference), &way, &sensed,
                         message)
         : invert(self, reference, load, direction_for(self, reference), &sensed, &stack, &kept,
-                 &fraction, message)) {
+                 &fraction, &line, message)) {
         return 1;
     }
     demand_of(self, &sensed, &outputs->T_ref, &outputs->saturated);
@@ -305,6 +318,7 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
                              SmaMessage *message)
 {
     SensedTemperature sensed;
+    TangentLine line;
     ReversalPoint *stack;
     size_t kept;
     double fraction, output, temperature, sample, held = SMA_STATE_NONE;
@@ -337,7 +351,8 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
     direction = direction_for(self, reference);
     if (self->shaping == SHAPING_REACHABLE
         ? shaped_demand(self, reference, load, direction, &way, &sensed, message)
-        : invert(self, reference, load, direction, &sensed, &stack, &kept, &fraction, message)) {
+        : invert(self, reference, load, direction, &sensed, &stack, &kept, &fraction, &line,
+                 message)) {
         return 1;
     }
     warning[0] = '\0';
@@ -375,6 +390,7 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
         self->reversal_count = kept;
         self->previous_temperature = sensed.temperature;
         self->previous_fraction = fraction;
+        self->previous_line = line;
     }
     if (self->anticipation > 0.0) {
         self->earlier_reference = self->last_reference;
@@ -411,7 +427,9 @@ void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out
     out[2] = self->previous_temperature;
     out[3] = self->previous_fraction;
     phase_lag_filter_state_write(&self->filter, out + 4);
-    out[6] = (double)self->reversal_count;
+    out[6] = self->previous_line.exponent;
+    out[7] = self->previous_line.slope;
+    out[8] = (double)self->reversal_count;
     for (i = 0; i < self->reversal_count; i++) {
         out[FEEDFORWARD_STATE_FIXED + 2 * i] = self->reversals[i].temperature;
         out[FEEDFORWARD_STATE_FIXED + 2 * i + 1] = self->reversals[i].xi_MF;
@@ -448,7 +466,8 @@ static int read_model(const FeedforwardStepper *self, const double *in, size_t c
 int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, size_t count,
                                    SmaMessage *message)
 {
-    int direction, reference_present, temperature_present, fraction_present;
+    int direction, reference_present, temperature_present, fraction_present, exponent_present;
+    int slope_present;
     int shaped = self->shaping == SHAPING_REACHABLE, present;
     size_t anticipated = self->anticipation > 0.0 ? 3 : 0, i;
     static const char *const entries[3] = {"earlier", "previous", "held"};
@@ -472,7 +491,17 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
         return sma_message_set(message, "state entries previous_temperature and "
                                "previous_fraction must both be numbers or both be null");
     }
-    points_given = in[6];
+    if (read_optional_number(in[6], "previous_exponent", -HUGE_VAL, HUGE_VAL, "",
+                             &exponent_present, message)
+        || read_optional_number(in[7], "previous_slope", 5e-324, HUGE_VAL, "K", &slope_present,
+                                message)) {
+        return 1;
+    }
+    if (exponent_present != slope_present) {
+        return sma_message_set(message, "state entries previous_exponent and previous_slope "
+                               "must both be numbers or both be null");
+    }
+    points_given = in[8];
     if (!(points_given >= 0.0 && points_given <= (double)depth
           && points_given == floor(points_given))) {
         return sma_message_set(message, "reversals must be a list of at most %lu [T, xi_MF] "
@@ -515,6 +544,8 @@ int feedforward_stepper_state_read(FeedforwardStepper *self, const double *in, s
     self->previous_reference = in[1];
     self->previous_temperature = in[2];
     self->previous_fraction = in[3];
+    self->previous_line.exponent = in[6];
+    self->previous_line.slope = in[7];
     if (anticipated) {
         self->earlier_reference = in[own - 3];
         self->last_reference = in[own - 2];

@@ -25,13 +25,15 @@
  * A wire with a data range (validity.T_data_min ...): the first step whose T_ref or load lies
  * outside it adds one warning, once per stepper.
  *
- * Saved state (feedforward_stepper_state_*): 7 + 2 n doubles, Python's None stored as NaN
+ * Saved state (feedforward_stepper_state_*): 9 + 2 n doubles, Python's None stored as NaN
  * (SMA_STATE_NONE):
  *   [0] direction (+1 / -1)          [1] previous_reference [ohm] or None
  *   [2] previous_temperature [degC] or None      [3] previous_fraction [1] or None
  *   [4] filter previous_input [W] or None        [5] filter previous_output [W] or None
- *   [6] n, the number of reversal points (0 .. memory_depth)
- *   [7 + 2 i], [8 + 2 i]  reversal i (oldest first): T [degC], xi_MF [1]
+ *   [6] previous_exponent [1] or None            [7] previous_slope [K] or None
+ *       (the two-stage search's tangent at T_ref,k-1: Lambda and -dLambda/d(1/T_K))
+ *   [8] n, the number of reversal points (0 .. memory_depth)
+ *   [9 + 2 i], [10 + 2 i]  reversal i (oldest first): T [degC], xi_MF [1]
  *   anticipation > 0: then 3 doubles, the anticipation's R_ref,k-2, R_ref,k-1 and held aim
  *   [ohm] (each NaN = None)
  *   shaping "reachable": then the model wire's state, PLANT_STATE_FIXED + 2 m doubles (plant.h)
@@ -50,12 +52,13 @@
 #include "minor_loops.h"
 #include "parameters.h"
 #include "phase_lag.h"
+#include "sensing.h"
 #include "shaping.h"
 #include "sma_message.h"
 
-#define FEEDFORWARD_STATE_FIXED 7   /* doubles before the reversal points */
+#define FEEDFORWARD_STATE_FIXED 9   /* doubles before the reversal points */
 /* Python's STATE_FORMAT: the FMI layer's header names it, the doubles follow. */
-#define FEEDFORWARD_STATE_FORMAT "sma-fmu compensator state 2: reversal stack"
+#define FEEDFORWARD_STATE_FORMAT "sma-fmu compensator state 3: reversal stack, search tangent"
 
 /* INVERSES = ("major", "minor-loop"): an inverse is its index in that tuple. */
 typedef enum {
@@ -94,6 +97,7 @@ typedef struct FeedforwardStepper {
     size_t reversal_count;        /* points in use (<= params.memory_depth) */
     double previous_temperature;  /* T_ref,k-1 [degC]; NaN = None */
     double previous_fraction;     /* xi_MF,k-1 [1] the compensator assumed; NaN = None */
+    TangentLine previous_line;    /* the two-stage search's tangent at T_ref,k-1; NaN = None */
     BranchCache branches;
     char warning[1024];           /* validity warning of the last step; "" = None */
     double load_before;           /* load of the last step [kg] (-inf before the first) */
@@ -136,7 +140,8 @@ int feedforward_stepper_step(FeedforwardStepper *self, double reference, double 
                              SmaMessage *message);
 /* Saved state, layout above. state_read checks every entry as Python's restore() does (the
  * message names the entry: direction, previous_reference, previous_temperature,
- * previous_fraction, reversals / reversals[i], previous_input, previous_output; shaped,
+ * previous_fraction, previous_exponent, previous_slope, reversals / reversals[i],
+ * previous_input, previous_output; shaped,
  * "state entry model: " and the plant's) and changes nothing when it refuses. */
 size_t feedforward_stepper_state_size(const FeedforwardStepper *self);
 void feedforward_stepper_state_write(const FeedforwardStepper *self, double *out);

@@ -94,12 +94,12 @@ static void split_with_slope(const Stage *stage, double u, double *mf, double *p
 }
 
 int two_stage_inverse(double xi_mf, double xi_p, double exponent, double start,
-                      double *inverse_kelvin, const BranchConstants *constants,
-                      SmaMessage *message)
+                      const TangentLine *line, double *inverse_kelvin, double *slope_out,
+                      const BranchConstants *constants, SmaMessage *message)
 {
     Stage first, second;
     double other, low, high, u, limit, mf, p, mf1, p1, q1, mf2, p2, q2, residual, slope;
-    double step, next;
+    double step, next, tangent;
     int i;
     first.energy = constants->energy_over_kB;
     first.inverse_centre = constants->inv_centre_K;
@@ -127,12 +127,19 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double start,
     }
     if (low < start && start < high) {   /* a caller's start (NaN: none) */
         u = start;
+        if (line != NULL) {   /* the tangent's step from it, where that stays in the bracket */
+            tangent = start + (line->exponent - exponent) / line->slope;
+            if (low < tangent && tangent < high) {
+                u = tangent;
+            }
+        }
     } else if (first.energy >= second.energy) {
         u = newton_start(xi_mf, xi_p, &first, &second, *inverse_kelvin, low, high);
     } else {
         u = newton_start(xi_mf, xi_p, &second, &first, other, low, high);
     }
     limit = ROOT_TOLERANCE_K / (first.energy >= second.energy ? first.energy : second.energy);
+    slope = 0.0;
     for (i = 0; i < ROOT_CAP; i++) {
         split_with_slope(&first, u, &mf1, &p1, &q1);
         split_with_slope(&second, u, &mf2, &p2, &q2);
@@ -173,19 +180,21 @@ int two_stage_inverse(double xi_mf, double xi_p, double exponent, double start,
         u = next;
     }
     *inverse_kelvin = u;
+    *slope_out = slope;
     return 0;
 }
 
 int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *constants,
                              double margin, SensedTemperature *sensed, SmaMessage *message)
 {
-    return temperature_near(xi_mf, xi_p, constants, margin, NAN, sensed, message);
+    return temperature_near(xi_mf, xi_p, constants, margin, NAN, NULL, sensed, NULL, message);
 }
 
 int temperature_near(double xi_mf, double xi_p, const BranchConstants *constants, double margin,
-                     double near, SensedTemperature *sensed, SmaMessage *message)
+                     double near, const TangentLine *line, SensedTemperature *sensed,
+                     TangentLine *tangent, SmaMessage *message)
 {
-    double delta = margin * constants->M, exponent, inverse_kelvin, start;
+    double delta = margin * constants->M, exponent, inverse_kelvin, start, slope = 0.0;
     int saturated = 0;
     if (!(xi_mf >= delta && xi_p >= delta)) {
         clamped(&xi_mf, &xi_p, constants->M, delta);
@@ -196,8 +205,8 @@ int temperature_near(double xi_mf, double xi_p, const BranchConstants *constants
     if (constants->w2 != 0.0) {
         /* 1/(near + 273.15) where that is a temperature above absolute zero, else none */
         start = near + KELVIN_OFFSET > 0.0 ? 1.0 / (near + KELVIN_OFFSET) : NAN;
-        if (two_stage_inverse(xi_mf, xi_p, exponent, start, &inverse_kelvin, constants,
-                              message)) {
+        if (two_stage_inverse(xi_mf, xi_p, exponent, start, line, &inverse_kelvin, &slope,
+                              constants, message)) {
             return 1;
         }
     } else if (!(inverse_kelvin > 0.0)) {
@@ -207,6 +216,10 @@ int temperature_near(double xi_mf, double xi_p, const BranchConstants *constants
     }
     sensed->temperature = 1.0 / inverse_kelvin - KELVIN_OFFSET;
     sensed->saturated = saturated;
+    if (tangent != NULL) {   /* the line at the answer: a two-stage search's, with a slope */
+        tangent->exponent = slope > 0.0 ? exponent : NAN;
+        tangent->slope = slope > 0.0 ? slope : NAN;
+    }
     return 0;
 }
 

@@ -33,6 +33,12 @@ typedef struct SensedTemperature {
  * difference from its own saturated end. */
 void mixed_fractions_of_resistance(double resistance, const BranchConstants *constants,
                                    const WireParameters *params, double *xi_mf, double *xi_p);
+/* Lambda's tangent at a root of the two-stage search (sensing.temperature_with_tangent's
+ * line): Lambda [1] and -dLambda/d(1/T_K) [K]; NaN, NaN: none. */
+typedef struct TangentLine {
+    double exponent;
+    double slope;
+} TangentLine;
 #define ROOT_CAP 200              /* two_stage_root.ROOT_CAP */
 #define ROOT_TOLERANCE_K 1e-14    /* two_stage_root.ROOT_TOLERANCE_K [K] */
 
@@ -40,20 +46,25 @@ void mixed_fractions_of_resistance(double resistance, const BranchConstants *con
  * Lambda(1/T_K) = ln(xi_P/xi_MF) inside the bracket of stage 1's closed form
  * (*inverse_kelvin on entry) and stage 2's (from 0 where one is <= 0; refused when the
  * branch does not reach the target at any temperature), `exponent` = ln(xi_P/xi_MF), from
- * `start` [1/K] where it lies inside the bracket (NaN: none, the search's own start);
- * runtime/two_stage_root.py's two_stage_inverse, the same operations. */
+ * `start` [1/K] where it lies inside the bracket (NaN: none, the search's own start), and
+ * with `line` (NULL: none), Lambda's tangent at `start`, from that tangent's Newton step where
+ * it lies inside the bracket; *slope is -Lambda' [K] of the last evaluation (0 where a
+ * fraction underflowed). runtime/two_stage_root.py's two_stage_inverse, the same operations. */
 int two_stage_inverse(double xi_mf, double xi_p, double exponent, double start,
-                      double *inverse_kelvin, const BranchConstants *constants,
-                      SmaMessage *message);
+                      const TangentLine *line, double *inverse_kelvin, double *slope,
+                      const BranchConstants *constants, SmaMessage *message);
 /* Invert a major branch: (xi_MF, xi_P) [1] -> *sensed; `margin` is delta/M [1]. Refuses
  * ("temperature-sensing inverse diverges at Lambda = ...") when 1/T_K would be <= 0. */
 int temperature_of_fractions(double xi_mf, double xi_p, const BranchConstants *constants,
                              double margin, SensedTemperature *sensed, SmaMessage *message);
 /* temperature_of_fractions with `near` [degC], a temperature close to the answer (NaN: none;
- * sensing.temperature_of_fractions's near): a two-stage search starts there when it lies
- * inside the bracket. The same answer to the search's tolerance, not bit for bit. */
+ * sensing.temperature_with_tangent's near) and `line` (NULL: none), Lambda's tangent there:
+ * a two-stage search starts there (from the tangent's step) when it lies inside the bracket.
+ * The same answer to the search's tolerance, not bit for bit. *tangent (NULL: not wanted)
+ * gets the search's line at the answer; both NaN for one stage or an underflowed slope. */
 int temperature_near(double xi_mf, double xi_p, const BranchConstants *constants, double margin,
-                     double near, SensedTemperature *sensed, SmaMessage *message);
+                     double near, const TangentLine *line, SensedTemperature *sensed,
+                     TangentLine *tangent, SmaMessage *message);
 /* Invert the branch of the stack points[0 .. count) (count 0: the major branch of
  * `direction`) -> *sensed and *kept, how many points of the stack remain after the walk.
  * No argument checks (the compensator's hot path). */
