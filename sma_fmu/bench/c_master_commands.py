@@ -158,16 +158,16 @@ def _per_worker(done, runs_of):
 def _phases(client, spec, chunks, native_dir, rounds):
     """C-master and library phases on the same workers, C first and last, alternating: each
     phase runs every chunk (the sweep's tasks) on all the workers at once; before each C
-    phase the workers' C masters are closed, so each phase pays a host's start-up (start,
-    unpack, load). ([C phases' {pid: runs/s}], [library phases' ({pid: runs/s by the run
-    table's wall s}, {pid: runs/s in its tasks, metrics included})], CPU [s] per run of
-    the C master (worker and host) and of the library (with its metrics))."""
-    from sma_fmu.studies.tasks import close_worker_masters
-
+    phase the workers are restarted, so each C phase pays what a new sweep's workers pay
+    (its C master's start-up: the host started, the FMUs' model descriptions read, the FMUs
+    unpacked and loaded). ([C phases' {pid: runs/s}], [library phases' ({pid: runs/s by
+    the run table's wall s}, {pid: runs/s in its tasks, metrics included})], CPU [s] per
+    run of the C master (worker and host) and of the library (with its metrics))."""
     c_phases, library_phases, c_cpu, library_cpu = [], [], [], []
     for index in range(2 * rounds + 1):
         if index % 2 == 0:
-            client.run(close_worker_masters)
+            if index:
+                client.restart()
             done = client.gather([client.submit(_timed_task, spec.templates, chunk, native_dir,
                                                 pure=False) for chunk in chunks])
             c_phases.append(_per_worker(done, lambda task: (task[2], task[1])))
@@ -200,7 +200,8 @@ def _one_at_a_time(spec, native_dir):
 
 
 def sweep_throughput(native_dir, folder, workers=2, spec_path=None, rounds=3):
-    """{"runs", "workers": {pid: C-master runs per second (median over its phases)},
+    """{"runs", "workers": [C-master runs per second of each phase's fastest worker, its
+    next, ... (medians over the phases)],
     "per_worker" (median over the C phases of their workers' median), "library_per_s" (the
     same of the library phases, one over the run table's wall s per run), "library_wall_s",
     "library_task_per_s" (the library's runs per second in its tasks, metrics included),
@@ -228,14 +229,13 @@ def sweep_throughput(native_dir, folder, workers=2, spec_path=None, rounds=3):
     walls = [statistics.median(table.values()) for table, _ in library]
     tasks = [statistics.median(table.values()) for _, table in library]
     around = [(c_rates[i] + c_rates[i + 1]) / 2 for i in range(rounds)]
-    pids = {pid for phase in c for pid in phase}
+    slots = [sorted(phase.values(), reverse=True) for phase in c]   # fastest worker first
     out = Path(folder) / "sweep"
     wall, _ = _command(["sweep", str(spec_path), "--fmus", str(native_dir), "--workers",
                         str(workers), "--quiet"], out)
     median = statistics.median(walls)
     return {"runs": len(runs), "rounds": rounds,
-            "workers": {str(pid): round(statistics.median(p[pid] for p in c if pid in p), 1)
-                        for pid in sorted(pids)},
+            "workers": [round(statistics.median(rates), 1) for rates in zip(*slots)],
             "per_worker": round(statistics.median(c_rates), 1),
             "library_per_s": round(median, 2), "library_wall_s": round(1.0 / median, 4),
             "library_task_per_s": round(statistics.median(tasks), 2),
@@ -287,7 +287,7 @@ def command_lines(commands, sweep=None):
                      f"{len(sweep['workers'])} workers, {sweep['rounds']} library phases between "
                      f"C-master phases on the same workers (load average {sweep['load'][0]:.1f}"
                      f"-{sweep['load'][1]:.1f}): {sweep['per_worker']:.1f} runs/s per worker "
-                     f"process ({', '.join(f'{v:.1f}' for v in sweep['workers'].values())}), "
+                     f"process ({', '.join(f'{v:.1f}' for v in sweep['workers'])}), "
                      f"scalar library {sweep['library_per_s']:.2f} runs/s per worker process "
                      f"(run table's wall s per run {sweep['library_wall_s']:.3f}): "
                      f"{ratio['median']:.1f} x ({ratio['min']:.1f} ... {ratio['max']:.1f}): "
