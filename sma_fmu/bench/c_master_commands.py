@@ -15,8 +15,9 @@
   as many processes at once, at the same time); the CPU per run of both; the whole ``sma-fmu
   sweep`` command; and whether the sweep's metrics equal those of each point run alone in a
   C master of its own, to the bit. Both paths run in the same kind of process, two at once:
-  a library run alone in a process would have the machine (its scheduling group, below)
-  to itself while each C-master worker shares it with the other.
+  where the kernel shares the CPU between sessions first (Linux's autogroup), a library
+  run alone would have the session's share to itself while each C-master worker shares
+  it with the other, and under load the ratio would fall towards half.
 """
 import json
 import os
