@@ -44,9 +44,11 @@ def test_the_sweep_measure_checks_its_metrics_to_the_bit(native_dir, tmp_path):
 
     spec = tmp_path / "grid.toml"
     spec.write_text(SPEC, encoding="utf-8")
-    sweep = sweep_throughput(native_dir, tmp_path, workers=1, spec_path=spec)
+    sweep = sweep_throughput(native_dir, tmp_path, workers=1, spec_path=spec, rounds=1)
     assert sweep["equal"] and sweep["runs"] == 4 and len(sweep["workers"]) == 1
-    assert sweep["per_worker"] > 0 and sweep["library_per_s"] > 0
+    assert sweep["per_worker"] > 0 and sweep["library_per_s"] > 0 and sweep["rounds"] == 1
+    assert sweep["library_task_per_s"] <= sweep["library_per_s"]   # its metrics' time on top
+    assert sweep["ratio"]["min"] <= sweep["ratio"]["median"] <= sweep["ratio"]["max"]
     assert (tmp_path / "sweep" / "results.parquet").is_file()
-    line = command_lines({}, sweep)[-1]
-    assert f"target >= {SWEEP_TARGET:g}" in line and "to the bit: yes" in line
+    first, second = command_lines({}, sweep)[-2:]
+    assert f"target >= {SWEEP_TARGET:g}" in first and "to the bit: yes" in second
