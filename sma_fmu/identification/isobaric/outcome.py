@@ -189,4 +189,4 @@ def outcome(prepared, layout, solution, jacobian, order, first, on_bound, **extr
         profile_unknowns=n - k, knots_per_branch=[f.profile.knots_per_branch for f in prepared],
         converged=bool(solution.status > 0), message=str(solution.message), on_bound=on_bound,
         file_rms=file_rms, undetermined=undetermined,
-        strain_parts=strain_parts(prepared, layout, solution.x), **extra)
+        strain_parts=strain_parts(prepared, layout, solution.x, states), **extra)

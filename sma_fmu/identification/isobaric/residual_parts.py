@@ -11,7 +11,7 @@ expansion the model lacks there) is told from one in the transformation or in a 
 """
 import numpy as np
 
-from sma_fmu.identification.isobaric.jacobian import file_model, file_state
+from sma_fmu.identification.isobaric.jacobian import file_model
 from sma_fmu.runtime.constants import COOLING, HEATING
 
 __all__ = ["END_SHARE", "strain_parts", "parts_line"]
@@ -29,15 +29,15 @@ def _part(residual, rows, noise, total):
             "share": squares / total if total > 0 else 0.0}
 
 
-def strain_parts(prepared, layout, x):
+def strain_parts(prepared, layout, x, states):
     """Per file: {"parts": [{"direction", "phase", "rows", "rms" [1], "ratio", "share"}],
     "cycles": [{"cycle", "rows", "rms", "ratio", "share"}]} of the strain residual at the
-    solution ``x`` (rows of left-out cycles excluded, as in the residual RMS; a part without
-    rows has RMS and ratio None and share 0)."""
+    solution ``x``, whose per-file ``states`` (``jacobian.file_state``) the caller has (rows
+    of left-out cycles excluded, as in the residual RMS; a part without rows has RMS and
+    ratio None and share 0)."""
     params = layout.params(x)
     out = []
-    for f in prepared:
-        _, _, wire, direction, level, bounds = file_state(x, layout, f)
+    for f, (_, _, wire, direction, level, bounds) in zip(prepared, states):
         strain, _, q = file_model(params, f.data, wire, layout.levels(x, f.index), direction,
                                   level, f.per_cycle, share=True)
         residual = strain - f.data.strain
