@@ -6,7 +6,7 @@
 The filter starts in steady state at its first input: v_(-1) = y_(-1) = v_0.
 """
 from .checks import require_nonnegative, require_positive
-from .state_entries import StateError, read_entries, read_optional_number
+from .state_entries import read_entries, read_optional_number, require_pair
 
 __all__ = ["tustin_coefficients", "PhaseLagFilter"]
 
@@ -58,7 +58,6 @@ class PhaseLagFilter:
         read_entries(state, ("previous_input", "previous_output"), what="filter state")
         previous_input = read_optional_number(state, "previous_input", unit="W")
         previous_output = read_optional_number(state, "previous_output", unit="W")
-        if (previous_input is None) != (previous_output is None):
-            raise StateError("filter state entries previous_input and previous_output must both "
-                             "be numbers or both be null")
+        require_pair("previous_input", previous_input, "previous_output", previous_output,
+                     what="filter state")
         self.previous_input, self.previous_output = previous_input, previous_output

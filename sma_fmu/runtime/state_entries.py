@@ -79,9 +79,9 @@ def read_direction(state, key="direction"):
     return int(value)
 
 
-def require_pair(first_key, first, second_key, second):
+def require_pair(first_key, first, second_key, second, what="state"):
     """Refuse (StateError) a pair of entries read as optional numbers where one is None and
-    the other is not: they are one memory, filled together."""
+    the other is not: they are one memory, filled together (``what`` names whose entries)."""
     if (first is None) != (second is None):
-        raise StateError(f"state entries {first_key} and {second_key} must both be numbers or "
+        raise StateError(f"{what} entries {first_key} and {second_key} must both be numbers or "
                          f"both be null")
