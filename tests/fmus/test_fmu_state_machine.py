@@ -105,6 +105,16 @@ def test_only_inputs_and_parameters_can_be_set_and_fixed_ones_only_before_initia
     plant.fmu.doStep(1e-3, 1e-3)
 
 
+def test_a_refused_long_string_is_shown_cut_not_whole(plant):
+    """A host's 5-kB string is named in the refusal by its first 200 characters and its
+    length, as the C family shows it, not echoed whole into the host's log."""
+    text = "%s%n%x" * 1000
+    plant.refused(plant.fmu.setString, [plant.refs["wire_digest"]], [text],
+                  words=["wire_digest", "nothing was set", "(6000 characters)"])
+    message = plant.messages[-1][1]
+    assert len(message) < 600 and text[:200] in message and text[:201] not in message
+
+
 def test_reinitialization_is_refused_and_keeps_the_wire_state(plant):
     plant.start(load=0.05, P_in=3.0)
     for k in range(500):

@@ -301,7 +301,7 @@ class CallGuard:
             problem = None if name is None else check(value)
             if name is None or problem:
                 why = problem or self.interface.setting_refusal(kind, reference, self.state)
-                return self.refuse(function, f"{why}; nothing was set (value {value!r})")
+                return self.refuse(function, f"{why}; nothing was set (value {shown_value(value)})")
             names.append(name)
         slave = self.slave
         for name, value in zip(names, values):
@@ -371,6 +371,17 @@ class CallGuard:
 
     def set_integer(self, references, values):
         self._set("fmi2SetInteger", "Integer", references, values, _check_integer)
+
+
+SHOWN_CHARACTERS = 200   # a refused string is shown up to this many characters, as the C family does
+
+
+def shown_value(value):
+    """``value`` as a refusal message shows it: its repr, a long string cut to its first
+    :data:`SHOWN_CHARACTERS` characters (a host's 5-kB string would otherwise fill the log)."""
+    if isinstance(value, str) and len(value) > SHOWN_CHARACTERS:
+        return f"{value[:SHOWN_CHARACTERS]!r}... ({len(value)} characters)"
+    return repr(value)
 
 
 def _check_real(value):
