@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from sma_fmu.cli import main
+from sma_fmu.cosim.run_warnings import WARNINGS_KEPT, WarningTexts, model_text, ordered
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.runtime.validity import DATA_RANGE_NOTE
 from sma_fmu.wire.parameter_file import load_parameters
@@ -79,3 +80,25 @@ def test_the_fmpy_master_relays_the_c_family_fmus_warning(runs, native_dir, tmp_
 @needs("gcc")
 def test_the_c_master_relays_its_fmus_warning(runs, native_dir, tmp_path, capsys):
     _run_and_check(runs, tmp_path / "out", capsys, "--fmus", str(native_dir), "--master", "c")
+
+
+def test_a_component_lists_twenty_distinct_texts_then_counts_the_messages():
+    texts = WarningTexts()
+    for excursion in range(25):
+        texts.add(f"T = {300 + excursion} degC rose above validity.T_max = 300 degC")
+        texts.add("T = 300 degC rose above validity.T_max = 300 degC")   # a repeat: kept once
+    listed = texts.texts()
+    assert len(listed) == WARNINGS_KEPT + 1 == 21
+    assert listed[0].startswith("T = 300 degC") and listed[19].startswith("T = 319 degC")
+    assert listed[-1] == "and 5 more warning messages (not listed)"
+
+
+def test_the_fmus_prefix_comes_off_and_the_plant_comes_first():
+    assert model_text("SmaActuator 'plant': fmi2DoStep: T = 1 degC: x") == "T = 1 degC: x"
+    assert model_text("SmaFeedforward 'f': fmi3ExitInitializationMode: a: b") == "a: b"
+    assert model_text("T = 1 degC: no prefix") == "T = 1 degC: no prefix"
+    found = {"compensator": WarningTexts(), "plant": WarningTexts(), "driver": WarningTexts()}
+    for name, texts in found.items():
+        texts.add(f"from the {name}")
+        texts.add("shared")
+    assert ordered(found) == ["from the plant", "shared", "from the compensator", "from the driver"]
