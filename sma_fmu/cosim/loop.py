@@ -46,10 +46,11 @@ FMU master passes its own as ``run_loop(..., driver=...)``.
 """
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from sma_fmu.cosim.run_warnings import WarningTexts, ordered
 from sma_fmu.runtime.drive_limit import DriveLimit, LinearDriver
 from sma_fmu.runtime.feedforward import FeedforwardStepper
 from sma_fmu.runtime.measurement import ResistanceSensor
@@ -74,20 +75,26 @@ ROWS_PER_CHUNK = 4096   # rows gathered as tuples before they go into the result
 @dataclass
 class LoopResult:
     """Time series of one run: ``data`` is a structured array with the fields of :data:`COLUMNS`
-    (None when the run streamed its rows to a sink)."""
+    (None when the run streamed its rows to a sink); ``warnings`` the model's warnings [str]
+    the run gave, each once (:mod:`sma_fmu.cosim.run_warnings`; none from the system hosts)."""
 
     scenario: object
     data: np.ndarray
     path: str
     wall_time_s: float
+    warnings: list = field(default_factory=list)
 
 
 class LibraryPlant:
-    """The plant as the runtime :class:`PlantStepper` (library path)."""
+    """The plant as the runtime :class:`PlantStepper` (library path); ``warnings`` the
+    :class:`~sma_fmu.cosim.run_warnings.WarningTexts` of its start and steps."""
 
     def __init__(self, scenario):
         self.stepper = PlantStepper(scenario.params, scenario.T_start, scenario.hysteresis_mode,
                                     scenario.load.value(0.0))
+        self.warnings = WarningTexts()
+        if self.stepper.warning is not None:   # what an FMU logs at exitInitializationMode
+            self.warnings.add(self.stepper.warning)
 
     def outputs(self):
         """The :data:`PLANT_OUTPUTS` now."""
@@ -95,20 +102,26 @@ class LibraryPlant:
 
     def step(self, time_s, power, load, step_size):
         """Advance one step; returns the :data:`PLANT_OUTPUTS` at its end."""
-        return self.stepper.step(power, load, step_size)[:7]
+        stepper = self.stepper
+        outputs = stepper.step(power, load, step_size)
+        if stepper.warning is not None:
+            self.warnings.add(stepper.warning)
+        return outputs[:7]
 
     def close(self):
         """Nothing to release."""
 
 
 class LibraryCompensator:
-    """The compensator as the runtime :class:`FeedforwardStepper` (library path)."""
+    """The compensator as the runtime :class:`FeedforwardStepper` (library path); ``warnings``
+    the :class:`~sma_fmu.cosim.run_warnings.WarningTexts` of its steps."""
 
     def __init__(self, scenario):
         c = scenario.controller
         self.stepper = FeedforwardStepper(scenario.compensator_params, c.alpha, c.beta,
                                           c.model_load, c.adapt_to_load, c.inverse, c.shaping,
                                           c.power_cap_W, c.anticipation_s)
+        self.warnings = WarningTexts()   # (its start sets none: initial_outputs warns of nothing)
 
     def initial(self, reference, load):
         """(P_ff [W], T_ref [degC], saturated) before the first step (what a Jacobi host passes on)."""
@@ -116,7 +129,11 @@ class LibraryCompensator:
 
     def step(self, time_s, reference, load, step_size):
         """(P_ff [W], T_ref [degC], saturated) for the sample at ``time_s``."""
-        return self.stepper.step(reference, load, step_size)
+        stepper = self.stepper
+        outputs = stepper.step(reference, load, step_size)
+        if stepper.warning is not None:
+            self.warnings.add(stepper.warning)
+        return outputs
 
     def close(self):
         """Nothing to release."""
@@ -270,4 +287,7 @@ def run_library(scenario, coupling="gauss-seidel", sink=None):
     plant = LibraryPlant(scenario)
     compensator = LibraryCompensator(scenario) if scenario.controller.feedforward else None
     data = run_loop(scenario, plant, compensator, coupling, sink=sink)
-    return LoopResult(scenario, data, "library", time.perf_counter() - start)
+    warnings = {"plant": plant.warnings}
+    if compensator is not None:
+        warnings["compensator"] = compensator.warnings
+    return LoopResult(scenario, data, "library", time.perf_counter() - start, ordered(warnings))

@@ -23,6 +23,7 @@ from functools import partial
 
 from sma_fmu.cosim.event_drive import EventDrivenPlant, PassThroughDriver, traced_driver
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
+from sma_fmu.cosim.run_warnings import WarningTexts, model_text, ordered
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.instance3 import open_instance
 from sma_fmu.fmi.loop.system import loop_system
@@ -266,9 +267,23 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
         elif driver is not None and power_trace is not None:
             driver = traced_driver(driver, power_trace)
         data = run_loop(scenario, plant, parts.get("compensator"), driver=driver, sink=sink)
+        warnings = _logged_warnings(parts)
     except FmuError as error:
         raise FmuError(f"scenario {scenario.name}: {error}", error.status) from None
     finally:
         for part in parts.values():
             part.close()
-    return LoopResult(scenario, data, "fmu", time.perf_counter() - start)
+    return LoopResult(scenario, data, "fmu", time.perf_counter() - start, warnings)
+
+
+def _logged_warnings(parts):
+    """The warnings the FMUs of ``parts`` ({component: FmuPlant, ...}) logged, in the
+    runtime's text (:mod:`sma_fmu.cosim.run_warnings`): read from the messages each
+    instance's logger kept, after the run (nothing per step)."""
+    found = {}
+    for name, part in parts.items():
+        texts = found[name] = WarningTexts()
+        for status, message in part.fmu.messages:
+            if status == "warning":
+                texts.add(model_text(message))
+    return ordered(found)

@@ -41,6 +41,7 @@ import time
 from pathlib import Path
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
+from sma_fmu.cosim.run_warnings import WarningTexts, model_text, ordered
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.unpacked import WIN64, acquire, release
 from sma_fmu.fmi.hosts import CHostError, compile_host
@@ -278,7 +279,7 @@ class CMaster:
         if run.host is not self._host:
             self._send(run)
         scenario, rows = run.scenario, run.rows
-        logs, failure, done, writing = [], None, False, 0.0
+        logs, warnings, failure, done, writing = [], {}, None, False, 0.0
         try:
             if run.sent:
                 for tag, payload in self._host.frames():
@@ -286,8 +287,11 @@ class CMaster:
                         rows.add(payload)
                     elif tag == b"LOG_":
                         entry = log_entry(payload)
-                        if entry[0] >= 2:  # what a failure quotes (warnings are not kept: a
-                            logs.append(entry)  # long run may log one per step)
+                        if entry[0] >= 2:  # what a failure quotes
+                            logs.append(entry)
+                        elif entry[0] == 1:  # a warning: each text once (a bounded number)
+                            texts = warnings.get(entry[1]) or warnings.setdefault(entry[1], WarningTexts())
+                            texts.add(model_text(entry[2]))
                     elif tag == b"FAIL":
                         failure = payload.decode("utf-8", "replace")
                     elif tag == b"DONE":   # with the seconds the host spent writing the CSV
@@ -306,7 +310,7 @@ class CMaster:
             self._host_died(scenario, rows.count, rows.count * scenario.step_s if rows.started else 0.0)
         data = rows.finish()
         wall = time.perf_counter() - run.started - (self.startup_s - run.before) - writing
-        return LoopResult(scenario, data, "fmu", wall)
+        return LoopResult(scenario, data, "fmu", wall, ordered(warnings))
 
     def run(self, scenario, sink=None, columns=None):
         """Run ``scenario``; a :class:`LoopResult` (``path`` "fmu"), its ``data`` None when

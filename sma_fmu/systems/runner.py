@@ -5,6 +5,9 @@ For each scenario ``NAME`` in ``out_dir``: ``NAME/timeseries.csv`` (or ``.parque
 ``FOLDER-NAME`` instead, so none overwrites another. For each group of scenarios (see
 :attr:`~sma_fmu.cosim.scenario.Scenario.group`), with figures: ``comparison-GROUP.png``. Over the whole
 run: ``comparison.md``, which ranks the runs by RMSE in each group, and ``summary.json``.
+Each run's warnings (the model's, :mod:`sma_fmu.cosim.run_warnings`, then the metrics'
+reachability warning) go into its ``metrics.json`` ``warnings`` and are printed once each,
+``warning: NAME: TEXT``.
 Everything is written into a temporary folder and moved into ``out_dir`` at the end.
 Figures are drawn only when asked (``figures=True``, ``--figures``): without them no PNG is
 written and matplotlib is never imported, so a run costs what its loop costs (docs/scenarios.md).
@@ -195,6 +198,8 @@ def _record_run(scenario, run, fmu_dir, folder, every, fmt):
         metrics, figure_rows = recorder.close()
         if bar is not None:
             bar.close()
+    # the model's warnings (the steppers', or the FMUs' log), then the metrics' own
+    metrics["warnings"] = result.warnings + metrics["warnings"]
     return metrics, figure_rows, wall_time_s
 
 
