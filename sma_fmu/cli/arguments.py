@@ -41,15 +41,49 @@ class HelpFormatter(argparse.HelpFormatter):
 
 
 class Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line, ``sma-fmu: error: ...``, exit status 2."""
+    """ArgumentParser whose errors are one line, ``sma-fmu: error: ...``, exit status 2.
+
+    Options are never abbreviated: ``run --output DIR`` would otherwise be taken for
+    ``--output-interval``; an unknown option is named with the command's closest ones.
+    """
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", HelpFormatter)
+        kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
+
+    def parse_args(self, args=None, namespace=None):
+        namespace, unknown = self.parse_known_args(args, namespace)
+        if unknown:
+            self.error(f"unrecognized arguments: {' '.join(unknown)}"
+                       f"{_closest_options(self, namespace, unknown)}")
+        return namespace
 
     def error(self, message):
         command = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
         self.exit(fail(f"{command}{message} (see {self.prog} --help)"))
+
+
+def _closest_options(parser, namespace, unknown):
+    """``"; did you mean '--out'?"`` for the first unknown option with close names among the
+    options of the (sub)command ``namespace`` was parsed by, or ``""``."""
+    from sma_fmu.console.suggest import did_you_mean
+
+    command = parser
+    while command._subparsers is not None:   # the chosen command, down the sub-commands
+        chooser = next(a for a in command._subparsers._group_actions
+                       if isinstance(a, argparse._SubParsersAction))
+        chosen = chooser.choices.get(getattr(namespace, chooser.dest, None))
+        if chosen is None:
+            break
+        command = chosen
+    options = [name for action in command._actions for name in action.option_strings]
+    for word in unknown:
+        if word.startswith("--"):
+            hint = did_you_mean(word.partition("=")[0], options)
+            if hint:
+                return f"; {hint}"
+    return ""
 
 
 def _number(text, rule=None, rule_text=""):

@@ -43,6 +43,19 @@ def test_folder_given_as_scenario_or_csv(tmp_path, capsys):
            str(tmp_path), "is a folder, not a CSV file")
 
 
+# -- options: never abbreviated, an unknown one named with the command's closest ---------------
+
+def test_an_option_is_never_taken_for_a_longer_one(tmp_path, capsys, monkeypatch):
+    """``run --output DIR`` is not ``--output-interval DIR``: it is unknown, and the error
+    names ``--out``; nothing is written."""
+    monkeypatch.chdir(tmp_path)
+    line = _fails(capsys, ["run", "heavy-pi", "--path", "library", "--output", "out"],
+                  "unrecognized arguments: --output out", "did you mean '--out'")
+    assert "--output-interval: expected" not in line and not list(tmp_path.iterdir())
+    _fails(capsys, ["run", "heavy-pi", "--figure"], "--figure", "'--figures'")
+    _fails(capsys, ["fit", "isobaric", "x.csv", "--lodd", "1"], "--lodd", "'--load'")
+
+
 # -- --out naming an existing file or an unwritable place -------------------------------------
 
 @pytest.mark.parametrize("command", [
