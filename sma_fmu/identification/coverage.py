@@ -69,8 +69,8 @@ def data_range(temperatures, stresses, base):
 
 
 def coverage(params, base_set, fitted, note=""):
-    """The JSON-ready coverage of a fit: {"data_range", "data_range_note",
-    "stress_conversion", "not_identified_here"}.
+    """The JSON-ready coverage of a fit: {"data_range", "data_range_note", "ambient_note"
+    (why a run at the file's T_room warns, or ""), "stress_conversion", "not_identified_here"}.
 
     ``params``: the fitted WireParameters (the range already in it), ``base_set``: the base
     file's ParameterSet, ``fitted``: the names the fit determined. A parameter is "not
@@ -95,6 +95,7 @@ def coverage(params, base_set, fitted, note=""):
     return {
         "data_range": {key: getattr(params, key) for key in DATA_RANGE},
         "data_range_note": note,
+        "ambient_note": _ambient_note(params),
         "stress_conversion": {
             "diameter_m": params.diameter,
             "source": f"geometry.diameter of {name}",
@@ -104,6 +105,20 @@ def coverage(params, base_set, fitted, note=""):
         "not_identified_here": {"base_file": str(base_set.path), "by_section": taken,
                                 "defaults": defaults},
     }
+
+
+def _ambient_note(params):
+    """Why a run at the file's own ambient T_room warns, if it does ("" otherwise): a run
+    starts at T_room, so below T_data_min every run of this wire warns at its start."""
+    low, high, ambient = params.T_data_min, params.T_data_max, params.T_room
+    if low is not None and ambient < low:
+        side = f"below the data's range (T_data_min = {low:g} degC)"
+    elif high is not None and ambient > high:
+        side = f"above the data's range (T_data_max = {high:g} degC)"
+    else:
+        return ""
+    return (f"thermal.T_room = {ambient:g} degC is {side}: a run at this ambient starts "
+            f"outside it and warns; set thermal.T_room to your lab's ambient")
 
 
 def coverage_lines(report):
@@ -116,6 +131,8 @@ def coverage_lines(report):
              f"(validity.T_data_*, stress_data_*: the FMUs warn once outside it)"]
     if part["data_range_note"]:
         lines.append(f"data range: {part['data_range_note']}")
+    if part.get("ambient_note"):
+        lines.append(f"note: {part['ambient_note']}")
     lines.append(f"MPa <-> kg on a {conversion['diameter_m'] * 1e3:g} mm wire "
                  f"({conversion['source']}): 1 MPa = {conversion['kg_per_MPa']:.4g} kg")
     taken = part["not_identified_here"]

@@ -56,6 +56,11 @@ def test_the_flexinol_fit_records_its_range_diameter_and_what_it_kept(flexinol, 
     kept = coverage["not_identified_here"]["by_section"]
     assert kept["phases"] == {"R_P": 33.0, "R_M": 50.5, "R_F": 48.5}
     assert set(kept["thermal"]) == {"A_s", "c_p", "h_c", "T_room"}
+    # the kept ambient (10 degC) is below the data (about 30 degC): every run at it warns
+    ambient = kept["thermal"]["T_room"]
+    assert ambient < fitted.T_data_min
+    assert f"thermal.T_room = {ambient:g} degC is below the data's range" in coverage["ambient_note"]
+    assert f"note: {coverage['ambient_note']}" in console
     assert "T_alpha" in kept["strain"] and "T_alpha" in coverage["not_identified_here"]["defaults"]
     assert not {"a_h", "w2", "nu_h", "alpha_P", "nu"} & {n for s in kept.values() for n in s}
     assert "not identified here" in console and "[phases] R_P, R_M, R_F" in console
