@@ -1,7 +1,9 @@
 """A richer structure that leaves the wire file's valid parameters is not kept, and the fit
 goes on without it: three noise-free files at 200-400 MPa, cooled from 281 to -74 degC and
 heated back (as simulated isobaric tests are written), sent the second stage's heating
-centre at no load below absolute zero and stopped the whole fit with an error."""
+centre at no load below absolute zero and stopped the whole fit with an error. Such a file
+holds no cycle with both branches, so its thermal hysteresis is n/a: the report and the
+console say why, and no note prints "nan"."""
 import json
 
 import numpy as np
@@ -44,7 +46,7 @@ def test_an_invalid_parameter_is_a_measurement_error_naming_it():
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
-def test_a_second_stage_below_absolute_zero_leaves_the_one_stage_fit(tmp_path):
+def test_a_second_stage_below_absolute_zero_leaves_the_one_stage_fit(tmp_path, capsys):
     paths = [_write(tmp_path, s) for s in STRESSES]
     out = tmp_path / "fit"
     assert main(["fit", "isobaric", *map(str, paths), "--quiet", "--out", str(out)]) == 0
@@ -55,3 +57,11 @@ def test_a_second_stage_below_absolute_zero_leaves_the_one_stage_fit(tmp_path):
         heating, cooling = _centres(stress)
         assert entry["model_heating_degC"] == pytest.approx(heating, abs=1.0)
         assert entry["model_cooling_degC"] == pytest.approx(cooling, abs=1.0)
+    console = capsys.readouterr().out
+    for entry in report["hysteresis"]:
+        assert entry["thermocouple_K"] is None and entry["wire_K"] is None
+        assert "no such branch" in entry["thermocouple_K_why_missing"]
+        assert "no such branch" in entry["wire_K_why_missing"]
+        assert entry["narrowing_K_per_lag_unit"] is None and "nan" not in entry["note"]
+        assert f"{entry['file']}: thermal hysteresis (median over cycles) n/a at the " \
+               f"thermocouple, n/a at the wire (model): no cycle holds both branches (" in console
