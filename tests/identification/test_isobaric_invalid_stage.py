@@ -64,4 +64,4 @@ def test_a_second_stage_below_absolute_zero_leaves_the_one_stage_fit(tmp_path, c
         assert "no such branch" in entry["wire_K_why_missing"]
         assert entry["narrowing_K_per_lag_unit"] is None and "nan" not in entry["note"]
         assert f"{entry['file']}: thermal hysteresis (median over cycles) n/a at the " \
-               f"thermocouple, n/a at the wire (model): no cycle holds both branches (" in console
+               f"thermocouple, n/a at the wire (model) (n/a: heating: no such branch" in console

@@ -129,8 +129,8 @@ def format_isobaric_report(report):
             return f"{value:.3g} K" if value is not None else "n/a"
         reasons = dict.fromkeys(entry.get(f"{key}_why_missing") for key in
                                 ("thermocouple_K", "wire_K") if entry[key] is None)
-        # a cycle needs both branches: a file of one cooling, then one heating branch has none
-        why = (": no cycle holds both branches (" + "; ".join(reasons) + ")") if reasons else ""
+        # e.g. a file of one cooling, then one heating branch holds no cycle with both
+        why = (" (n/a: " + "; ".join(reasons) + ")") if reasons else ""
         lines.append(f"{entry['file']}: thermal hysteresis (median over cycles) "
                      f"{told('thermocouple_K')} at the thermocouple, {told('wire_K')} at the "
                      f"wire (model){why}")
