@@ -127,8 +127,9 @@ def format_isobaric_report(report):
         def told(key):
             value = entry[key]
             return f"{value:.3g} K" if value is not None else "n/a"
-        reasons = dict.fromkeys(entry.get(f"{key}_why_missing") for key in
-                                ("thermocouple_K", "wire_K") if entry[key] is None)
+        reasons = dict.fromkeys(reason for key in ("thermocouple_K", "wire_K")
+                                if entry[key] is None
+                                for reason in entry[f"{key}_why_missing"].split("; "))
         # e.g. a file of one cooling, then one heating branch holds no cycle with both
         why = (" (n/a: " + "; ".join(reasons) + ")") if reasons else ""
         lines.append(f"{entry['file']}: thermal hysteresis (median over cycles) "
