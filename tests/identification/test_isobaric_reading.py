@@ -10,6 +10,7 @@ import pytest
 from real_isobaric import real_folder
 from sma_fmu.cli import main
 from sma_fmu.files.package_data import shipped_file
+from sma_fmu.identification.isobaric.columns import classify
 from sma_fmu.identification.isobaric.files import read_isobaric
 from sma_fmu.identification.isobaric.stress import constant_load_rows
 from sma_fmu.identification.isobaric.table import read_table
@@ -164,3 +165,19 @@ def test_the_asmada_file_reads_as_written():
     assert names == ["temperature_C", "strain"] and data.notes == []
     np.testing.assert_array_equal(data.temperature, table[:, 0])
     np.testing.assert_array_equal(data.strain, table[:, 1])
+
+
+def test_a_strain_column_in_a_length_unit_is_refused_naming_what_to_call_it(tmp_path):
+    """A machine's extensometer channel named "_Strain1 (mm)" was read as a strain fraction
+    and refused as 'they look like percent'."""
+    rows = [f"{t},{20 + t / 100:.3f},39.4,{19.9 + 0.001 * t:.4f}" for t in range(40)]
+    path = tmp_path / "export.csv"
+    path.write_text("Time (s),Temperature Chamber (C),Stress (MPa),_Strain1 (mm)\n"
+                    + "\n".join(rows) + "\n", encoding="utf-8")
+    with pytest.raises(MeasurementError, match=r"export.csv: column '_Strain1 \(mm\)' is named "
+                                               r"strain but its unit is mm, a length: name it "
+                                               r"extension_mm"):
+        read_isobaric(path)
+    assert classify("Strain (mm/mm)") == ("strain", "fraction")
+    assert classify("Strain (%)") == ("strain", "percent")
+    assert classify("_Strain1 (mm)") == ("strain", "fraction")   # the reader refuses it above

@@ -44,11 +44,25 @@ SCALE = {"ms": 1e-3, "s": 1.0, "min": 60.0, "h": 3600.0, "m": 1.0, "mm": 1e-3, "
          "MPa": 1.0, "kPa": 1e-3, "GPa": 1e3, "Pa": 1e-6, "psi": 6.894757e-3, "ksi": 6.894757}
 
 
-def classify(name):
-    """(quantity, unit) of a column name, or None."""
+def _tokens(name):
+    """The words of a column name (symbols spelled out, brackets and blanks dropped)."""
     text = name.strip().replace("°", "deg").replace("Ω", "ohm").replace("²", "2")
     text = text.replace("μ", "µ")      # Greek mu as the micro sign
-    tokens = [t for t in re.split(r"[^A-Za-z0-9%/µ]+", text) if t]
+    return [t for t in re.split(r"[^A-Za-z0-9%/µ]+", text) if t]
+
+
+def _length_unit(name):
+    """The length unit a strain column's name carries instead of a strain unit (an
+    extensometer channel named ``_Strain1 (mm)``), or None."""
+    rest = [t.lower() for t in _tokens(name)[1:]]
+    if any(t in _STRAIN for t in rest):
+        return None
+    return next((t for t in rest if t and t in _LENGTH), None)
+
+
+def classify(name):
+    """(quantity, unit) of a column name, or None."""
+    tokens = _tokens(name)
     if not tokens:
         return None
     first, rest = tokens[0].lower(), [t.lower() for t in tokens[1:]]
@@ -69,6 +83,12 @@ def find_columns(path, names):
         if kind is None:
             continue
         quantity, unit = kind
+        if quantity == "strain" and _length_unit(name):
+            length = _LENGTH[_length_unit(name)]
+            raise MeasurementError(f"{path}: column {name!r} is named strain but its unit is "
+                                   f"{length}, a length: name it extension_{length} if it holds "
+                                   f"the elongation, or length_{length} if it holds the gauge "
+                                   f"length")
         if quantity == "strain" and "strain" in found and "strain_other" not in found \
                 and unit != found["strain"][1]:
             found["strain_other"] = (index, unit)   # the strain twice: % and fraction

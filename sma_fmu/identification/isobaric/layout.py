@@ -13,7 +13,17 @@ from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.model_terms import domain_widths
 from sma_fmu.runtime.parameters import ParameterError
 
-__all__ = ["Layout"]
+__all__ = ["Layout", "InvalidParameter"]
+
+
+class InvalidParameter(MeasurementError):
+    """The fit reached a parameter the wire file refuses; ``detail`` names it and its range.
+    A richer structure tried from a fit that holds (a second stage, separate widths, the
+    centre law) is then not kept, rather than stopping the fit."""
+
+    def __init__(self, paths, detail):
+        super().__init__(f"{paths}: the fit reached an invalid parameter ({detail})")
+        self.detail = detail
 
 
 class Layout:
@@ -137,8 +147,7 @@ class Layout:
             return self.base.replace(**changes)
         except ParameterError as error:
             detail = str(error).split(": ", 1)[-1]
-            raise MeasurementError(f"{self.paths}: the fit reached an invalid parameter "
-                                   f"({detail})") from None
+            raise InvalidParameter(self.paths, detail) from None
 
     def time_order(self, files):
         """Column order for the sparse solves: every file's offsets and knots by the sample

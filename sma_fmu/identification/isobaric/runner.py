@@ -202,9 +202,18 @@ def hysteresis_report(data, fit, rows):
         for key, source in (("thermocouple_K", "data"), ("wire_K", "model")):
             values = [r[source] for r in mine if np.isfinite(r[source])]
             entry[key] = float(np.median(values)) if values else None
+            if not values:      # why, from the cycles' own notes (each reason once)
+                reasons = dict.fromkeys(r[f"{source}_note"] for r in mine if r[f"{source}_note"])
+                entry[f"{key}_why_missing"] = "; ".join(reasons) or "no cycle in the file"
         out.append(entry)
     for entry, sensor in zip(out, fit.sensor):
         entry["narrowing_K_per_lag_unit"] = sensor["narrowing"]
+        if sensor["narrowing"] is None or not np.isfinite(sensor["narrowing"]):
+            entry["narrowing_K_per_lag_unit"] = None
+            entry["note"] = ("how much a lag would narrow the wire's hysteresis is not known: "
+                             "no cycle holds a heating and a cooling ramp to take their rates "
+                             "from")
+            continue
         entry["note"] = (f"a lag of 1 {sensor['unit'].rstrip('s')} of the wire behind the "
                          f"thermocouple would make the wire's hysteresis about "
                          f"{sensor['narrowing']:.3g} K narrower than the thermocouple's (the "

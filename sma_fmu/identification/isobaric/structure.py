@@ -14,6 +14,7 @@ from scipy import sparse
 
 from sma_fmu.identification.isobaric.first_fit import ROUNDS, first_fit
 from sma_fmu.identification.isobaric.jacobian import file_jacobian, scalar_sensitivities
+from sma_fmu.identification.isobaric.layout import InvalidParameter
 from sma_fmu.identification.isobaric.outcome import residual_blocks
 from sma_fmu.identification.isobaric.outliers import mark_outliers
 from sma_fmu.identification.isobaric.solver import levenberg_marquardt
@@ -158,23 +159,27 @@ def choose(prepared, base, layout_of, kind, widths, stages, lagged, outliers, cl
         kept = with_head(trial.vector, trial.solution.x)
         carried = _Trial(fresh.layout, _carry(trial.layout, kept, fresh.layout, fresh.vector),
                          fresh.lower, fresh.upper)
-        tries = [_first(prepared, carried, clock)]
-        if count == 2:
-            tries.append(_first(prepared, fresh, clock))
-        return min(tries, key=lambda t: t.solution.cost)
+        tries = []
+        for candidate in [carried] + ([fresh] if count == 2 else []):
+            try:    # a richer start that leaves the valid parameters is not a fit
+                tries.append(_first(prepared, candidate, clock))
+            except InvalidParameter:
+                pass    # the joint fit's second look says why (second_look)
+        return min(tries, key=lambda t: t.solution.cost) if tries else None
 
     rejected = []
     if widths == "auto":
         clock.stage("first fit: widths")
         wider = richer(1, "separate")
-        if wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
+        if wider is not None and \
+                wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
             trial, kind = outlying(wider), "separate"
         else:
             rejected.append("widths")
     if stages == 2:
         clock.stage("first fit: stages")
         wider = richer(2, kind)
-        w2 = wider.solution.x[wider.layout.phys.index("w2")]
+        w2 = wider.solution.x[wider.layout.phys.index("w2")] if wider is not None else 0.0
         if w2 > STAGE_SHARE_MIN and \
                 wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
             trial = outlying(wider)
@@ -215,7 +220,13 @@ def second_look(prepared, base, layout_of, state, kind, rejected, clock, max_eva
         vector, lower, upper = starts(prepared, layout, base)
         start = _carry(state.layout, state.solution.x, layout, vector)
         residuals, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
-        solution = solve(np.clip(start, lower, upper), max_evaluations)
+        try:
+            solution = solve(np.clip(start, lower, upper), max_evaluations)
+        except InvalidParameter as error:
+            notes.append(("a second stage" if what == "stages" else "separate heating and "
+                          "cooling widths") + f" reached an invalid parameter ({error.detail}): "
+                         + ("one stage" if what == "stages" else "one width") + " kept")
+            continue
         if what == "stages":
             w2 = solution.x[layout.phys.index("w2")]
             if w2 > STAGE_SHARE_MIN and \
@@ -257,7 +268,11 @@ def law_look(prepared, base, layout_of, state, kind, clock, max_evaluations):
     vector, lower, upper = starts(prepared, layout, base)
     start = _carry(state.layout, state.solution.x, layout, vector)
     _, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
-    solution = solve(np.clip(start, lower, upper), max_evaluations)
+    try:
+        solution = solve(np.clip(start, lower, upper), max_evaluations)
+    except InvalidParameter as error:
+        return state, (f"centres that follow the transformation strain reached an invalid "
+                       f"parameter ({error.detail}): linear centres kept")
     old = state.solution
     crossed = _crossed_centres(layout.params(solution.x), sorted({f.data.load for f in prepared}))
     if solution.status > 0 and solution.cost <= (1.0 - STAGE_GAIN_MIN) * old.cost and not crossed:

@@ -124,11 +124,17 @@ def format_isobaric_report(report):
                          f"model; cooling {slopes['data']['cooling']:.4g} data, "
                          f"{slopes['model']['cooling']:.4g} model")
     for entry in report.get("hysteresis", []):
-        thermocouple, wire = entry["thermocouple_K"], entry["wire_K"]
+        def told(key):
+            value = entry[key]
+            return f"{value:.3g} K" if value is not None else "n/a"
+        reasons = dict.fromkeys(reason for key in ("thermocouple_K", "wire_K")
+                                if entry[key] is None
+                                for reason in entry[f"{key}_why_missing"].split("; "))
+        # e.g. a file of one cooling, then one heating branch holds no cycle with both
+        why = (" (n/a: " + "; ".join(reasons) + ")") if reasons else ""
         lines.append(f"{entry['file']}: thermal hysteresis (median over cycles) "
-                     + (f"{thermocouple:.3g} K" if thermocouple is not None else "n/a")
-                     + " at the thermocouple, "
-                     + (f"{wire:.3g} K" if wire is not None else "n/a") + " at the wire (model)")
+                     f"{told('thermocouple_K')} at the thermocouple, {told('wire_K')} at the "
+                     f"wire (model){why}")
     for entry in report["files"]:
         if entry["lag"]:
             lag = entry["lag"]
