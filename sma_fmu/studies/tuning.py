@@ -4,7 +4,8 @@ Per scenario, scipy's ``differential_evolution`` (vectorized: each generation is
 batch, :func:`~sma_fmu.studies.batch.run_batch`) searches Kp and Ki, and for the
 feedforward controllers also the phase-lag times alpha and beta, within :data:`BOUNDS`,
 for the least RMSE of R - R_ref over the scenario's metrics window (the same RMSE as
-``sma-fmu run``; t >= 2 s for the paper's 30-s runs). The best gains are run once more on the scalar library path, and that
+``sma-fmu run``; t >= 2 s for the paper's 30-s runs), or, for a stroke scenario, the least
+RMSE of its stroke [um] (:mod:`sma_fmu.studies.criterion`: the default there, or chosen). The best gains are run once more on the scalar library path, and that
 RMSE is the one reported. Writes ``NAME/controller.toml`` (a ``[controller]`` table that
 pastes into the scenario), ``report.json`` and ``report.md`` (the controllers ranked at
 the scenario's own gains and at each controller's tuned gains).
@@ -23,7 +24,6 @@ streams on the nominal wire at the tuned gains (:mod:`sma_fmu.cosim.noise_seeds`
 """
 import dataclasses
 import json
-import math
 import time
 from collections import namedtuple
 from datetime import datetime, timezone
@@ -40,9 +40,12 @@ from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.fmi.loop.gains import GAIN_KEYS
 from sma_fmu.studies.batch import run_batch, unsupported_reason
+from sma_fmu.studies.criterion import (UNITS, criterion_rmse, scenario_criterion, stroke_fields,
+                                       stroke_markdown)
 from sma_fmu.studies.margins import loop_margins
 from sma_fmu.studies.overrides import StudyError, template
 from sma_fmu.studies.robust import draw_scenarios, robust_value
+from sma_fmu.systems.stroke_table import is_stroke
 
 __all__ = ["BOUNDS", "TUNED", "tune_scenario", "controller_snippet", "run_tuning",
            "ranking_markdown"]
@@ -51,7 +54,6 @@ __all__ = ["BOUNDS", "TUNED", "tune_scenario", "controller_snippet", "run_tuning
 BOUNDS = {"Kp": (0.0, 5.0), "Ki": (0.0, 20.0), "alpha": (0.0, 3.0), "beta": (0.02, 1.5)}
 TUNED = {"pi": ("Kp", "Ki"), "pi+ff-fixed": ("Kp", "Ki", "alpha", "beta"),
          "pi+ff-adaptive": ("Kp", "Ki", "alpha", "beta")}
-_FAILED_RMSE = 1e6   # what a run that fails costs the optimiser [ohm]
 _SHAPED_KEYS = ("shaping", "power_cap_W", "anticipation_s")   # kept in the snippet as given
 _LibraryRun = namedtuple("_LibraryRun", "metrics")             # a library run, as a batch's
 
@@ -61,19 +63,18 @@ def _with_gains(scenario, names, values):
         scenario.controller, **{name: float(v) for name, v in zip(names, values)}))
 
 
-def _rmse(metrics):
-    value = None if metrics is None else metrics["overall"]["rmse_ohm"]
-    return _FAILED_RMSE if value is None or not math.isfinite(value) else value
-
-
 def _robust_record(scenario, best, names, start, robust):
-    """The draws' RMSEs [ohm] (scalar path) at the given and the tuned gains, and the score."""
+    """The draws' RMSEs (scalar path) at the given and the tuned gains, and the score: R's
+    [ohm], and for a stroke scenario the stroke's [um] beside."""
     record = robust.as_dict()
+    criteria = ("resistance", "stroke") if is_stroke(scenario) else ("resistance",)
     for label, values in (("given", start), ("tuned", [getattr(best.controller, n) for n in names])):
-        rmses = [_rmse(scenario_metrics(run_library(draw).data, draw))
-                 for draw in (_with_gains(d, names, values) for d in draw_scenarios(scenario, robust))]
-        record[f"rmse_{label}_ohm"] = rmses
-        record[f"score_{label}_ohm"] = float(robust_value(rmses, robust.quantile))
+        metrics = [scenario_metrics(run_library(draw).data, draw)
+                   for draw in (_with_gains(d, names, values) for d in draw_scenarios(scenario, robust))]
+        for name in criteria:
+            rmses = [criterion_rmse(m, name) for m in metrics]
+            record[f"rmse_{label}_{UNITS[name]}"] = rmses
+            record[f"score_{label}_{UNITS[name]}"] = float(robust_value(rmses, robust.quantile))
     return record
 
 
@@ -90,13 +91,15 @@ def _library_runs(scenarios):
             for scenario in scenarios]
 
 
-def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
+def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None, criterion=None):
     """Tune one scenario's controller; returns a JSON-ready record (values, RMSE, effort).
 
     ``robust``: a :class:`~sma_fmu.studies.robust.RobustCriterion`, or None for the RMSE of
-    the scenario as it is. A scenario the batch engine does not implement runs on the
-    library path (module docstring).
+    the scenario as it is. ``criterion``: "stroke" or "resistance", or None for the
+    scenario's default (:func:`~sma_fmu.studies.criterion.scenario_criterion`). A scenario
+    the batch engine does not implement runs on the library path (module docstring).
     """
+    criterion = scenario_criterion(scenario, criterion)
     reason = unsupported_reason(scenario)
     runs = _library_runs if reason else run_batch
     names = _tuned_names(scenario)
@@ -109,7 +112,7 @@ def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
         batch = [_with_gains(draw, names, column) for column in np.atleast_2d(candidates).T
                  for draw in draws]
         evaluations += len(batch)
-        rmses = np.array([_rmse(run.metrics) for run in runs(batch)])
+        rmses = np.array([criterion_rmse(run.metrics, criterion) for run in runs(batch)])
         return robust_value(rmses.reshape(-1, len(draws)), quantile)
 
     began = time.perf_counter()
@@ -131,6 +134,8 @@ def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None):
     if robust is not None:
         extra["robust"] = _robust_record(scenario, best, names, start, robust)
     record = _record(scenario, names, result, start, tuned, given, evaluations, seconds, seed)
+    if is_stroke(scenario):
+        extra.update(stroke_fields(criterion, tuned, given, float(result.fun)))
     if reason:
         record["optimiser"]["method"] = ("scipy differential_evolution, on the library path "
                                          f"(not in the batch engine: {reason})")
@@ -164,11 +169,19 @@ def controller_snippet(record):
     lines = [f"# sma-fmu tune {record['scenario']} ({datetime.now(timezone.utc).date()}): "
              f"RMSE {record['rmse_ohm']['tuned']:.4f} ohm, against "
              f"{record['rmse_ohm']['given']:.4f} ohm at the scenario's gains"]
+    unit = UNITS[record.get("criterion", "resistance")]
+    if "criterion" in record:
+        lines[0] = (f"# sma-fmu tune {record['scenario']} ({datetime.now(timezone.utc).date()}), "
+                    f"criterion {record['criterion']}: stroke RMSE {record['rmse_um']['tuned']:.1f} "
+                    f"um, against {record['rmse_um']['given']:.1f} um at the scenario's gains "
+                    f"(R: {record['rmse_ohm']['tuned']:.4f} ohm, against "
+                    f"{record['rmse_ohm']['given']:.4f})")
     robust = record.get("robust")
     if robust:
         lines.append(f"# robust: quantile {robust['quantile']:g} of {robust['draws']} draws "
                      f"(noise, +-{100 * robust['spread']:g} % wire): "
-                     f"{robust['score_tuned_ohm']:.4f} ohm, against {robust['score_given_ohm']:.4f}")
+                     f"{robust[f'score_tuned_{unit}']:.4f} {unit}, against "
+                     f"{robust[f'score_given_{unit}']:.4f}")
     margins = record["margins"]["tuned"]
     lines += [f"# margins of the linearised loop: gain {margins['gain_margin_dB']:.1f} dB, "
               f"phase {margins['phase_margin_deg']:.1f} deg",
@@ -191,7 +204,8 @@ def ranking_markdown(records):
     """Per group of scenarios with every controller: RMSE [ohm] and order, given vs tuned gains.
 
     Columns: the three controllers, then any other inverse present (a group without it
-    shows "-" there and ranks the rest).
+    shows "-" there and ranks the rest). Stroke scenarios' records are in a table of their
+    own (:func:`~sma_fmu.studies.criterion.stroke_markdown`), after the others'.
     """
     groups, labels = {}, list(CONTROLLERS)
     for record in records:
@@ -213,11 +227,15 @@ def ranking_markdown(records):
                          " | ".join(f"{rmse[c]:.3f}" if c in rmse else "-" for c in labels)
                          + f" | {order} |")
     robust = next((r["robust"] for r in records if r.get("robust")), None)
+    plain = [record for record in records if "criterion" not in record]
     score = "" if robust is None else (f" | score given | score tuned")
-    lines += ["", f"| scenario | RMSE given | RMSE tuned{score} | tuned values (* at a bound) | "
-              "gain margin [dB] | phase margin [deg] |",
-              "|---|---:|---:|" + ("---:|---:|" if robust else "") + "---|---:|---:|"]
-    for record in records:
+    if plain:
+        lines += ["", f"| scenario | RMSE given | RMSE tuned{score} | tuned values (* at a bound) | "
+                  "gain margin [dB] | phase margin [deg] |",
+                  "|---|---:|---:|" + ("---:|---:|" if robust else "") + "---|---:|---:|"]
+    else:                                        # stroke scenarios only: their table alone
+        lines = lines[:1]
+    for record in plain:
         values = ", ".join(f"{name} = {value:.4g}{'*' if name in record['at_bound'] else ''}"
                            for name, value in record["tuned"].items())
         scores = "" if robust is None else (
@@ -227,6 +245,7 @@ def ranking_markdown(records):
         lines.append(f"| {record['scenario']} | {record['rmse_ohm']['given']:.3f} | "
                      f"{record['rmse_ohm']['tuned']:.3f}{scores} | {values} | "
                      f"{margins['gain_margin_dB']:.1f} | {margins['phase_margin_deg']:.1f} |")
+    lines += stroke_markdown(records)
     if robust is not None:
         lines += ["", f"Score: the {robust['quantile']:g} quantile of the RMSE over "
                       f"{robust['draws']} draws (noise stream; {', '.join(robust['parameters'])} "
@@ -245,12 +264,14 @@ def _with_stop_time(scenario, stop_time_s):
 
 
 def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_s=None,
-               progress=print, robust=None):
+               progress=print, robust=None, criterion=None):
     """Tune every scenario file in ``paths``; write snippets and reports; return the records.
 
-    ``robust``: a :class:`~sma_fmu.studies.robust.RobustCriterion` or None (see the module
-    docstring)."""
+    ``robust``: a :class:`~sma_fmu.studies.robust.RobustCriterion` or None; ``criterion``:
+    "stroke", "resistance" or None (each scenario's default) (see the module docstring)."""
     scenarios = [load_scenario(p) for p in paths]
+    for scenario in scenarios:                  # refused before any work starts
+        scenario_criterion(scenario, criterion)
     if stop_time_s is not None and not stop_time_s > 0.0:
         raise StudyError(f"--stop-time {stop_time_s!r}: must be > 0 s")
     if stop_time_s is not None:
@@ -259,12 +280,20 @@ def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_
     for index, scenario in enumerate(scenarios, start=1):
         progress(f"[{index}/{len(scenarios)}] tuning {scenario.name} "
                  f"({', '.join(_tuned_names(scenario))}) ...")
-        record = tune_scenario(scenario, seed, generations, population, robust)
-        progress(f"    RMSE {record['rmse_ohm']['given']:.4f} -> {record['rmse_ohm']['tuned']:.4f}"
-                 f" ohm: " + ", ".join(f"{k} = {v:.4g}" for k, v in record["tuned"].items()))
+        record = tune_scenario(scenario, seed, generations, population, robust, criterion)
+        gains = ", ".join(f"{k} = {v:.4g}" for k, v in record["tuned"].items())
+        unit = UNITS[record.get("criterion", "resistance")]
+        if "criterion" in record:
+            progress(f"    criterion {record['criterion']}: stroke RMSE "
+                     f"{record['rmse_um']['given']:.1f} -> {record['rmse_um']['tuned']:.1f} um, "
+                     f"RMSE {record['rmse_ohm']['given']:.4f} -> "
+                     f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
+        else:
+            progress(f"    RMSE {record['rmse_ohm']['given']:.4f} -> "
+                     f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
         if robust is not None:
-            progress(f"    robust score {record['robust']['score_given_ohm']:.4f} -> "
-                     f"{record['robust']['score_tuned_ohm']:.4f} ohm")
+            progress(f"    robust score {record['robust'][f'score_given_{unit}']:.4f} -> "
+                     f"{record['robust'][f'score_tuned_{unit}']:.4f} {unit}")
         records.append(record)
     with staged_folder(out_dir) as stage:
         for record in records:
