@@ -48,7 +48,7 @@ def _tune(args):
         robust = RobustCriterion(args.draws, args.spread, args.quantile, args.seed)
     run_tuning(paths, out, seed=args.seed, generations=args.generations,
                population=args.population, stop_time_s=args.stop_time, progress=echo,
-               robust=robust, criterion=args.criterion)
+               robust=robust, criterion=args.criterion, joint=args.joint)
     print(f"written: {out}/report.md, report.json, NAME/controller.toml")
     return 0
 
@@ -88,6 +88,10 @@ def register(commands):
                       help="what is minimised: the RMSE of the stroke [um] or of R - R_ref "
                            "[ohm] (default: stroke for a stroke scenario, else resistance; "
                            "stroke on a resistance scenario is refused)")
+    tune.add_argument("--joint", action="store_true",
+                      help="one gain set for all the scenarios given: minimise the worst of "
+                           "their scores relative to their given gains' (they must tune the "
+                           "same gains)")
     tune.add_argument("--robust", action="store_true",
                       help="score gains by a quantile of the RMSE over Monte Carlo draws of "
                            "the noise stream and the wire (+- --spread on its thermal and "

@@ -29,7 +29,7 @@ from collections import namedtuple
 from datetime import datetime, timezone
 
 import numpy as np
-from scipy.optimize import differential_evolution
+from scipy.optimize import OptimizeResult, differential_evolution
 
 from sma_fmu.console import progress
 from sma_fmu.cosim.loop import run_library
@@ -91,6 +91,39 @@ def _library_runs(scenarios):
             for scenario in scenarios]
 
 
+class _Objective:
+    """A scenario's score of candidate gains (minimised): the criterion's RMSE, or its
+    quantile over the robust draws; one batch per call (the library path where the batch
+    engine lacks an option: :attr:`reason`)."""
+
+    def __init__(self, scenario, names, criterion, robust):
+        self.reason = unsupported_reason(scenario)
+        self.runs = _library_runs if self.reason else run_batch
+        self.names, self.criterion = names, criterion
+        self.draws = [scenario] if robust is None else draw_scenarios(scenario, robust)
+        self.quantile = 0.5 if robust is None else robust.quantile
+        self.evaluations = 0
+
+    def __call__(self, candidates):              # (D, S) -> (S,)
+        batch = [_with_gains(draw, self.names, column)
+                 for column in np.atleast_2d(candidates).T for draw in self.draws]
+        self.evaluations += len(batch)
+        rmses = np.array([criterion_rmse(run.metrics, self.criterion) for run in self.runs(batch)])
+        return robust_value(rmses.reshape(-1, len(self.draws)), self.quantile)
+
+
+def _search(cost, names, start, seed, generations, population, label):
+    """scipy's differential evolution of ``cost`` from ``start``: (result, seconds)."""
+    began = time.perf_counter()
+    with progress.bar(generations, f"tuning {label}", unit="generation") as shown:
+        result = differential_evolution(
+            cost, [BOUNDS[name] for name in names], maxiter=generations, popsize=population,
+            rng=seed, polish=False, vectorized=True, updating="deferred", tol=1e-4,
+            x0=np.clip(start, [BOUNDS[n][0] for n in names], [BOUNDS[n][1] for n in names]),
+            callback=lambda *_: shown.update(1) and None)
+    return result, time.perf_counter() - began
+
+
 def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None, criterion=None):
     """Tune one scenario's controller; returns a JSON-ready record (values, RMSE, effort).
 
@@ -99,31 +132,51 @@ def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None, 
     scenario's default (:func:`~sma_fmu.studies.criterion.scenario_criterion`). A scenario
     the batch engine does not implement runs on the library path (module docstring).
     """
-    criterion = scenario_criterion(scenario, criterion)
-    reason = unsupported_reason(scenario)
-    runs = _library_runs if reason else run_batch
     names = _tuned_names(scenario)
-    draws = [scenario] if robust is None else draw_scenarios(scenario, robust)
-    quantile = 0.5 if robust is None else robust.quantile
-    evaluations = 0
-
-    def cost(candidates):                      # (D, S) -> (S,)
-        nonlocal evaluations
-        batch = [_with_gains(draw, names, column) for column in np.atleast_2d(candidates).T
-                 for draw in draws]
-        evaluations += len(batch)
-        rmses = np.array([criterion_rmse(run.metrics, criterion) for run in runs(batch)])
-        return robust_value(rmses.reshape(-1, len(draws)), quantile)
-
-    began = time.perf_counter()
+    objective = _Objective(scenario, names, scenario_criterion(scenario, criterion), robust)
     start = [getattr(scenario.controller, name) for name in names]
-    with progress.bar(generations, f"tuning {scenario.name}", unit="generation") as shown:
-        result = differential_evolution(
-            cost, [BOUNDS[name] for name in names], maxiter=generations, popsize=population,
-            rng=seed, polish=False, vectorized=True, updating="deferred", tol=1e-4,
-            x0=np.clip(start, [BOUNDS[n][0] for n in names], [BOUNDS[n][1] for n in names]),
-            callback=lambda *_: shown.update(1) and None)
-    seconds = time.perf_counter() - began
+    result, seconds = _search(objective, names, start, seed, generations, population,
+                              scenario.name)
+    return _finish(scenario, names, start, result, objective, robust, seconds, seed)
+
+
+def tune_jointly(scenarios, seed=1, generations=30, population=12, robust=None, criterion=None):
+    """One gain set for all ``scenarios`` (the same gains tuned); a record per scenario.
+
+    **choice**: the score minimised is the worst (largest) of the scenarios' scores, each
+    relative to its score at its own given gains (ratios: the criteria's units and scales
+    differ; the worst, so that no scenario pays for another's gain). The search starts from
+    the first scenario's gains.
+    """
+    names = _tuned_names(scenarios[0])
+    for scenario in scenarios[1:]:
+        if _tuned_names(scenario) != names:
+            raise StudyError(f"--joint: {scenario.name} tunes {', '.join(_tuned_names(scenario))}"
+                             f", {scenarios[0].name} {', '.join(names)}: not one gain set")
+    objectives = [_Objective(s, names, scenario_criterion(s, criterion), robust) for s in scenarios]
+    starts = [[getattr(s.controller, name) for name in names] for s in scenarios]
+    scales = [float(objective(np.array(start))[0]) for objective, start in zip(objectives, starts)]
+
+    def worst(candidates):
+        return np.max([objective(candidates) / scale
+                       for objective, scale in zip(objectives, scales)], axis=0)
+
+    label = " + ".join(s.name for s in scenarios)
+    result, seconds = _search(worst, names, starts[0], seed, generations, population, label)
+    records = []
+    for scenario, objective, start, scale in zip(scenarios, objectives, starts, scales):
+        own = OptimizeResult({**result, "fun": float(objective(result.x)[0])})   # its own score
+        record = _finish(scenario, names, start, own, objective, robust, seconds, seed)
+        record["joint"] = {"scenarios": [s.name for s in scenarios], "combine": "worst ratio",
+                           "given_score": scale, "ratio": own.fun / scale,
+                           "worst_ratio": float(result.fun)}
+        records.append(record)
+    return records
+
+
+def _finish(scenario, names, start, result, objective, robust, seconds, seed):
+    """The record of the search's ``result``: the best gains run again on the library path,
+    the given gains' run, the margins, the robust draws and the noise seeds."""
     best = _with_gains(scenario, names, result.x)
     tuned = scenario_metrics(run_library(best).data, best)   # the reported RMSE: scalar path
     given = scenario_metrics(run_library(scenario).data, scenario)
@@ -133,12 +186,13 @@ def tune_scenario(scenario, seed=1, generations=30, population=12, robust=None, 
         extra["noise_seeds"] = {"median_ohm": median, "rmse_ohm": values}
     if robust is not None:
         extra["robust"] = _robust_record(scenario, best, names, start, robust)
-    record = _record(scenario, names, result, start, tuned, given, evaluations, seconds, seed)
+    record = _record(scenario, names, result, start, tuned, given, objective.evaluations,
+                     seconds, seed)
     if is_stroke(scenario):
-        extra.update(stroke_fields(criterion, tuned, given, float(result.fun)))
-    if reason:
+        extra.update(stroke_fields(objective.criterion, tuned, given, float(result.fun)))
+    if objective.reason:
         record["optimiser"]["method"] = ("scipy differential_evolution, on the library path "
-                                         f"(not in the batch engine: {reason})")
+                                         f"(not in the batch engine: {objective.reason})")
     return {**record, **extra}
 
 
@@ -182,6 +236,10 @@ def controller_snippet(record):
                      f"(noise, +-{100 * robust['spread']:g} % wire): "
                      f"{robust[f'score_tuned_{unit}']:.4f} {unit}, against "
                      f"{robust[f'score_given_{unit}']:.4f}")
+    if "joint" in record:
+        lines.append(f"# tuned jointly with {', '.join(record['joint']['scenarios'])}: score "
+                     f"{record['joint']['ratio']:.3f} x the given gains' here, worst "
+                     f"{record['joint']['worst_ratio']:.3f}")
     margins = record["margins"]["tuned"]
     lines += [f"# margins of the linearised loop: gain {margins['gain_margin_dB']:.1f} dB, "
               f"phase {margins['phase_margin_deg']:.1f} deg",
@@ -246,6 +304,10 @@ def ranking_markdown(records):
                      f"{record['rmse_ohm']['tuned']:.3f}{scores} | {values} | "
                      f"{margins['gain_margin_dB']:.1f} | {margins['phase_margin_deg']:.1f} |")
     lines += stroke_markdown(records)
+    if any("joint" in record for record in records):
+        lines += ["", "Tuned jointly: one gain set for all the scenarios, minimising the worst "
+                      "of their scores relative to their given gains' (" + ", ".join(
+                          f"{r['scenario']} {r['joint']['ratio']:.3f}" for r in records) + ")."]
     if robust is not None:
         lines += ["", f"Score: the {robust['quantile']:g} quantile of the RMSE over "
                       f"{robust['draws']} draws (noise stream; {', '.join(robust['parameters'])} "
@@ -263,12 +325,33 @@ def _with_stop_time(scenario, stop_time_s):
         raise StudyError(f"--stop-time {stop_time_s!r}: {error}") from None
 
 
+def _print_record(record, robust, progress):
+    """The console's lines of one tuned record: the criterion's RMSE, given -> tuned."""
+    gains = ", ".join(f"{k} = {v:.4g}" for k, v in record["tuned"].items())
+    unit = UNITS[record.get("criterion", "resistance")]
+    if "criterion" in record:
+        progress(f"    criterion {record['criterion']}: stroke RMSE "
+                 f"{record['rmse_um']['given']:.1f} -> {record['rmse_um']['tuned']:.1f} um, "
+                 f"RMSE {record['rmse_ohm']['given']:.4f} -> "
+                 f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
+    else:
+        progress(f"    RMSE {record['rmse_ohm']['given']:.4f} -> "
+                 f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
+    if robust is not None:
+        progress(f"    robust score {record['robust'][f'score_given_{unit}']:.4f} -> "
+                 f"{record['robust'][f'score_tuned_{unit}']:.4f} {unit}")
+    if "joint" in record:
+        progress(f"    jointly tuned: score {record['joint']['ratio']:.3f} x the given gains' "
+                 f"(worst of all {record['joint']['worst_ratio']:.3f})")
+
+
 def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_s=None,
-               progress=print, robust=None, criterion=None):
+               progress=print, robust=None, criterion=None, joint=False):
     """Tune every scenario file in ``paths``; write snippets and reports; return the records.
 
     ``robust``: a :class:`~sma_fmu.studies.robust.RobustCriterion` or None; ``criterion``:
-    "stroke", "resistance" or None (each scenario's default) (see the module docstring)."""
+    "stroke", "resistance" or None (each scenario's default); ``joint``: one gain set for
+    all (:func:`tune_jointly`) (see the module docstring)."""
     scenarios = [load_scenario(p) for p in paths]
     for scenario in scenarios:                  # refused before any work starts
         scenario_criterion(scenario, criterion)
@@ -276,25 +359,21 @@ def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_
         raise StudyError(f"--stop-time {stop_time_s!r}: must be > 0 s")
     if stop_time_s is not None:
         scenarios = [_with_stop_time(s, stop_time_s) for s in scenarios]
-    records = []
-    for index, scenario in enumerate(scenarios, start=1):
-        progress(f"[{index}/{len(scenarios)}] tuning {scenario.name} "
-                 f"({', '.join(_tuned_names(scenario))}) ...")
-        record = tune_scenario(scenario, seed, generations, population, robust, criterion)
-        gains = ", ".join(f"{k} = {v:.4g}" for k, v in record["tuned"].items())
-        unit = UNITS[record.get("criterion", "resistance")]
-        if "criterion" in record:
-            progress(f"    criterion {record['criterion']}: stroke RMSE "
-                     f"{record['rmse_um']['given']:.1f} -> {record['rmse_um']['tuned']:.1f} um, "
-                     f"RMSE {record['rmse_ohm']['given']:.4f} -> "
-                     f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
-        else:
-            progress(f"    RMSE {record['rmse_ohm']['given']:.4f} -> "
-                     f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
-        if robust is not None:
-            progress(f"    robust score {record['robust'][f'score_given_{unit}']:.4f} -> "
-                     f"{record['robust'][f'score_tuned_{unit}']:.4f} {unit}")
-        records.append(record)
+    if joint:
+        progress(f"tuning {len(scenarios)} scenarios jointly "
+                 f"({', '.join(_tuned_names(scenarios[0]))}) ...")
+        records = tune_jointly(scenarios, seed, generations, population, robust, criterion)
+        for record in records:
+            progress(f"  {record['scenario']}:")
+            _print_record(record, robust, progress)
+    else:
+        records = []
+        for index, scenario in enumerate(scenarios, start=1):
+            progress(f"[{index}/{len(scenarios)}] tuning {scenario.name} "
+                     f"({', '.join(_tuned_names(scenario))}) ...")
+            records.append(tune_scenario(scenario, seed, generations, population, robust,
+                                         criterion))
+            _print_record(records[-1], robust, progress)
     with staged_folder(out_dir) as stage:
         for record in records:
             (stage / record["scenario"]).mkdir()

@@ -107,3 +107,28 @@ def test_a_resistance_scenario_keeps_its_record(tmp_path):
 def test_a_bad_criterion_is_refused(tmp_path, capsys, argv, parts):
     fails(capsys, ["tune", *argv, "--out", str(tmp_path / "t")], *parts)
     assert not (tmp_path / "t").exists()
+
+
+def test_joint_tuning_gives_one_gain_set_for_both_stroke_scenarios(tmp_path, capsys):
+    names = [NAME, "flexinol-stroke-profile-pi+ff-adaptive"]
+    out = tmp_path / "tune"
+    assert main(["tune", *names, "--joint", *SHORT, "--out", str(out)]) == 0
+    records = json.loads((out / "report.json").read_text())
+    assert records[0]["tuned"] == records[1]["tuned"]
+    ratios = []
+    for name, record in zip(names, records):
+        scenario = _short(name)
+        tuned, given = _metrics(_with(scenario, record["tuned"])), _metrics(scenario)
+        ratios.append(tuned["stroke"]["rmse_um"] / given["stroke"]["rmse_um"])
+        assert record["joint"]["ratio"] == pytest.approx(ratios[-1], rel=1e-9)
+    # the score minimised: the worst ratio, never above the given gains' 1
+    assert records[0]["joint"]["worst_ratio"] == pytest.approx(max(ratios), rel=1e-9)
+    assert max(ratios) <= 1.0 + 1e-9
+    assert "tuned jointly with" in (out / NAME / "controller.toml").read_text()
+    assert "jointly tuned: score" in capsys.readouterr().out
+
+
+def test_joint_tuning_refuses_other_gain_sets(tmp_path, capsys):
+    fails(capsys, ["tune", "heavy-pi", "heavy-pi+ff-adaptive", "--joint", "--out",
+                   str(tmp_path / "t")], "--joint", "heavy-pi+ff-adaptive", "not one gain set")
+    assert not (tmp_path / "t").exists()
