@@ -72,7 +72,8 @@ def register(commands):
     sweep.set_defaults(handler=_sweep)
 
     tune = commands.add_parser("tune", help="optimise Kp, Ki (and alpha, beta with "
-                                            "feedforward) for RMSE; [controller] snippets")
+                                            "feedforward) for the RMSE of R, or of a stroke "
+                                            "scenario's stroke; [controller] snippets")
     add_scenario_arguments(tune)
     tune.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: results/tune)")
     tune.add_argument("--seed", type=bounded_integer(0, 2 ** 32 - 1), default=1,
