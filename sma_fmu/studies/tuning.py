@@ -5,10 +5,12 @@ batch, :func:`~sma_fmu.studies.batch.run_batch`) searches Kp and Ki, and for the
 feedforward controllers also the phase-lag times alpha and beta, within :data:`BOUNDS`,
 for the least RMSE of R - R_ref over the scenario's metrics window (the same RMSE as
 ``sma-fmu run``; t >= 2 s for the paper's 30-s runs), or, for a stroke scenario, the least
-RMSE of its stroke [um] (:mod:`sma_fmu.studies.criterion`: the default there, or chosen). The best gains are run once more on the scalar library path, and that
-RMSE is the one reported. Writes ``NAME/controller.toml`` (a ``[controller]`` table that
-pastes into the scenario), ``report.json`` and ``report.md`` (the controllers ranked at
-the scenario's own gains and at each controller's tuned gains).
+RMSE of its stroke [um] (:mod:`sma_fmu.studies.criterion`: the default there, or chosen).
+The best gains are run once more on the scalar library path, and that RMSE is the one
+reported. Writes ``NAME/controller.toml`` (a ``[controller]`` table that pastes into the
+scenario), ``report.json`` and ``report.md`` (:mod:`sma_fmu.studies.tuning_report`: the
+controllers ranked at the scenario's own gains and at each controller's tuned gains).
+:func:`tune_jointly` (``--joint``) seeks one gain set for several scenarios.
 
 A scenario the batch engine does not implement (the shaped compensator) is tuned on the
 scalar library path instead, one run at a time (about 1.5 s per 30-s run: keep
@@ -23,10 +25,8 @@ margins of the linearised loop at the given and the tuned gains
 streams on the nominal wire at the tuned gains (:mod:`sma_fmu.cosim.noise_seeds`).
 """
 import dataclasses
-import json
 import time
 from collections import namedtuple
-from datetime import datetime, timezone
 
 import numpy as np
 from scipy.optimize import OptimizeResult, differential_evolution
@@ -35,26 +35,25 @@ from sma_fmu.console import progress
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.noise_seeds import noise_seed_rmse
-from sma_fmu.cosim.scenario import CONTROLLERS, load_scenario
+from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
-from sma_fmu.fmi.loop.gains import GAIN_KEYS
 from sma_fmu.studies.batch import run_batch, unsupported_reason
-from sma_fmu.studies.criterion import (UNITS, criterion_rmse, scenario_criterion, stroke_fields,
-                                       stroke_markdown)
+from sma_fmu.studies.criterion import UNITS, criterion_rmse, scenario_criterion, stroke_fields
 from sma_fmu.studies.margins import loop_margins
 from sma_fmu.studies.overrides import StudyError, template
 from sma_fmu.studies.robust import draw_scenarios, robust_value
+from sma_fmu.studies.tuning_report import (SHAPED_KEYS, controller_snippet, print_record,
+                                           ranking_markdown)
 from sma_fmu.systems.stroke_table import is_stroke
 
-__all__ = ["BOUNDS", "TUNED", "tune_scenario", "controller_snippet", "run_tuning",
+__all__ = ["BOUNDS", "TUNED", "tune_scenario", "tune_jointly", "controller_snippet", "run_tuning",
            "ranking_markdown"]
 
 # search ranges; units: Kp [W/ohm], Ki [W/(ohm.s)], alpha and beta [s]
 BOUNDS = {"Kp": (0.0, 5.0), "Ki": (0.0, 20.0), "alpha": (0.0, 3.0), "beta": (0.02, 1.5)}
 TUNED = {"pi": ("Kp", "Ki"), "pi+ff-fixed": ("Kp", "Ki", "alpha", "beta"),
          "pi+ff-adaptive": ("Kp", "Ki", "alpha", "beta")}
-_SHAPED_KEYS = ("shaping", "power_cap_W", "anticipation_s")   # kept in the snippet as given
 _LibraryRun = namedtuple("_LibraryRun", "metrics")             # a library run, as a batch's
 
 
@@ -68,9 +67,10 @@ def _robust_record(scenario, best, names, start, robust):
     [ohm], and for a stroke scenario the stroke's [um] beside."""
     record = robust.as_dict()
     criteria = ("resistance", "stroke") if is_stroke(scenario) else ("resistance",)
-    for label, values in (("given", start), ("tuned", [getattr(best.controller, n) for n in names])):
-        metrics = [scenario_metrics(run_library(draw).data, draw)
-                   for draw in (_with_gains(d, names, values) for d in draw_scenarios(scenario, robust))]
+    tuned = [getattr(best.controller, n) for n in names]
+    for label, values in (("given", start), ("tuned", tuned)):
+        metrics = [scenario_metrics(run_library(draw).data, draw) for draw in
+                   (_with_gains(d, names, values) for d in draw_scenarios(scenario, robust))]
         for name in criteria:
             rmses = [criterion_rmse(m, name) for m in metrics]
             record[f"rmse_{label}_{UNITS[name]}"] = rmses
@@ -200,7 +200,7 @@ def _record(scenario, names, result, start, tuned, given, evaluations, seconds, 
     """The record's fields common to both criteria."""
     return {"scenario": scenario.name, "group": scenario.group,
             "controller": scenario.controller.kind, "inverse": scenario.controller.inverse,
-            **{key: getattr(scenario.controller, key) for key in _SHAPED_KEYS},
+            **{key: getattr(scenario.controller, key) for key in SHAPED_KEYS},
             "hysteresis_mode": scenario.hysteresis_mode,
             "tuned": {name: float(v) for name, v in zip(names, result.x)},
             "given": {name: float(v) for name, v in zip(names, start)},
@@ -218,104 +218,6 @@ def _record(scenario, names, result, start, tuned, given, evaluations, seconds, 
                           "seconds": seconds}}
 
 
-def controller_snippet(record):
-    """The tuned gains as a ``[controller]`` TOML table that pastes into the scenario."""
-    lines = [f"# sma-fmu tune {record['scenario']} ({datetime.now(timezone.utc).date()}): "
-             f"RMSE {record['rmse_ohm']['tuned']:.4f} ohm, against "
-             f"{record['rmse_ohm']['given']:.4f} ohm at the scenario's gains"]
-    unit = UNITS[record.get("criterion", "resistance")]
-    if "criterion" in record:
-        lines[0] = (f"# sma-fmu tune {record['scenario']} ({datetime.now(timezone.utc).date()}), "
-                    f"criterion {record['criterion']}: stroke RMSE {record['rmse_um']['tuned']:.1f} "
-                    f"um, against {record['rmse_um']['given']:.1f} um at the scenario's gains "
-                    f"(R: {record['rmse_ohm']['tuned']:.4f} ohm, against "
-                    f"{record['rmse_ohm']['given']:.4f})")
-    robust = record.get("robust")
-    if robust:
-        lines.append(f"# robust: quantile {robust['quantile']:g} of {robust['draws']} draws "
-                     f"(noise, +-{100 * robust['spread']:g} % wire): "
-                     f"{robust[f'score_tuned_{unit}']:.4f} {unit}, against "
-                     f"{robust[f'score_given_{unit}']:.4f}")
-    if "joint" in record:
-        lines.append(f"# tuned jointly with {', '.join(record['joint']['scenarios'])}: score "
-                     f"{record['joint']['ratio']:.3f} x the given gains' here, worst "
-                     f"{record['joint']['worst_ratio']:.3f}")
-    margins = record["margins"]["tuned"]
-    lines += [f"# margins of the linearised loop: gain {margins['gain_margin_dB']:.1f} dB, "
-              f"phase {margins['phase_margin_deg']:.1f} deg",
-              "[controller]", f"kind = {json.dumps(record['controller'])}"]
-    if record.get("inverse", "major") != "major":
-        lines.append(f"inverse = {json.dumps(record['inverse'])}")
-    lines += [f"{key} = {json.dumps(record[key])}" for key in _SHAPED_KEYS
-              if record.get(key) not in (None, "none", 0.0)]
-    lines += [f"{GAIN_KEYS[name]} = {value!r}" for name, value in record["tuned"].items()]
-    return "\n".join(lines) + "\n"
-
-
-def _label(record):
-    """The controller's column: its kind, with a non-default inverse in parentheses."""
-    inverse = record.get("inverse", "major")
-    return record["controller"] + ("" if inverse == "major" else f" ({inverse})")
-
-
-def ranking_markdown(records):
-    """Per group of scenarios with every controller: RMSE [ohm] and order, given vs tuned gains.
-
-    Columns: the three controllers, then any other inverse present (a group without it
-    shows "-" there and ranks the rest). Stroke scenarios' records are in a table of their
-    own (:func:`~sma_fmu.studies.criterion.stroke_markdown`), after the others'.
-    """
-    groups, labels = {}, list(CONTROLLERS)
-    for record in records:
-        label = _label(record)
-        if label not in labels:
-            labels.append(label)
-        groups.setdefault((record["group"], record["hysteresis_mode"]), {})[label] = record
-    windows = ", ".join(sorted({record["window"] for record in records}))
-    lines = ["# Tuned gains", "", f"RMSE of R - R_ref over {windows} [ohm], on the library path.",
-             "", "| scenario | mode | gains | " + " | ".join(labels) + " | ranking, best first |",
-             "|---|---|---|" + "---:|" * len(labels) + "---|"]
-    for (group, mode), members in groups.items():
-        if not set(CONTROLLERS) <= set(members):
-            continue
-        for gains in ("given", "tuned"):
-            rmse = {c: members[c]["rmse_ohm"][gains] for c in labels if c in members}
-            order = " < ".join(sorted(rmse, key=rmse.get))
-            lines.append(f"| {group} | {mode} | {gains} | " +
-                         " | ".join(f"{rmse[c]:.3f}" if c in rmse else "-" for c in labels)
-                         + f" | {order} |")
-    robust = next((r["robust"] for r in records if r.get("robust")), None)
-    plain = [record for record in records if "criterion" not in record]
-    score = "" if robust is None else (f" | score given | score tuned")
-    if plain:
-        lines += ["", f"| scenario | RMSE given | RMSE tuned{score} | tuned values (* at a bound) | "
-                  "gain margin [dB] | phase margin [deg] |",
-                  "|---|---:|---:|" + ("---:|---:|" if robust else "") + "---|---:|---:|"]
-    else:                                        # stroke scenarios only: their table alone
-        lines = lines[:1]
-    for record in plain:
-        values = ", ".join(f"{name} = {value:.4g}{'*' if name in record['at_bound'] else ''}"
-                           for name, value in record["tuned"].items())
-        scores = "" if robust is None else (
-            f" | {record['robust']['score_given_ohm']:.3f} | {record['robust']['score_tuned_ohm']:.3f}"
-            if record.get("robust") else " | - | -")
-        margins = record["margins"]["tuned"]
-        lines.append(f"| {record['scenario']} | {record['rmse_ohm']['given']:.3f} | "
-                     f"{record['rmse_ohm']['tuned']:.3f}{scores} | {values} | "
-                     f"{margins['gain_margin_dB']:.1f} | {margins['phase_margin_deg']:.1f} |")
-    lines += stroke_markdown(records)
-    if any("joint" in record for record in records):
-        lines += ["", "Tuned jointly: one gain set for all the scenarios, minimising the worst "
-                      "of their scores relative to their given gains' (" + ", ".join(
-                          f"{r['scenario']} {r['joint']['ratio']:.3f}" for r in records) + ")."]
-    if robust is not None:
-        lines += ["", f"Score: the {robust['quantile']:g} quantile of the RMSE over "
-                      f"{robust['draws']} draws (noise stream; {', '.join(robust['parameters'])} "
-                      f"each x U[{1 - robust['spread']:g}, {1 + robust['spread']:g}]). Margins: "
-                      "the loop linearised where the wire is steepest."]
-    return "\n".join(lines) + "\n"
-
-
 def _with_stop_time(scenario, stop_time_s):
     """``scenario`` lasting ``stop_time_s`` [s], checked as in a file (whole steps, at most
     MAX_STEPS, the [analysis] windows inside the run)."""
@@ -323,26 +225,6 @@ def _with_stop_time(scenario, stop_time_s):
         return template(scenario).scenario({"scenario.stop_time_s": float(stop_time_s)})
     except StudyError as error:
         raise StudyError(f"--stop-time {stop_time_s!r}: {error}") from None
-
-
-def _print_record(record, robust, progress):
-    """The console's lines of one tuned record: the criterion's RMSE, given -> tuned."""
-    gains = ", ".join(f"{k} = {v:.4g}" for k, v in record["tuned"].items())
-    unit = UNITS[record.get("criterion", "resistance")]
-    if "criterion" in record:
-        progress(f"    criterion {record['criterion']}: stroke RMSE "
-                 f"{record['rmse_um']['given']:.1f} -> {record['rmse_um']['tuned']:.1f} um, "
-                 f"RMSE {record['rmse_ohm']['given']:.4f} -> "
-                 f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
-    else:
-        progress(f"    RMSE {record['rmse_ohm']['given']:.4f} -> "
-                 f"{record['rmse_ohm']['tuned']:.4f} ohm: {gains}")
-    if robust is not None:
-        progress(f"    robust score {record['robust'][f'score_given_{unit}']:.4f} -> "
-                 f"{record['robust'][f'score_tuned_{unit}']:.4f} {unit}")
-    if "joint" in record:
-        progress(f"    jointly tuned: score {record['joint']['ratio']:.3f} x the given gains' "
-                 f"(worst of all {record['joint']['worst_ratio']:.3f})")
 
 
 def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_s=None,
@@ -365,7 +247,7 @@ def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_
         records = tune_jointly(scenarios, seed, generations, population, robust, criterion)
         for record in records:
             progress(f"  {record['scenario']}:")
-            _print_record(record, robust, progress)
+            print_record(record, robust, progress)
     else:
         records = []
         for index, scenario in enumerate(scenarios, start=1):
@@ -373,7 +255,7 @@ def run_tuning(paths, out_dir, seed=1, generations=30, population=12, stop_time_
                      f"({', '.join(_tuned_names(scenario))}) ...")
             records.append(tune_scenario(scenario, seed, generations, population, robust,
                                          criterion))
-            _print_record(records[-1], robust, progress)
+            print_record(records[-1], robust, progress)
     with staged_folder(out_dir) as stage:
         for record in records:
             (stage / record["scenario"]).mkdir()
