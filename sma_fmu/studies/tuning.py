@@ -104,9 +104,11 @@ class _Objective:
         self.quantile = 0.5 if robust is None else robust.quantile
         self.evaluations = 0
 
-    def __call__(self, candidates):              # (D, S) -> (S,)
+    def __call__(self, candidates):              # (D, S) -> (S,); (D,) is one candidate
+        candidates = np.asarray(candidates, dtype=float)
+        columns = candidates.T if candidates.ndim == 2 else [candidates]
         batch = [_with_gains(draw, self.names, column)
-                 for column in np.atleast_2d(candidates).T for draw in self.draws]
+                 for column in columns for draw in self.draws]
         self.evaluations += len(batch)
         rmses = np.array([criterion_rmse(run.metrics, self.criterion) for run in self.runs(batch)])
         return robust_value(rmses.reshape(-1, len(self.draws)), self.quantile)
