@@ -48,7 +48,7 @@ def _tune(args):
         robust = RobustCriterion(args.draws, args.spread, args.quantile, args.seed)
     run_tuning(paths, out, seed=args.seed, generations=args.generations,
                population=args.population, stop_time_s=args.stop_time, progress=echo,
-               robust=robust)
+               robust=robust, criterion=args.criterion, joint=args.joint)
     print(f"written: {out}/report.md, report.json, NAME/controller.toml")
     return 0
 
@@ -72,7 +72,8 @@ def register(commands):
     sweep.set_defaults(handler=_sweep)
 
     tune = commands.add_parser("tune", help="optimise Kp, Ki (and alpha, beta with "
-                                            "feedforward) for RMSE; [controller] snippets")
+                                            "feedforward) for the RMSE of R, or of a stroke "
+                                            "scenario's stroke; [controller] snippets")
     add_scenario_arguments(tune)
     tune.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: results/tune)")
     tune.add_argument("--seed", type=bounded_integer(0, 2 ** 32 - 1), default=1,
@@ -84,6 +85,14 @@ def register(commands):
     tune.add_argument("--stop-time", type=float, metavar="S",
                       help="tune over the first S seconds, checked as a scenario's stop_time_s "
                            "(at most 4,000,000 steps) (default: the scenario's duration)")
+    tune.add_argument("--criterion", choices=("stroke", "resistance"),   # criterion.CRITERIA
+                      help="what is minimised: the RMSE of the stroke [um] or of R - R_ref "
+                           "[ohm] (default: stroke for a stroke scenario, else resistance; "
+                           "stroke on a resistance scenario is refused)")
+    tune.add_argument("--joint", action="store_true",
+                      help="one gain set for all the scenarios given: minimise the worst of "
+                           "their scores relative to their given gains' (they must tune the "
+                           "same gains)")
     tune.add_argument("--robust", action="store_true",
                       help="score gains by a quantile of the RMSE over Monte Carlo draws of "
                            "the noise stream and the wire (+- --spread on its thermal and "

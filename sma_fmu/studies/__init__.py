@@ -7,7 +7,8 @@
   with numpy (:func:`run_batch`; its throughput: :mod:`~sma_fmu.studies.batch_benchmark`);
 - :mod:`~sma_fmu.studies.spec`, :mod:`~sma_fmu.studies.design`, :mod:`~sma_fmu.studies.sweep`,
   :mod:`~sma_fmu.studies.results`: study specs, their designs, ``sma-fmu sweep``, its results;
-- :mod:`~sma_fmu.studies.tuning`: ``sma-fmu tune``.
+- :mod:`~sma_fmu.studies.tuning`: ``sma-fmu tune`` (its criterion:
+  :mod:`~sma_fmu.studies.criterion`; its reports: :mod:`~sma_fmu.studies.tuning_report`).
 See docs/studies.md.
 """
 from sma_fmu.studies.batch import BatchUnsupported, run_batch

@@ -240,6 +240,7 @@ def test_analysis_window_outside_the_run(tmp_path, capsys):
     (["tune", "paper", "--generations", "1000000"], ["--generations", "in [1, 1000]"]),
     (["tune", "paper", "--population", "0"], ["--population", "in [1, 100]"]),
     (["tune", "paper", "--seed", "-1"], ["--seed", "in [0, 4294967295]"]),
+    (["tune", "paper", "--criterion", "position"], ["--criterion", "invalid choice: 'position'"]),
     (["sweep", "x.toml", "--workers", "100000"], ["--workers", "in [1, 256]"]),
     (["resistance", "--temperature", "1e999", "--load", "0", "--direction", "heating"],
      ["--temperature", "expected a finite number, got '1e999'"]),

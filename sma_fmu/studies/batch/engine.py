@@ -204,6 +204,7 @@ def _loop(scenarios, inputs, record):
     integral = np.zeros(size)
     series = _Series(inputs) if record == "timeseries" else None
     totals = MetricsAccumulator(inputs, scenarios) if record == "metrics" else None
+    stroke = totals is not None and totals.stroke_runs.size > 0   # the accumulator needs x_k
     failed = dict(inputs.failures)
     rows = chunk_steps(size, n)
     work, raw, mask = np.empty(size), np.empty(size), np.empty(size)
@@ -218,6 +219,7 @@ def _loop(scenarios, inputs, record):
         for run, message in compensator.diverged.items():
             failed.setdefault(run, message)
         errors = np.empty((stop - start + 1, size))
+        lengths = np.empty((stop - start + 1, size)) if stroke else None   # x_k [m]
         feedback = np.empty((stop - start, size))
         power = np.empty((stop - start + 1, size))      # the PI's output u_k: the demand
         power[-1] = np.nan
@@ -230,6 +232,8 @@ def _loop(scenarios, inputs, record):
                 plant.set_segments(inputs.segment_row(k), inputs.segment_row(k - 1))
             if series is not None:
                 series.sample(k, plant)
+            if stroke:
+                lengths[j] = plant.length()
             e, fb, u = errors[j], feedback[j], power[j]
             subtract(plant.R, references[j], e)
             if sensed:                                 # the PI's error: the sensor's reading
@@ -266,6 +270,8 @@ def _loop(scenarios, inputs, record):
                 u = driven
             plant.step(u)
         np.subtract(plant.R, references[-1], out=errors[-1])   # e_stop, counted by the next chunk
+        if stroke:
+            lengths[-1] = plant.length()
         if series is not None:
             series.controls(start, compensator, feedback, applied[:-1])
         finite = np.isfinite(power[:-1]).all(axis=0)
@@ -275,7 +281,8 @@ def _loop(scenarios, inputs, record):
             last = stop == n
             totals.add(start, errors if last else errors[:-1], applied if last else applied[:-1],
                        compensator.saturated if not last else np.vstack(
-                           [compensator.saturated, np.zeros((1, size), dtype=bool)]))
+                           [compensator.saturated, np.zeros((1, size), dtype=bool)]),
+                       None if lengths is None else lengths if last else lengths[:-1])
     if series is not None:
         series.sample(n, plant)
     return series, totals, failed

@@ -5,13 +5,16 @@ The same record as :func:`sma_fmu.cosim.metrics.scenario_metrics`: the windows a
 reachable band comes from :func:`~sma_fmu.runtime.reachable_band.reachable_band` per run
 and load segment; the record (and its warning) from
 :func:`~sma_fmu.cosim.metrics.assemble_metrics`. Sums run over chunks instead of a stored
-series, so they agree to rounding (tests/studies/test_batch.py binds the two).
+series, so they agree to rounding (tests/studies/test_batch.py binds the two). A stroke
+scenario's ``stroke`` record comes from the wire's lengths x_k the loop hands over with each
+chunk: the error (x_0 - x_k) - stroke_ref(t_k) [m], as the library's
+(tests/studies/test_batch_stroke.py binds the two).
 """
 import math
 
 import numpy as np
 
-from sma_fmu.cosim.metrics import EMPTY_METRICS, assemble_metrics, metric_windows
+from sma_fmu.cosim.metrics import EMPTY_METRICS, assemble_metrics, metric_windows, stroke_metrics
 
 __all__ = ["MetricsAccumulator"]
 
@@ -98,16 +101,54 @@ class MetricsAccumulator:
             columns = slice(None) if runs == list(range(size)) else np.array(runs)
             self.groups.append({"columns": columns, "window": window, "segments": parts,
                                 "overall": _Totals(*window, size),
-                                "reachable": _Totals(*window, size)})
+                                "reachable": _Totals(*window, size),
+                                "stroke": _Totals(*window, size),
+                                "stroke_segments": [_Totals(*_index_range(inside), size)
+                                                    for inside in segments]})
         self.saturated, self.clamped = np.zeros(size), np.zeros(size)
         self.unreachable = np.zeros(size)
         self._inside = {side: np.zeros(size, dtype=bool) for side in _SIDES}   # carried over
         self._opened = {side: {} for side in _SIDES}
         self.intervals = [[] for _ in range(size)]
+        self._stroke_references(scenarios, t)
 
-    def add(self, start, errors, power, saturated):
-        """Rows k = start ... of e [ohm], applied power P [W] (nan at k = n) and flags, (c, N)."""
+    def _stroke_references(self, scenarios, times):
+        """The stroke runs (:attr:`stroke_runs`) and their references [m] at t_k, one column
+        per reference object (the runs of a tuning share theirs)."""
+        columns, index, self._start_length = {}, [], None
+        for scenario in scenarios:
+            reference = scenario.reference
+            if getattr(reference, "quantity", None) == "stroke":
+                index.append(columns.setdefault(id(reference), (len(columns), reference))[0])
+        self.stroke_runs = np.array([run for run, scenario in enumerate(scenarios) if getattr(
+            scenario.reference, "quantity", None) == "stroke"], dtype=int)
+        self._stroke_column = np.array(index, dtype=int)
+        self._stroke_reference = np.array(
+            [[reference.stroke(time) for time in times.tolist()]
+             for _, reference in columns.values()]).T if columns else None
+
+    def _add_stroke(self, start, lengths):
+        """Rows k = start ... of the wire's lengths x [m] (c, N): the stroke errors' sums."""
+        runs = self.stroke_runs
+        if start == 0:
+            self._start_length = lengths[0, runs].copy()
+        stop = start + lengths.shape[0]
+        errors = np.zeros(lengths.shape)
+        errors[:, runs] = ((self._start_length - lengths[:, runs])
+                           - self._stroke_reference[start:stop][:, self._stroke_column])
+        absolute = np.abs(errors)
+        squares = absolute * absolute
+        for group in self.groups:
+            group["stroke"].add(start, absolute, squares, group["columns"])
+            for part in group["stroke_segments"]:
+                part.add(start, absolute, squares, group["columns"])
+
+    def add(self, start, errors, power, saturated, lengths=None):
+        """Rows k = start ... of e [ohm], applied power P [W] (nan at k = n) and flags, (c, N);
+        ``lengths``: the wire's x [m] at the same rows (needed when :attr:`stroke_runs`)."""
         stop = start + errors.shape[0]
+        if self.stroke_runs.size:
+            self._add_stroke(start, lengths)
         bands = self.inputs.unreachable(start, stop)    # None: all reachable, usually
         if bands is None:
             below = above = np.zeros(errors.shape, dtype=bool) if any(
@@ -174,4 +215,8 @@ class MetricsAccumulator:
             clamped_fraction=float(self.clamped[run] / (count - 1)) if count > 1 else None,
             unreachable_fraction=float(self.unreachable[run] / count) if count else math.nan,
             reachable=group["reachable"].metrics(run, self.step_s),
-            intervals=intervals)
+            intervals=intervals,
+            stroke=stroke_metrics(group["stroke"].metrics(run, self.step_s),
+                                  [part.metrics(run, self.step_s)
+                                   for part in group["stroke_segments"]])
+            if run in self.stroke_runs else None)
