@@ -23,6 +23,7 @@ from functools import partial
 
 from sma_fmu.cosim.event_drive import EventDrivenPlant, PassThroughDriver, traced_driver
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
+from sma_fmu.cosim.stroke_table import available_program, is_stroke, stroke_reference_at
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.instance3 import open_instance
 from sma_fmu.fmi.loop.system import loop_system
@@ -251,6 +252,10 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
                              f"event mode and early return need FMI 3.0 FMUs (sma-fmu build "
                              f"--native --fmi 3)")
     start = time.perf_counter()
+    # a stroke reference mapped in C at every step when a compiler is there (one process
+    # for the run, not a search per step in Python), else by the Python map: the same R_ref
+    reference_at = (stroke_reference_at(scenario, available_program()) if is_stroke(scenario)
+                    else None)
     parts = {}
     try:
         parts["plant"] = FmuPlant(system.component("plant"), combined=combined, events=events)
@@ -265,7 +270,8 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
             plant, driver = EventDrivenPlant(driver, plant, power_trace), PassThroughDriver()
         elif driver is not None and power_trace is not None:
             driver = traced_driver(driver, power_trace)
-        data = run_loop(scenario, plant, parts.get("compensator"), driver=driver, sink=sink)
+        data = run_loop(scenario, plant, parts.get("compensator"), driver=driver, sink=sink,
+                        reference_at=reference_at)
     except FmuError as error:
         raise FmuError(f"scenario {scenario.name}: {error}", error.status) from None
     finally:
