@@ -7,6 +7,9 @@ with a PWM drive puts the SmaPwmDriver FMU between the PI and the plant, stepped
 PI and before the plant in the same step: the plant gets the wave's mean over that step.
 Which FMUs a scenario needs and their start values are the loop system's
 (:func:`~sma_fmu.fmi.loop.system.loop_system`), as for the C master and the system tools.
+A stroke reference is mapped to R_ref at every step before the loop, in C as the C master
+does (:mod:`sma_fmu.cosim.stroke_table`), or in Python step by step where no C compiler is:
+the same values.
 
 Each step is one fmi2SetReal, one fmi2DoStep and one fmi2GetReal per FMU (the compensator
 also one fmi2GetBoolean), called through ctypes with argument objects built once
