@@ -26,7 +26,10 @@ from sma_fmu.systems.c_master import CMaster
 __all__ = ["SCENARIOS", "TARGET", "RSS_TARGET_MB", "c_master_times", "hour_run_rss",
            "c_master_lines"]
 
-SCENARIOS = PAPER_SET + ("setpoints-pwm-pi+ff-adaptive", "setpoints-pwm-continuous-pi+ff-adaptive")
+SCENARIOS = PAPER_SET + ("setpoints-pwm-pi+ff-adaptive", "setpoints-pwm-continuous-pi+ff-adaptive",
+                         # stroke control: the C master maps the stroke reference in C, in the run
+                         "flexinol-stroke-load-step-pi+ff-adaptive",
+                         "flexinol-stroke-profile-pi+ff-adaptive")
 TARGET = 0.25          # C master / library wall time, recording included
 RSS_TARGET_MB = 200.0  # peak resident memory of a one-hour run at 1 ms
 HOUR_SCENARIO = "setpoints-pwm-pi+ff-adaptive"   # all five FMUs

@@ -11,7 +11,7 @@ costs per step in the Python runtime (:mod:`sma_fmu.runtime.stroke`).
 - with native FMUs (``--fmus``): the same scenarios through the C master against the library
   path (:func:`~sma_fmu.bench.c_master.c_master_times`, recording included; the C master's
   wall includes its mapping of the stroke into the signals FMU's table, done in C:
-  :mod:`sma_fmu.systems.stroke_table`).
+  :mod:`sma_fmu.cosim.stroke_table`).
 
 CPU time per step, the median of the passes (a shared machine's other work is not counted);
 the moving strokes in C too (``stroke_timing.c`` compiled with the C family's sources: the
@@ -28,6 +28,7 @@ import time
 
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.scenario import load_scenario
+from sma_fmu.cosim.stroke_table import stroke_table_input, stroke_table_program
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import staged_folder
 from sma_fmu.files.package_data import shipped_file
@@ -35,7 +36,6 @@ from sma_fmu.bench.inverse import timing_program
 from sma_fmu.fmi.packaging.runtime_program import wire_numbers
 from sma_fmu.runtime import stroke as stroke_module
 from sma_fmu.runtime.stroke import StrokeMap, start_length
-from sma_fmu.systems.stroke_table import stroke_table_input, stroke_table_program
 from sma_fmu.wire.parameter_file import load_parameter_set
 
 __all__ = ["SCENARIOS", "STEPS", "map_costs", "c_map_ns", "c_table_ns", "c_map_costs", "scenario_walls",
@@ -105,7 +105,7 @@ def c_map_ns(program, stroke_map, load, direction, strokes, passes):
 
 def c_table_ns(program, scenario, passes):
     """Median CPU time [ns per step] of the C master's stroke table of ``scenario`` (``program``:
-    :func:`~sma_fmu.systems.stroke_table.stroke_table_program`): the whole process's CPU (its
+    :func:`~sma_fmu.cosim.stroke_table.stroke_table_program`): the whole process's CPU (its
     start and reading its input included) over the run's steps."""
     text, costs = stroke_table_input(scenario).encode("ascii"), []
     for _ in range(passes):

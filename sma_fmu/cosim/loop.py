@@ -176,7 +176,8 @@ def library_sensor(scenario):
         sensor.noise_ohm_rms, sensor.full_scale_ohm, sensor.bits, sensor.seed)
 
 
-def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=None, sink=None):
+def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=None, sink=None,
+             reference_at=None):
     """Close the loop over ``scenario``; returns the structured time-series array.
 
     ``plant`` has ``outputs()`` and ``step(t, power, load, h)`` returning the
@@ -193,6 +194,9 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
     ``sink``: None keeps the whole series and returns it; else a callable that gets the
     rows in blocks of :data:`ROWS_PER_CHUNK` (the last one shorter), as structured arrays
     it may keep, and the run keeps nothing (returns None): memory does not grow with it.
+    ``reference_at``: R_ref(t) [ohm] as the loop samples it, when the caller has it in a
+    faster form than the scenario's reference (a stroke mapped in C, the same values); None
+    takes ``scenario.reference.value``.
     """
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {', '.join(COUPLINGS)}, got {coupling!r}")
@@ -200,7 +204,8 @@ def run_loop(scenario, plant, compensator=None, coupling="gauss-seidel", driver=
     if driver is None:
         driver = library_driver(scenario)
     h, n = scenario.step_s, scenario.steps
-    reference_at, load_at = scenario.reference.value, scenario.load.value
+    reference_at = scenario.reference.value if reference_at is None else reference_at
+    load_at = scenario.load.value
     if sink is None:  # the result: its memory is all the run keeps
         data = np.empty(n + 1, dtype=TIMESERIES_DTYPE)
     else:

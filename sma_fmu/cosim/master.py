@@ -7,6 +7,9 @@ with a PWM drive puts the SmaPwmDriver FMU between the PI and the plant, stepped
 PI and before the plant in the same step: the plant gets the wave's mean over that step.
 Which FMUs a scenario needs and their start values are the loop system's
 (:func:`~sma_fmu.fmi.loop.system.loop_system`), as for the C master and the system tools.
+A stroke reference is mapped to R_ref at every step before the loop, in C as the C master
+does (:mod:`sma_fmu.cosim.stroke_table`), or in Python step by step where no C compiler is:
+the same values.
 
 Each step is one fmi2SetReal, one fmi2DoStep and one fmi2GetReal per FMU (the compensator
 also one fmi2GetBoolean), called through ctypes with argument objects built once
@@ -24,6 +27,7 @@ from functools import partial
 from sma_fmu.cosim.event_drive import EventDrivenPlant, PassThroughDriver, traced_driver
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
 from sma_fmu.cosim.run_warnings import WarningTexts, model_text, ordered
+from sma_fmu.cosim.stroke_table import available_program, is_stroke, stroke_reference_at
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.instance3 import open_instance
 from sma_fmu.fmi.loop.system import loop_system
@@ -252,6 +256,10 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
                              f"event mode and early return need FMI 3.0 FMUs (sma-fmu build "
                              f"--native --fmi 3)")
     start = time.perf_counter()
+    # a stroke reference mapped in C at every step when a compiler is there (one process
+    # for the run, not a search per step in Python), else by the Python map: the same R_ref
+    reference_at = (stroke_reference_at(scenario, available_program()) if is_stroke(scenario)
+                    else None)
     parts = {}
     try:
         parts["plant"] = FmuPlant(system.component("plant"), combined=combined, events=events)
@@ -266,7 +274,8 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
             plant, driver = EventDrivenPlant(driver, plant, power_trace), PassThroughDriver()
         elif driver is not None and power_trace is not None:
             driver = traced_driver(driver, power_trace)
-        data = run_loop(scenario, plant, parts.get("compensator"), driver=driver, sink=sink)
+        data = run_loop(scenario, plant, parts.get("compensator"), driver=driver, sink=sink,
+                        reference_at=reference_at)
         warnings = _logged_warnings(parts)
     except FmuError as error:
         raise FmuError(f"scenario {scenario.name}: {error}", error.status) from None

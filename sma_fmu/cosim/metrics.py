@@ -225,8 +225,8 @@ class StreamingMetrics:
         self.scenario = scenario
         self.overall, self.reachable = ErrorSums(), ErrorSums()
         self.segments = [ErrorSums() for _ in scenario.load.segments(scenario.stop_time_s)]
-        self._stroke_at = (scenario.reference.stroke
-                           if getattr(scenario.reference, "quantity", None) == "stroke" else None)
+        self._strokes = (scenario.reference.strokes
+                         if getattr(scenario.reference, "quantity", None) == "stroke" else None)
         self.stroke = ErrorSums()                      # stroke errors [m], the window's
         self.stroke_segments = [ErrorSums() for _ in self.segments]
         self.window = self.saturated = self.clamped = self.unreachable = 0
@@ -268,9 +268,8 @@ class StreamingMetrics:
         self.unreachable += 0 if reachable else int(np.count_nonzero(unreachable[window]))
         self._join(unreachable_intervals(t, below, above), float(t[0]))
         self._last_time = float(t[-1])
-        if self._stroke_at is not None:
-            stroke_at = self._stroke_at
-            stroke_error = block["stroke"] - np.array([stroke_at(time) for time in t.tolist()])
+        if self._strokes is not None:
+            stroke_error = block["stroke"] - np.array(self._strokes(t.tolist()))
             self.stroke.add(stroke_error[window])
             for sums, inside in zip(self.stroke_segments, segments):
                 sums.add(stroke_error[inside])
@@ -300,7 +299,7 @@ class StreamingMetrics:
             unreachable_fraction=self.unreachable / window if window else math.nan,
             reachable=self.reachable.metrics(step),
             intervals=sorted(self.intervals),
-            stroke=None if self._stroke_at is None else stroke_metrics(
+            stroke=None if self._strokes is None else stroke_metrics(
                 self.stroke.metrics(step), [sums.metrics(step) for sums in self.stroke_segments]))
 
 

@@ -180,7 +180,7 @@ class _RunFigure:
                     line.set_data([], [])
                     continue
             if name == "stroke_reference":
-                values = 1e3 * np.array([scenario.reference.stroke(time) for time in t.tolist()])
+                values = 1e3 * np.array(scenario.reference.strokes(t.tolist()))
             else:
                 values = 1e3 * data["stroke"] if name == "stroke" else data[name]
             line.set_data(*envelope(t[:-1], values[:-1]) if early else envelope(t, values))

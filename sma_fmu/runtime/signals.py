@@ -110,6 +110,13 @@ class ReferenceSignal:
             return s["offset_ohm"] + s["amplitude_ohm"] * wave(angle)
         return _interpolate(self._times, self._values, t)
 
+    def values(self, times):
+        """:meth:`value` at each of ``times`` [s], as a list: the same numbers, a constant
+        reference's without a call per time (a run's rows, 30 000 of them at 1 ms)."""
+        if self.kind == "constant":
+            return [self._s["value_ohm"]] * len(times)
+        return list(map(self.value, times))
+
     def trend(self, t):
         """+1 or -1 [1]: the sign of the change the reference last made at or before ``t`` [s]
         (its slope at t where it moves; +1 while it never moved). A pure function of t, so a

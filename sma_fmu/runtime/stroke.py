@@ -62,8 +62,9 @@ def step_table(step_s, values):
     """``values`` [ohm] at t_k = k ``step_s`` [s], k = 0, 1, ..., as a ``[reference]`` table:
     the knots inside a run of equal values left out (a table interpolates them back)."""
     last = len(values) - 1
-    kept = [k for k in range(last + 1)
-            if k in (0, last) or not values[k - 1] == values[k] == values[k + 1]]
+    inner = [k for k, (before, value, after) in enumerate(zip(values, values[1:], values[2:]), 1)
+             if not before == value == after]
+    kept = [0, *inner, last] if last > 0 else [0]
     return {"kind": "table", "times_s": [k * step_s for k in kept],
             "values_ohm": [values[k] for k in kept]}
 
@@ -191,6 +192,11 @@ class StrokeReference:
     def stroke(self, t):
         """The stroke reference [m] at ``t`` [s]."""
         return 1e-3 * self.signal.value(t)
+
+    def strokes(self, times):
+        """:meth:`stroke` [m] at each of ``times`` [s], as a list (a run's rows: see
+        :meth:`~.signals.ReferenceSignal.values`)."""
+        return [1e-3 * value for value in self.signal.values(times)]
 
     def target(self, t):
         """The :class:`StrokeTarget` at ``t`` [s]."""

@@ -26,8 +26,9 @@ hung FMU) is killed and the run fails naming the time it reached
 (:data:`DEFAULT_TIMEOUT_S`; ``sma-fmu run --timeout``).
 
 A stroke reference reaches the signals FMU as the R_ref table it maps to at every step; the
-C master maps it in C (:mod:`.stroke_table`, the same text as the Python map's), part of
-the run's wall time, not in Python (some 2.7 s before a 30-s run of the 0.5 Hz profile).
+C master maps it in C (:mod:`sma_fmu.cosim.stroke_table`, the same text as the Python map's),
+part of the run's wall time, not in Python (some 2.7 s before a 30-s run of the 0.5 Hz
+profile).
 
 With a :class:`~sma_fmu.cosim.recording.RunRecorder` writing CSV as the sink, the host
 writes the CSV's rows itself (its "csv" line; the same text as the recorder's, byte for
@@ -42,6 +43,7 @@ from pathlib import Path
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
 from sma_fmu.cosim.run_warnings import WarningTexts, model_text, ordered
+from sma_fmu.cosim.stroke_table import available_program, is_stroke, stroke_table_text
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.unpacked import WIN64, acquire, release
 from sma_fmu.fmi.hosts import CHostError, compile_host
@@ -50,7 +52,6 @@ from sma_fmu.systems.loop_host_process import (STATUS_NAMES, HostProcess, failed
                                                host_stderr, log_entry)
 from sma_fmu.systems.c_master_rows import RowAssembler, csv_columns, recorded_columns
 from sma_fmu.systems.closed_loop import closed_loop
-from sma_fmu.systems.stroke_table import is_stroke, stroke_table_program, stroke_table_text
 from sma_fmu.systems.loop_host import loop_host_lines, wine_executable, wine_path
 
 __all__ = ["MASTERS", "DEFAULT_TIMEOUT_S", "CMasterError", "CMaster", "run_c_master"]
@@ -242,10 +243,9 @@ class CMaster:
         started = time.perf_counter()
         text = None
         if is_stroke(scenario):   # the stroke's R_ref table, mapped in C (part of the run)
-            try:
-                program = stroke_table_program(self.cache)   # compiled once: start-up
-            except CHostError:   # no compiler (a wheel's prebuilt host): mapped in Python
-                program = None
+            # compiled once: start-up; None without a compiler (a wheel's prebuilt host):
+            # mapped in Python
+            program = available_program(self.cache)
             self.startup_s += time.perf_counter() - started
             started = time.perf_counter()
             text = None if program is None else stroke_table_text(scenario, program)

@@ -1,12 +1,14 @@
 """A stroke scenario through the FMUs: the C-family FMUs under the fmpy master and the C
 master, and the pythonfmu family under the fmpy master, against the library path, every
 column to 1e-9 (the master maps the stroke to the signals FMU's R_ref table; the plant and
-the compensator are the FMUs')."""
+the compensator are the FMUs'). The fmpy master without a C compiler maps it in Python: the
+same run to the bit."""
 import numpy as np
 import pytest
 
 from sma_fmu.cosim.loop import run_library
 from sma_fmu.cosim.master import run_fmus
+from sma_fmu.cosim.stroke_table import available_program
 from sma_fmu.cosim.metrics import scenario_metrics
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.files.package_data import shipped_file
@@ -45,10 +47,17 @@ def test_the_c_family_fmus_give_the_library_paths_stroke_run(native_dir, tmp_pat
     assert ours["rmse_um"] == pytest.approx(theirs["rmse_um"], abs=1e-3)
 
 
-def test_the_pythonfmu_family_gives_the_library_paths_stroke_run(fmus, tmp_path):
+def test_the_pythonfmu_family_gives_the_library_paths_stroke_run(fmus, tmp_path, monkeypatch):
+    """With a C compiler the fmpy master maps the stroke in C; without one (a machine with
+    the pythonfmu family only) in Python: the same run to the bit, both the library's."""
     scenario = _short_profile(tmp_path)
     library = run_library(scenario).data
+    assert available_program() is not None
     python_family = run_fmus(scenario, fmus["SmaActuator"].parent).data
     for column in COLUMNS:
         assert np.allclose(python_family[column], library[column], rtol=0.0, atol=1e-9,
                            equal_nan=True), column
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))   # part of the program's key
+    assert available_program() is None
+    without = run_fmus(scenario, fmus["SmaActuator"].parent).data
+    assert without.tobytes() == python_family.tobytes()

@@ -6,13 +6,15 @@ the spec's fractions, not from the map); on the Flexinol fit (two stages, stress
 expansion) the plant itself, placed at the map's temperature on the branch, gives back the
 asked stroke and R_ref.
 """
+import math
+
 import pytest
 
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
 from sma_fmu.runtime.plant import PlantStepper
-from sma_fmu.runtime.signals import reference_from_table
-from sma_fmu.runtime.stroke import StrokeMap, start_length
+from sma_fmu.runtime.signals import load_from_table, reference_from_table
+from sma_fmu.runtime.stroke import StrokeMap, StrokeReference, start_length, step_table
 from sma_fmu.wire.parameter_file import load_parameter_set
 
 
@@ -109,3 +111,30 @@ def test_the_trend_is_the_sign_of_the_last_change(table, t, trend):
     signal = reference_from_table({"quantity": "stroke", **table})
     assert signal.trend(t) == trend
     assert signal.unit == "mm" and signal.as_table().items() >= {"quantity": "stroke", **table}.items()
+
+
+@pytest.mark.parametrize("values,kept", [
+    ([7.0], [0]), ([7.0, 7.0], [0, 1]), ([5.0, 5.0, 5.0, 5.0], [0, 3]),
+    ([1.0, 1.0, 2.0, 2.0, 2.0, 3.0], [0, 1, 2, 4, 5]),
+    ([1.0, math.nan, math.nan, math.nan, 1.0], [0, 1, 2, 3, 4]),   # NaN equals nothing
+])
+def test_a_step_table_leaves_out_the_knots_inside_runs_of_equal_values(values, kept):
+    table = step_table(0.5, values)
+    assert table["times_s"] == [0.5 * k for k in kept]
+    assert [repr(v) for v in table["values_ohm"]] == [repr(values[k]) for k in kept]
+
+
+@pytest.mark.parametrize("table", [
+    {"kind": "constant", "value_mm": 15.0},
+    {"kind": "cosine", "offset_mm": 15.0, "amplitude_mm": 8.0, "frequency_hz": 0.5},
+    {"kind": "table", "times_s": [0.0, 1.0, 2.0], "values_mm": [5.0, 9.0, 4.0]},
+])
+def test_a_runs_strokes_are_its_stroke_at_each_time(flexinol, table):
+    """``strokes`` (the metrics' rows at once) gives ``stroke`` at every time, to the bit."""
+    signal = reference_from_table({"quantity": "stroke", **table})
+    reference = StrokeReference(signal, load_from_table({"times_s": [0.0], "values_kg": [0.1]}),
+                                StrokeMap(flexinol, start_length(flexinol, None, 0.1)))
+    times = [0.001 * k for k in range(2501)]
+    strokes = reference.strokes(times)
+    assert strokes == [reference.stroke(t) for t in times]
+    assert (len(set(strokes)) == 1) == (table["kind"] == "constant")

@@ -35,7 +35,7 @@ def _gains(controller, component):
 def component_settings(scenario, name, reference_text=None):
     """{parameter: value} the scenario sets in component ``name`` beside the wire's parameters.
     ``reference_text``: the signals' ``reference`` text when the caller made it already (the
-    C master maps a stroke reference in C, :mod:`sma_fmu.systems.stroke_table`)."""
+    C master maps a stroke reference in C, :mod:`sma_fmu.cosim.stroke_table`)."""
     c, drive = scenario.controller, scenario.drive
     if name == "signals":
         return {"reference": reference_text if reference_text is not None

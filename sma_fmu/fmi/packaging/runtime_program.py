@@ -1,5 +1,5 @@
 """A small C program compiled with the C family's runtime sources (equal to the Python runtime
-to the double): the C master's stroke table (:mod:`sma_fmu.systems.stroke_table`) and the
+to the double): the C master's stroke table (:mod:`sma_fmu.cosim.stroke_table`) and the
 bench's timing programs (``sma_fmu/bench/*_timing.c``).
 
 :func:`runtime_program` compiles one with the system C compiler, no fused multiply-add (as the

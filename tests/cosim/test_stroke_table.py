@@ -1,13 +1,14 @@
-"""The C master's stroke table (systems/stroke_table.c): a stroke reference of every kind mapped
+"""The masters' stroke table (cosim/stroke_table.c): a stroke reference of every kind mapped
 in C gives the Python map's table text, character for character (R_ref at every step, the
-branch of the reference's trend, the loads stepping), on the Flexinol fit (thermal expansion:
+branch of the reference's trend, the loads stepping), and the fmpy master's R_ref(t) read
+back from it the Python map's value at every step, on the Flexinol fit (thermal expansion:
 the two branches give different R_ref) and on the reference wire (closed form)."""
 import pytest
 
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.runtime.scenario_signals import table_text
-from sma_fmu.systems.stroke_table import stroke_table_program, stroke_table_text
+from sma_fmu.cosim.stroke_table import stroke_reference_at, stroke_table_program, stroke_table_text
 from system_needs import needs
 
 pytestmark = needs("gcc")
@@ -46,6 +47,9 @@ def test_the_c_stroke_table_is_the_python_maps_text(tmp_path, program, kind, wir
     assert stroke_table_text(scenario, program) == table_text(python)
     if kind != "constant":   # the reference moved: R_ref did too
         assert len(set(python["values_ohm"])) > 2
+    mapped, h = stroke_reference_at(scenario, program), scenario.step_s
+    assert [mapped(k * h) for k in range(scenario.steps + 1)] == [
+        scenario.reference.value(k * h) for k in range(scenario.steps + 1)]
 
 
 def test_both_branches_give_their_own_r_ref_on_the_flexinol_fit(tmp_path):

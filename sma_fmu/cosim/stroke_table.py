@@ -1,26 +1,31 @@
-"""A stroke reference's R_ref table for the signals FMU, mapped in C (``stroke_table.c``).
+"""A stroke reference's R_ref at every step, mapped in C (``stroke_table.c``), for the masters.
 
 The FMUs hold no stroke map: a master gives the signals FMU the R_ref the stroke maps to at
 every step, as a table (:meth:`~sma_fmu.runtime.stroke.StrokeReference.resistance_table`).
 In Python that mapping costs some 90 us a step on the Flexinol fit (a secant search per new
-stroke): about 2.7 s before a 30-s run of the 0.5 Hz profile, more than the C master's whole
+stroke): about 2.7 s over a 30-s run of the 0.5 Hz profile, more than the C master's whole
 loop. :func:`stroke_table_text` maps the steps in C with the C family's runtime (its signals
 and stroke map equal Python's to the double) and writes the table as Python does
 (:func:`~sma_fmu.runtime.stroke.step_table`, ``table_text``): the same text, character for
-character; the C master uses it. The program is compiled once per source and compiler
-(:func:`~sma_fmu.fmi.packaging.runtime_program.runtime_program`).
+character; the C master gives it to the signals FMU. The fmpy master samples the same table
+in its loop (:func:`stroke_reference_at`). The program is compiled once per source and
+compiler (:func:`~sma_fmu.fmi.packaging.runtime_program.runtime_program`); where no C
+compiler is (a wheel's prebuilt binaries only), :func:`available_program` is None and both
+masters map the stroke in Python, the same values.
 """
 import array
 import os
 import subprocess
 from pathlib import Path
 
+from sma_fmu.fmi.hosts import CHostError
 from sma_fmu.fmi.packaging.runtime_program import runtime_program, wire_numbers
 from sma_fmu.runtime.scenario_signals import table_text
-from sma_fmu.runtime.signals import REFERENCE_KINDS, unit_key
+from sma_fmu.runtime.signals import REFERENCE_KINDS, reference_from_table, unit_key
 from sma_fmu.runtime.stroke import step_table
 
-__all__ = ["SOURCE", "is_stroke", "stroke_table_program", "stroke_table_input", "stroke_table_text"]
+__all__ = ["SOURCE", "is_stroke", "stroke_table_program", "available_program", "stroke_table_input",
+           "stroke_values", "stroke_table_text", "stroke_reference_at"]
 
 SOURCE = Path(__file__).parent / "stroke_table.c"
 
@@ -41,6 +46,15 @@ def stroke_table_program(cache=None):
     if program is None or not program.is_file():
         program = _PROGRAMS[key] = runtime_program(SOURCE, cache)
     return program
+
+
+def available_program(cache=None):
+    """:func:`stroke_table_program`'s, or None when it cannot be built (no C compiler: the
+    stroke is then mapped in Python)."""
+    try:
+        return stroke_table_program(cache)
+    except CHostError:
+        return None
 
 
 def _array(values):
@@ -65,11 +79,10 @@ def stroke_table_input(scenario):
     return " ".join(map(repr, map(float, numbers)))
 
 
-def stroke_table_text(scenario, program=None):
-    """The signals FMU's ``reference`` text of ``scenario`` (a stroke reference): the JSON
-    text :func:`~sma_fmu.runtime.scenario_signals.table_text` writes of
-    ``scenario.reference.resistance_table(scenario.step_s, scenario.steps)``, computed in C.
-    ``program``: :func:`stroke_table_program`'s (None: that of the temporary folder). Raises
+def stroke_values(scenario, program=None):
+    """R_ref [ohm] at t_k = k h, k = 0 ... steps, of ``scenario`` (a stroke reference),
+    computed in C: ``scenario.reference.value(k h)`` to the double. ``program``:
+    :func:`stroke_table_program`'s (None: that of the temporary folder). Raises
     :class:`~sma_fmu.fmi.hosts.CHostError` when it cannot be built and ``ValueError`` with
     the map's message when it refuses."""
     program = stroke_table_program() if program is None else program
@@ -82,4 +95,22 @@ def stroke_table_text(scenario, program=None):
     if len(values) != scenario.steps + 1:
         raise ValueError(f"scenario {scenario.name}: the stroke reference's R_ref table: "
                          f"{len(values)} values for {scenario.steps + 1} steps")
-    return table_text(step_table(scenario.step_s, values.tolist()))
+    return values.tolist()
+
+
+def stroke_table_text(scenario, program=None):
+    """The signals FMU's ``reference`` text of ``scenario`` (a stroke reference): the JSON
+    text :func:`~sma_fmu.runtime.scenario_signals.table_text` writes of
+    ``scenario.reference.resistance_table(scenario.step_s, scenario.steps)``, computed in C
+    (:func:`stroke_values`)."""
+    return table_text(step_table(scenario.step_s, stroke_values(scenario, program)))
+
+
+def stroke_reference_at(scenario, program):
+    """R_ref(t) [ohm] of ``scenario`` (a stroke reference) for a loop that samples it at
+    t_k = k h: the table :func:`stroke_table_text` writes, read back (it gives its knots, and
+    the held values between them, exactly at those times: the Python map's values), or the
+    Python map itself when ``program`` is None (no C compiler)."""
+    if program is None:
+        return scenario.reference.value
+    return reference_from_table(step_table(scenario.step_s, stroke_values(scenario, program))).value

@@ -1,6 +1,6 @@
 /*
  * stroke_table.c - a stroke reference's R_ref at every step in C, for the C master
- * (sma_fmu/systems/stroke_table.py): StrokeReference.value of runtime/stroke.py at t_k = k h,
+ * (sma_fmu/cosim/stroke_table.py): StrokeReference.value of runtime/stroke.py at t_k = k h,
  * with the C runtime's signals and stroke map (equal to Python's to the double), so the C
  * master does not map 30 000 steps in Python.
  *
