@@ -12,7 +12,7 @@ resistance scenario's records are as they always were.
 import math
 
 from sma_fmu.studies.overrides import StudyError
-from sma_fmu.systems.stroke_table import is_stroke
+from sma_fmu.cosim.stroke_table import is_stroke
 
 __all__ = ["CRITERIA", "UNITS", "scenario_criterion", "criterion_rmse",
            "stroke_fields", "stroke_markdown"]

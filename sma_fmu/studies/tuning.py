@@ -45,7 +45,7 @@ from sma_fmu.studies.overrides import StudyError, template
 from sma_fmu.studies.robust import draw_scenarios, robust_value
 from sma_fmu.studies.tuning_report import (SHAPED_KEYS, controller_snippet, print_record,
                                            ranking_markdown)
-from sma_fmu.systems.stroke_table import is_stroke
+from sma_fmu.cosim.stroke_table import is_stroke
 
 __all__ = ["BOUNDS", "TUNED", "tune_scenario", "tune_jointly", "controller_snippet", "run_tuning",
            "ranking_markdown"]
