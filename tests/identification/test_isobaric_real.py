@@ -40,6 +40,21 @@ def test_the_shared_files_read_as_they_are(params):
     assert [b.direction for b in hf.branches if b.complete] == [-1, 1]
 
 
+def test_the_shared_files_written_steps(params):
+    """The written step the verdict's noise floor rests on: NiTiHf's temperature is padded to
+    seven decimals (308.4050000) and its values move by the smallest difference between them;
+    Flexinol writes every float in full, so its floor is nothing."""
+    hf = read_isobaric(_nitihf(300), load_of_stress(300.0, params.diameter))
+    levels = np.diff(np.unique(hf.temperature))
+    assert hf.resolution["temperature"]["step"] == pytest.approx(levels[levels > 0].min(),
+                                                                 rel=1e-6)
+    assert hf.resolution["strain"]["unit"] == "percent"
+    assert hf.resolution["strain"]["step"] == pytest.approx(
+        hf.resolution["strain"]["written"] / 100.0)
+    flex = read_isobaric(_flexinol(172))
+    assert flex.resolution["temperature"]["step"] < 1e-12
+
+
 @pytest.fixture(scope="module")
 def flexinol_fit(tmp_path_factory, parameter_set):
     out = tmp_path_factory.mktemp("flex") / "fit"

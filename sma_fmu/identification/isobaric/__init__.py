@@ -17,7 +17,8 @@ The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` w
   centre laws: linear, or following Clausius-Clapeyron) and :mod:`~.starts` (the unknowns,
   their starts and bounds), :mod:`~.jacobian` and
   :mod:`~.solver` (sparse Levenberg-Marquardt), :mod:`~.covariance`, :mod:`~.outliers`
-  (outlier cycles, bounds) and :mod:`~.outcome` (what the fit found, the verdict);
+  (outlier cycles, bounds) and :mod:`~.outcome` (what the fit found, the verdict, judged
+  against noise floored at the file's written step, :mod:`~.resolution`);
 - :mod:`~.centre_law`: the report's word on the centre law (the centres' standard errors,
   what was done with the shares);
 - :mod:`~.halfway` and :mod:`~.summary`: half-strain temperatures and transformation strain

@@ -43,6 +43,7 @@ import numpy as np
 from sma_fmu.identification.isobaric.columns import SCALE, choose_strain, find_columns
 from sma_fmu.identification.isobaric.cycles import (Branch, select_cycles, smooth,
                                                    split_branches)
+from sma_fmu.identification.isobaric.resolution import written_step
 from sma_fmu.identification.isobaric.stress import constant_load_rows, file_stress
 from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
 from sma_fmu.identification.isobaric.table import number, plain, read_table
@@ -76,6 +77,8 @@ class IsobaricData:
     stress_column: float = None  # median of the file's stress column [MPa], if it has one
     notes: list = field(default_factory=list)   # what reading left out or assumed, in words
     reference_source: str = ""  # where reference_length came from
+    resolution: dict = field(default_factory=dict)  # quantity -> {"written" step, its "unit",
+    #                                                  "step" in the data's units}, see resolution
 
     @property
     def levels(self):
@@ -234,30 +237,49 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     keep, stress, notes = _constant_load(path, table, columns, given)
     rows = table.rows[keep]
 
+    steps = {}
+
     def column(quantity):
-        """A column's values on the rows at constant load."""
-        return _numbers(path, names, table.rows, columns[quantity][0],
-                        table.decimal_comma)[0][keep]
+        """A column's values on the rows at constant load (its written step kept in ``steps``)."""
+        values, texts = _numbers(path, names, table.rows, columns[quantity][0], table.decimal_comma)
+        steps[quantity] = written_step(texts, table.decimal_comma)
+        return values[keep]
+
+    def resolution(quantity, raw, converted):
+        """{"written", "unit", "step"} of a column: its written step, and that step in the data's
+        units (the conversions are linear: scaled by the ratio of the spans)."""
+        span = float(np.ptp(raw))
+        scale = float(np.ptp(converted)) / span if span > 0 else 1.0
+        unit = columns[quantity][1]
+        return {"written": steps[quantity], "unit": "K" if unit == "C" else unit,
+                "step": steps[quantity] * scale}
 
     t_index, t_unit = columns["temperature"]
-    temperature = _temperature(path, names[t_index], t_unit, column("temperature"))
+    raw = column("temperature")
+    temperature = _temperature(path, names[t_index], t_unit, raw)
+    written = {"temperature": resolution("temperature", raw, temperature)}
     shape = next(q for q in ("strain", "length", "extension") if q in columns)
     s_index, s_unit = columns[shape]
-    strain = _strain(path, shape, names[s_index], s_unit, column(shape), reference_length)
+    raw = column(shape)
+    strain = _strain(path, shape, names[s_index], s_unit, raw, reference_length)
+    written["strain"] = resolution(shape, raw, strain)
     notes += _reference_notes(shape, names[s_index], s_unit, reference_length, reference_source,
                               model_length)
     strain_note = ""
     if "strain_other" in columns:
         o_index, o_unit = columns["strain_other"]
-        other = _strain(path, "strain", names[o_index], o_unit, column("strain_other"),
-                        reference_length)
+        raw = column("strain_other")
+        other = _strain(path, "strain", names[o_index], o_unit, raw, reference_length)
         strain, chosen, strain_note = choose_strain(path, (names[s_index], strain),
                                                     (names[o_index], other))
         if chosen != names[s_index]:
+            written["strain"] = resolution("strain_other", raw, other)
             columns["strain"] = columns.pop("strain_other")
         else:
             columns.pop("strain_other")
     resistance = column("resistance") if "resistance" in columns else None
+    if resistance is not None:
+        written["resistance"] = resolution("resistance", resistance, resistance)
     if resistance is not None and not (resistance > 0).all():
         bad = int(np.argmin(resistance))
         raise MeasurementError(f"{path}: line {rows[bad][0]}: {names[columns['resistance'][0]]} "
@@ -303,7 +325,7 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     units = {q: (names[i], u) for q, (i, u) in columns.items()}
     return IsobaricData(path, float(load), float(reference_length), shape == "length", units,
                         temperature, strain, resistance, time, smoothed, branches, splitting,
-                        strain_note, stress, notes, reference_source)
+                        strain_note, stress, notes, reference_source, written)
 
 
 _NAMES = {HEATING: "heating", COOLING: "cooling"}

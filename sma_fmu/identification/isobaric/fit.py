@@ -35,7 +35,9 @@ its knots are fitted jointly with the parameters against the residuals (profile 
 temperature)/sigma_T, (model strain - measured strain)/sigma_eps (and resistance), each
 sigma the data's own scatter (median absolute second difference). So the profile can move
 only as far as the thermocouple noise allows, and a temperature residual much larger than
-the noise says the model does not explain the data (:func:`~.outcome.verdict`). The
+the noise says the model does not explain the data (:func:`~.outcome.verdict`; it judges
+against the estimate or, where that is smaller, the file's quantisation,
+:mod:`~.resolution`). The
 covariance s^2 (J^T J)^-1 of all unknowns (:mod:`~.covariance`) accounts for the
 temperature noise. Levenberg-Marquardt with sparse direct steps (:mod:`~.solver`) runs on
 a sparse Jacobian (:mod:`~.jacobian`); whether it converged is part of the outcome.
@@ -55,6 +57,7 @@ from sma_fmu.identification.isobaric.outcome import (EXPLAINED_RATIO, IsobaricFi
                                                      outcome, residual_blocks)
 from sma_fmu.identification.isobaric.outliers import OUTLIER_OPTIONS, bound_names
 from sma_fmu.identification.isobaric.profile import pointwise_error, temperature_profile
+from sma_fmu.identification.isobaric.resolution import judged_noise
 from sma_fmu.identification.isobaric.sensor import choose_lag, lag_sensitivity
 from sma_fmu.identification.isobaric.starts import PROFILE_BOUND, PROFILE_TOLERANCE_K
 from sma_fmu.identification.isobaric.structure import (Clock, Joint, choose, joint, joint_starts,
@@ -83,10 +86,15 @@ class PreparedFile:
     sigma: dict             # noise estimates: temperature [K], strain [1], resistance [ohm]
     per_cycle: bool
     weight: np.ndarray = None   # per sample: 1, or 0 for the strain of a left-out cycle
+    floor: dict = None      # the quantisation of each column's written step (same keys, units)
+    judged: dict = None     # what the verdict judges against: the larger of sigma and floor
 
     def __post_init__(self):
         if self.weight is None:
             self.weight = np.ones(self.data.strain.size)
+        if self.judged is None:
+            self.floor, self.judged = judged_noise(self.sigma,
+                                                   getattr(self.data, "resolution", {}))
 
     @property
     def lag_unit(self):
@@ -94,7 +102,8 @@ class PreparedFile:
 
 
 def prepare(data, index, residual="per-cycle"):
-    """:class:`PreparedFile` of one IsobaricData: profiles, step, noise estimates."""
+    """:class:`PreparedFile` of one IsobaricData: profiles, step, noise estimates (the
+    weights) and the noise the verdict judges against (:mod:`~.resolution`)."""
     def floor(values, estimate, least=1.0):
         return max(estimate, _FLOOR * max(float(np.ptp(values)), least))
     window = data.splitting.window_samples if data.splitting is not None else 5

@@ -9,6 +9,7 @@ from sma_fmu.identification.isobaric.covariance import (named, named_values,
                                                         reported_covariance, wire_covariance)
 from sma_fmu.identification.isobaric.jacobian import file_model, file_state
 from sma_fmu.identification.isobaric.residual_parts import strain_parts
+from sma_fmu.identification.isobaric.resolution import floor_notes
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.identification.measurements import MeasurementError
 from sma_fmu.runtime.constant_load import hysteresis_centre
@@ -43,7 +44,8 @@ class IsobaricFit:
     wire_bounds: list         # per file: first row of each wire branch, then the end
     sigma: list               # per file: {"temperature", "strain", "resistance"} noise estimates
     residual_rms: dict        # {"temperature_K", "strain", "resistance_ohm"} of the fit
-    noise: dict               # the same keys: the noise estimates (RMS over the files)
+    noise: dict               # the same keys: the noise the verdict judged against, per file
+    #                           the larger of estimate and quantisation floor (RMS over the files)
     verdict: str              # one line: explained or not, and why
     variance_factor: float    # s^2: 1 when the noise estimates describe the residuals
     dof: int
@@ -65,14 +67,22 @@ class IsobaricFit:
     first_fit: dict = None    # the first fit (profile held): cost, evaluations, message
     sensor: list = None       # per file: {"narrowing": K per unit of lag, "unit": s or samples}
     strain_parts: list = None  # per file: the strain residual by direction, phase and cycle
+    noise_estimates: dict = None  # the keys of ``noise``: the estimates (the weights) alone
+    noise_floors: dict = None     # the keys of ``noise``: the files' quantisation floors
+    floor_notes: list = field(default_factory=list)   # which noise was floored, per file
+    floors: list = None       # per file: the keys of ``sigma``: quantisation floors
 
 
-def verdict(rms, noise):
-    """One line: whether the residuals are what the noise estimates predict."""
+def verdict(rms, noise, floored=()):
+    """One line: whether the residuals are what the noise predicts (``noise``: the estimates,
+    or for the keys in ``floored`` the file's quantisation where that is larger)."""
     ratios = {key: rms[key] / noise[key] for key in rms if rms[key] is not None and noise[key]}
     unit = {"temperature_K": " K", "strain": "", "resistance_ohm": " ohm"}
-    worst = [f"{key.split('_')[0]} residual {rms[key]:.3g}{unit[key]} is {ratio:.1f}x its noise "
-             f"estimate {noise[key]:.3g}{unit[key]}" for key, ratio in ratios.items()
+
+    def what(key):
+        return "noise (floored at the file's resolution)" if key in floored else "noise estimate"
+    worst = [f"{key.split('_')[0]} residual {rms[key]:.3g}{unit[key]} is {ratio:.1f}x its "
+             f"{what(key)} {noise[key]:.3g}{unit[key]}" for key, ratio in ratios.items()
              if ratio > EXPLAINED_RATIO]
     if worst:
         return "the model does not explain the data: " + "; ".join(worst) + \
@@ -80,7 +90,9 @@ def verdict(rms, noise):
              if ratios.get("temperature_K", 0) > EXPLAINED_RATIO else "")
     return ("the model explains the data within the noise: residuals "
             + ", ".join(f"{key.split('_')[0]} {ratio:.2f}x" for key, ratio in ratios.items())
-            + " their noise estimates")
+            + " their noise estimates"
+            + (f" ({', '.join(k.split('_')[0] for k in ratios if k in floored)} floored at the "
+               f"file's resolution)" if any(k in floored for k in ratios) else ""))
 
 
 def residual_blocks(x, layout, prepared):
@@ -124,9 +136,12 @@ def check_inside(params, prepared):
 
 
 def _rms(parts, prepared):
-    """(overall RMS, noise RMS, per-file RMS) of the residual blocks, in their units."""
+    """(overall RMS, noise RMS, per-file RMS) of the residual blocks, in their units; the noise
+    RMS for each of the files' ``judged``, ``sigma`` (estimates) and ``floor`` (quantisation),
+    so ``noise`` is {"judged", "sigma", "floor"} of {key: RMS}."""
     rms = {"temperature_K": [], "strain": [], "resistance_ohm": []}
-    noise = {"temperature_K": [], "strain": [], "resistance_ohm": []}
+    noise = {kind: {"temperature_K": [], "strain": [], "resistance_ohm": []}
+             for kind in ("judged", "sigma", "floor")}
     i, file_rms = 0, []
     for f in prepared:
         file_rms.append({})
@@ -135,15 +150,17 @@ def _rms(parts, prepared):
             if sigma_key in f.sigma:
                 kept = f.weight > 0 if sigma_key != "temperature" else slice(None)
                 rms[key].append(parts[i][kept] * f.sigma[sigma_key])
-                noise[key].append(np.full(parts[i][kept].size, f.sigma[sigma_key]))
+                for kind in noise:
+                    noise[kind][key].append(np.full(parts[i][kept].size,
+                                                    getattr(f, kind)[sigma_key]))
                 kept_rows = rms[key][-1]    # none when every cycle of the file was left out
                 file_rms[-1][key] = float(np.sqrt(np.mean(kept_rows ** 2))) if kept_rows.size \
                     else float("nan")
                 i += 1
     rms = {key: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) if v else None
            for key, v in rms.items()}
-    noise = {key: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) if v else None
-             for key, v in noise.items()}
+    noise = {kind: {key: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) if v else None
+                    for key, v in values.items()} for kind, values in noise.items()}
     return rms, noise, file_rms
 
 
@@ -170,6 +187,8 @@ def outcome(prepared, layout, solution, jacobian, order, first, on_bound, **extr
     parts = residual_blocks(solution.x, layout, prepared)
     states = [file_state(solution.x, layout, f) for f in prepared]
     rms, noise, file_rms = _rms(parts, prepared)
+    keys = {"temperature": "temperature_K", "strain": "strain", "resistance": "resistance_ohm"}
+    floored = {keys[key] for f in prepared for key in f.sigma if f.floor[key] > f.sigma[key]}
     wire_names, wire_values, wire_cov = wire_covariance(names, values, cov_named, layout)
     lags = [None if c is None else {"value": float(solution.x[c]), "std_error": float(errors[c]),
                                     "unit": f.lag_unit, "step": f.step,
@@ -185,7 +204,9 @@ def outcome(prepared, layout, solution, jacobian, order, first, on_bound, **extr
         profiles=[s[2] for s in states], measured_profiles=[s[0] for s in states],
         directions=[s[3] for s in states], row_levels=[s[4] for s in states],
         wire_bounds=[s[5] for s in states], sigma=[f.sigma for f in prepared], residual_rms=rms,
-        noise=noise, verdict=verdict(rms, noise), variance_factor=factor, dof=dof,
+        noise=noise["judged"], verdict=verdict(rms, noise["judged"], floored),
+        noise_estimates=noise["sigma"], noise_floors=noise["floor"],
+        floor_notes=floor_notes(prepared), floors=[f.floor for f in prepared], variance_factor=factor, dof=dof,
         profile_unknowns=n - k, knots_per_branch=[f.profile.knots_per_branch for f in prepared],
         converged=bool(solution.status > 0), message=str(solution.message), on_bound=on_bound,
         file_rms=file_rms, undetermined=undetermined,

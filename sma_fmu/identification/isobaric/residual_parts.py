@@ -5,7 +5,8 @@ same residual as the verdict's (the joint fit's wire temperature, left-out cycle
 excluded) is split by the direction of the wire's branch and the model's transformed share
 q at the row: the austenite end (q < END_SHARE), the transformation, the martensite end
 (q > 1 - END_SHARE); and by cycle. Each part gives its rows, its RMS, that RMS over the
-file's strain noise estimate, and its share of the file's sum of squared residuals (the
+file's strain noise (the verdict's: the estimate, or the file's quantisation where that is
+larger, :mod:`~.resolution`), and its share of the file's sum of squared residuals (the
 shares add up to 1), so a misfit at the ends of the branches (a shape or a thermal
 expansion the model lacks there) is told from one in the transformation or in a few cycles.
 """
@@ -42,7 +43,7 @@ def strain_parts(prepared, layout, x, states):
                                   level, f.per_cycle, share=True)
         residual = strain - f.data.strain
         kept = f.weight > 0
-        noise = f.sigma["strain"]
+        noise = f.judged["strain"]
         total = float(np.sum(residual[kept] ** 2))
         phase = np.where(q < END_SHARE, 0, np.where(q > 1.0 - END_SHARE, 2, 1))
         parts = []
@@ -65,5 +66,5 @@ def parts_line(name, entry, count=3):
     parts = sorted((p for p in entry["parts"] if p["rows"]), key=lambda p: -p["share"])
     text = "; ".join(f"{p['direction']} {p['phase']} {p['ratio']:.2g}x ({100 * p['share']:.0f} %)"
                      for p in parts[:count])
-    return (f"{name}: strain residual by part (RMS over its noise estimate, share of the "
+    return (f"{name}: strain residual by part (RMS over its noise, share of the "
             f"squares): {text}")

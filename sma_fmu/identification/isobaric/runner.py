@@ -109,9 +109,9 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
                                                         "cc_share_c")
                                           if n not in fit.wire_names]
     per_file = []
-    for data, offsets, sigma, lag, knots, rms_of_file, parts in zip(
-            files, fit.offsets, fit.sigma, fit.lags, fit.knots_per_branch, fit.file_rms,
-            fit.strain_parts):
+    for data, offsets, sigma, floors, lag, knots, rms_of_file, parts in zip(
+            files, fit.offsets, fit.sigma, fit.floors, fit.lags, fit.knots_per_branch,
+            fit.file_rms, fit.strain_parts):
         per_file.append({
             "file": str(data.path), "load_kg": data.load,
             "cycles_found": splitting_note(data.splitting, data.branches, data.time is not None),
@@ -128,6 +128,8 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
             "branches": len(data.branches),
             "cycles": len({b.cycle for b in data.branches if b.complete}),
             "noise_estimates": sigma,
+            "noise_floors": floors,
+            "resolution": data.resolution,
             "residual_rms": rms_of_file,
             "strain_residual_parts": parts,
             "strain_offsets_per_level": offsets,
@@ -172,7 +174,10 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
                         else getattr(params.terms, name)) * load_of_stress(1.0, params.diameter)
             for name in ("b_h", "b_c") + (("b2_h", "b2_c") if params.terms.two_stage else ())},
         "residual_rms": fit.residual_rms,
-        "noise_estimates": fit.noise,
+        "noise_estimates": fit.noise_estimates,
+        "noise_floors": fit.noise_floors,
+        "noise_judged": fit.noise,
+        "noise_floor_notes": fit.floor_notes,
         "verdict": fit.verdict,
         "variance_factor": fit.variance_factor,
         "degrees_of_freedom": fit.dof,

@@ -77,15 +77,15 @@ def format_isobaric_report(report):
     found is printed while reading)."""
     rms = report["residual_rms"]
     solver = report["solver"]
-    noise = report["noise_estimates"]
+    noise = report.get("noise_judged", report["noise_estimates"])
     state = "converged" if solver["converged"] else f"NOT CONVERGED ({solver['message']})"
     lines = [f"isobaric fit: {report['points']} points in {len(report['files'])} file(s); "
              f"{solver['seconds']:.2f} s ({solver['evaluations']} evaluations), {state}",
-             f"residual RMS (noise estimate): strain {rms['strain']:.3g} ({noise['strain']:.3g}), "
+             f"residual RMS (noise): strain {rms['strain']:.3g} ({noise['strain']:.3g}), "
              f"temperature {rms['temperature_K']:.3g} K ({noise['temperature_K']:.3g} K)"
              + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
                 if rms["resistance_ohm"] else ""),
-             report["verdict"]]
+             report["verdict"], *report.get("noise_floor_notes", [])]
     if "strain residual" in report["verdict"]:     # not explained: say where it sits
         lines += [parts_line(Path(entry["file"]).name, entry["strain_residual_parts"])
                   for entry in report["files"] if entry.get("strain_residual_parts")]

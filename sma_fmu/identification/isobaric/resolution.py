@@ -1,0 +1,71 @@
+"""The resolution a file's columns are written with, and the noise a verdict judges against.
+
+The fit's noise estimates (:func:`~.files.noise_level`, the scatter of second differences)
+weight the residuals. On a file that was filtered, or written with few digits, most second
+differences are exactly zero and the estimate falls below what the file can show at all: a
+value rounded to a step q carries a rounding error of q/sqrt(12) RMS (uniform on +-q/2).
+The verdict, the strain residual parts and every "x its noise" text therefore judge the
+residuals against the larger of the estimate and that quantisation floor; the fit's weights
+keep the estimate.
+
+The step is read from the text as written: the place of the last nonzero digit of each cell
+(trailing zeros are padding: ``308.4050000`` is a 0.001 step), the finest over the column.
+Not the smallest difference of the sorted unique values: that equals the step only where
+the rows visit neighbouring levels, and overstates it on a fast ramp, a short file or
+sparsely sampled levels, so a floor from it could hide a real misfit. The written digits can
+only understate the step (a float written in full gives about 1e-17, a floor of nothing),
+never overstate it.
+"""
+import math
+from decimal import Decimal, InvalidOperation
+
+__all__ = ["written_step", "quantisation", "judged_noise", "floor_notes"]
+
+_QUANTITIES = {"temperature": "K", "strain": "", "resistance": "ohm"}
+
+
+def written_step(texts, decimal_comma=False):
+    """The finest step a column's cells are written with, in the column's own unit: 10 to
+    the place of the last nonzero digit, the smallest over ``texts``; 0.0 when every cell
+    is zero or none is a plain number."""
+    finest = None
+    for text in texts:
+        try:
+            value = Decimal(text.strip().replace(",", ".") if decimal_comma else text.strip())
+        except InvalidOperation:
+            continue
+        if not value.is_finite() or value.is_zero():
+            continue
+        place = value.normalize().as_tuple().exponent
+        finest = place if finest is None else min(finest, place)
+    return 0.0 if finest is None else 10.0 ** finest
+
+
+def quantisation(step):
+    """RMS rounding error [the step's unit] of values written to ``step``: step/sqrt(12)."""
+    return step / math.sqrt(12.0)
+
+
+def judged_noise(sigma, resolution):
+    """(floors, judged): per quantity of ``sigma`` (the noise estimates), the quantisation
+    of the file's ``resolution`` ({quantity: {"step": ...}} in the data's units; a quantity
+    without one has floor 0) and the larger of estimate and floor."""
+    floors = {key: quantisation(resolution.get(key, {}).get("step", 0.0)) for key in sigma}
+    return floors, {key: max(sigma[key], floors[key]) for key in sigma}
+
+
+def floor_notes(prepared):
+    """One line per file and quantity whose noise was floored at the file's resolution:
+    "noise floored at the file's resolution: 0.1 K written, 0.029 K"."""
+    notes = []
+    for f in prepared:
+        for key, unit in _QUANTITIES.items():
+            if key in f.sigma and f.floor[key] > f.sigma[key]:
+                written = f.data.resolution[key]
+                column_unit = f" {written['unit']}" if written["unit"] not in ("", "fraction") \
+                    else ""
+                own = f" {unit}" if unit else ""
+                notes.append(f"{f.data.path.name}: {key} noise floored at the file's resolution: "
+                             f"{written['written']:.3g}{column_unit} written, "
+                             f"{f.floor[key]:.2g}{own} (estimate {f.sigma[key]:.2g}{own})")
+    return notes
