@@ -11,6 +11,7 @@ from sma_fmu.cli import main
 from sma_fmu.identification.isobaric.files import noise_level, read_isobaric
 from sma_fmu.identification.isobaric.fit import fit_isobaric
 from sma_fmu.identification.isobaric.outcome import verdict
+from sma_fmu.identification.isobaric.resolution import smooth_note
 from sma_fmu.identification.isobaric.resolution import written_step
 from sma_fmu.identification.isobaric.synthetic import (IsobaricProgramme, isobaric_table,
                                                        isobaric_text)
@@ -76,6 +77,10 @@ def test_a_noise_free_file_is_judged_against_its_resolution(tmp_path, params, ca
     assert "clean.csv: strain noise floored at the file's resolution: 0.0001 percent written" \
         in printed
     report = json.loads((out / "report.json").read_text())
+    # 0.0029 K and 2.9e-7 lie below a lab sensor's scatter: a ratio to them says little
+    assert report["noise_smooth_note"].startswith("the noise judged against (temperature 0.00289 K, "
+                                                  "strain 2.89e-07) is below a lab sensor's scatter")
+    assert f"note: {report['noise_smooth_note']}" in printed
     entry, = report["files"]
     assert entry["noise_floors"]["temperature"] == pytest.approx(floor_K)
     assert entry["noise_estimates"]["temperature"] == pytest.approx(sigma["temperature"])
@@ -95,6 +100,16 @@ def test_a_noisy_file_is_judged_against_its_estimate(tmp_path, params):
     assert fit.noise == fit.noise_estimates and fit.floor_notes == []
     assert fit.verdict == verdict(fit.residual_rms, fit.noise_estimates)
     assert "floored" not in fit.verdict
+    assert smooth_note(fit.noise, fit.residual_rms) == ""   # a sensor's scatter: no note
+
+
+def test_a_smooth_note_names_only_the_noise_below_a_sensors_scatter():
+    rms = {"temperature_K": 0.67, "strain": 1.0e-4, "resistance_ohm": None}
+    note = smooth_note({"temperature_K": 3.6e-7, "strain": 3.5e-5, "resistance_ohm": None}, rms)
+    assert note.startswith("the noise judged against (temperature 3.6e-07 K) is below a lab "
+                           "sensor's scatter (temperature 0.005 K)")
+    assert "(temperature 0.67 K, strain 0.0001)" in note
+    assert smooth_note({"temperature_K": 0.005, "strain": 5e-7}, rms) == ""   # at the scatter
 
 
 def test_the_verdict_names_a_floored_noise():

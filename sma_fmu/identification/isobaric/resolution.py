@@ -19,9 +19,14 @@ never overstate it.
 import math
 from decimal import Decimal, InvalidOperation
 
-__all__ = ["written_step", "quantisation", "judged_noise", "floor_notes"]
+__all__ = ["written_step", "quantisation", "judged_noise", "floor_notes", "smooth_note",
+           "SENSOR_SCATTER"]
 
 _QUANTITIES = {"temperature": "K", "strain": "", "resistance": "ohm"}
+# the least scatter a lab's raw recording shows (a thermocouple or RTD read to 0.01 K, an
+# extensometer to 1e-6 of strain), halved: a noise below it is a filter's remains or none
+SENSOR_SCATTER = {"temperature_K": 0.005, "strain": 5e-7}
+_UNITS = {"temperature_K": " K", "strain": ""}
 
 
 def written_step(texts, decimal_comma=False):
@@ -69,3 +74,21 @@ def floor_notes(prepared):
                              f"{written['written']:.3g}{column_unit} written, "
                              f"{f.floor[key]:.2g}{own} (estimate {f.sigma[key]:.2g}{own})")
     return notes
+
+
+def smooth_note(noise, rms):
+    """A note when the noise judged against (``noise``, {"temperature_K", "strain", ...}) lies
+    below :data:`SENSOR_SCATTER` ("" otherwise): the data were filtered or computed, so a
+    ratio to that noise ("1898133.9x") says little, and the residuals ``rms`` are given in
+    their own units instead."""
+    below = [key for key, least in SENSOR_SCATTER.items()
+             if noise.get(key) is not None and noise[key] < least]
+    if not below:
+        return ""
+    what = lambda values, keys: ", ".join(   # noqa: E731
+        f"{key.split('_')[0]} {values[key]:.3g}{_UNITS[key]}" for key in keys)
+    return (f"the noise judged against ({what(noise, below)}) is below a lab sensor's scatter "
+            f"({what(SENSOR_SCATTER, below)}): the data look filtered or computed, so a ratio "
+            f"to it says little; judge the residual RMS in its units ("
+            f"{what(rms, [k for k in SENSOR_SCATTER if rms.get(k) is not None])}) and the "
+            f"half-strain temperatures below")

@@ -18,6 +18,7 @@ from sma_fmu.identification.isobaric.summary import format_isobaric_report, half
 from sma_fmu.identification.isobaric.cycles import parse_cycles, splitting_note
 from sma_fmu.identification.isobaric.figures import isobaric_figures
 from sma_fmu.identification.isobaric.files import read_isobaric
+from sma_fmu.identification.isobaric.resolution import smooth_note
 from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
 from sma_fmu.identification.isobaric.tables import cycle_rows, rows_csv, rows_markdown
 from sma_fmu.identification.isobaric.centre_law import centre_gradient, law_note
@@ -178,6 +179,7 @@ def isobaric_report(files, fit, base_set, residual, rows, outliers="leave-out"):
         "noise_floors": fit.noise_floors,
         "noise_judged": fit.noise,
         "noise_floor_notes": fit.floor_notes,
+        "noise_smooth_note": smooth_note(fit.noise, fit.residual_rms),
         "verdict": fit.verdict,
         "variance_factor": fit.variance_factor,
         "degrees_of_freedom": fit.dof,

@@ -86,6 +86,8 @@ def format_isobaric_report(report):
              + (f", resistance {rms['resistance_ohm']:.3g} ohm ({noise['resistance_ohm']:.3g} ohm)"
                 if rms["resistance_ohm"] else ""),
              report["verdict"], *report.get("noise_floor_notes", [])]
+    if report.get("noise_smooth_note"):
+        lines.append(f"note: {report['noise_smooth_note']}")
     if "strain residual" in report["verdict"]:     # not explained: say where it sits
         lines += [parts_line(Path(entry["file"]).name, entry["strain_residual_parts"])
                   for entry in report["files"] if entry.get("strain_residual_parts")]
