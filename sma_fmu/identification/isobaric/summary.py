@@ -132,8 +132,17 @@ def format_isobaric_report(report):
         reasons = dict.fromkeys(reason for key in ("thermocouple_K", "wire_K")
                                 if entry[key] is None
                                 for reason in entry[f"{key}_why_missing"].split("; "))
-        # e.g. a file of one cooling, then one heating branch holds no cycle with both
-        why = (" (n/a: " + "; ".join(reasons) + ")") if reasons else ""
+        # e.g. a file of one cooling, then one heating branch holds no cycle with both:
+        # "heating, cooling: no such branch ...", each reason once with the branches it names
+        named = {}
+        for reason in reasons:
+            branch, colon, text = reason.partition(": ")
+            if colon and branch in ("heating", "cooling"):
+                named.setdefault(text, []).append(branch)
+            else:
+                named.setdefault(reason, [])
+        why = (" (n/a: " + "; ".join(f"{', '.join(b)}: {t}" if b else t
+                                     for t, b in named.items()) + ")") if reasons else ""
         lines.append(f"{entry['file']}: thermal hysteresis (median over cycles) "
                      f"{told('thermocouple_K')} at the thermocouple, {told('wire_K')} at the "
                      f"wire (model){why}")
