@@ -8,6 +8,13 @@ Every embedded FMU is named as in the SSP, packed with the scenario's values as 
 defaults (:mod:`.packed`), and its parameters are also set to them as start values. The
 container has no inputs; its outputs are the loop system's (:data:`~sma_fmu.fmi.loop.wiring.OUTPUTS`),
 with the units of the embedded FMUs (added to the builder's modelDescription.xml, which has none).
+
+The container passes an embedded FMU's warnings from fmi2DoStep on, but takes one from
+fmi2ExitInitializationMode for a failure: its own fmi2ExitInitializationMode then returns
+fmi2Error (fmpy stops, libcosim ends the process). The plant warns there when it starts
+outside its wire's data range (``validity.T_data_min`` ..., as the Flexinol fit's stroke
+scenarios start, at T_room 10 degC against data from 29.8 degC), so such a scenario is
+refused before anything is built (:func:`container_refusal`).
 """
 import io
 import tempfile
@@ -18,11 +25,12 @@ from pathlib import Path
 from sma_fmu.cosim.scenario import load_scenario
 from sma_fmu.fmi.python_family.slave_support.model_description import set_units
 from sma_fmu.files.output_folder import OutputError, write_file
+from sma_fmu.runtime.plant import PlantStepper
 from sma_fmu.systems.closed_loop import closed_loop, identifier
 from sma_fmu.systems.packed import packed_fmu
 from sma_fmu.systems.toolbox_log import toolbox_messages
 
-__all__ = ["build_container", "export_container"]
+__all__ = ["build_container", "export_container", "container_refusal"]
 
 
 def _text(value):
@@ -49,6 +57,19 @@ _EXPECTED_WITHOUT_COMPENSATOR = _EXPECTED + ("Input 'Port pi/P_ff' is not connec
 # PI's); one without a limit leaves that input unconnected (it is not read)
 _EXPECTED_LIMITED = ("Loop of links through the embedded FMU 'driver'",)
 _EXPECTED_UNLIMITED_DRIVER = ("Input 'Port driver/R' is not connected",)
+
+
+def container_refusal(scenario):
+    """Why ``scenario`` cannot run as a container (its plant warns at initialization,
+    which the container reports as an error: see the module docstring), or None."""
+    warning = PlantStepper(scenario.params, scenario.T_start, scenario.hysteresis_mode,
+                           scenario.load.value(0.0)).warning
+    if warning is None:
+        return None
+    return (f"the plant warns at its start ({warning}), and an FMU container takes a warning "
+            f"at initialization for an error (its fmi2ExitInitializationMode fails); start "
+            f"the wire inside its data range ([plant] T_start_degC), or run the loop as an "
+            f"SSP (--path ssp, export ssp)")
 
 
 def _configure(container, system):
@@ -101,6 +122,9 @@ def build_container(system, out, step_size=None, argument="--out"):
     from fmu_manipulation_toolbox.container.errors import FMUContainerError
 
     scenario = system.scenario
+    refusal = container_refusal(scenario)
+    if refusal:
+        raise ValueError(f"{scenario.path}: {refusal}")
     step_size = scenario.step_s if step_size is None else step_size
     expected = _EXPECTED if scenario.controller.feedforward else _EXPECTED_WITHOUT_COMPENSATOR
     if scenario.drive.driver:

@@ -107,9 +107,8 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
     :data:`~sma_fmu.systems.c_master.DEFAULT_TIMEOUT_S`). Each run streams into its files
     (:class:`~sma_fmu.cosim.recording.RunRecorder`): memory does not grow with its length.
     ``figures``: also write the figures (the command line's ``--figures``; without
-    them matplotlib is never imported). A scenario with a stroke
-    reference runs on the library and FMU paths only (the master maps the stroke to an R_ref
-    table for the signals FMU), not with ``events``: ValueError before any run.
+    them matplotlib is never imported). On ``path="container"`` a scenario whose plant warns
+    at its start is refused before any run (:func:`~sma_fmu.systems.container.container_refusal`).
     """
     if path not in PATHS:
         raise ValueError(f"path must be one of {', '.join(PATHS)}, got {path!r}")
@@ -129,12 +128,12 @@ def run_scenarios(paths, out_dir, path="fmu", fmu_dir=DEFAULT_FMU_DIR, progress=
         run = lambda scenario, fmu_dir, sink: _fmpy(scenario, fmu_dir, sink, events=True)  # noqa: E731
     timeseries_name(fmt)
     scenarios = [load_scenario(p) for p in paths]
-    for scenario in scenarios:
-        if (path not in ("library", "fmu") or events) and getattr(
-                scenario.reference, "quantity", None) == "stroke":
-            raise ValueError(f"{scenario.path}: a stroke reference ([reference] quantity = "
-                             f"'stroke') runs on --path library and --path fmu (without "
-                             f"--events) only, not --path {path}{' --events' if events else ''}")
+    if path == "container":
+        from sma_fmu.systems.container import container_refusal
+        for scenario in scenarios:
+            refusal = container_refusal(scenario)
+            if refusal:
+                raise ValueError(f"{scenario.path}: {refusal}")
     every = [interval_steps(output_interval_s, s.step_s, "--output-interval")
              if output_interval_s is not None
              else interval_steps(s.output_interval_s, s.step_s, f"{s.path}: [scenario] output_interval_s")

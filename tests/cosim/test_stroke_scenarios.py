@@ -87,18 +87,6 @@ def test_stroke_metrics_are_the_stroke_error_in_micrometres(tmp_path):
     assert len(metrics["segments_rmse_um"]) == 3
 
 
-@pytest.mark.parametrize("path,events", [("ssp", False), ("container", False), ("fmu", True)])
-def test_a_stroke_scenario_is_refused_off_the_library_and_fmu_paths_before_any_run(
-        tmp_path, path, events):
-    from sma_fmu.systems.runner import run_scenarios
-
-    out = tmp_path / "out"
-    with pytest.raises(ValueError, match=rf"runs on --path library and --path fmu \(without "
-                                         rf"--events\) only, not --path {path}"):
-        run_scenarios([shipped_file("scenarios", f"{HOLD}.toml")], out, path=path, events=events)
-    assert not out.exists()
-
-
 def test_the_signals_fmu_gets_the_mapped_r_ref_as_a_table_exact_at_every_step():
     from sma_fmu.fmi.loop.values import component_settings
     from sma_fmu.runtime.scenario_signals import SignalSource
