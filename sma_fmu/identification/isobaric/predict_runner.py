@@ -25,15 +25,20 @@ from sma_fmu.wire.parameter_file import load_parameter_set
 
 __all__ = ["run_isobaric_predict", "format_predict_report"]
 
+DENSE_ROWS = 2000   # a file with fewer rows draws its measured points large and opaque
+
 
 def _figure(data, result):
     figure = Figure(figsize=(11, 4.2))
     left, right = figure.subplots(1, 2)
     t = data.smoothed
+    # a dense file's points as a faint cloud, a sparse one's (tens of rows) as clear dots
+    sparse = t.size < DENSE_ROWS
     for b in data.branches:
         rows = slice(b.start, b.stop)
         colour = "tab:red" if b.direction == HEATING else "tab:blue"
-        left.plot(t[rows], 100 * result["measured"][rows], ".", ms=2, color=colour, alpha=0.35)
+        left.plot(t[rows], 100 * result["measured"][rows], ".", ms=5 if sparse else 2,
+                  color=colour, alpha=0.9 if sparse else 0.35)
         left.plot(t[rows], 100 * result["predicted"][rows], "-", lw=1.2, color="k"
                   if b.direction == HEATING else "0.45")
         left.plot(t[rows], 100 * result["own_zero"][rows], ":", lw=0.8, color="tab:purple")
@@ -47,9 +52,10 @@ def _figure(data, result):
     left.set(title=f"{data.path.name}, {report['stress_MPa']:.4g} MPa\nstrain RMS "
                    f"{rms['strain']:.3g} offset-matched, {rms['strain_own_zero']:.3g} own zero",
              xlabel="measured temperature (smoothed) [degC]", ylabel="strain [%]")
-    left.legend(fontsize=7)
+    # below the axes: inside, it hides the transformation or the own-zero curve
+    left.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
     sample = data.time if data.time is not None else np.arange(data.strain.size)
-    right.plot(sample, 100 * (result["predicted"] - result["measured"]), ".", ms=1.5)
+    right.plot(sample, 100 * (result["predicted"] - result["measured"]), ".", ms=4 if sparse else 1.5)
     right.set(title="predicted (offset-matched) - measured", xlabel="time [s]"
               if data.time is not None else "sample", ylabel="strain [%]")
     for axis in (left, right):
