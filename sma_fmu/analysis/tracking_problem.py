@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sma_fmu.runtime.plant import PlantStepper
+from sma_fmu.runtime.signals import is_stroke
 from sma_fmu.runtime.thermal import step_decay, thermal_step
 
 __all__ = ["TrackingProblem", "TemperatureGrid"]
@@ -57,7 +58,7 @@ class TrackingProblem:
             references=np.array([scenario.reference.value(t) for t in times]),
             step_loads=loads[:-1], sample_loads=np.concatenate((loads[:1], loads[:-1])),
             weights=(times >= scenario.analysis.metrics_start_s - 1e-9 * h).astype(float),
-            stroke_references=None if getattr(scenario.reference, "quantity", None) != "stroke"
+            stroke_references=None if not is_stroke(scenario.reference)
             else np.array([scenario.reference.stroke(t) for t in times]))
 
     @property

@@ -27,11 +27,12 @@ from functools import partial
 from sma_fmu.cosim.event_drive import EventDrivenPlant, PassThroughDriver, traced_driver
 from sma_fmu.cosim.loop import PLANT_OUTPUTS, LoopResult, run_loop
 from sma_fmu.cosim.run_warnings import WarningTexts, model_text, ordered
-from sma_fmu.cosim.stroke_table import available_program, is_stroke, stroke_reference_at
+from sma_fmu.cosim.stroke_table import available_program, stroke_reference_at
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.instance3 import open_instance
 from sma_fmu.fmi.loop.system import loop_system
 from sma_fmu.fmi.packaging.fmu_names import DEFAULT_FMU_DIR, default_fmu_paths
+from sma_fmu.runtime.signals import is_stroke
 
 __all__ = ["FMU_BLOCKS", "FmuPlant", "FmuCompensator", "FmuDriver", "LeanStep", "run_fmus"]
 
@@ -258,7 +259,7 @@ def run_fmus(scenario, fmu_dir=DEFAULT_FMU_DIR, sink=None, combined=None, events
     start = time.perf_counter()
     # a stroke reference mapped in C at every step when a compiler is there (one process
     # for the run, not a search per step in Python), else by the Python map: the same R_ref
-    reference_at = (stroke_reference_at(scenario, available_program()) if is_stroke(scenario)
+    reference_at = (stroke_reference_at(scenario, available_program()) if is_stroke(scenario.reference)
                     else None)
     parts = {}
     try:

@@ -22,6 +22,7 @@ import numpy as np
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK
 from sma_fmu.runtime.reachable_band import reachable_band
+from sma_fmu.runtime.signals import is_stroke
 
 __all__ = ["EMPTY_METRICS", "error_metrics", "band_edges", "stroke_metrics", "unreachable_samples",
            "unreachable_intervals", "reachability_warning", "metric_windows", "assemble_metrics",
@@ -226,7 +227,7 @@ class StreamingMetrics:
         self.overall, self.reachable = ErrorSums(), ErrorSums()
         self.segments = [ErrorSums() for _ in scenario.load.segments(scenario.stop_time_s)]
         self._strokes = (scenario.reference.strokes
-                         if getattr(scenario.reference, "quantity", None) == "stroke" else None)
+                         if is_stroke(scenario.reference) else None)
         self.stroke = ErrorSums()                      # stroke errors [m], the window's
         self.stroke_segments = [ErrorSums() for _ in self.segments]
         self.window = self.saturated = self.clamped = self.unreachable = 0

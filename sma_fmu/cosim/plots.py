@@ -31,6 +31,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from sma_fmu.runtime.signals import is_stroke
+
 __all__ = ["plot_run", "plot_comparison", "rolling_rms", "envelope", "ENVELOPE_SPANS"]
 
 ENVELOPE_SPANS = 1500   # spans a line is cut into: more than the pixels a panel is wide
@@ -222,7 +224,7 @@ def plot_run(data, scenario, path):
     """Resistance, temperature, power (total, feedforward, feedback), load and stroke (with a
     stroke reference's curve, its panel taller); PNG at ``path``. The figure is kept for the
     next run of the same kind (:class:`_RunFigure`)."""
-    stroke_reference = getattr(scenario.reference, "quantity", None) == "stroke"
+    stroke_reference = is_stroke(scenario.reference)
     _kept("run" + ("_stroke" if stroke_reference else ""),
           lambda: _RunFigure(stroke_reference)).draw(data, scenario, path)
 

@@ -24,18 +24,13 @@ from sma_fmu.runtime.scenario_signals import table_text
 from sma_fmu.runtime.signals import REFERENCE_KINDS, reference_from_table, unit_key
 from sma_fmu.runtime.stroke import step_table
 
-__all__ = ["SOURCE", "is_stroke", "stroke_table_program", "available_program", "stroke_table_input",
+__all__ = ["SOURCE", "stroke_table_program", "available_program", "stroke_table_input",
            "stroke_values", "stroke_table_text", "stroke_reference_at"]
 
 SOURCE = Path(__file__).parent / "stroke_table.c"
 
 
 _PROGRAMS = {}   # the program's executable, by cache folder and compiler settings
-
-
-def is_stroke(scenario):
-    """Whether ``scenario``'s reference is a stroke."""
-    return getattr(scenario.reference, "quantity", None) == "stroke"
 
 
 def stroke_table_program(cache=None):

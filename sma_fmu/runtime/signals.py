@@ -10,12 +10,18 @@ to R_ref through the model.
 import bisect
 import math
 
-__all__ = ["REFERENCE_KINDS", "unit_key", "MAX_REFERENCE_OHM", "MAX_STROKE_MM", "QUANTITIES", "ReferenceSignal", "LoadProfile", "reference_from_table",
+__all__ = ["REFERENCE_KINDS", "unit_key", "MAX_REFERENCE_OHM", "MAX_STROKE_MM", "QUANTITIES", "is_stroke", "ReferenceSignal", "LoadProfile", "reference_from_table",
            "load_from_table"]
 
 MAX_REFERENCE_OHM = 1e6  # a wire's resistance is ohms to kilo-ohms; beyond this is a typo
 MAX_STROKE_MM = 1e4      # |stroke| [mm]: a wire's stroke is millimetres; beyond this is a typo
 QUANTITIES = {"resistance": "ohm", "stroke": "mm"}   # quantity -> unit of its keys
+
+
+def is_stroke(reference):
+    """Whether ``reference`` (a scenario's) is a stroke [mm], mapped to R_ref through the
+    model, rather than R_ref [ohm] itself."""
+    return getattr(reference, "quantity", None) == "stroke"
 
 # kind -> (required keys, optional keys with defaults)
 REFERENCE_KINDS = {

@@ -12,7 +12,7 @@ resistance scenario's records are as they always were.
 import math
 
 from sma_fmu.studies.overrides import StudyError
-from sma_fmu.cosim.stroke_table import is_stroke
+from sma_fmu.runtime.signals import is_stroke
 
 __all__ = ["CRITERIA", "UNITS", "scenario_criterion", "criterion_rmse",
            "stroke_fields", "stroke_markdown"]
@@ -27,10 +27,10 @@ def scenario_criterion(scenario, chosen=None):
     None for its default ("stroke" for a stroke scenario, else "resistance"). Raises
     :class:`StudyError` for "stroke" on a resistance scenario."""
     if chosen is None:
-        return "stroke" if is_stroke(scenario) else "resistance"
+        return "stroke" if is_stroke(scenario.reference) else "resistance"
     if chosen not in CRITERIA:
         raise StudyError(f"--criterion {chosen!r}: must be one of {', '.join(CRITERIA)}")
-    if chosen == "stroke" and not is_stroke(scenario):
+    if chosen == "stroke" and not is_stroke(scenario.reference):
         raise StudyError(f"--criterion stroke: scenario {scenario.name}'s reference is a "
                          "resistance, not a stroke")
     return chosen

@@ -45,7 +45,7 @@ from sma_fmu.studies.overrides import StudyError, template
 from sma_fmu.studies.robust import draw_scenarios, robust_value
 from sma_fmu.studies.tuning_report import (SHAPED_KEYS, controller_snippet, print_record,
                                            ranking_markdown)
-from sma_fmu.cosim.stroke_table import is_stroke
+from sma_fmu.runtime.signals import is_stroke
 
 __all__ = ["BOUNDS", "TUNED", "tune_scenario", "tune_jointly", "controller_snippet", "run_tuning",
            "ranking_markdown"]
@@ -66,7 +66,7 @@ def _robust_record(scenario, best, names, start, robust):
     """The draws' RMSEs (scalar path) at the given and the tuned gains, and the score: R's
     [ohm], and for a stroke scenario the stroke's [um] beside."""
     record = robust.as_dict()
-    criteria = ("resistance", "stroke") if is_stroke(scenario) else ("resistance",)
+    criteria = ("resistance", "stroke") if is_stroke(scenario.reference) else ("resistance",)
     tuned = [getattr(best.controller, n) for n in names]
     for label, values in (("given", start), ("tuned", tuned)):
         metrics = [scenario_metrics(run_library(draw).data, draw) for draw in
@@ -190,7 +190,7 @@ def _finish(scenario, names, start, result, objective, robust, seconds, seed):
         extra["robust"] = _robust_record(scenario, best, names, start, robust)
     record = _record(scenario, names, result, start, tuned, given, objective.evaluations,
                      seconds, seed)
-    if is_stroke(scenario):
+    if is_stroke(scenario.reference):
         extra.update(stroke_fields(objective.criterion, tuned, given, float(result.fun)))
     if objective.reason:
         record["optimiser"]["method"] = ("scipy differential_evolution, on the library path "

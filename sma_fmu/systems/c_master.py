@@ -43,11 +43,12 @@ from pathlib import Path
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK, LoopResult
 from sma_fmu.cosim.run_warnings import WarningTexts, model_text, ordered
-from sma_fmu.cosim.stroke_table import available_program, is_stroke, stroke_table_text
+from sma_fmu.cosim.stroke_table import available_program, stroke_table_text
 from sma_fmu.fmi.driving.instance import FmuError
 from sma_fmu.fmi.driving.unpacked import WIN64, acquire, release
 from sma_fmu.fmi.hosts import CHostError, compile_host
 from sma_fmu.fmi.loop.system import check_variables
+from sma_fmu.runtime.signals import is_stroke
 from sma_fmu.systems.loop_host_process import (STATUS_NAMES, HostProcess, failed_call,
                                                host_stderr, log_entry)
 from sma_fmu.systems.c_master_rows import RowAssembler, csv_columns, recorded_columns
@@ -242,7 +243,7 @@ class CMaster:
         not read yet is start-up)."""
         started = time.perf_counter()
         text = None
-        if is_stroke(scenario):   # the stroke's R_ref table, mapped in C (part of the run)
+        if is_stroke(scenario.reference):   # the stroke's R_ref table, mapped in C (part of the run)
             # compiled once: start-up; None without a compiler (a wheel's prebuilt host):
             # mapped in Python
             program = available_program(self.cache)

@@ -18,6 +18,7 @@ a master that sets the inputs itself, without the signals component, starts the 
 from sma_fmu.fmi.loop.gains import GAINS
 from sma_fmu.fmi.python_family.slave_support.choices import choice_code
 from sma_fmu.runtime.scenario_signals import table_text
+from sma_fmu.runtime.signals import is_stroke
 
 __all__ = ["WIRES", "component_settings", "wire_of", "input_starts"]
 
@@ -70,7 +71,7 @@ def _reference_table(scenario):
     R_ref it maps to at every step, as a table in ohm (the FMUs hold no stroke map: the
     master maps the stroke, and the table gives those values at the steps exactly)."""
     reference = scenario.reference
-    if getattr(reference, "quantity", None) == "stroke":
+    if is_stroke(reference):
         return reference.resistance_table(scenario.step_s, scenario.steps)
     return reference.as_table()
 

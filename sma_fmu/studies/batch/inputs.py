@@ -17,6 +17,7 @@ import numpy as np
 from sma_fmu.runtime.constant_load import branch_constants
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.reachable_band import band_of_branch
+from sma_fmu.runtime.signals import is_stroke
 from sma_fmu.runtime.thermal import step_decay
 
 __all__ = ["BatchInputs", "CONSTANT_FIELDS", "LOAD_TOLERANCE_S"]
@@ -45,7 +46,7 @@ def _row(heating, cooling, params):
 def _reference_key(reference):
     """What makes two scenarios' R_ref the same: a resistance reference's kind and settings;
     a stroke reference's R_ref depends on its wire and loads too, so it is shared with none."""
-    if getattr(reference, "quantity", None) == "stroke":
+    if is_stroke(reference):
         return "stroke", id(reference)
     settings = tuple(sorted((key, tuple(value) if isinstance(value, list) else value)
                             for key, value in reference.settings.items()))

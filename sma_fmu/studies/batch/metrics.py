@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from sma_fmu.cosim.metrics import EMPTY_METRICS, assemble_metrics, metric_windows, stroke_metrics
+from sma_fmu.runtime.signals import is_stroke
 
 __all__ = ["MetricsAccumulator"]
 
@@ -118,10 +119,10 @@ class MetricsAccumulator:
         columns, index, self._start_length = {}, [], None
         for scenario in scenarios:
             reference = scenario.reference
-            if getattr(reference, "quantity", None) == "stroke":
+            if is_stroke(reference):
                 index.append(columns.setdefault(id(reference), (len(columns), reference))[0])
-        self.stroke_runs = np.array([run for run, scenario in enumerate(scenarios) if getattr(
-            scenario.reference, "quantity", None) == "stroke"], dtype=int)
+        self.stroke_runs = np.array([run for run, scenario in enumerate(scenarios) if is_stroke(
+            scenario.reference)], dtype=int)
         self._stroke_column = np.array(index, dtype=int)
         self._stroke_reference = np.array(
             [[reference.stroke(time) for time in times.tolist()]
