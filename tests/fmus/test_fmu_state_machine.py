@@ -100,6 +100,9 @@ def test_only_inputs_and_parameters_can_be_set_and_fixed_ones_only_before_initia
                   words=["nothing was set"])
     assert plant.get("R", "T", "R_P", "P_in") == [R, T, params.R_P, 0.0]  # nothing changed
     plant.refused(plant.fmu.getReal, [123456], words=["value reference 123456"])
+    plant.refused(plant.fmu.getReal, list(range(123456, 123556)),
+                  words=["value reference 123460", ", and 95 more"])
+    assert "value reference 123461" not in plant.messages[-1][1]
     plant.refused(plant.fmu.getBoolean, [plant.refs["R"]], words=["Real variable R, not a Boolean"])
     plant.set(P_in=0.5)                       # inputs can be set
     plant.fmu.doStep(1e-3, 1e-3)

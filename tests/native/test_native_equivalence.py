@@ -305,6 +305,12 @@ def test_refusals_agree(families):
         for side in (twins.py, twins.nat):
             assert side.call("getReal", [999])[0] == 3
         twins.same_log()
+        for side in (twins.py, twins.nat):   # a host's thousand bad references: five named
+            assert side.call("getReal", list(range(1000, 2000)))[0] == 3
+        twins.same_log()
+        message = twins.nat.log[-1][1]
+        assert message.endswith("value reference 1004 is not a variable of SmaActuator, and 995 more")
+        assert "value reference 1005" not in message
         assert twins.both("call", "terminate")[0][0] == 0
         assert twins.both("step", 0.0, 1e-3) == [3, 3]
         twins.same_log()

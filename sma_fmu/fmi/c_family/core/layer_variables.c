@@ -13,6 +13,9 @@
 
 #include "layer.h"
 
+/* unknown value references a refused get describes; the rest are counted (guards.py) */
+#define REFERENCES_SHOWN 5
+
 static const char *const KIND_NAMES[] = {"Real", "Integer", "Boolean", "String"};
 static const char *const FMI3_KIND_NAMES[] = {"Float64", "Int32", "Boolean", "String"};
 static const char *const CAUSALITY_NAMES[] = {"parameter", "input", "output", "local"};
@@ -304,7 +307,7 @@ static int quick_get(const Instance *in, SmaKind kind, const unsigned int vr[], 
 SmaStatus layer_get(Instance *in, const char *function, SmaKind kind,
                      const unsigned int vr[], size_t nvr, void *value)
 {
-    size_t i, index, used = 0;
+    size_t i, index, used = 0, unknown = 0;
     char text[1500];
     if (quick_get(in, kind, vr, nvr, value)) return SMA_OK;
     if (in->state == STATE_INSTANTIATED ||
@@ -322,6 +325,7 @@ SmaStatus layer_get(Instance *in, const char *function, SmaKind kind,
         if (!v || v->kind != kind) {
             char why[300];
             put_missing(kind, value, i);
+            if (++unknown > REFERENCES_SHOWN) continue;  /* counted after the loop */
             describe_reference(in, kind, vr[i], why, sizeof why);
             if (used < sizeof text)
                 used += (size_t)snprintf(text + used, sizeof text - used, "%s%s",
@@ -330,6 +334,9 @@ SmaStatus layer_get(Instance *in, const char *function, SmaKind kind,
         else if (kind == SMA_STRING) ((const char **)value)[i] = in->values[index].text;
         else ((int *)value)[i] = in->values[index].integer;
     }
+    if (unknown > REFERENCES_SHOWN && used < sizeof text)
+        snprintf(text + used, sizeof text - used, ", and %lu more",
+                 (unsigned long)(unknown - REFERENCES_SHOWN));
     if (text[0]) return layer_refuse(in, SMA_ERROR, function, text);
     return SMA_OK;
 }

@@ -310,7 +310,11 @@ class CallGuard:
             self.outputs_current = False
 
     def _unknown(self, kind, references):
-        return ", ".join(self.interface.describe_reference(kind, r) for r in references)
+        """The refusal's text for ``references`` that are not ``kind`` variables: the first
+        :data:`REFERENCES_SHOWN` described, the rest counted (as the C family words it)."""
+        shown = [self.interface.describe_reference(kind, r) for r in references[:REFERENCES_SHOWN]]
+        more = len(references) - len(shown)
+        return ", ".join(shown) + (f", and {more} more" if more else "")
 
     def get_real(self, references):
         # hot path of a running co-simulation: stepComplete, known references (one dict
@@ -374,6 +378,7 @@ class CallGuard:
 
 
 SHOWN_CHARACTERS = 200   # a refused string is shown up to this many characters, as the C family does
+REFERENCES_SHOWN = 5      # unknown value references a refused get describes; the rest are counted
 
 
 def shown_value(value):
