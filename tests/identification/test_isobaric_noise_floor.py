@@ -123,3 +123,33 @@ def test_the_verdict_names_a_floored_noise():
                            f"{0.8 / floor:.1f}x its noise (floored at the file's resolution) "
                            f"{floor:.3g} K")
     assert np.isclose(0.8 / floor, 27.7, atol=0.05)
+
+
+def _band(axis):
+    """(half-height [data units], label) of the residual panel's band."""
+    band, = [patch for patch in axis.patches if patch.get_label() and
+             not patch.get_label().startswith("_")]
+    corners = band.get_patch_transform().transform(band.get_path().vertices)
+    return (corners[:, 1].max() - corners[:, 1].min()) / 2, band.get_label()
+
+
+def test_the_residual_figure_draws_the_noise_the_verdict_judges_against(tmp_path, params):
+    """The residual figure's band is the judged noise: on the noise-free file the floor
+    (step/sqrt(12)), labelled so; on the noisy one the estimate."""
+    from sma_fmu.identification.isobaric.figures import _residuals
+    clean = read_isobaric(_file(tmp_path, params, 4, "clean.csv", noise_K=0.0, noise_strain=0.0,
+                                residual=0.0, dwell=0.0))
+    fit = fit_isobaric([clean], params, residual="none", lag="none")
+    strain_axis, temperature_axis = _residuals([clean], fit).axes
+    height, label = _band(strain_axis)
+    assert height == pytest.approx(100 * 1e-6 / math.sqrt(12.0))   # the panel is in % strain
+    assert label == "noise floored at the file's resolution"
+    height, label = _band(temperature_axis)
+    assert height == pytest.approx(0.01 / math.sqrt(12.0))
+    assert label == "noise floored at the file's resolution"
+    noisy = read_isobaric(_file(tmp_path, params, 4, "noisy.csv", noise_K=3.0, noise_strain=1e-4))
+    fit = fit_isobaric([noisy], params, lag="none")
+    strain_axis, temperature_axis = _residuals([noisy], fit).axes
+    assert _band(strain_axis) == (pytest.approx(100 * fit.sigma[0]["strain"]), "noise estimate")
+    assert _band(temperature_axis) == (pytest.approx(fit.sigma[0]["temperature"]),
+                                       "noise estimate")

@@ -14,7 +14,7 @@
   other cycles' is marked at the panel's edge with its value. With one cycle it shows that
   cycle's values, and a quantity no cycle has is said so in its panel.
 - ``fit_isobaric_residuals.png``: strain and temperature residuals against sample or time,
-  with their noise estimates.
+  with the noise the verdict judges against (the estimate, or the file's quantisation where larger).
 - ``fit_isobaric_resistance.png`` when a file has resistance.
 
 Drawn on :class:`matplotlib.figure.Figure` objects (no pyplot, no backend switch).
@@ -277,24 +277,36 @@ def _left_out(data, fit, k):
 def _residuals(files, fit):
     figure = Figure(figsize=(10, 5.2 * len(files)))
     axes = figure.subplots(2 * len(files), 1, squeeze=False)[:, 0]
-    for k, (data, wire, measured, offsets, sigma) in enumerate(
-            zip(files, fit.profiles, fit.measured_profiles, fit.offsets, fit.sigma)):
+    floors = fit.floors or [{} for _ in files]
+    for k, (data, wire, measured, offsets, sigma, floor) in enumerate(
+            zip(files, fit.profiles, fit.measured_profiles, fit.offsets, fit.sigma, floors)):
         sample = data.time if data.time is not None else np.arange(data.strain.size)
         strain, _ = file_model(fit.params, data, wire, offsets, fit.directions[k],
                                fit.row_levels[k], len(offsets) > 1)
-        _residual_panel(axes[2 * k], sample, 100 * (strain - data.strain), 100 * sigma["strain"],
-                        "tab:blue", _left_out(data, fit, k), ylabel="model - data [% strain]",
-                        title=f"{data.path.name}: strain residuals (band: the noise estimate)")
-        _residual_panel(axes[2 * k + 1], sample, data.temperature - measured, sigma["temperature"],
-                        "tab:orange", None,
+        band, label = _band(sigma, floor, "strain")
+        _residual_panel(axes[2 * k], sample, 100 * (strain - data.strain), 100 * band,
+                        "tab:blue", _left_out(data, fit, k), band_label=label,
+                        ylabel="model - data [% strain]",
+                        title=f"{data.path.name}: strain residuals (band: the {label})")
+        band, label = _band(sigma, floor, "temperature")
+        _residual_panel(axes[2 * k + 1], sample, data.temperature - measured, band,
+                        "tab:orange", None, band_label=label,
                         xlabel="time [s]" if data.time is not None else "sample",
                         ylabel="measured - fitted [K]",
                         title="thermocouple temperature: measured minus fitted profile")
     return figure
 
 
-def _residual_panel(axis, sample, residual, noise, colour, left_out, **labels):
-    """Residuals against sample or time, with a band of +-``noise`` (the noise estimate);
+def _band(sigma, floor, key):
+    """The residual band of quantity ``key`` and its label: the noise the verdict judges
+    against, the estimate or, where larger, the file's quantisation floor."""
+    if floor.get(key, 0.0) > sigma[key]:
+        return floor[key], "noise floored at the file's resolution"
+    return sigma[key], "noise estimate"
+
+
+def _residual_panel(axis, sample, residual, noise, colour, left_out, band_label, **labels):
+    """Residuals against sample or time, with a band of +-``noise`` (named ``band_label``);
     ``left_out`` samples (outlier cycles) in grey, outside the axis range they would set."""
     kept = np.ones(residual.size, dtype=bool) if left_out is None else ~left_out
     axis.plot(sample[kept], residual[kept], ".", ms=1, alpha=0.5, color=colour)
@@ -304,7 +316,7 @@ def _residual_panel(axis, sample, residual, noise, colour, left_out, **labels):
         low, high = np.percentile(residual[kept], [0.05, 99.95]) if kept.any() else (-1, 1)
         margin = 0.2 * max(high - low, 2 * noise)
         axis.set_ylim(min(low, -noise) - margin, max(high, noise) + margin)
-    axis.axhspan(-noise, noise, color="tab:green", alpha=0.2, label="noise estimate")
+    axis.axhspan(-noise, noise, color="tab:green", alpha=0.2, label=band_label)
     axis.set(**labels)
     axis.legend(fontsize=7)
     axis.grid(alpha=0.3)
