@@ -13,6 +13,13 @@ reach at the load of that sample (:func:`sma_fmu.runtime.reachable_band.reachabl
 no controller can track it. The metrics give the fraction of the window where that is
 so, the metrics over the reachable rest, the intervals (whole run) and a warning.
 
+Ambient: passive cooling brings the wire to T_room at best, so once heated through its
+transformation it returns at most to R_amb(f), its cooling major branch at T_room
+(:func:`ambient_edges`). Where R_ref lies inside the band but above R_amb(f) (a wire whose
+cooling transformation lies at or below the ambient), no controller with a heater alone can
+track it after the first heating: ``above_ambient_fraction`` of the window, and a warning.
+For the shipped wires R_amb lies within 0.006 ohm of R_cold, so this says nothing there.
+
 Stroke: a scenario whose reference is a stroke adds ``stroke``, the error of the stroke
 x_0 - x against the stroke reference, in micrometres (RMSE, max |e|, IAE, per load segment).
 """
@@ -21,10 +28,13 @@ import math
 import numpy as np
 
 from sma_fmu.cosim.loop import ROWS_PER_CHUNK
+from sma_fmu.runtime.constant_load import constant_load_resistance
+from sma_fmu.runtime.constants import COOLING
 from sma_fmu.runtime.reachable_band import reachable_band
 from sma_fmu.runtime.signals import is_stroke
 
-__all__ = ["EMPTY_METRICS", "error_metrics", "band_edges", "stroke_metrics", "unreachable_samples",
+__all__ = ["EMPTY_METRICS", "error_metrics", "band_edges", "ambient_edges", "stroke_metrics",
+           "unreachable_samples", "ambient_warning",
            "unreachable_intervals", "reachability_warning", "metric_windows", "assemble_metrics",
            "scenario_metrics", "ErrorSums", "StreamingMetrics"]
 
@@ -47,21 +57,34 @@ def error_metrics(errors, step_size):
         }
 
 
-def band_edges(loads, params):
-    """Arrays (R_hot, R_cold) [ohm] of the reachable band at each load [kg] of ``loads``.
-
-    The band is computed once per distinct load (loads are piecewise constant).
-    """
+def _per_load(loads, value):
+    """Arrays of the numbers ``value(load)`` gives (a tuple) at each load [kg] of ``loads``,
+    computed once per distinct load (loads are piecewise constant)."""
     loads = np.asarray(loads, dtype=float)
     if loads.size and loads[0] == loads[-1] and (loads == loads[0]).all():  # one load (mostly)
-        band = reachable_band(float(loads[0]), params)
-        return np.full_like(loads, band.hot), np.full_like(loads, band.cold)
-    hot, cold = np.empty_like(loads), np.empty_like(loads)
+        return tuple(np.full_like(loads, number) for number in value(float(loads[0])))
+    columns = None
     ordered = np.sort(loads)   # the distinct loads (np.unique would import numpy.ma: 40 ms)
     for load in ordered[np.concatenate(([True], ordered[1:] != ordered[:-1]))]:
-        band = reachable_band(float(load), params)
-        hot[loads == load], cold[loads == load] = band.hot, band.cold
-    return hot, cold
+        numbers = value(float(load))
+        columns = columns or tuple(np.empty_like(loads) for _ in numbers)
+        for column, number in zip(columns, numbers):
+            column[loads == load] = number
+    return columns or ()
+
+
+def band_edges(loads, params):
+    """Arrays (R_hot, R_cold) [ohm] of the reachable band at each load [kg] of ``loads``."""
+    return _per_load(loads, lambda load: tuple(reachable_band(load, params))) or (
+        np.empty(0), np.empty(0))
+
+
+def ambient_edges(loads, params):
+    """Array R_amb(f) [ohm] at each load [kg] of ``loads``: the resistance on the cooling
+    major branch at T_room, the most a wire heated through its transformation gets back by
+    passive cooling (module docstring)."""
+    return (_per_load(loads, lambda load: (constant_load_resistance(
+        params.T_room, load, COOLING, params),)) or (np.empty(0),))[0]
 
 
 def unreachable_samples(references, loads, params):
@@ -105,6 +128,22 @@ def reachability_warning(intervals, fraction):
             f"metric window; no controller can track it there")
 
 
+def ambient_warning(fraction, first_time, edges, params):
+    """The warning for R_ref above the ambient end (module docstring), or None.
+
+    ``fraction`` [1] of the window, from ``first_time`` [s]; ``edges`` {load [kg]: R_amb
+    [ohm]} where it happened."""
+    if not fraction > 0.0:   # none, or no window (nan)
+        return None
+    where = ", ".join(f"{edge:.4g} ohm at {load:g} kg" for load, edge in sorted(edges.items()))
+    return (f"R_ref lies above what passive cooling reaches in {100.0 * fraction:.1f} % of the "
+            f"metric window (from t = {first_time:g} s): cooled to thermal.T_room = "
+            f"{params.T_room:g} degC, a wire heated through its transformation returns only to "
+            f"{where} (its cooling branch at T_room), so no heater-driven controller tracks it "
+            f"there; set thermal.T_room to the bench's ambient, or keep the reference below "
+            f"that resistance")
+
+
 def metric_windows(times, scenario):
     """Boolean masks over ``times`` [s]: (the metrics window, [one per load segment]).
 
@@ -135,19 +174,23 @@ def stroke_metrics(overall, segments):
 
 
 def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped_fraction,
-                     unreachable_fraction, reachable, intervals, stroke=None):
+                     unreachable_fraction, reachable, intervals, stroke=None, ambient=None):
     """The metrics record of one run of ``scenario``, ready for JSON, from its parts.
 
     ``overall``, ``reachable`` and each of ``segments`` (one per load segment, in order) are
     :func:`error_metrics` dicts; the fractions [1] are shares of the metrics window;
     ``intervals`` are the :func:`unreachable_intervals` of the whole run; ``stroke`` the
-    :func:`stroke_metrics` of a stroke reference (None: none). Adds the header
+    :func:`stroke_metrics` of a stroke reference (None: none); ``ambient`` (fraction [1],
+    first time [s], {load: R_amb}) of R_ref above the ambient end (None: not computed, as
+    in the batch engine: ``above_ambient_fraction`` is None). Adds the header
     (scenario, controller, the wire: its parameter file and digest, and the compensator's
     model where a study gives it other values, window), each segment's times and load, and
     the warning.
     """
     metrics_start = scenario.analysis.metrics_start_s
-    warning = reachability_warning(intervals, unreachable_fraction)
+    warnings = [reachability_warning(intervals, unreachable_fraction)]
+    if ambient is not None:
+        warnings.append(ambient_warning(*ambient, scenario.params))
     model = scenario.compensator_parameter_set
     return {
         "scenario": scenario.name,
@@ -167,7 +210,8 @@ def assemble_metrics(scenario, *, overall, segments, saturated_fraction, clamped
         "unreachable_fraction": unreachable_fraction,
         "reachable": reachable,
         "unreachable_intervals_s": intervals,
-        "warnings": [] if warning is None else [warning],
+        "above_ambient_fraction": None if ambient is None else ambient[0],
+        "warnings": [warning for warning in warnings if warning is not None],
         **({} if stroke is None else {"stroke": stroke}),
     }
 
@@ -230,8 +274,9 @@ class StreamingMetrics:
                          if is_stroke(scenario.reference) else None)
         self.stroke = ErrorSums()                      # stroke errors [m], the window's
         self.stroke_segments = [ErrorSums() for _ in self.segments]
-        self.window = self.saturated = self.clamped = self.unreachable = 0
+        self.window = self.saturated = self.clamped = self.unreachable = self.above_ambient = 0
         self.intervals = []
+        self._ambient_first, self._ambient_edges = None, {}   # (time [s], {load: R_amb})
         self._last_time = None   # the time of the last row seen [s]
 
     def update(self, block):
@@ -267,6 +312,7 @@ class StreamingMetrics:
         # the final row's P is NaN, never 0: counting it changes nothing (see result)
         self.clamped += int(np.count_nonzero(inside(block["P"]) == 0.0))
         self.unreachable += 0 if reachable else int(np.count_nonzero(unreachable[window]))
+        self._count_above_ambient(block, window, unreachable)
         self._join(unreachable_intervals(t, below, above), float(t[0]))
         self._last_time = float(t[-1])
         if self._strokes is not None:
@@ -274,6 +320,18 @@ class StreamingMetrics:
             self.stroke.add(stroke_error[window])
             for sums, inside in zip(self.stroke_segments, segments):
                 sums.add(stroke_error[inside])
+
+    def _count_above_ambient(self, block, window, unreachable):
+        """Count the window's samples with R_ref inside the band but above R_amb(f)."""
+        edge = ambient_edges(block["load"], self.scenario.params)
+        above = (block["R_ref"] > edge) & window & ~unreachable
+        if not above.any():
+            return
+        self.above_ambient += int(np.count_nonzero(above))
+        if self._ambient_first is None:
+            self._ambient_first = float(block["t"][np.argmax(above)])
+        for load, value in zip(block["load"][above].tolist(), edge[above].tolist()):
+            self._ambient_edges.setdefault(load, value)
 
     def _join(self, intervals, first_time):
         """Add a block's unreachable intervals, joining one that goes on from the last block."""
@@ -301,7 +359,9 @@ class StreamingMetrics:
             reachable=self.reachable.metrics(step),
             intervals=sorted(self.intervals),
             stroke=None if self._strokes is None else stroke_metrics(
-                self.stroke.metrics(step), [sums.metrics(step) for sums in self.stroke_segments]))
+                self.stroke.metrics(step), [sums.metrics(step) for sums in self.stroke_segments]),
+            ambient=(self.above_ambient / window if window else math.nan, self._ambient_first,
+                     self._ambient_edges))
 
 
 def scenario_metrics(data, scenario):

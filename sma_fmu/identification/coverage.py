@@ -15,7 +15,8 @@ module says which part:
 import math
 from pathlib import Path
 
-from sma_fmu.runtime.constants import STANDARD_GRAVITY
+from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
+from sma_fmu.runtime.constants import COOLING, STANDARD_GRAVITY
 from sma_fmu.runtime.model_terms import TERM_DEFAULTS
 from sma_fmu.runtime.parameters import DATA_RANGE, PARAMETER_SPECS
 
@@ -30,6 +31,7 @@ DATA_RANGE_MEANINGS = {
 }
 _SETTINGS = ("validity",)   # sections a fit sets itself (the range, the physical limits)
 _TERMS = {name for name, default in TERM_DEFAULTS if isinstance(default, float)}  # a number
+COOLED_SHARE = 0.99   # a cooling transformation this complete at T_room counts as complete
 
 
 def stress_of_load(load, diameter):
@@ -95,7 +97,8 @@ def coverage(params, base_set, fitted, note=""):
     return {
         "data_range": {key: getattr(params, key) for key in DATA_RANGE},
         "data_range_note": note,
-        "ambient_note": _ambient_note(params),
+        "ambient_note": "; ".join(note for note in (_ambient_note(params), _cooling_note(params))
+                                  if note),
         "stress_conversion": {
             "diameter_m": params.diameter,
             "source": f"geometry.diameter of {name}",
@@ -119,6 +122,23 @@ def _ambient_note(params):
         return ""
     return (f"thermal.T_room = {ambient:g} degC is {side}: a run at this ambient starts "
             f"outside it and warns; set thermal.T_room to your lab's ambient")
+
+
+def _cooling_note(params):
+    """Why a heated wire of this fit does not cool back at its ambient ("" when it does): at
+    the data's lowest load, where the cooling transformation lies coldest, the model's is
+    less than :data:`COOLED_SHARE` complete at T_room, so passive cooling returns a wire
+    heated through it only part of the way (runs warn: ``above_ambient_fraction``)."""
+    if params.load_data_min is None:
+        return ""
+    constants = branch_constants(params.load_data_min, COOLING, params)
+    share = branch_fractions(params.T_room, constants)[0] / constants.M if constants.M else 1.0
+    if share >= COOLED_SHARE:
+        return ""
+    return (f"at {params.stress_data_min:g} MPa the model's cooling transformation is only "
+            f"{100.0 * share:.0f} % complete at thermal.T_room = {params.T_room:g} degC: "
+            f"passive cooling to that ambient returns a heated wire only that far, and runs "
+            f"asking for more warn; set thermal.T_room to your bench's ambient")
 
 
 def coverage_lines(report):

@@ -115,3 +115,22 @@ def test_constant_load_on_the_reference_fits_as_before_and_gets_a_range(tmp_path
     assert fitted.stress_data_min <= 0.0032 * stress_of < fitted.stress_data_min + 0.1
     assert "nu_h" not in report["coverage"]["not_identified_here"]["by_section"]["constant_load"]
     assert report["coverage"]["not_identified_here"]["by_section"]["thermal"]["h_c"] == 106.0
+
+
+def test_a_cooling_transformation_incomplete_at_the_ambient_is_noted():
+    """A wire whose cooling centre at the data's lowest load sits at its T_room (a NiTi with
+    M_f below the bench's ambient) is half transformed there, closed form of the logistic
+    at its centre: the note says 50 %; the reference wire's 10 degC room, 42 K below that
+    centre, gives none."""
+    from sma_fmu.files.package_data import shipped_file
+    from sma_fmu.identification.coverage import coverage
+    base = load_parameter_set(shipped_file("models", "reference_wire.toml"))
+    ranged = base.params.replace(T_data_min=0.0, T_data_max=120.0, stress_data_min=50.0,
+                                 stress_data_max=100.0)
+    assert base.params.w2 is None and (base.params.a_c, base.params.b_c) == (52.0, 60.0)
+    assert coverage(ranged, base, set(), "")["ambient_note"] == ""
+    centre = 52.0 + 60.0 * ranged.load_data_min           # a_c + b_c f, spec section 4
+    warm = ranged.replace(T_room=centre)
+    note = coverage(warm, base, set(), "")["ambient_note"]
+    assert note.startswith("at 50 MPa the model's cooling transformation is only 50 % complete "
+                           f"at thermal.T_room = {centre:g} degC")
