@@ -88,6 +88,7 @@ class PreparedFile:
     weight: np.ndarray = None   # per sample: 1, or 0 for the strain of a left-out cycle
     floor: dict = None      # the quantisation of each column's written step (same keys, units)
     judged: dict = None     # what the verdict judges against: the larger of sigma and floor
+    held: bool = False      # a temperature without scatter: the knots held to its own fit
 
     def __post_init__(self):
         if self.weight is None:
@@ -105,9 +106,10 @@ def prepare(data, index, residual="per-cycle"):
     """:class:`PreparedFile` of one IsobaricData: profiles, step, noise estimates (the
     weights) and the noise the verdict judges against (:mod:`~.resolution`)."""
     def floor(values, estimate, least=1.0):
-        return max(estimate, _FLOOR * max(float(np.ptp(values)), least))
+        return max(estimate, relative_floor(values, least))
     window = data.splitting.window_samples if data.splitting is not None else 5
-    sigma = {"temperature": floor(data.temperature, noise_level(data.temperature)),
+    scatter = noise_level(data.temperature)
+    sigma = {"temperature": floor(data.temperature, scatter),
              "strain": floor(data.strain, noise_level(data.strain), 1e-3)}
     if data.resistance is not None:
         sigma["resistance"] = floor(data.resistance, noise_level(data.resistance))
@@ -117,10 +119,31 @@ def prepare(data, index, residual="per-cycle"):
                                   strain=data.strain)
     # the thermocouple profile's standard error, or the share of the thermocouple tolerance
     # the joint fit's knot bound stands for, where that is larger: the first fit's
-    # temperature uncertainty, and PROFILE_BOUND of it the joint fit's knot bound
-    error = np.maximum(pointwise_error(thermocouple), PROFILE_TOLERANCE_K / PROFILE_BOUND)
+    # temperature uncertainty, and PROFILE_BOUND of it the joint fit's knot bound. A
+    # temperature without any scatter (computed, or resampled on a grid) is the wire's: no
+    # noise prices the profile's moves, so within the tolerance they would absorb the
+    # model's misfit and shift the centres (held_temperature)
+    written = judged_noise(sigma, getattr(data, "resolution", {}))[0]["temperature"]
+    held = held_temperature(scatter, max(relative_floor(data.temperature), written))
+    error = np.maximum(pointwise_error(thermocouple),
+                       sigma["temperature"] if held else PROFILE_TOLERANCE_K / PROFILE_BOUND)
     return PreparedFile(index, data, profile, thermocouple, error, step, spread, sigma,
-                        residual == "per-cycle")
+                        residual == "per-cycle", held=held)
+
+
+def relative_floor(values, least=1.0):
+    """The least noise [the values' unit] a column is weighted with: _FLOOR of its range (of
+    ``least`` where the range is smaller), so that a noise-free column keeps a finite weight."""
+    return _FLOOR * max(float(np.ptp(values)), least)
+
+
+def held_temperature(scatter, floor):
+    """True when a file's temperature shows no scatter beyond its written digits: its noise
+    estimate ``scatter`` [K] (:func:`~.files.noise_level`) is no larger than ``floor`` [K],
+    the larger of its quantisation (:mod:`~.resolution`) and :func:`relative_floor`. Its
+    wire temperature is then held at the temperature's own fit: the knots move only by their
+    standard error, not by the thermocouple tolerance."""
+    return bool(scatter <= floor)
 
 
 def _check_options(residual, lag, widths, stages, outliers, centre_law):

@@ -19,6 +19,8 @@ never overstate it.
 import math
 from decimal import Decimal, InvalidOperation
 
+from sma_fmu.identification.isobaric.starts import PROFILE_BOUND, PROFILE_TOLERANCE_K
+
 __all__ = ["written_step", "quantisation", "judged_noise", "floor_notes", "smooth_note",
            "SENSOR_SCATTER"]
 
@@ -61,9 +63,15 @@ def judged_noise(sigma, resolution):
 
 def floor_notes(prepared):
     """One line per file and quantity whose noise was floored at the file's resolution:
-    "noise floored at the file's resolution: 0.1 K written, 0.029 K"."""
+    "noise floored at the file's resolution: 0.1 K written, 0.029 K"; one per file whose
+    temperature shows no scatter at all, held (``held`` of :func:`~.fit.prepare`)."""
     notes = []
     for f in prepared:
+        if getattr(f, "held", False):
+            notes.append(f"{f.data.path.name}: the temperature shows no scatter (computed or "
+                         f"resampled): the wire temperature is held at it, its profile's knots "
+                         f"within {PROFILE_BOUND:g} standard errors of its own fit, not within "
+                         f"the {PROFILE_TOLERANCE_K:g} K thermocouple tolerance")
         for key, unit in _QUANTITIES.items():
             if key in f.sigma and f.floor[key] > f.sigma[key]:
                 written = f.data.resolution[key]
