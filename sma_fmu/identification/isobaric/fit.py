@@ -61,7 +61,8 @@ from sma_fmu.identification.isobaric.resolution import judged_noise
 from sma_fmu.identification.isobaric.sensor import choose_lag, lag_sensitivity
 from sma_fmu.identification.isobaric.starts import PROFILE_BOUND, PROFILE_TOLERANCE_K
 from sma_fmu.identification.isobaric.structure import (Clock, Joint, choose, joint, joint_starts,
-                                                       law_look, second_look, with_head)
+                                                       law_look, second_look, simpler_look,
+                                                       with_head)
 
 __all__ = ["RESIDUAL_OPTIONS", "LAG_OPTIONS", "OUTLIER_OPTIONS", "IsobaricFit", "fit_isobaric",
            "prepare", "residual_blocks", "EXPLAINED_RATIO"]
@@ -209,6 +210,9 @@ def fit_isobaric(files, base, residual="per-cycle", lag="fit", max_evaluations=3
                            trial.vector)
             state, kind, stages, notes = second_look(prepared, base, layout_of, state, kind,
                                                       rejected, clock, max_evaluations)
+            state, stages, note = simpler_look(prepared, base, layout_of, state, kind, clock,
+                                               max_evaluations)
+            notes += [note] if note else []
             if fit_law:
                 state, note = law_look(prepared, base,
                                        lambda count, kind: layout_of(count, kind, centre_law),

@@ -23,7 +23,8 @@ from sma_fmu.runtime.constant_load import hysteresis_centre, second_centre
 from sma_fmu.runtime.constants import COOLING, HEATING
 from sma_fmu.runtime.model_terms import domain_widths
 
-__all__ = ["Clock", "Joint", "joint", "choose", "joint_starts", "second_look", "law_look",
+__all__ = ["Clock", "Joint", "joint", "choose", "joint_starts", "second_look", "simpler_look",
+           "law_look",
            "with_head",
            "STAGE_SHARE_MIN", "STAGE_GAIN_MIN", "JOINT_FTOL", "FIRST_FTOL", "SCAN_EVALUATIONS",
            "LAG_STARTS"]
@@ -244,6 +245,30 @@ def second_look(prepared, base, layout_of, state, kind, rejected, clock, max_eva
                          f"(cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
                          f"one): one width kept")
     return state, kind, stages, notes
+
+
+def simpler_look(prepared, base, layout_of, state, kind, clock, max_evaluations):
+    """One stage again when the joint fit with the first fit's second stage did not converge
+    (a stage kept on a first fit that stopped at its limit can be all but empty and its
+    centres loosely held): tried from that solution, kept when it converges, as a richer
+    model must (:func:`law_look`). Returns (state, stages, note: "" when nothing changed)."""
+    if state.solution.status > 0 or state.layout.stages == 1:
+        return state, state.layout.stages, ""
+    layout = layout_of(1, kind)
+    vector, lower, upper = starts(prepared, layout, base)
+    start = _carry(state.layout, state.solution.x, layout, vector)
+    _, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
+    try:
+        solution = solve(np.clip(start, lower, upper), max_evaluations)
+    except InvalidParameter:
+        return state, 2, ""
+    if solution.status <= 0:
+        return state, 2, ""
+    w2 = state.solution.x[state.layout.phys.index("w2")]
+    return (Joint(layout, solution, jacobian, order, lower, upper, vector), 1,
+            f"a second stage did not converge in the joint fit ({state.solution.message}; "
+            f"w2 = {w2:.3g}), one stage did (cost {solution.cost:.6g} against "
+            f"{state.solution.cost:.6g}): one stage kept")
 
 
 def _crossed_centres(params, loads):
