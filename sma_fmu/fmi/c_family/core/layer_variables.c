@@ -13,7 +13,7 @@
 
 #include "layer.h"
 
-/* unknown value references a refused get describes; the rest are counted (guards.py) */
+/* unknown value references a refused get describes; the rest are counted (refusal_text.py) */
 #define REFERENCES_SHOWN 5
 
 static const char *const KIND_NAMES[] = {"Real", "Integer", "Boolean", "String"};

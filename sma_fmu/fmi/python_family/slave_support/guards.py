@@ -25,6 +25,7 @@ from pythonfmu.enums import Fmi2Status
 from .compiled import attribute_reader
 from .fast_path import ATTACH, DESCRIBE, PENDING, FastPath
 from .lifecycle import ALLOWED, ERROR, INITIALIZATION, INSTANTIATED, STEP_COMPLETE, TERMINATED
+from .refusal_text import shown_value, unknown_references
 from .saved_state import SavedStates
 
 __all__ = ["CallGuard"]
@@ -310,11 +311,8 @@ class CallGuard:
             self.outputs_current = False
 
     def _unknown(self, kind, references):
-        """The refusal's text for ``references`` that are not ``kind`` variables: the first
-        :data:`REFERENCES_SHOWN` described, the rest counted (as the C family words it)."""
-        shown = [self.interface.describe_reference(kind, r) for r in references[:REFERENCES_SHOWN]]
-        more = len(references) - len(shown)
-        return ", ".join(shown) + (f", and {more} more" if more else "")
+        return unknown_references(lambda r: self.interface.describe_reference(kind, r),
+                                  references)
 
     def get_real(self, references):
         # hot path of a running co-simulation: stepComplete, known references (one dict
@@ -375,18 +373,6 @@ class CallGuard:
 
     def set_integer(self, references, values):
         self._set("fmi2SetInteger", "Integer", references, values, _check_integer)
-
-
-SHOWN_CHARACTERS = 200   # a refused string is shown up to this many characters, as the C family does
-REFERENCES_SHOWN = 5      # unknown value references a refused get describes; the rest are counted
-
-
-def shown_value(value):
-    """``value`` as a refusal message shows it: its repr, a long string cut to its first
-    :data:`SHOWN_CHARACTERS` characters (a host's 5-kB string would otherwise fill the log)."""
-    if isinstance(value, str) and len(value) > SHOWN_CHARACTERS:
-        return f"{value[:SHOWN_CHARACTERS]!r}... ({len(value)} characters)"
-    return repr(value)
 
 
 def _check_real(value):
