@@ -187,6 +187,30 @@ def test_ecos_leaves_no_copy_of_the_ssp_behind(fmu_dir, tmp_path, monkeypatch):
     assert list(temporary.iterdir()) == [] and os.environ["TMPDIR"] == str(temporary)
 
 
+def test_libcosim_records_the_saturated_flag_and_leaves_no_log_behind(fmu_dir, tmp_path, monkeypatch):
+    """libcosim logs the Boolean ``saturated`` through a file observer into a folder of the
+    run's own: on a loop whose compensator saturates (from step 1001 on), the flags equal
+    the library's Jacobi loop, and nothing is left in TMPDIR; after a failed run either."""
+    import tempfile
+
+    from sma_fmu.systems import hosts
+    from sma_fmu.systems.runs import run_host
+
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temporary))
+    scenario = short("heavy-pi+ff-adaptive-reachable", stop_time_s=1.2, load=None)
+    flags = run_host("libcosim", scenario, fmu_dir).data["saturated"]
+    library = run_library(scenario, "jacobi").data["saturated"]
+    assert 0 < library.sum() < library.size and np.array_equal(flags, library)
+    assert list(temporary.iterdir()) == []
+    ssp = write_ssp(closed_loop(short("heavy-pi", stop_time_s=0.01, load=None), fmu_dir),
+                    tmp_path / "pi.ssp")
+    with pytest.raises(hosts.HostError, match="has no variable compensator.saturated"):
+        hosts.run_ssp_libcosim(ssp, 10, {"saturated": ("compensator", "saturated")})
+    assert list(temporary.iterdir()) == []
+
+
 def test_fmpy_simulate_ssp_runs_the_loop_from_zero_inputs(adaptive, fmu_dir):
     """As docs/systems.md says: fmpy's simulate_ssp feeds 0.0 into every input at t = 0;
     the compensator takes R_ref = 0 ohm as no reference yet, with one warning."""
