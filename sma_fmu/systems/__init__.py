@@ -5,7 +5,8 @@
 - :mod:`.ssp`: the SSP 1.0 package (SystemStructure.ssd + the FMUs);
 - :mod:`.packed`: the FMUs packed with the scenario's values as their defaults;
 - :mod:`.container`: the whole loop as one FMI 2.0 FMU (fmu-manipulation-toolbox);
-- :mod:`.hosts`: running them in libcosim, Ecos and fmpy, results as loop time series;
+- :mod:`.hosts`: running them in libcosim, Ecos and fmpy, results as loop time series
+  (:mod:`.libcosim_flags`: libcosim's Booleans, logged alone);
   :mod:`.omsimulator` and :mod:`.fmpy_ssp`: the SSP in OMSimulator and fmpy's ``simulate_ssp``;
 - :mod:`.host_needs`: what each known SSP host needs and applies;
 - :mod:`.loop_host`: the loop in the plain C loop host; :mod:`.c_master` (with

@@ -24,6 +24,7 @@ import numpy as np
 from sma_fmu.cosim.loop import COLUMNS
 from sma_fmu.files.archives import require_safe_archive
 from sma_fmu.fmi.loop.wiring import loop_outputs
+from sma_fmu.systems.libcosim_flags import file_observer, read_flags
 from sma_fmu.systems.ssp import PARAMETER_SET
 
 __all__ = ["HostError", "STATE_COLUMNS", "STEP_COLUMNS", "NO_COMPENSATOR", "loop_series",
@@ -66,43 +67,59 @@ def loop_series(scenario, samples, steps):
 
 
 # --------------------------------------------------------------------------- libcosim
-def _libcosim_run(execution, observed, steps, what):
-    """Step a libcosim execution; returns {column: n + 1 samples} of ``observed`` variables.
+def _libcosim_run(load, observed, steps, what):
+    """Step the libcosim execution ``load()`` makes; returns {column: n + 1 samples} of ``observed``.
 
     ``observed`` maps columns to (slave name, variable name); Reals are recorded by a
-    time-series observer (which keeps the sample after initialization), Booleans by
-    reading the last values after each step.
+    time-series observer (which keeps the sample after initialization), Booleans by a file
+    observer that logs them alone (:mod:`.libcosim_flags`) into a folder of ours, removed
+    when the run ends, and read once the execution is gone.
+    """
+    with tempfile.TemporaryDirectory(prefix="sma-fmu-libcosim-", ignore_cleanup_errors=True) as folder:
+        samples, flags = _libcosim_steps(load, observed, steps, what, folder)
+        try:
+            samples.update(read_flags(folder, flags, steps, what))
+        except ValueError as error:
+            raise HostError(str(error)) from None
+    return samples
+
+
+def _libcosim_steps(load, observed, steps, what, folder):
+    """Run ``steps`` steps; returns ({column: Real samples}, {column: (slave, Boolean)}).
+
+    The execution and the file observer live in this function only, so both are gone (and
+    libcosim has closed its files) when it returns or raises.
     """
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimObserver import CosimObserver
 
-    series = CosimObserver.create_time_series(buffer_size=steps + 1)
-    last = CosimObserver.create_last_value()
-    execution.add_observer(series)
-    execution.add_observer(last)
-    slaves = {info.name.decode(): info.index for info in execution.slave_infos()}
-    variables = {(name, v.name.decode()): v for name, index in slaves.items()
-                 for v in execution.slave_variables(index)}
-    reals, booleans = {}, {}
-    for column, key in observed.items():
-        if key not in variables:
-            raise HostError(f"libcosim: {what} has no variable {key[0]}.{key[1]}")
-        variable = variables[key]
-        if variable.type == CosimVariableType.BOOLEAN.value:
-            booleans[column] = (slaves[key[0]], variable.reference)
-        else:
-            reals[column] = (slaves[key[0]], variable.reference)
-            series.start_time_series(slaves[key[0]], variable.reference, CosimVariableType.REAL)
-    flags = {column: [False] for column in booleans}
-    for k in range(steps):
-        if not execution.step():
-            raise HostError(f"libcosim: {what}: step {k} (t = {k} steps) failed; see its log")
-        for column, (index, reference) in booleans.items():
-            flags[column].append(bool(last.last_boolean_values(index, [reference])[0]))
-    samples = {column: _libcosim_samples(series, index, reference, steps)
-               for column, (index, reference) in reals.items()}
-    samples.update({column: np.array(values) for column, values in flags.items()})
-    return samples
+    execution = log = None
+    try:
+        execution = load()
+        slaves = {info.name.decode(): info.index for info in execution.slave_infos()}
+        variables = {(name, v.name.decode()): v for name, index in slaves.items()
+                     for v in execution.slave_variables(index)}
+        missing = [key for key in observed.values() if key not in variables]
+        if missing:
+            raise HostError(f"libcosim: {what} has no variable {missing[0][0]}.{missing[0][1]}")
+        flags = {column: key for column, key in observed.items()
+                 if variables[key].type == CosimVariableType.BOOLEAN.value}
+        reals = {column: (slaves[key[0]], variables[key].reference)
+                 for column, key in observed.items() if column not in flags}
+        series = CosimObserver.create_time_series(buffer_size=steps + 1)
+        execution.add_observer(series)
+        for index, reference in reals.values():
+            series.start_time_series(index, reference, CosimVariableType.REAL)
+        if flags:
+            log = file_observer(folder, flags)
+            execution.add_observer(log)
+        if not execution.step(steps):
+            stopped = execution.status().current_time * 1e-9
+            raise HostError(f"libcosim: {what}: the run failed at t = {stopped:g} s; see its log")
+        return {column: _libcosim_samples(series, index, reference, steps)
+                for column, (index, reference) in reals.items()}, flags
+    finally:
+        del execution, log  # even when an error's traceback keeps this frame
 
 
 def _libcosim_samples(series, index, reference, steps):
@@ -130,11 +147,13 @@ def run_ssp_libcosim(ssp_path, steps, outputs):
     from libcosimpy.CosimExecution import CosimExecution
 
     _quiet_libcosim()
-    try:
-        execution = CosimExecution.from_ssp_file(str(ssp_path))
-    except AssertionError:
-        raise HostError(f"libcosim cannot load {ssp_path}; see its log") from None
-    return _libcosim_run(execution, outputs, steps, str(ssp_path))
+
+    def load():
+        try:
+            return CosimExecution.from_ssp_file(str(ssp_path))
+        except AssertionError:
+            raise HostError(f"libcosim cannot load {ssp_path}; see its log") from None
+    return _libcosim_run(load, outputs, steps, str(ssp_path))
 
 
 def run_container_libcosim(fmu_path, step_size, steps, outputs):
@@ -144,12 +163,15 @@ def run_container_libcosim(fmu_path, step_size, steps, outputs):
     from libcosimpy.CosimSlave import CosimLocalSlave
 
     _quiet_libcosim()
-    execution = CosimExecution.from_step_size(step_size=int(round(step_size * 1e9)))
-    slave = CosimLocalSlave(fmu_path=str(fmu_path), instance_name="loop")
-    if execution.add_local_slave(local_slave=slave) < 0:
-        raise HostError(f"libcosim cannot load {fmu_path}; see its log")
+
+    def load():  # the execution owns the slave once added
+        execution = CosimExecution.from_step_size(step_size=int(round(step_size * 1e9)))
+        slave = CosimLocalSlave(fmu_path=str(fmu_path), instance_name="loop")
+        if execution.add_local_slave(local_slave=slave) < 0:
+            raise HostError(f"libcosim cannot load {fmu_path}; see its log")
+        return execution
     observed = {column: ("loop", column) for column in outputs}
-    return _libcosim_run(execution, observed, steps, str(fmu_path))
+    return _libcosim_run(load, observed, steps, str(fmu_path))
 
 
 # ------------------------------------------------------------------------------- Ecos

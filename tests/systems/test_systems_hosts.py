@@ -7,6 +7,7 @@ FMUs load libpython themselves). Each run must match the library loop of its cou
 time-series column. The scenarios are shortened to 2.2 s (RMSE from 2 s on), with a load
 step at 0.6 s.
 """
+import contextlib
 import dataclasses
 import io
 import json
@@ -185,6 +186,61 @@ def test_ecos_leaves_no_copy_of_the_ssp_behind(fmu_dir, tmp_path, monkeypatch):
     with pytest.raises(hosts.HostError):
         hosts.run_ssp_ecos(ssp, 1e-3, 10, loop_outputs(feedforward=True))
     assert list(temporary.iterdir()) == [] and os.environ["TMPDIR"] == str(temporary)
+
+
+def test_libcosim_records_the_saturated_flag_and_leaves_no_log_behind(fmu_dir, tmp_path, monkeypatch):
+    """libcosim logs the Boolean ``saturated`` through a file observer into a folder of the
+    run's own: on a loop whose compensator saturates (from step 1001 on), the flags equal
+    the library's Jacobi loop, and nothing is left in TMPDIR; after a failed run either."""
+    import tempfile
+
+    from sma_fmu.systems import hosts
+    from sma_fmu.systems.runs import run_host
+
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temporary))
+    scenario = short("heavy-pi+ff-adaptive-reachable", stop_time_s=1.2, load=None)
+    flags = run_host("libcosim", scenario, fmu_dir).data["saturated"]
+    library = run_library(scenario, "jacobi").data["saturated"]
+    assert 0 < library.sum() < library.size and np.array_equal(flags, library)
+    assert list(temporary.iterdir()) == []
+    ssp = write_ssp(closed_loop(short("heavy-pi", stop_time_s=0.01, load=None), fmu_dir),
+                    tmp_path / "pi.ssp")
+    with pytest.raises(hosts.HostError, match="has no variable compensator.saturated"):
+        hosts.run_ssp_libcosim(ssp, 10, {"saturated": ("compensator", "saturated")})
+    assert list(temporary.iterdir()) == []
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="needs /proc/self/fd")
+def test_an_error_after_a_libcosim_run_leaves_its_log_closed_and_removed(fmu_dir, tmp_path,
+                                                                         monkeypatch):
+    """libcosim closes the file observer's CSV only when the execution and the observer are
+    both gone: an error raised after the steps (its traceback keeping the frames) must not
+    keep them, or the file stays open in a removed folder (and cannot be removed on Windows)."""
+    import tempfile
+
+    from sma_fmu.systems import hosts
+
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temporary))
+    ssp = write_ssp(closed_loop(short("heavy-pi+ff-adaptive", stop_time_s=0.2), fmu_dir),
+                    tmp_path / "ff.ssp")
+
+    def fail(*args):
+        raise RuntimeError("after the steps")
+    monkeypatch.setattr(hosts, "_libcosim_samples", fail)
+    with pytest.raises(RuntimeError, match="after the steps") as raised:  # keeps the traceback
+        hosts.run_ssp_libcosim(ssp, 200, {"saturated": ("compensator", "saturated"),
+                                          "R": ("plant", "R")})
+    assert raised.traceback[-1].name == "fail"
+    open_files = []
+    for fd in os.listdir("/proc/self/fd"):
+        with contextlib.suppress(OSError):
+            open_files.append(os.readlink(f"/proc/self/fd/{fd}"))
+    assert [name for name in open_files if str(temporary) in name] == []
+    assert list(temporary.iterdir()) == []
 
 
 def test_fmpy_simulate_ssp_runs_the_loop_from_zero_inputs(adaptive, fmu_dir):
