@@ -62,8 +62,8 @@ def bound_scenarios(paths, out_dir, power_cap=None, progress=print, current_A=No
     """Bound every scenario file in ``paths``; write ``bound.json`` and ``bound.md``; return rows.
 
     ``power_cap`` P_cap [W] or None; ``current_A`` I_max [A] and ``voltage_V`` V_max [V], None:
-    each scenario's ``[drive]`` limits; ``preview`` adds the receding-horizon benchmark
-    (:mod:`.preview_search`, minutes per scenario). All files are read before the first
+    each scenario's ``[drive]`` limits; ``preview`` adds the receding-horizon benchmarks
+    in mode "continuous" (:mod:`.preview_search`, minutes per scenario). All files are read before the first
     computation.
     """
     scenarios = [load_scenario(path) for path in paths]

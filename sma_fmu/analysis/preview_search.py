@@ -17,7 +17,12 @@ Every power is in [0, P_max(R_k)] (the driver's limit at the plant's R at the st
 as the one-step inverse takes it), and the plant is the runtime's :class:`PlantStepper`,
 so the powers replayed through a fresh plant give the same R_k: the RMSE is achievable, an
 upper bound on the optimum in any hysteresis mode. Cost: about (candidates x horizon / block)
-plant steps and inversions per step, 2-4 min for a 30-s scenario at the defaults.
+plant steps and inversions per step, 1-2 min of CPU for a 30-s scenario at the defaults.
+
+It is a heuristic, and not monotone in the horizon: the model's reversal memory makes the
+run settle into one periodic regime or another, and a longer horizon can pick a worse one
+(:data:`HORIZONS`). In mode "switch" its base policy chatters and it is far above the node
+program's path (:mod:`.switch_dp`); it never goes below the rigorous bound there (tested).
 """
 import copy
 import math
@@ -27,10 +32,12 @@ import numpy as np
 from .inverse_tracker import OneStepInverse
 from .power_limit import PowerLimit
 
-__all__ = ["PreviewSearch", "preview_search", "BLOCK_STEPS", "HORIZON_STEPS"]
+__all__ = ["PreviewSearch", "preview_search", "BLOCK_STEPS", "HORIZON_STEPS", "HORIZONS"]
 
 BLOCK_STEPS = 20      # steps between two decisions (20 ms at the paper's 1-ms step)
 HORIZON_STEPS = 400   # steps each candidate is rolled out over (0.4 s: a lower turn and after)
+HORIZONS = (200, 300, 400)   # steps: the horizons `sma-fmu bound --preview` tries (not monotone:
+                             # 300 gave 0.148 ohm on the bench load-step, 400 0.180, 800 0.421)
 HOLDS = (1, 2, 4, 8)  # blocks a candidate holds 0 W
 FULL = (1, 2, 4)      # blocks a candidate holds P_max
 OFFSETS = (-0.5, 0.25, 0.5, 1.0, 2.0)   # ohm: aim above (cooler) or below R_ref

@@ -31,8 +31,8 @@ def register(commands):
                        help="the driver's voltage limit [V], P <= V^2 / R (default: the "
                             "scenario's [drive] V_max_V, else none)")
     bound.add_argument("--preview", action="store_true",
-                       help="add a benchmark that searches with the reference's future known "
-                            "(receding horizon over the plant; minutes per scenario)")
+                       help="continuous mode: add benchmarks that search with the reference's "
+                            "future known (receding horizon over the plant; minutes per scenario)")
     bound.add_argument("--out", type=Path, default=Path("results") / "bound", metavar="DIR",
                        help="output folder")
     bound.set_defaults(handler=_bound)
