@@ -7,6 +7,8 @@
   "switch" hysteresis: a rigorous lower bound and an achievable power sequence;
 - :mod:`~sma_fmu.analysis.inverse_tracker`: a perfect-knowledge one-step inverse of the
   plant (any mode), an achievable benchmark;
+- :mod:`~sma_fmu.analysis.preview_search`: a receding-horizon search over the plant with the
+  reference's future known (any mode), a slower, better achievable benchmark;
 - :mod:`~sma_fmu.analysis.tracking_bound`: the bound of a scenario, from all of these.
 
 Every model evaluation goes through :mod:`sma_fmu.runtime`; nothing here re-implements

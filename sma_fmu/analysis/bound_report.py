@@ -58,11 +58,13 @@ def _stroke_row(scenario, bound):
 
 
 def bound_scenarios(paths, out_dir, power_cap=None, progress=print, current_A=None,
-                    voltage_V=None):
+                    voltage_V=None, preview=False):
     """Bound every scenario file in ``paths``; write ``bound.json`` and ``bound.md``; return rows.
 
     ``power_cap`` P_cap [W] or None; ``current_A`` I_max [A] and ``voltage_V`` V_max [V], None:
-    each scenario's ``[drive]`` limits. All files are read before the first computation.
+    each scenario's ``[drive]`` limits; ``preview`` adds the receding-horizon benchmarks
+    in mode "continuous" (:mod:`.preview_search`, minutes per scenario). All files are read before the first
+    computation.
     """
     scenarios = [load_scenario(path) for path in paths]
     bounds, rows = {}, []
@@ -73,7 +75,7 @@ def bound_scenarios(paths, out_dir, power_cap=None, progress=print, current_A=No
             if key not in bounds:
                 progress(f"bounding {scenario.name} ({scenario.hysteresis_mode}, "
                          f"{limit.describe()}) ...")
-                bounds[key] = tracking_bound(scenario, limit)
+                bounds[key] = tracking_bound(scenario, limit, preview=preview)
             bound = bounds[key]
             rmse, per_seed = noise_seed_rmse(scenario)
             stroke = None if bound.stroke is None else _stroke_row(scenario, bound.stroke)

@@ -8,13 +8,17 @@ branch from the present state after a reversal; the major branch in mode "switch
 the power from the thermal step, clamped into [0, P_max].
 
 It is greedy: in mode "switch", where a small rise of R needs the far cooling branch,
-it does poorly (the dynamic program of :mod:`.switch_dp` is the benchmark there).
+it does poorly (the dynamic program of :mod:`.switch_dp` is the benchmark there), and in
+either mode it cannot prepare for the reference's lower turn, after which passive cooling
+is too slow (:mod:`.preview_search` can).
 
 Optionally it prefers passive cooling: P = 0 whenever R after a passive step lies within
 ``tolerance`` [ohm] of the target. In mode "continuous" this turns the power into a
-sawtooth at the step rate that ratchets xi_MF down at a moderate temperature (the minor
-branches of spec section 6 have no return-point memory), which tracks the paper's
-reference to a few hundredths of an ohm: a property of the model, not of a real wire.
+sawtooth at the step rate (hundreds of temperature reversals per second). The minor loops
+of spec section 6 have return-point memory (:mod:`sma_fmu.runtime.minor_loops`): each small
+loop closes where it began, so the sawtooth gains little, 12-20 % below the plain inverse
+on the paper's reference (before that memory it ratcheted xi_MF down and tracked to a few
+hundredths of an ohm, a property of the old model, not of a real wire).
 """
 import numpy as np
 

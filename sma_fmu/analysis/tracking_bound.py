@@ -14,7 +14,9 @@ driver's current and voltage limit (the scenario's ``[drive]``, :mod:`.power_lim
   major branches covers it), so this module does not pretend to more.
 - **benchmarks**: power sequences replayed through the runtime plant, so each RMSE is
   reachable: mode "switch": the node program's path; mode "continuous": the one-step
-  inverse of :mod:`.inverse_tracker` with a few passive-cooling tolerances.
+  inverse of :mod:`.inverse_tracker` with a few passive-cooling tolerances and, on request,
+  the receding-horizon search with preview of :mod:`.preview_search` at a few horizons
+  (minutes; it beats the one-step inverse there by far).
 
 The optimum lies between the lower bound and the best benchmark; their difference says
 how tight the bound is. Each benchmark also reports its peak power and how often the
@@ -39,6 +41,7 @@ from sma_fmu.cosim.metrics import band_edges
 
 from .inverse_tracker import track
 from .power_limit import PowerLimit
+from .preview_search import HORIZONS, preview_search
 from .switch_dp import cell_lower_bound, node_path, replay_path
 from .tracking_problem import TemperatureGrid, TrackingProblem
 
@@ -141,13 +144,15 @@ def _benchmark(problem, method, powers, resistances):
                      float(powers[problem.weights[:-1] > 0].max()), reversal_rate(problem, powers))
 
 
-def tracking_bound(scenario, power_cap=None, mode=None, current_A=None, voltage_V=None):
+def tracking_bound(scenario, power_cap=None, mode=None, current_A=None, voltage_V=None,
+                   preview=False):
     """:class:`TrackingBound` of a :class:`~sma_fmu.cosim.scenario.Scenario`.
 
     ``power_cap`` P_cap [W] (None: no upper limit) or a whole
     :class:`~.power_limit.PowerLimit`; ``current_A`` I_max [A] and ``voltage_V`` V_max [V]
     (0: none), None: the scenario's ``[drive]`` limits (none by default); ``mode`` overrides
-    the hysteresis mode.
+    the hysteresis mode; ``preview`` adds the receding-horizon benchmarks in mode
+    "continuous" (minutes).
     """
     start = time.perf_counter()
     problem = TrackingProblem.from_scenario(scenario, mode)
@@ -169,6 +174,10 @@ def tracking_bound(scenario, power_cap=None, mode=None, current_A=None, voltage_
             runs.append((_benchmark(problem, "one-step inverse of the plant" + (
                 f", 0 W where a passive step lands within {tolerance:g} ohm" if tolerance else ""),
                 powers, resistances), powers))
+        for horizon in HORIZONS if preview else ():
+            powers, resistances = preview_search(problem, limit, horizon=horizon)
+            runs.append((_benchmark(problem, "receding-horizon search with preview, horizon "
+                                    f"{horizon} steps", powers, resistances), powers))
     benchmarks = tuple(benchmark for benchmark, _ in runs)
     stroke = (None if problem.stroke_references is None
               else stroke_bound(scenario, problem, runs))

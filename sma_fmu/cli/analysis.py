@@ -9,7 +9,8 @@ __all__ = ["register"]
 def _bound(args):
     from sma_fmu.analysis.bound_report import bound_markdown, bound_scenarios
     rows = bound_scenarios(scenario_paths(args), args.out, args.power_cap,
-                           current_A=args.current_limit, voltage_V=args.voltage_limit)
+                           current_A=args.current_limit, voltage_V=args.voltage_limit,
+                           preview=args.preview)
     print(bound_markdown(rows))
     print(f"written: {args.out}/bound.json, bound.md")
     return 0
@@ -29,6 +30,9 @@ def register(commands):
     bound.add_argument("--voltage-limit", type=positive_number, metavar="V",
                        help="the driver's voltage limit [V], P <= V^2 / R (default: the "
                             "scenario's [drive] V_max_V, else none)")
+    bound.add_argument("--preview", action="store_true",
+                       help="continuous mode: add benchmarks that search with the reference's "
+                            "future known (receding horizon over the plant; minutes per scenario)")
     bound.add_argument("--out", type=Path, default=Path("results") / "bound", metavar="DIR",
                        help="output folder")
     bound.set_defaults(handler=_bound)
