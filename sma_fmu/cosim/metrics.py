@@ -57,34 +57,31 @@ def error_metrics(errors, step_size):
         }
 
 
-def _per_load(loads, value):
-    """Arrays of the numbers ``value(load)`` gives (a tuple) at each load [kg] of ``loads``,
-    computed once per distinct load (loads are piecewise constant)."""
+def _per_load(loads, value, count):
+    """``count`` arrays of the numbers ``value(load)`` gives (a tuple of ``count``) at each
+    load [kg] of ``loads``, computed once per distinct load (loads are piecewise constant)."""
     loads = np.asarray(loads, dtype=float)
     if loads.size and loads[0] == loads[-1] and (loads == loads[0]).all():  # one load (mostly)
         return tuple(np.full_like(loads, number) for number in value(float(loads[0])))
-    columns = None
+    columns = tuple(np.empty_like(loads) for _ in range(count))
     ordered = np.sort(loads)   # the distinct loads (np.unique would import numpy.ma: 40 ms)
     for load in ordered[np.concatenate(([True], ordered[1:] != ordered[:-1]))]:
-        numbers = value(float(load))
-        columns = columns or tuple(np.empty_like(loads) for _ in numbers)
-        for column, number in zip(columns, numbers):
+        for column, number in zip(columns, value(float(load))):
             column[loads == load] = number
-    return columns or ()
+    return columns
 
 
 def band_edges(loads, params):
     """Arrays (R_hot, R_cold) [ohm] of the reachable band at each load [kg] of ``loads``."""
-    return _per_load(loads, lambda load: tuple(reachable_band(load, params))) or (
-        np.empty(0), np.empty(0))
+    return _per_load(loads, lambda load: reachable_band(load, params), 2)
 
 
 def ambient_edges(loads, params):
     """Array R_amb(f) [ohm] at each load [kg] of ``loads``: the resistance on the cooling
     major branch at T_room, the most a wire heated through its transformation gets back by
     passive cooling (module docstring)."""
-    return (_per_load(loads, lambda load: (constant_load_resistance(
-        params.T_room, load, COOLING, params),)) or (np.empty(0),))[0]
+    return _per_load(loads, lambda load: (constant_load_resistance(
+        params.T_room, load, COOLING, params),), 1)[0]
 
 
 def unreachable_samples(references, loads, params):

@@ -209,6 +209,17 @@ def joint_starts(prepared, trial, start, solve, lagged):
     return [s.x for s in scans[:2]]
 
 
+def _from_state(prepared, base, state, layout, clock, max_evaluations):
+    """The joint fit of ``layout`` started from ``state``'s solution (the unknowns both
+    share carried over, :func:`_carry`), as a :class:`Joint`; an InvalidParameter of its
+    solve propagates. What the looks at another structure each start with."""
+    vector, lower, upper = starts(prepared, layout, base)
+    start = _carry(state.layout, state.solution.x, layout, vector)
+    _, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
+    solution = solve(np.clip(start, lower, upper), max_evaluations)
+    return Joint(layout, solution, jacobian, order, lower, upper, vector)
+
+
 def second_look(prepared, base, layout_of, state, kind, rejected, clock, max_evaluations):
     """The joint fit's word on each richer structure the first fit did not keep (the first
     fit holds the temperature, and on filtered files, whose noise estimates are tiny, that
@@ -217,29 +228,26 @@ def second_look(prepared, base, layout_of, state, kind, rejected, clock, max_eva
     notes, stages = [], state.layout.stages
     for what in rejected:
         count, width_kind = (stages, "separate") if what == "widths" else (2, kind)
-        layout = layout_of(count, width_kind)
-        vector, lower, upper = starts(prepared, layout, base)
-        start = _carry(state.layout, state.solution.x, layout, vector)
-        residuals, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
         try:
-            solution = solve(np.clip(start, lower, upper), max_evaluations)
+            richer = _from_state(prepared, base, state, layout_of(count, width_kind), clock,
+                                 max_evaluations)
         except InvalidParameter as error:
             notes.append(("a second stage" if what == "stages" else "separate heating and "
                           "cooling widths") + f" reached an invalid parameter ({error.detail}): "
                          + ("one stage" if what == "stages" else "one width") + " kept")
             continue
+        solution = richer.solution
         if what == "stages":
-            w2 = solution.x[layout.phys.index("w2")]
+            w2 = solution.x[richer.layout.phys.index("w2")]
             if w2 > STAGE_SHARE_MIN and \
                     solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
-                state, stages = Joint(layout, solution, jacobian, order, lower, upper, vector), 2
+                state, stages = richer, 2
             else:
                 notes.append(f"a second stage does not fit these data better (w2 = {w2:.3g}, "
                              f"cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
                              f"one stage): one stage kept")
         elif solution.cost <= (1.0 - STAGE_GAIN_MIN) * state.solution.cost:
-            state, kind = Joint(layout, solution, jacobian, order, lower, upper, vector), \
-                width_kind
+            state, kind = richer, width_kind
         else:
             notes.append(f"separate heating and cooling widths do not fit these data better "
                          f"(cost {solution.cost:.6g} against {state.solution.cost:.6g} with "
@@ -254,18 +262,15 @@ def simpler_look(prepared, base, layout_of, state, kind, clock, max_evaluations)
     model must (:func:`law_look`). Returns (state, stages, note: "" when nothing changed)."""
     if state.solution.status > 0 or state.layout.stages == 1:
         return state, state.layout.stages, ""
-    layout = layout_of(1, kind)
-    vector, lower, upper = starts(prepared, layout, base)
-    start = _carry(state.layout, state.solution.x, layout, vector)
-    _, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
     try:
-        solution = solve(np.clip(start, lower, upper), max_evaluations)
+        simpler = _from_state(prepared, base, state, layout_of(1, kind), clock, max_evaluations)
     except InvalidParameter:
         return state, 2, ""
+    solution = simpler.solution
     if solution.status <= 0:
         return state, 2, ""
     w2 = state.solution.x[state.layout.phys.index("w2")]
-    return (Joint(layout, solution, jacobian, order, lower, upper, vector), 1,
+    return (simpler, 1,
             f"a second stage did not converge in the joint fit ({state.solution.message}; "
             f"w2 = {w2:.3g}), one stage did (cost {solution.cost:.6g} against "
             f"{state.solution.cost:.6g}): one stage kept")
@@ -289,19 +294,17 @@ def law_look(prepared, base, layout_of, state, kind, clock, max_evaluations):
     centre at or above its cooling one at each file's load. Returns (state, note: "" when
     kept, else why not)."""
     clock.stage("joint fit: centre law")
-    layout = layout_of(state.layout.stages, kind)
-    vector, lower, upper = starts(prepared, layout, base)
-    start = _carry(state.layout, state.solution.x, layout, vector)
-    _, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
     try:
-        solution = solve(np.clip(start, lower, upper), max_evaluations)
+        law = _from_state(prepared, base, state, layout_of(state.layout.stages, kind), clock,
+                          max_evaluations)
     except InvalidParameter as error:
         return state, (f"centres that follow the transformation strain reached an invalid "
                        f"parameter ({error.detail}): linear centres kept")
-    old = state.solution
-    crossed = _crossed_centres(layout.params(solution.x), sorted({f.data.load for f in prepared}))
+    old, solution = state.solution, law.solution
+    crossed = _crossed_centres(law.layout.params(solution.x),
+                               sorted({f.data.load for f in prepared}))
     if solution.status > 0 and solution.cost <= (1.0 - STAGE_GAIN_MIN) * old.cost and not crossed:
-        return Joint(layout, solution, jacobian, order, lower, upper, vector), ""
+        return law, ""
     costs = f"cost {solution.cost:.6g} against {old.cost:.6g} with linear centres"
     if solution.status <= 0:
         why = f"did not converge ({solution.message}; {costs})"
