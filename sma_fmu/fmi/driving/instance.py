@@ -133,8 +133,14 @@ class FmuInstance:
         self._key = None
         try:
             self._fmu = self._slave(description)
-        except BaseException:
+        except BaseException as error:
             self._release()
+            if "Cannot find shared library" in str(error):   # fmpy's words: no binary here
+                from fmpy import platform
+                raise FmuError(f"{self.path}: the FMU has no binary for this platform "
+                               f"({platform}); build it here (sma-fmu build; with --native a "
+                               f"compiler compiles its sources) or check it with sma-fmu check",
+                               3) from None
             raise
         self._ports = {}
         self._reported = 0  # messages before this index are in an earlier FmuError already
