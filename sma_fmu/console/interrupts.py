@@ -16,8 +16,8 @@ must not get it:
   KeyboardInterrupt comes at its end.
 
 A child process (a compiler) started with :func:`run_child` ends with the command: on a
-Ctrl-C it is asked to end (SIGTERM to its process group: gcc removes its temporary files,
-its cc1 and as end too), then killed.
+Ctrl-C it is asked to end (SIGTERM to its process group: its cc1 and as end too), then
+killed; a compiler's temporary files go to a folder of its own, removed after it.
 
 After the first KeyboardInterrupt, further Ctrl-C are ignored: the command is already on its
 way out, cleaning up. :func:`seen` tells whether a Ctrl-C came at all: the command line then
@@ -32,6 +32,7 @@ import re
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 
 __all__ = ["handle_interrupts", "deferred", "seen", "in_fmu_code", "run_child", "CHILD_GRACE_S"]
@@ -202,11 +203,24 @@ def _end_group(process):
         process.wait()
 
 
-def run_child(command, timeout=None, **options):
+def run_child(command, timeout=None, own_temp=False, **options):
     """:func:`subprocess.run` with ``capture_output=True``, in a process group of its own,
     which ends with the command: on a Ctrl-C (any exception here) or after ``timeout``
     seconds (then :class:`subprocess.TimeoutExpired`) the group is asked to end, then
-    killed. Returns the :class:`subprocess.CompletedProcess`."""
+    killed. Returns the :class:`subprocess.CompletedProcess`.
+
+    ``own_temp``: the child (a compiler) gets a temporary folder of its own as TMPDIR (TMP,
+    TEMP), removed when it has ended: a gcc ended by a Ctrl-C does not always remove its
+    ``cc*.s`` and ``cc*.o`` (its ``as`` may still hold them), and nothing may be left behind."""
+    if not own_temp:
+        return _run_group(command, timeout, options)
+    with tempfile.TemporaryDirectory(prefix="sma-fmu-child-", ignore_cleanup_errors=True) as temp:
+        env = dict(options.pop("env", None) or os.environ)
+        env.update(TMPDIR=temp, TMP=temp, TEMP=temp)
+        return _run_group(command, timeout, dict(options, env=env))
+
+
+def _run_group(command, timeout, options):
     with subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                           stderr=subprocess.PIPE, start_new_session=hasattr(os, "killpg"),
                           **options) as process:

@@ -7,11 +7,13 @@ import random
 import shutil
 import signal
 import sys
+from pathlib import Path
 
 import pytest
 
 from interrupting import interrupt_in_time
 from sma_fmu.console import interrupts
+from sma_fmu.console.interrupts import run_child
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.fmi.packaging.pythonfmu_build import _renamer, code_stamp
 
@@ -122,3 +124,15 @@ def test_a_process_about_to_exit_ignores_a_late_ctrl_c():
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_a_compiler_gets_a_temporary_folder_of_its_own_removed_after_it(tmp_path, monkeypatch):
+    """A gcc ended by a Ctrl-C may leave its cc*.s behind (its as still holds it): the
+    compilers run with TMPDIR in a folder of their own, which goes when they end."""
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    leave = ("import os, tempfile; folder = tempfile.gettempdir(); "
+             "open(os.path.join(folder, 'ccLEFT.s'), 'w').close(); print(folder)")
+    result = run_child([sys.executable, "-c", leave], text=True, timeout=60, own_temp=True)
+    folder = result.stdout.strip()
+    assert result.returncode == 0 and folder and folder != str(tmp_path)
+    assert not (tmp_path / "ccLEFT.s").exists() and not Path(folder).exists()

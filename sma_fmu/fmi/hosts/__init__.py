@@ -117,7 +117,7 @@ def build_once(executable, command, compiler, hint="install gcc or set CC", time
     with tempfile.TemporaryDirectory(dir=executable.parent) as stage:
         built = Path(stage) / executable.name
         try:
-            result = run_child(command(built), text=True, timeout=timeout)
+            result = run_child(command(built), text=True, timeout=timeout, own_temp=True)
         except (OSError, subprocess.SubprocessError) as error:
             raise CHostError(f"C compiler {shlex.join(compiler)!r} could not run to build "
                              f"{executable.stem} ({error}): {hint}") from None
@@ -169,7 +169,7 @@ def write_prebuilt_hosts(folder=None):
             command = [*c_compiler(), *_FLAGS, *include_flags(HOSTS), "-o", str(folder / name),
                        str(HOSTS / f"{name}.c"), f"-L{library}",
                        "-lcosimc", f"-Wl,-rpath,{_RELATIVE_LIBCOSIMC}"]
-            result = run_child(command, text=True, timeout=300)
+            result = run_child(command, text=True, timeout=300, own_temp=True)
             if result.returncode != 0:
                 raise CHostError(f"could not build the prebuilt cosim_host: {result.stderr.strip()}")
         else:

@@ -171,7 +171,7 @@ def compile_shared(entry, sources_folder, output, prefer_zig=False):
                 if path.suffix in (".c", ".h"):
                     shutil.copyfile(path, Path(stage) / path.name)
             try:
-                result = run_child(command, text=True, timeout=900, cwd=stage)
+                result = run_child(command, text=True, timeout=900, cwd=stage, own_temp=True)
             except (OSError, subprocess.SubprocessError) as error:
                 return f"C compiler {' '.join(compiler)!r} could not run ({error})"
             if result.returncode != 0 or not (Path(stage) / name).is_file():
@@ -197,7 +197,7 @@ def compile_host_for(entry, name, output):
     command = [*zig, "-target", entry.zig, "-std=c11", "-O2", "-Wall", "-Wextra", "-Werror",
                f'-DPLATFORM="{entry.tuple}"', *include_flags(HOSTS), "-o", str(output),
                str(HOSTS / f"{name}.c"), "-ldl"]
-    result = run_child(command, text=True, timeout=900)
+    result = run_child(command, text=True, timeout=900, own_temp=True)
     if result.returncode != 0:
         raise RuntimeError(f"zig cc could not build {name} for {entry.tuple}: {result.stderr[-3000:]}")
     return None

@@ -127,7 +127,7 @@ def _compile(compiler, target, defines):
                    *[str(path) for name, path in sorted(_source_files().items()) if name.endswith(".c")],
                    *target["libraries"]]
         try:
-            result = run_child(command, text=True, timeout=300)
+            result = run_child(command, text=True, timeout=300, own_temp=True)
         except (OSError, subprocess.SubprocessError) as error:
             return FrontBuild(problem=f"C compiler {' '.join(compiler)!r} could not run ({error})")
         if result.returncode != 0 or not output.is_file():
