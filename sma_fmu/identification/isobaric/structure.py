@@ -3,8 +3,11 @@ the lag's valley, the outlier cycles, the widths and the stages (:mod:`~.first_f
 joint fit's starts, and its second look at a richer structure the first fit did not keep.
 
 Richer models are kept only when they lower the cost by STAGE_GAIN_MIN (a second stage also
-needs w2 > STAGE_SHARE_MIN): with a fitted lag, separate widths blur the lag against the
-centres, so one width comes first. The centre law's shares come last (:func:`law_look`).
+needs w2 > STAGE_SHARE_MIN, and the first fit keeps one only when that fit converged; else
+the joint fit decides): with a fitted lag, separate widths blur the lag against the
+centres, so one width comes first. The joint fit tries a second stage from its one-stage
+solution split in two halves (:mod:`~.split`). The centre law's shares come last
+(:func:`law_look`).
 """
 import time
 from dataclasses import dataclass
@@ -18,6 +21,7 @@ from sma_fmu.identification.isobaric.layout import InvalidParameter
 from sma_fmu.identification.isobaric.outcome import residual_blocks
 from sma_fmu.identification.isobaric.outliers import mark_outliers
 from sma_fmu.identification.isobaric.solver import levenberg_marquardt
+from sma_fmu.identification.isobaric.split import split_stage
 from sma_fmu.identification.isobaric.starts import starts
 from sma_fmu.runtime.constant_load import hysteresis_centre, second_centre
 from sma_fmu.runtime.constants import COOLING, HEATING
@@ -181,7 +185,9 @@ def choose(prepared, base, layout_of, kind, widths, stages, lagged, outliers, cl
         clock.stage("first fit: stages")
         wider = richer(2, kind)
         w2 = wider.solution.x[wider.layout.phys.index("w2")] if wider is not None else 0.0
-        if w2 > STAGE_SHARE_MIN and \
+        # a first fit that stopped at its limit has not settled the stage (it can be one
+        # narrowing to a step): the joint fit's second look decides, from the split
+        if w2 > STAGE_SHARE_MIN and wider.solution.status > 0 and \
                 wider.solution.cost <= (1.0 - STAGE_GAIN_MIN) * trial.solution.cost:
             trial = outlying(wider)
         else:
@@ -209,28 +215,39 @@ def joint_starts(prepared, trial, start, solve, lagged):
     return [s.x for s in scans[:2]]
 
 
-def _from_state(prepared, base, state, layout, clock, max_evaluations):
+def _from_state(prepared, base, state, layout, clock, max_evaluations, shape=None):
     """The joint fit of ``layout`` started from ``state``'s solution (the unknowns both
-    share carried over, :func:`_carry`), as a :class:`Joint`; an InvalidParameter of its
-    solve propagates. What the looks at another structure each start with."""
+    share carried over, :func:`_carry`; then ``shape(start)`` when given), as a
+    :class:`Joint`; an InvalidParameter of its solve propagates. What the looks at another
+    structure each start with."""
     vector, lower, upper = starts(prepared, layout, base)
     start = _carry(state.layout, state.solution.x, layout, vector)
+    start = shape(start) if shape is not None else start
     _, jacobian, solve, order = joint(prepared, layout, lower, upper, clock)
     solution = solve(np.clip(start, lower, upper), max_evaluations)
     return Joint(layout, solution, jacobian, order, lower, upper, vector)
 
 
+def _splitter(prepared, state, layout):
+    """The start shaper that splits the one-stage joint fit ``state``'s stage in two halves
+    for the two-stage ``layout`` (:func:`~.split.split_stage`, at the files' loads)."""
+    loads = [f.data.load for f in prepared]
+    return lambda start: split_stage(state.layout, state.solution.x, layout, start, loads)
+
+
 def second_look(prepared, base, layout_of, state, kind, rejected, clock, max_evaluations):
     """The joint fit's word on each richer structure the first fit did not keep (the first
     fit holds the temperature, and on filtered files, whose noise estimates are tiny, that
-    can hide what the joint fit sees): tried from the joint solution, kept when it lowers
-    the joint cost by STAGE_GAIN_MIN. Returns (state, width kind, stages, notes)."""
+    can hide what the joint fit sees): tried from the joint solution (a second stage from
+    its stage split in two, :func:`_splitter`), kept when it lowers the joint cost by
+    STAGE_GAIN_MIN. Returns (state, width kind, stages, notes)."""
     notes, stages = [], state.layout.stages
     for what in rejected:
         count, width_kind = (stages, "separate") if what == "widths" else (2, kind)
+        layout = layout_of(count, width_kind)
         try:
-            richer = _from_state(prepared, base, state, layout_of(count, width_kind), clock,
-                                 max_evaluations)
+            richer = _from_state(prepared, base, state, layout, clock, max_evaluations,
+                                 None if what == "widths" else _splitter(prepared, state, layout))
         except InvalidParameter as error:
             notes.append(("a second stage" if what == "stages" else "separate heating and "
                           "cooling widths") + f" reached an invalid parameter ({error.detail}): "
