@@ -11,9 +11,11 @@ from sma_fmu.identification.isobaric.synthetic import stress_of_load
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.runtime.constants import COOLING, HEATING
 
-__all__ = ["half_strain_table", "format_isobaric_report", "GRID_POINTS"]
+__all__ = ["half_strain_table", "format_isobaric_report", "share_done", "unfinished_note",
+           "GRID_POINTS", "DONE_SHARE"]
 
 GRID_POINTS = 2000
+DONE_SHARE = 0.99   # a branch whose model transformation is this far done at its end is whole
 _WORD = {HEATING: "heating", COOLING: "cooling"}
 
 
@@ -50,6 +52,9 @@ def half_strain_table(files, fit):
                 spans_model.append(transformation_strain(grid, model, d))
             entry[f"data_{_WORD[d]}_degC"] = _median(found_data)
             entry[f"model_{_WORD[d]}_degC"] = _median(found_model)
+            ends = [b for b in data.branches if b.complete and b.direction == d]
+            note = unfinished_note(data.smoothed, ends, data.load, d, fit.params)
+            entry.setdefault("model_unfinished", []).extend([note] if note else [])
         entry["data_transformation_strain"] = _median(spans_data)
         entry["model_transformation_strain"] = _median(spans_model)
         rows.append(entry)
@@ -62,6 +67,31 @@ def half_strain_table(files, fit):
             "note": "half-strain temperatures: half way between the sloped baselines of the "
                     "tangent construction, on the measured (smoothed) temperature; spans: the "
                     "transformation strain between the baselines at that temperature [1]"}
+
+
+def share_done(temperature, load, direction, params):
+    """How far [1] the model's transformation of ``direction`` (+1/-1) is done at
+    ``temperature`` [degC] and ``load`` [kg]: 1 - q heating (the martensite gone), q cooling."""
+    _, _, q = branch_curve(np.array([float(temperature)]), load, direction, params, 1.0)
+    return float(1.0 - q[0]) if direction == HEATING else float(q[0])
+
+
+def unfinished_note(temperature, branches, load, direction, params):
+    """A note ("" when none) when the model's transformation is less than DONE_SHARE done
+    at the far end of the file's ``branches`` of ``direction`` (heating: the hottest sample
+    of each, cooling: the coldest; the median over them): the rest of it lies beyond the
+    data, the model's extrapolation, which the identified file's FMUs then run."""
+    if not branches:
+        return ""
+    ends = [float((np.max if direction == HEATING else np.min)(temperature[b.start:b.stop]))
+            for b in branches]
+    end = float(np.median(ends))
+    done = share_done(end, load, direction, params)
+    if done >= DONE_SHARE:
+        return ""
+    return (f"{_WORD[direction]}: the data end at {end:.4g} degC with "
+            f"{100.0 * (1.0 - done):.2g} % of the model's transformation still to come; that "
+            f"part is the model's extrapolation beyond the data (measure further to pin it)")
 
 
 def _table(rows, header):
@@ -112,6 +142,7 @@ def format_isobaric_report(report):
                          f"{100 * row['data_transformation_strain']:.3g} / "
                          f"{100 * row['model_transformation_strain']:.3g} %; strain RMS "
                          f"{entry['residual_rms']['strain']:.3g}")
+            lines += [f"note: {row['file']}: {note}" for note in row.get("model_unfinished", [])]
         first = report["files"][0]
         per_mpa = first["load_kg"] / first["stress_MPa"] if first["stress_MPa"] else 0.0
         centres = [f"{name} {report['parameters'][name]['value'] * per_mpa:.4g}"
