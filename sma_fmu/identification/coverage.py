@@ -16,7 +16,7 @@ import math
 from pathlib import Path
 
 from sma_fmu.runtime.constant_load import branch_constants, branch_fractions
-from sma_fmu.runtime.constants import COOLING, STANDARD_GRAVITY
+from sma_fmu.runtime.constants import COOLING, HEATING, STANDARD_GRAVITY
 from sma_fmu.runtime.model_terms import TERM_DEFAULTS
 from sma_fmu.runtime.parameters import DATA_RANGE, PARAMETER_SPECS
 
@@ -31,7 +31,7 @@ DATA_RANGE_MEANINGS = {
 }
 _SETTINGS = ("validity",)   # sections a fit sets itself (the range, the physical limits)
 _TERMS = {name for name, default in TERM_DEFAULTS if isinstance(default, float)}  # a number
-COOLED_SHARE = 0.99   # a cooling transformation this complete at T_room counts as complete
+DONE_SHARE = 0.99   # a transformation this far done counts as done (share_done)
 
 
 def stress_of_load(load, diameter):
@@ -124,16 +124,24 @@ def _ambient_note(params):
             f"outside it and warns; set thermal.T_room to your lab's ambient")
 
 
+def share_done(temperature, load, direction, params):
+    """How far [1] the model's major-branch transformation of ``direction`` (+1/-1) is done at
+    ``temperature`` [degC] and ``load`` [kg]: the share of M gone to austenite on heating,
+    come to martensite on cooling."""
+    constants = branch_constants(load, direction, params)
+    share = branch_fractions(temperature, constants)[0] / constants.M if constants.M else 1.0
+    return 1.0 - share if direction == HEATING else share
+
+
 def _cooling_note(params):
     """Why a heated wire of this fit does not cool back at its ambient ("" when it does): at
     the data's lowest load, where the cooling transformation lies coldest, the model's is
-    less than :data:`COOLED_SHARE` complete at T_room, so passive cooling returns a wire
+    less than :data:`DONE_SHARE` complete at T_room, so passive cooling returns a wire
     heated through it only part of the way (runs warn: ``above_ambient_fraction``)."""
     if params.load_data_min is None:
         return ""
-    constants = branch_constants(params.load_data_min, COOLING, params)
-    share = branch_fractions(params.T_room, constants)[0] / constants.M if constants.M else 1.0
-    if share >= COOLED_SHARE:
+    share = share_done(params.T_room, params.load_data_min, COOLING, params)
+    if share >= DONE_SHARE:
         return ""
     return (f"at {params.stress_data_min:g} MPa the model's cooling transformation is only "
             f"{100.0 * share:.0f} % complete at thermal.T_room = {params.T_room:g} degC: "

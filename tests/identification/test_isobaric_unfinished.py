@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from sma_fmu.identification.isobaric.cycles import Branch
-from sma_fmu.identification.isobaric.summary import DONE_SHARE, share_done, unfinished_note
+from sma_fmu.identification.coverage import DONE_SHARE, share_done
+from sma_fmu.identification.isobaric.summary import unfinished_note
 from sma_fmu.runtime.constant_load import hysteresis_centre
 from sma_fmu.runtime.constants import COOLING, HEATING
 

@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sma_fmu.identification.coverage import DONE_SHARE, share_done
 from sma_fmu.identification.isobaric.halfway import (half_strain_temperature, stress_slope,
                                                      transformation_strain)
 from sma_fmu.identification.isobaric.residual_parts import parts_line
@@ -11,11 +12,9 @@ from sma_fmu.identification.isobaric.synthetic import stress_of_load
 from sma_fmu.identification.isobaric.terms import branch_curve
 from sma_fmu.runtime.constants import COOLING, HEATING
 
-__all__ = ["half_strain_table", "format_isobaric_report", "share_done", "unfinished_note",
-           "GRID_POINTS", "DONE_SHARE"]
+__all__ = ["half_strain_table", "format_isobaric_report", "unfinished_note", "GRID_POINTS"]
 
 GRID_POINTS = 2000
-DONE_SHARE = 0.99   # a branch whose model transformation is this far done at its end is whole
 _WORD = {HEATING: "heating", COOLING: "cooling"}
 
 
@@ -67,13 +66,6 @@ def half_strain_table(files, fit):
             "note": "half-strain temperatures: half way between the sloped baselines of the "
                     "tangent construction, on the measured (smoothed) temperature; spans: the "
                     "transformation strain between the baselines at that temperature [1]"}
-
-
-def share_done(temperature, load, direction, params):
-    """How far [1] the model's transformation of ``direction`` (+1/-1) is done at
-    ``temperature`` [degC] and ``load`` [kg]: 1 - q heating (the martensite gone), q cooling."""
-    _, _, q = branch_curve(np.array([float(temperature)]), load, direction, params, 1.0)
-    return float(1.0 - q[0]) if direction == HEATING else float(q[0])
 
 
 def unfinished_note(temperature, branches, load, direction, params):
