@@ -81,12 +81,15 @@ def _fit(args):
         _check_fit_loads(args)
     else:
         _only_for(args, _ISOBARIC_ONLY, "isobaric", "fit")
-    require_inputs(*((path, "file") for path in args.files), (args.model, "parameter file"))
+    from sma_fmu.identification.workbook import expand_workbooks, file_part
+    require_inputs(*((file_part(path), "file") for path in args.files),
+                   (args.model, "parameter file"))
     require("fit", "fit")
     from sma_fmu.console.progress import echo
     from sma_fmu.identification.runner import format_report, run_fit
     out = args.out or Path("results") / f"fit-{args.experiment}"
     if args.experiment == "isobaric":
+        args.files = expand_workbooks(args.files)
         return _fit_isobaric(args, out)
     _only_for(args, _ISOBARIC_ONLY, "isobaric", "fit")
     report = run_fit(args.experiment, args.files, out, args.model, progress=echo)
@@ -197,7 +200,8 @@ def _synth(args):
 
 
 def _predict(args):
-    require_inputs((args.file, "file"), (args.model, "parameter file"))
+    from sma_fmu.identification.workbook import file_part
+    require_inputs((file_part(args.file), "file"), (args.model, "parameter file"))
     require("fit", "predict")
     from sma_fmu.identification.isobaric.predict_runner import (format_predict_report,
                                                                 run_isobaric_predict)
@@ -217,7 +221,9 @@ def register(commands):
     """Add ``fit``, ``predict`` and ``synth`` to the ``commands`` subparsers."""
     fit = commands.add_parser("fit", help="identify parameters from measurements (CSV)")
     fit.add_argument("experiment", choices=EXPERIMENTS)
-    fit.add_argument("files", nargs="+", metavar="FILE", help="measurement CSV file(s)")
+    fit.add_argument("files", nargs="+", metavar="FILE",
+                     help="measurement CSV file(s); isobaric also an Excel workbook: BOOK.xlsx "
+                          "(each sheet a file) or BOOK.xlsx#SHEET")
     fit.add_argument("--out", type=Path, metavar="DIR",
                      help="output folder (default: results/fit-EXPERIMENT)")
     fit.add_argument("--model", metavar="FILE",
@@ -267,7 +273,8 @@ def register(commands):
         "predict", help="run the plant runtime (the FMU's code) through a lab file's measured "
                         "temperature and compare the strain")
     predict.add_argument("experiment", choices=("isobaric",))
-    predict.add_argument("file", metavar="FILE", help="isobaric measurement file")
+    predict.add_argument("file", metavar="FILE",
+                         help="isobaric measurement file (CSV, or a workbook's sheet: BOOK.xlsx#SHEET)")
     predict.add_argument("--model", required=True, metavar="PARAMS",
                          help="parameter file, e.g. the identified.toml of sma-fmu fit isobaric")
     loads = predict.add_mutually_exclusive_group()

@@ -12,8 +12,8 @@ __all__ = ["EXTRAS", "MissingExtra", "missing", "require", "extra_of_module"]
 
 # extra -> ((import name, distribution), ...): what the commands of that extra import
 EXTRAS = {
-    # fit, predict, synth isobaric: least squares, sparse solvers, BLAS threads
-    "fit": (("scipy", "scipy"), ("threadpoolctl", "threadpoolctl")),
+    # fit, predict, synth isobaric: least squares, sparse solvers, BLAS threads, workbooks
+    "fit": (("scipy", "scipy"), ("threadpoolctl", "threadpoolctl"), ("openpyxl", "openpyxl")),
     # sweep, tune and the studies API: tables, Parquet results, Dask, optimisers
     "studies": (("scipy", "scipy"), ("pandas", "pandas"), ("pyarrow", "pyarrow"),
                 ("dask", "dask"), ("distributed", "distributed")),

@@ -15,7 +15,7 @@ from sma_fmu.files.package_data import shipped_file
 PYPROJECT = Path(__file__).parents[2] / "pyproject.toml"
 MAIN_JOB = {"numpy", "fmpy", "pythonfmu", "matplotlib", "tqdm"}
 # what no module of the main job may import (each is an extra's)
-OPTIONAL = ("scipy", "pandas", "pyarrow", "dask", "distributed", "threadpoolctl",
+OPTIONAL = ("scipy", "pandas", "pyarrow", "dask", "distributed", "threadpoolctl", "openpyxl",
             "fmu_manipulation_toolbox", "libcosimpy")
 
 

@@ -1,5 +1,6 @@
 """The table in an isobaric file's text: preamble, column row and data rows, read by the csv
-module, however the lab's machine wrote it.
+module, however the lab's machine wrote it (a workbook's sheet is first written out as CSV
+text: :mod:`sma_fmu.identification.workbook`).
 
 - Cells quoted or not (``"Time (h)","Temperature (°C)"``): the csv module removes the quotes.
 - Whole rows written as one quoted cell, the quotes inside doubled (rows such as
@@ -19,6 +20,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from sma_fmu.identification.workbook import sheet_text, split_sheet
 from sma_fmu.identification.measurements import MeasurementError
 
 __all__ = ["Table", "read_table", "number", "is_number", "plain", "check_separators"]
@@ -75,6 +77,8 @@ def check_separators(path, delimiter, lines):
 
 
 def _text(path):
+    if split_sheet(path) is not None:
+        return sheet_text(path)
     try:
         return Path(path).read_text(encoding="utf-8-sig")
     except FileNotFoundError:

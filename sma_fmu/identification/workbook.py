@@ -1,0 +1,140 @@
+"""Excel workbooks as isobaric files: each worksheet one file, named ``BOOK.xlsx#SHEET``.
+
+Test machines and labs often keep a test series as one workbook, a sheet per stress (the
+sheet's first row the column names, one row per sample below). ``BOOK.xlsx`` given alone
+stands for every sheet of the book, in the book's order; ``BOOK.xlsx#SHEET`` for one sheet
+(``#`` because a sheet name may hold anything but ``[]:*?/\\``, and a shell leaves a ``#``
+inside a word alone). openpyxl reads the book (values as last saved, not formulas); the sheet
+is then written out as CSV text and read by :mod:`sma_fmu.identification.isobaric.table` like any other file, so a sheet
+obeys every rule a CSV file does. A number is written with 15 significant digits, as Excel
+shows it, so 0.00153653 stored as 0.0015365300000000001 reads as typed, with its written
+step. Old binary ``.xls`` books and OpenDocument sheets are refused, naming the formats read.
+"""
+import csv
+import datetime
+import io
+from pathlib import Path
+
+__all__ = ["SUFFIXES", "split_sheet", "expand_workbooks", "sheet_text", "file_part"]
+
+SUFFIXES = (".xlsx", ".xlsm")
+_OTHER = (".xls", ".ods", ".numbers")
+_SEPARATOR = "#"
+
+
+def _error(message):
+    """A MeasurementError (imported here: naming a book's file part needs no numpy, so the
+    command line still answers a wrong path at once)."""
+    from sma_fmu.identification.measurements import MeasurementError
+    return MeasurementError(message)
+
+
+def split_sheet(path):
+    """(book path, sheet name or None) of ``path`` when it names a workbook, else None."""
+    text = str(path)
+    head, mark, sheet = text.rpartition(_SEPARATOR)
+    if mark and head.lower().endswith(SUFFIXES):
+        return Path(head), sheet
+    if text.lower().endswith(SUFFIXES):
+        return Path(text), None
+    return None
+
+
+def file_part(path):
+    """The file on disk that ``path`` names (a workbook's, without ``#SHEET``)."""
+    book = split_sheet(path)
+    return book[0] if book else Path(path)
+
+
+def _refuse_other(path):
+    suffix = Path(str(path)).suffix.lower()
+    if suffix in _OTHER:
+        raise _error(f"{path}: a {suffix} spreadsheet is not read; save it as .xlsx "
+                               f"(each sheet then one file: BOOK.xlsx#SHEET) or each sheet as CSV")
+
+
+def _open(book):
+    try:
+        import openpyxl
+    except ImportError:
+        raise _error(f'{book}: reading a workbook needs openpyxl: pip install '
+                               f'"sma-fmu[fit]"') from None
+    try:
+        return openpyxl.load_workbook(book, read_only=True, data_only=True)
+    except FileNotFoundError:
+        raise _error(f"{book}: file not found") from None
+    except Exception as error:  # openpyxl raises zipfile, KeyError, ValueError... on bad books
+        raise _error(f"{book}: not a readable .xlsx/.xlsm workbook "
+                               f"({type(error).__name__})") from None
+
+
+def _sheet_names(book):
+    workbook = _open(book)
+    try:
+        return list(workbook.sheetnames)
+    finally:
+        workbook.close()
+
+
+def _check_sheet(book, sheet, names):
+    if sheet not in names:
+        listed = ", ".join(repr(name) for name in names)
+        raise _error(f"{book}: no sheet {sheet!r}; the book's sheets: {listed}")
+
+
+def expand_workbooks(paths):
+    """``paths`` with each bare workbook replaced by one ``BOOK#SHEET`` per sheet, and every
+    ``BOOK#SHEET`` checked (the sheet exists); other paths as given (as strings)."""
+    out = []
+    for path in paths:
+        _refuse_other(path)
+        book = split_sheet(path)
+        if book is None:
+            out.append(str(path))
+            continue
+        names = _sheet_names(book[0])
+        if book[1] is None:
+            out.extend(f"{book[0]}{_SEPARATOR}{name}" for name in names)
+        else:
+            _check_sheet(book[0], book[1], names)
+            out.append(str(path))
+    return out
+
+
+def _cell(value):
+    """A cell as the text a CSV file would hold."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, float):
+        return format(value, ".15g")
+    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        return value.isoformat()
+    return str(value)
+
+
+def sheet_text(path):
+    """The CSV text (comma-separated) of the sheet ``path`` (``BOOK#SHEET``, or a book with
+    one sheet) names; raises MeasurementError naming the book and the sheet."""
+    _refuse_other(path)
+    book, sheet = split_sheet(path)
+    workbook = _open(book)
+    try:
+        names = list(workbook.sheetnames)
+        if sheet is None:
+            if len(names) != 1:
+                raise _error(f"{book}: {len(names)} sheets; name one as "
+                                       f"{book.name}{_SEPARATOR}SHEET")
+            sheet = names[0]
+        _check_sheet(book, sheet, names)
+        stream = io.StringIO()
+        writer = csv.writer(stream, lineterminator="\n")
+        for row in workbook[sheet].iter_rows(values_only=True):
+            cells = [_cell(value) for value in row]
+            while cells and cells[-1] == "":
+                cells.pop()
+            writer.writerow(cells)
+        return stream.getvalue()
+    finally:
+        workbook.close()
