@@ -8,7 +8,8 @@ from pathlib import Path
 from sma_fmu.runtime.checks import direction_sign
 
 __all__ = ["Parser", "HelpFormatter", "finite_number", "positive_number", "nonnegative_number",
-           "positive_integer", "bounded_integer", "bounded_number", "number_list", "direction", "fail", "add_scenario_arguments",
+           "positive_integer", "bounded_integer", "bounded_number", "number_list", "column_rename",
+           "direction", "fail", "add_scenario_arguments",
            "scenario_paths", "add_fmus_argument", "add_quiet_argument", "require_inputs"]
 
 
@@ -159,6 +160,15 @@ def number_list(text):
         return [_number(item) for item in items]
     except argparse.ArgumentTypeError:
         raise argparse.ArgumentTypeError(f"expected comma-separated finite numbers, got {text!r}") from None
+
+
+def column_rename(text):
+    """argparse type: ``NEW=OLD`` (a file's column OLD read under the name NEW) -> (new, old)."""
+    new, mark, old = text.partition("=")
+    if not mark or not new.strip() or not old.strip():
+        raise argparse.ArgumentTypeError(f"expected NEW=OLD (e.g. strain_percent=Strain), got "
+                                         f"{text!r}")
+    return new.strip(), old
 
 
 def direction(text):

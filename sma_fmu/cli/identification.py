@@ -7,16 +7,19 @@ from pathlib import Path
 from sma_fmu.console.extras import require
 from sma_fmu.identification.limits import MAX_LOAD_KG, MAX_STRESS_MPA
 
-from .arguments import (add_quiet_argument, bounded_integer, bounded_number, finite_number,
-                        number_list, require_inputs)
+from .arguments import (add_quiet_argument, bounded_integer, bounded_number, column_rename,
+                        finite_number, number_list, require_inputs)
 
 __all__ = ["register"]
 
 EXPERIMENTS = ("constant-load", "constant-temperature", "isobaric")
 _ISOBARIC_ONLY = ("load", "stress", "residual_strain", "reference_length", "cycles", "lag",
-                  "stages", "keep_outliers", "widths", "centre_law")
+                  "stages", "keep_outliers", "widths", "centre_law", "column")
 _SYNTH_ISOBARIC_ONLY = ("points", "cycles", "rate", "dwell", "noise_strain", "drift", "strain_unit",
                         "lag_s", "drift_decay", "first_cycle_shift")
+_COLUMN_HELP = ("read the file's column OLD as NEW, a name the reader knows (strain_percent, "
+                "extension_mm, temperature_C, stress_MPa, ...), without editing the file; "
+                "repeat for more")
 _T_RANGE = {"isobaric": (15.0, 130.0)}  # others: (10, 110)
 # choice: synth's limits, wide for any real test file and checked before anything is made
 MAX_ROWS = 1_000_000          # rows (or samples) one synth call may write
@@ -62,7 +65,8 @@ def _fit_isobaric(args, out):
                               lag=args.lag or "auto", stages=args.stages or 2,
                               outliers="keep" if args.keep_outliers else "leave-out",
                               widths=args.widths or "auto", meter=_meter,
-                              centre_law=args.centre_law or "linear")
+                              centre_law=args.centre_law or "linear",
+                              renames=args.column)
     print(format_isobaric_report(report))
     print("\n".join(coverage_lines(report)))
     print(f"written: {out}/identified.toml, report.json, transformation_temperatures.md/.csv, "
@@ -211,7 +215,7 @@ def _predict(args):
             raise ValueError(f"predict: {name} {value!r} {unit} is outside (0, {high:g}] {unit}")
     out = args.out or Path("results") / "predict-isobaric"
     report = run_isobaric_predict(args.file, out, args.model, args.load, args.stress,
-                                  args.reference_length, args.lag)
+                                  args.reference_length, args.lag, args.column)
     print(format_predict_report(report))
     print(f"written: {out}/report.json, predicted.csv, predict_isobaric.png")
     return 0
@@ -266,6 +270,8 @@ def register(commands):
     fit.add_argument("--reference-length", type=bounded_number(0.0, 100.0, "m"), metavar="M",
                      help="isobaric: length the strain is measured from [m] (default: the base "
                           "file's x0)")
+    fit.add_argument("--column", type=column_rename, action="append", metavar="NEW=OLD",
+                     help=f"isobaric: {_COLUMN_HELP}")
     add_quiet_argument(fit)
     fit.set_defaults(handler=_fit)
 
@@ -274,7 +280,8 @@ def register(commands):
                         "temperature and compare the strain")
     predict.add_argument("experiment", choices=("isobaric",))
     predict.add_argument("file", metavar="FILE",
-                         help="isobaric measurement file (CSV, or a workbook's sheet: BOOK.xlsx#SHEET)")
+                         help="isobaric measurement file (CSV, or a workbook's sheet: "
+                              "BOOK.xlsx#SHEET)")
     predict.add_argument("--model", required=True, metavar="PARAMS",
                          help="parameter file, e.g. the identified.toml of sma-fmu fit isobaric")
     loads = predict.add_mutually_exclusive_group()
@@ -288,6 +295,8 @@ def register(commands):
                          metavar="TAU",
                          help="the wire's first-order lag behind the thermocouple [s, or samples "
                               "without a time column], as fit isobaric reports it")
+    predict.add_argument("--column", type=column_rename, action="append", metavar="NEW=OLD",
+                         help=_COLUMN_HELP)
     predict.add_argument("--out", type=Path, metavar="DIR",
                          help="output folder (default: results/predict-isobaric)")
     add_quiet_argument(predict)

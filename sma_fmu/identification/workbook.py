@@ -5,10 +5,11 @@ sheet's first row the column names, one row per sample below). ``BOOK.xlsx`` giv
 stands for every sheet of the book, in the book's order; ``BOOK.xlsx#SHEET`` for one sheet
 (``#`` because a sheet name may hold anything but ``[]:*?/\\``, and a shell leaves a ``#``
 inside a word alone). openpyxl reads the book (values as last saved, not formulas); the sheet
-is then written out as CSV text and read by :mod:`sma_fmu.identification.isobaric.table` like any other file, so a sheet
-obeys every rule a CSV file does. A number is written with 15 significant digits, as Excel
-shows it, so 0.00153653 stored as 0.0015365300000000001 reads as typed, with its written
-step. Old binary ``.xls`` books and OpenDocument sheets are refused, naming the formats read.
+is then written out as CSV text and read by :mod:`sma_fmu.identification.isobaric.table`
+like any other file, so a sheet obeys every rule a CSV file does. A number is written with
+15 significant digits, as Excel shows it, so 0.00153653 stored as 0.0015365300000000001 reads
+as typed, with its written step. Old binary ``.xls`` books and OpenDocument sheets are
+refused, naming the format to save them in.
 """
 import csv
 import datetime

@@ -5,6 +5,10 @@ any later word its unit (``"Temperature (°C)"``, ``Temp [K]``, ``time_s``, ``"T
 ``Extension (mm)``, ``Stress (MPa)``). :data:`QUANTITIES` is the table; :data:`SCALE` turns
 units into the ones the fit uses (s, m, MPa). Columns it does not know are ignored.
 
+A column whose name says the wrong thing (``Strain`` holding percent, an extensometer
+channel ``_Strain1 (mm)``) is read under a name the user gives, ``--column NEW=OLD``
+(:func:`read_as`), without editing a lab's file or workbook.
+
 Strain twice: files such as the NiTiHf ones carry ``Strain_p`` [%] and ``Strain`` [1].
 Both are read and must agree to within their resolution; the one with the finer resolution
 (the smallest step between its distinct values, as a fraction) is used, and the report says
@@ -16,7 +20,8 @@ import numpy as np
 
 from sma_fmu.identification.measurements import MeasurementError
 
-__all__ = ["QUANTITIES", "SCALE", "classify", "find_columns", "choose_strain"]
+__all__ = ["QUANTITIES", "SCALE", "classify", "find_columns", "choose_strain", "read_as",
+           "KNOWN_NAMES"]
 
 _TEMPERATURE = {"": "C", "c": "C", "degc": "C", "celsius": "C", "k": "K", "kelvin": "K",
                 "f": "F", "degf": "F", "fahrenheit": "F"}
@@ -75,6 +80,27 @@ def classify(name):
     return None
 
 
+KNOWN_NAMES = "strain, strain_percent, extension_mm, length_m, temperature_C, stress_MPa, time_s"
+
+
+def read_as(path, names, renames):
+    """The names the columns are read under: ``names`` with each (new, old) of ``renames``
+    (``--column NEW=OLD``) applied; raises naming the option when OLD is not a column of the
+    file or NEW says no quantity the reader knows."""
+    out = list(names)
+    stripped = [name.strip() for name in names]
+    for new, old in renames or ():
+        option = f"--column {new}={old}"
+        if classify(new) is None:
+            raise MeasurementError(f"{option}: {new!r} names no quantity the reader knows; "
+                                   f"give one such as {KNOWN_NAMES}")
+        if old.strip() not in stripped:
+            listed = ", ".join(repr(name) for name in names)
+            raise MeasurementError(f"{path}: {option}: no column {old!r} among {listed}")
+        out[stripped.index(old.strip())] = new
+    return out
+
+
 def find_columns(path, names):
     """{quantity: (index, unit)} of the column names; ``strain_other`` for a second strain."""
     found = {}
@@ -88,7 +114,7 @@ def find_columns(path, names):
             raise MeasurementError(f"{path}: column {name!r} is named strain but its unit is "
                                    f"{length}, a length: name it extension_{length} if it holds "
                                    f"the elongation, or length_{length} if it holds the gauge "
-                                   f"length")
+                                   f"length (or read it so: --column extension_{length}={name!r})")
         if quantity == "strain" and "strain" in found and "strain_other" not in found \
                 and unit != found["strain"][1]:
             found["strain_other"] = (index, unit)   # the strain twice: % and fraction
@@ -105,7 +131,8 @@ def find_columns(path, names):
         what = "no strain, length or extension column" if not shapes else \
             f"both {' and '.join(shapes)} columns"
         raise MeasurementError(f"{path}: {what} among {', '.join(names)}; give one of "
-                               f"strain_percent, strain, length_m, extension_mm")
+                               f"strain_percent, strain, length_m, extension_mm (rename it, or "
+                               f"--column NEW=OLD)")
     return found
 
 

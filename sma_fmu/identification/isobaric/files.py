@@ -40,12 +40,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from sma_fmu.identification.isobaric.columns import SCALE, choose_strain, find_columns
+from sma_fmu.identification.isobaric.columns import SCALE, choose_strain, find_columns, read_as
 from sma_fmu.identification.isobaric.cycles import (Branch, select_cycles, smooth,
                                                    split_branches)
 from sma_fmu.identification.isobaric.resolution import written_step
 from sma_fmu.identification.isobaric.stress import constant_load_rows, file_stress
 from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
+from sma_fmu.identification.isobaric.end_step import end_step
 from sma_fmu.identification.isobaric.table import number, plain, read_table
 from sma_fmu.identification.isobaric.timebase import time_seconds
 from sma_fmu.identification.limits import MAX_LOAD_KG, MAX_STRESS_MPA
@@ -152,8 +153,9 @@ def _temperature(path, name, unit, values):
 def _strain(path, quantity, name, unit, values, reference):
     if quantity == "strain":
         if unit == "fraction" and np.abs(values).max() > 1.0:
-            raise _unit_error(path, name, values, "exceed 1: they look like percent; name the "
-                                                   "column strain_percent")
+            raise _unit_error(path, name, values, f"exceed 1: they look like percent; name the "
+                                                   f"column strain_percent (or read it so: "
+                                                   f"--column strain_percent={name!r})")
         if unit == "percent" and np.ptp(values) < 0.05:
             raise _unit_error(path, name, values, "span under 0.05 %: they look like a fraction "
                                                    "(then name the column strain), or the wire "
@@ -216,7 +218,7 @@ def _reference_notes(shape, name, unit, reference, source, model_length):
 
 
 def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=None,
-                  reference_source="given", model_length=None):
+                  reference_source="given", model_length=None, renames=None):
     """Read one isobaric file as :class:`IsobaricData`.
 
     ``load`` [kg] wins over a load stated in the preamble; ``reference_length`` [m] is the
@@ -224,14 +226,17 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     ``reference_source`` says where it came from and ``model_length`` is the model's x0 [m]
     (both for the notes); ``diameter`` [m] converts a preamble ``stress: ... MPa``;
     ``cycles`` = (first, last) cycle numbers to keep (None: all; an end None: open), see
-    ``cycles.parse_cycles``.
+    ``cycles.parse_cycles``; ``renames`` = [(new, old)]: columns read under another name
+    (``--column NEW=OLD``; the report shows ``OLD (as NEW)``).
     """
     path = Path(path)
     table = read_table(path)
-    names = table.names
     if not table.rows:
         raise MeasurementError(f"{path}: no data rows after the column row")
+    names = read_as(path, table.names, renames)
     columns = find_columns(path, names)
+    names = [name if name == given else f"{given} (as {name})"
+             for given, name in zip(table.names, names)]
     diameter = diameter if diameter else 0.15e-3
     given = None if load is None else stress_of_load(load, diameter)
     keep, stress, notes = _constant_load(path, table, columns, given)
@@ -291,6 +296,12 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
         seconds, time_notes = time_seconds(path, names[index], unit, values, texts,
                                            [line for line, _ in table.rows])
         time, notes = seconds[keep], notes + time_notes    # spread on every row, then cut
+    cut, cut_note = end_step(strain, temperature, [line for line, _ in rows])
+    if cut_note:
+        temperature, strain, rows = temperature[cut], strain[cut], rows[cut]
+        resistance = resistance[cut] if resistance is not None else None
+        time = time[cut] if time is not None else None
+        notes.append(cut_note)
     if len(rows) < 50:
         raise MeasurementError(f"{path}: only {len(rows)} data rows; a thermal cycle needs more")
     if load is None and stress is not None:

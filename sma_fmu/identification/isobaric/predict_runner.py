@@ -72,8 +72,9 @@ def _csv(result):
 
 
 def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference_length=None,
-                         lag=0.0):
-    """Predict one file's strain with the plant runtime; write the outputs; return the report."""
+                         lag=0.0, renames=None):
+    """Predict one file's strain with the plant runtime; write the outputs; return the report
+    (``renames``: [(new, old)] columns read under another name, ``--column``)."""
     if load is not None and stress is not None:
         raise ValueError("predict: give --load or --stress, not both")
     check_folder(out_dir)
@@ -85,7 +86,7 @@ def run_isobaric_predict(path, out_dir, model, load=None, stress=None, reference
     source = "--reference-length" if reference_length is not None else \
         f"x0 of {Path(params_set.path).name}"
     data = read_isobaric(Path(path), load, reference, params.diameter, reference_source=source,
-                         model_length=params.x0)
+                         model_length=params.x0, renames=renames)
     result = predict_file(data, params, lag)
     report = dict(result["report"], model=str(params_set.path),
                   reference_length_m=data.reference_length, reference_length_source=source,

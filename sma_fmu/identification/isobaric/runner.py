@@ -231,13 +231,14 @@ def hysteresis_report(data, fit, rows):
 def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, residual="per-cycle",
                      reference_length=None, progress=lambda text: None, cycles=None, lag="auto",
                      stages=2, outliers="leave-out", widths="auto", meter=None,
-                     centre_law="linear"):
+                     centre_law="linear", renames=None):
     """Fit isobaric ``files``; write identified.toml, report.json, tables, figures; return report.
 
     ``cycles``: the text of ``--cycles`` (``5:``, ``3:10``, ``:20``, ``4``) or None for all;
     ``lag``: "auto", "fit" (the wire's lag behind the thermocouple) or "none"; ``meter``: a
     callable returning a tqdm-like progress bar (or None); ``centre_law``: "linear" or
-    "clausius-clapeyron" (:func:`~.fit.fit_isobaric`). A fit that did not converge is
+    "clausius-clapeyron" (:func:`~.fit.fit_isobaric`); ``renames``: [(new, old)] columns read
+    under another name (``--column``). A fit that did not converge is
     written too, marked so in identified.toml's header and report.json's ``solver``.
     """
     if not files:
@@ -255,7 +256,8 @@ def run_isobaric_fit(files, out_dir, loads=None, stresses=None, model=None, resi
     source = "--reference-length" if reference_length is not None else \
         f"x0 of {Path(base_set.path).name}"
     per_file = file_loads(files, loads, stresses, base.diameter)
-    data = [read_isobaric(Path(f), load, reference, base.diameter, selection, source, base.x0)
+    data = [read_isobaric(Path(f), load, reference, base.diameter, selection, source, base.x0,
+                          renames)
             for f, load in zip(files, per_file)]
     for d in data:
         for note in d.notes:
