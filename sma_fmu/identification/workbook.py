@@ -16,7 +16,8 @@ import datetime
 import io
 from pathlib import Path
 
-__all__ = ["SUFFIXES", "split_sheet", "expand_workbooks", "sheet_text", "file_part"]
+__all__ = ["SUFFIXES", "split_sheet", "expand_workbooks", "sheet_text", "file_part",
+           "refuse_other_spreadsheet"]
 
 SUFFIXES = (".xlsx", ".xlsm")
 _OTHER = (".xls", ".ods", ".numbers")
@@ -47,11 +48,12 @@ def file_part(path):
     return book[0] if book else Path(path)
 
 
-def _refuse_other(path):
+def refuse_other_spreadsheet(path):
+    """Raise naming the format to save in when ``path`` is a spreadsheet not read here."""
     suffix = Path(str(path)).suffix.lower()
     if suffix in _OTHER:
-        raise _error(f"{path}: a {suffix} spreadsheet is not read; save it as .xlsx "
-                               f"(each sheet then one file: BOOK.xlsx#SHEET) or each sheet as CSV")
+        raise _error(f"{path}: a {suffix} spreadsheet is not read; save it as .xlsx (each "
+                     f"sheet then one file: BOOK.xlsx#SHEET) or each sheet as CSV")
 
 
 def _open(book):
@@ -59,22 +61,14 @@ def _open(book):
         import openpyxl
     except ImportError:
         raise _error(f'{book}: reading a workbook needs openpyxl: pip install '
-                               f'"sma-fmu[fit]"') from None
+                     f'"sma-fmu[fit]"') from None
     try:
         return openpyxl.load_workbook(book, read_only=True, data_only=True)
     except FileNotFoundError:
         raise _error(f"{book}: file not found") from None
     except Exception as error:  # openpyxl raises zipfile, KeyError, ValueError... on bad books
         raise _error(f"{book}: not a readable .xlsx/.xlsm workbook "
-                               f"({type(error).__name__})") from None
-
-
-def _sheet_names(book):
-    workbook = _open(book)
-    try:
-        return list(workbook.sheetnames)
-    finally:
-        workbook.close()
+                     f"({type(error).__name__})") from None
 
 
 def _check_sheet(book, sheet, names):
@@ -84,21 +78,19 @@ def _check_sheet(book, sheet, names):
 
 
 def expand_workbooks(paths):
-    """``paths`` with each bare workbook replaced by one ``BOOK#SHEET`` per sheet, and every
-    ``BOOK#SHEET`` checked (the sheet exists); other paths as given (as strings)."""
+    """``paths`` (as strings) with each bare workbook replaced by one ``BOOK#SHEET`` per sheet;
+    a ``BOOK#SHEET`` is checked where it is read (:func:`sheet_text`)."""
     out = []
     for path in paths:
-        _refuse_other(path)
         book = split_sheet(path)
-        if book is None:
+        if book is None or book[1] is not None:
             out.append(str(path))
             continue
-        names = _sheet_names(book[0])
-        if book[1] is None:
-            out.extend(f"{book[0]}{_SEPARATOR}{name}" for name in names)
-        else:
-            _check_sheet(book[0], book[1], names)
-            out.append(str(path))
+        workbook = _open(book[0])
+        try:
+            out.extend(f"{book[0]}{_SEPARATOR}{name}" for name in workbook.sheetnames)
+        finally:
+            workbook.close()
     return out
 
 
@@ -118,7 +110,6 @@ def _cell(value):
 def sheet_text(path):
     """The CSV text (comma-separated) of the sheet ``path`` (``BOOK#SHEET``, or a book with
     one sheet) names; raises MeasurementError naming the book and the sheet."""
-    _refuse_other(path)
     book, sheet = split_sheet(path)
     workbook = _open(book)
     try:
@@ -126,7 +117,7 @@ def sheet_text(path):
         if sheet is None:
             if len(names) != 1:
                 raise _error(f"{book}: {len(names)} sheets; name one as "
-                                       f"{book.name}{_SEPARATOR}SHEET")
+                             f"{book.name}{_SEPARATOR}SHEET")
             sheet = names[0]
         _check_sheet(book, sheet, names)
         stream = io.StringIO()

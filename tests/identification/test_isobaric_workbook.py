@@ -110,3 +110,11 @@ def test_a_book_that_cannot_be_read_is_refused_in_one_line(tmp_path, capsys, nam
         path.write_bytes(content)
     fails(capsys, ["fit", "isobaric", str(path), "--load", "0.3", "--out",
                    str(tmp_path / "fit")], words)
+
+
+def test_predict_refuses_an_old_spreadsheet_as_fit_does(tmp_path, capsys):
+    path = tmp_path / "old.xls"
+    path.write_bytes(b"\xd0\xcf\x11\xe0")
+    model = str(shipped_file("models", "reference_wire.toml"))
+    fails(capsys, ["predict", "isobaric", str(path), "--model", model, "--load", "0.3",
+                   "--out", str(tmp_path / "p")], "a .xls spreadsheet is not read; save it as .xlsx")

@@ -9,7 +9,8 @@ The path from a lab's test to FMUs: ``sma-fmu fit isobaric FILE... --load KG`` w
   column holds, a strain given twice), :mod:`~.stress` (a stress column's load ramp, limit
   and spread), :mod:`~.timebase` (time stamps repeated at their resolution), :mod:`~.end_step`
   (a strain step at a file's start or end), :mod:`sma_fmu.identification.workbook` (a
-  workbook's sheets as files): the pieces of reading; :mod:`~.missing`: why a number is missing, named once;
+  workbook's sheets as files): the pieces of reading; :mod:`~.missing`: why a number is
+  missing, named once;
 - :mod:`~.fit`: the fit of parameters, temperature profile and lag (:func:`fit_isobaric`):
   a first fit at the thermocouple's profile (:mod:`~.first_fit`) that chooses the structure
   (:mod:`~.structure`), then the joint fit; on :mod:`~.terms` (the model with its optional

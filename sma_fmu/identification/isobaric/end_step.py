@@ -3,10 +3,11 @@
 Raw files can end (or start) with rows after a step in the strain that the test, not the
 wire, made: an extensometer that slips or is re-zeroed, a clip taken off, a sheet's rows
 pasted from elsewhere. The raw NiTiHf workbook of the public set (docs/identification.md,
-"Workbooks") has one in every sheet: its last 50 rows sit 0.20-0.21 % strain above the rest,
-one step 17-26 times any other step of the sheet, at the hot end where the strain is flat.
+"Workbooks") has one in every sheet: its last 49 rows sit 0.20-0.21 % strain above the rest,
+one step 14-26 times any other step of the sheet, at the hot end where the strain is flat.
 A model driven by temperature has no such step, and those rows would bend the fit and the
-data's own hot baseline (its half-strain temperature read 115 K off).
+data's own hot baseline (its heating half-strain temperature read 273.5 degC at 50 MPa,
+where the transformation runs through 150-170 degC).
 
 The rule: the largest strain step between two rows is more than :data:`STEP_FACTOR` times
 every other step of the file, and the rows on one side of it are the file's first or last
@@ -14,8 +15,7 @@ rows and at most :data:`END_SHARE` of them. Those rows are left out with a note 
 the lines, the step and the temperature there. In the lab files at hand (Flexinol,
 Karaman, Alex, UNT, ASMADA, Walgren) the largest step is at most 1.27 times the next (the
 steepest part of a transformation is several rows long), so the factor 5 leaves every one
-of them alone. A step inside the file is left to
-the residual-strain offsets.
+of them alone. A step inside the file is left to the residual-strain offsets.
 """
 import numpy as np
 

@@ -43,10 +43,10 @@ import numpy as np
 from sma_fmu.identification.isobaric.columns import SCALE, choose_strain, find_columns, read_as
 from sma_fmu.identification.isobaric.cycles import (Branch, select_cycles, smooth,
                                                    split_branches)
+from sma_fmu.identification.isobaric.end_step import end_step
 from sma_fmu.identification.isobaric.resolution import written_step
 from sma_fmu.identification.isobaric.stress import constant_load_rows, file_stress
 from sma_fmu.identification.isobaric.synthetic import load_of_stress, stress_of_load
-from sma_fmu.identification.isobaric.end_step import end_step
 from sma_fmu.identification.isobaric.table import number, plain, read_table
 from sma_fmu.identification.isobaric.timebase import time_seconds
 from sma_fmu.identification.limits import MAX_LOAD_KG, MAX_STRESS_MPA
@@ -296,11 +296,16 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
         seconds, time_notes = time_seconds(path, names[index], unit, values, texts,
                                            [line for line, _ in table.rows])
         time, notes = seconds[keep], notes + time_notes    # spread on every row, then cut
+
+    def rows_kept(kept):
+        """The per-row columns on the rows ``kept`` (a slice)."""
+        return (temperature[kept], strain[kept], rows[kept],
+                resistance[kept] if resistance is not None else None,
+                time[kept] if time is not None else None)
+
     cut, cut_note = end_step(strain, temperature, [line for line, _ in rows])
     if cut_note:
-        temperature, strain, rows = temperature[cut], strain[cut], rows[cut]
-        resistance = resistance[cut] if resistance is not None else None
-        time = time[cut] if time is not None else None
+        temperature, strain, rows, resistance, time = rows_kept(cut)
         notes.append(cut_note)
     if len(rows) < 50:
         raise MeasurementError(f"{path}: only {len(rows)} data rows; a thermal cycle needs more")
@@ -318,9 +323,7 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     if cycles is not None:
         keep, branches = select_cycles(branches, cycles, path)
         splitting.selected = f"{cycles[0] or 1} to {cycles[1] or 'the last'}"
-        temperature, strain, rows = temperature[keep], strain[keep], rows[keep]
-        resistance = resistance[keep] if resistance is not None else None
-        time = time[keep] if time is not None else None
+        temperature, strain, rows, resistance, time = rows_kept(keep)
     # the tangent construction gets a smoother signal, over the square root of the median
     # branch length (ASMADA's rule): a ramp bends where the transformation's latent heat
     # slows it, and a wider window (a quarter branch) moved the heating tangents by 3-5 K

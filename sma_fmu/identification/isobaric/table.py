@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from sma_fmu.identification.workbook import sheet_text, split_sheet
+from sma_fmu.identification.workbook import refuse_other_spreadsheet, sheet_text, split_sheet
 from sma_fmu.identification.measurements import MeasurementError
 
 __all__ = ["Table", "read_table", "number", "is_number", "plain", "check_separators"]
@@ -77,6 +77,7 @@ def check_separators(path, delimiter, lines):
 
 
 def _text(path):
+    refuse_other_spreadsheet(path)
     if split_sheet(path) is not None:
         return sheet_text(path)
     try:
