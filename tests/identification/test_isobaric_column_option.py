@@ -71,3 +71,17 @@ def test_a_rename_that_cannot_apply_is_refused(files, capsys, tmp_path, option, 
     fails(capsys, ["fit", "isobaric", str(files[0]), "--load", str(LOAD), "--column", option,
                    "--out", str(out)], words)
     assert not out.exists()
+
+
+def test_a_column_renamed_twice_is_refused(files, capsys, tmp_path):
+    fails(capsys, ["fit", "isobaric", str(files[0]), "--load", str(LOAD), "--column",
+                   "strain_percent=Strain", "--column", "strain=Strain", "--out",
+                   str(tmp_path / "fit")],
+          "--column strain=Strain: column 'Strain' is already read as 'strain_percent' "
+          "(--column strain_percent=Strain); give one --column for it")
+
+
+def test_the_hint_after_a_rename_names_the_file_s_column(files, capsys, tmp_path):
+    fails(capsys, ["fit", "isobaric", str(files[0]), "--load", str(LOAD), "--column",
+                   "strain=Strain", "--out", str(tmp_path / "fit")],
+          "column Strain (as strain): values", "--column strain_percent='Strain')")

@@ -86,9 +86,10 @@ KNOWN_NAMES = "strain, strain_percent, extension_mm, length_m, temperature_C, st
 def read_as(path, names, renames):
     """The names the columns are read under: ``names`` with each (new, old) of ``renames``
     (``--column NEW=OLD``) applied; raises naming the option when OLD is not a column of the
-    file or NEW says no quantity the reader knows."""
+    file or is renamed twice, or NEW says no quantity the reader knows."""
     out = list(names)
     stripped = [name.strip() for name in names]
+    given = {}                                   # column index -> the option that renamed it
     for new, old in renames or ():
         option = f"--column {new}={old}"
         if classify(new) is None:
@@ -97,7 +98,11 @@ def read_as(path, names, renames):
         if old.strip() not in stripped:
             listed = ", ".join(repr(name) for name in names)
             raise MeasurementError(f"{path}: {option}: no column {old!r} among {listed}")
-        out[stripped.index(old.strip())] = new
+        index = stripped.index(old.strip())
+        if index in given:
+            raise MeasurementError(f"{option}: column {old!r} is already read as {out[index]!r} "
+                                   f"({given[index]}); give one --column for it")
+        out[index], given[index] = new, option
     return out
 
 

@@ -150,12 +150,15 @@ def _temperature(path, name, unit, values):
     return values
 
 
-def _strain(path, quantity, name, unit, values, reference):
+def _strain(path, quantity, name, unit, values, reference, in_file=None):
+    """``values`` of the column ``name`` [``unit``] as strain [1]; ``in_file``: the column's
+    name in the file (for the ``--column`` hint), when ``name`` is how it is read."""
     if quantity == "strain":
         if unit == "fraction" and np.abs(values).max() > 1.0:
             raise _unit_error(path, name, values, f"exceed 1: they look like percent; name the "
                                                    f"column strain_percent (or read it so: "
-                                                   f"--column strain_percent={name!r})")
+                                                   f"--column strain_percent="
+                                                   f"{in_file or name!r})")
         if unit == "percent" and np.ptp(values) < 0.05:
             raise _unit_error(path, name, values, "span under 0.05 %: they look like a fraction "
                                                    "(then name the column strain), or the wire "
@@ -266,7 +269,8 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     shape = next(q for q in ("strain", "length", "extension") if q in columns)
     s_index, s_unit = columns[shape]
     raw = column(shape)
-    strain = _strain(path, shape, names[s_index], s_unit, raw, reference_length)
+    strain = _strain(path, shape, names[s_index], s_unit, raw, reference_length,
+                     table.names[s_index])
     written["strain"] = resolution(shape, raw, strain)
     notes += _reference_notes(shape, names[s_index], s_unit, reference_length, reference_source,
                               model_length)
@@ -274,7 +278,8 @@ def read_isobaric(path, load=None, reference_length=0.8, diameter=None, cycles=N
     if "strain_other" in columns:
         o_index, o_unit = columns["strain_other"]
         raw = column("strain_other")
-        other = _strain(path, "strain", names[o_index], o_unit, raw, reference_length)
+        other = _strain(path, "strain", names[o_index], o_unit, raw, reference_length,
+                        table.names[o_index])
         strain, chosen, strain_note = choose_strain(path, (names[s_index], strain),
                                                     (names[o_index], other))
         if chosen != names[s_index]:
