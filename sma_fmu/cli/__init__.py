@@ -68,7 +68,9 @@ def main(argv=None):
                 return args.handler(args)
             except (Exception, KeyboardInterrupt) as error:  # noqa: BLE001 - never a traceback
                 if interrupts.seen():   # whatever the Ctrl-C caused on its way out
-                    print("sma-fmu: interrupted", file=sys.stderr)
+                    placed = interrupts.outputs_placed()   # too late to undo: said so
+                    print("sma-fmu: interrupted" + (f" after writing {', '.join(placed)} in full"
+                                                    if placed else ""), file=sys.stderr)
                     return INTERRUPTED
                 return fail(_message(error, args.command))
     finally:

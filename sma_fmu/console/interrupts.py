@@ -20,9 +20,13 @@ Ctrl-C it is asked to end (SIGTERM to its process group: its cc1 and as end too)
 killed; a compiler's temporary files go to a folder of its own, removed after it.
 
 After the first KeyboardInterrupt, further Ctrl-C are ignored: the command is already on its
-way out, cleaning up. :func:`seen` tells whether a Ctrl-C came at all: the command line then
-reports "interrupted" whatever error the interrupt caused on its way (a compiler killed by the
-same Ctrl-C, an FMU that saw it). Without :func:`handle_interrupts` (the package used as a
+way out, cleaning up. A Ctrl-C that comes once a command's results are in place (during the
+move that puts them there, or in what the command does after it: printing its summary) cannot
+undo them: :func:`placed_output` records each, and the command line names them in its one line
+(``sma-fmu: interrupted after writing results in full``); exit status 130 all the same, so a
+script stops there. :func:`seen` tells whether a Ctrl-C came at all: the command line then
+reports "interrupted" whatever error the interrupt caused on its way (a compiler killed by
+the same Ctrl-C, an FMU that saw it). Without :func:`handle_interrupts` (the package used as a
 library) nothing here changes Python's behaviour.
 """
 import contextlib
@@ -35,7 +39,8 @@ import sys
 import tempfile
 import threading
 
-__all__ = ["handle_interrupts", "deferred", "seen", "in_fmu_code", "run_child", "CHILD_GRACE_S"]
+__all__ = ["handle_interrupts", "deferred", "seen", "placed_output", "outputs_placed",
+           "in_fmu_code", "run_child", "CHILD_GRACE_S"]
 
 CHILD_GRACE_S = 5.0   # how long a child (a compiler) may take to end when asked [s]
 # modules of a pythonfmu FMU's own code, as pythonfmu_build names them: <script>_<stamp> and
@@ -51,6 +56,7 @@ class _State:
     raised = False      # the KeyboardInterrupt has been raised: the command is ending
     pending = False     # one arrived inside a deferred section
     depth = 0           # deferred sections the main thread is in
+    placed = []         # outputs moved into place, complete (paths as given)
     previous = None     # the handlers replaced (SIGINT, sys.unraisablehook)
 
 
@@ -150,7 +156,7 @@ def handle_interrupts(then_ignore=False):
         yield
         return
     _State.seen = _State.raised = _State.pending = False
-    _State.depth, _State.traced = 0, []
+    _State.depth, _State.traced, _State.placed = 0, [], []
     _State.previous = (signal.signal(signal.SIGINT, _handler), sys.unraisablehook)
     sys.unraisablehook = _unraisable
     _State.installed = True
@@ -179,6 +185,19 @@ def deferred():
             _State.pending = False
             _State.raised = True
             raise KeyboardInterrupt
+
+
+def placed_output(path):
+    """Record that ``path``, a command's output, has been moved into place whole (with
+    :func:`handle_interrupts` installed; otherwise a no-op)."""
+    if _State.installed:
+        _State.placed.append(str(path))
+
+
+def outputs_placed():
+    """The outputs :func:`placed_output` recorded since :func:`handle_interrupts` began that
+    are still there (a build's intermediate one, in a temporary folder, is gone)."""
+    return [path for path in _State.placed if os.path.lexists(path)]
 
 
 def seen():

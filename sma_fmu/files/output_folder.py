@@ -3,7 +3,10 @@
 A command writes into a temporary folder beside its output folder and, only when all
 of it succeeded, moves the results into place (a rename). A failure, or a Ctrl-C
 (:mod:`sma_fmu.console.interrupts`: moving and cleaning up are not cut), removes the
-temporary folder and leaves the output folder as it was.
+temporary folder and leaves the output folder as it was. Once the results are in place a
+Ctrl-C cannot undo them: the move records them
+(:func:`~sma_fmu.console.interrupts.placed_output`) and the command line's ``interrupted``
+line names them as written in full.
 
 A rerun into the same folder replaces the previous results whole: the folder records
 what sma-fmu wrote into it (:data:`MARKER`), and those entries go, so no stale result
@@ -18,7 +21,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from sma_fmu.console.interrupts import deferred
+from sma_fmu.console.interrupts import deferred, placed_output
 from sma_fmu.console.progress import note
 
 __all__ = ["OutputError", "MARKER", "check_folder", "staged_folder", "write_file"]
@@ -105,6 +108,7 @@ def _commit(stage, out, argument, report):
     try:
         if not out.exists():
             os.replace(stage, out)
+            placed_output(out)
             return
         previous = [name for name in _written_before(out)   # names only, never a path
                     if name not in ("", ".", "..", MARKER) and Path(name).name == name
@@ -116,6 +120,7 @@ def _commit(stage, out, argument, report):
             if target.is_dir() and not target.is_symlink():
                 shutil.rmtree(target)
             os.replace(entry, target)
+        placed_output(out)
     except OSError as error:
         raise OutputError(f"{argument} {out}: cannot move the results into place: "
                           f"{error.strerror or error}") from None
@@ -136,8 +141,10 @@ def _remove(path):
         path.unlink()
 
 
-def write_file(path, data, argument="--out"):
-    """Write ``data`` (str or bytes) to ``path`` through a temporary file and a rename."""
+def write_file(path, data, argument="--out", final=True):
+    """Write ``data`` (str or bytes) to ``path`` through a temporary file and a rename.
+    ``final``: ``path`` is a command's result (recorded as placed, see the module); False for
+    a file kept for a resume (a sweep's parts), which an interrupted command keeps anyway."""
     path = Path(path)
     if path.is_dir():
         raise OutputError(f"{argument} {path}: is a folder; expected a file name")
@@ -158,3 +165,5 @@ def write_file(path, data, argument="--out"):
             with contextlib.suppress(OSError):
                 os.unlink(temporary)
             raise
+        if final:
+            placed_output(path)

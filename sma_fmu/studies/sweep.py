@@ -86,7 +86,7 @@ def _check_folder(out, spec, path="batch"):
                              f"not {path} (--fmus); give another --out, or remove that folder")
         return
     write_file(marker, json_text({"spec": str(spec.path), "fingerprint": fingerprint,
-                                  "runs": len(spec.runs()), "path": path}))
+                                  "runs": len(spec.runs()), "path": path}), final=False)
 
 
 def _check_fmus(spec, fmu_dir):
@@ -105,7 +105,7 @@ def _write_part(out, rows):
     first = min(row["run_id"] for row in rows)
     status = "error" if all(row["status"] == "error" for row in rows) else "part"
     name = f"part-{first:08d}-{len(rows):05d}{'-error' if status == 'error' else ''}.parquet"
-    write_file(Path(out) / PARTS / name, buffer.getvalue())
+    write_file(Path(out) / PARTS / name, buffer.getvalue(), final=False)   # kept for a resume
 
 
 def _error_rows(spec, runs, reason):

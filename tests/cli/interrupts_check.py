@@ -1,6 +1,7 @@
 """By hand: 50 Ctrl-Cs at random moments, 10 per command, across ``run paper`` (the fmpy
 master and the C master), ``build``, ``build --native`` and ``fit isobaric`` (the shipped
-example). Each must end with one line ``sma-fmu: interrupted``, exit status 130, no traceback,
+example). Each must end with one line ``sma-fmu: interrupted`` (``... after writing OUT in
+full`` when the results were in place, OUT then whole), exit status 130, no traceback,
 and leave no new file or folder (tests/support/interrupting.py). Half of them go to the whole
 process group (a terminal's Ctrl-C), half to sma-fmu alone (``kill -INT``). Prints one line per
 interrupt and a count; exit status 1 when one broke the contract.

@@ -1,8 +1,10 @@
 """Ctrl-C: one line ``sma-fmu: interrupted``, exit status 130, no traceback, nothing left
-behind, whenever it comes, in both masters, the in-process pythonfmu FMUs and the builds.
+behind, whenever it comes, in both masters, the in-process pythonfmu FMUs and the builds;
+once the results are in place (too late to undo), the line names them as written in full.
 
 The suite sends a seeded sample of SIGINTs (a few seconds each); tests/cli/interrupts_check.py
 sends 50 by hand. The unit tests below pin the rules of sma_fmu/console/interrupts.py."""
+import json
 import random
 import shutil
 import signal
@@ -13,7 +15,9 @@ import pytest
 
 from interrupting import interrupt_in_time
 from sma_fmu.console import interrupts
+from sma_fmu.cli import main
 from sma_fmu.console.interrupts import run_child
+from sma_fmu.files import output_folder
 from sma_fmu.files.package_data import shipped_file
 from sma_fmu.fmi.packaging.pythonfmu_build import _renamer, code_stamp
 
@@ -56,6 +60,37 @@ def test_a_ctrl_c_ends_with_one_line_and_leaves_nothing(work, name, after_s):
     result = interrupt_in_time(COMMANDS[name][0], work, after_s, EARLIEST_S)
     assert result.status != 0, f"{name} ended before the interrupt at {result.after_s} s"
     assert result.problems() == [], (name, after_s, result.stderr[-2000:])
+
+
+def test_a_ctrl_c_while_the_results_move_into_place_names_them_written_in_full(
+        tmp_path, monkeypatch, capsys):
+    """The moment CI once hit (``run paper`` with the C master, 1.87 s): the move is not cut,
+    so the results are whole; the line says so instead of claiming nothing was written."""
+    def commit_then_ctrl_c(*arguments):
+        commit(*arguments)
+        signal.raise_signal(signal.SIGINT)
+    commit = output_folder._commit
+    monkeypatch.setattr(output_folder, "_commit", commit_then_ctrl_c)
+    out = tmp_path / "examples"
+    assert main(["examples", "--out", str(out)]) == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == \
+        f"sma-fmu: interrupted after writing {out} in full"
+    listed = json.loads((out / output_folder.MARKER).read_text(encoding="utf-8"))["entries"]
+    assert sorted(listed) == sorted(e.name for e in out.iterdir() if e.name != output_folder.MARKER)
+    assert "scenarios" in listed and sorted(p.name for p in tmp_path.iterdir()) == ["examples"]
+
+
+def test_only_results_still_there_count_as_placed_not_a_sweeps_parts(tmp_path):
+    with interrupts.handle_interrupts():
+        output_folder.write_file(tmp_path / "result.ssp", b"whole")
+        output_folder.write_file(tmp_path / "part-1.parquet", b"kept for a resume", final=False)
+        with output_folder.staged_folder(tmp_path / "out") as stage:
+            (stage / "a.csv").write_text("1")
+        assert interrupts.outputs_placed() == [str(tmp_path / "result.ssp"), str(tmp_path / "out")]
+        shutil.rmtree(tmp_path / "out")   # an intermediate one, removed: not named
+        assert interrupts.outputs_placed() == [str(tmp_path / "result.ssp")]
+    with interrupts.handle_interrupts():   # a new command starts with none
+        assert interrupts.outputs_placed() == []
 
 
 def _frame_of(module_name):

@@ -6,10 +6,13 @@ terminal's Ctrl-C does: compilers and C masters get it too), then checks the con
 the command line: exit status 130, one line ``sma-fmu: interrupted`` on stderr, no traceback
 anywhere, and no file or folder that was not there before (in the working folder and the
 temporary folder; the compiler caches under the temporary folder are kept on purpose, and
-left out). Used by tests/cli/test_interrupts.py and by hand by
-tests/cli/interrupts_check.py (50 of them).
+left out). A Ctrl-C that came once the results were in place (the line ends ``after writing
+OUT in full``) may leave OUT, if it holds exactly what its marker lists. Used by
+tests/cli/test_interrupts.py and by hand by tests/cli/interrupts_check.py (50 of them).
 """
+import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -23,6 +26,8 @@ __all__ = ["Interrupted", "interrupt", "sma_fmu_command", "tree"]
 # caches under the temporary folder, kept across runs on purpose, each filled atomically: the
 # C family's compiler cache, the C hosts (sma-fmu-<host>-<key>), zig's
 _CACHE_PREFIXES = ("sma-fmu-", "zig")
+_LINE = re.compile(r"sma-fmu: interrupted(?: after writing (.+) in full)?")
+_MARKER = ".sma-fmu-output.json"   # sma_fmu.files.output_folder.MARKER, read here as a user would
 
 
 def sma_fmu_command():
@@ -55,6 +60,7 @@ class Interrupted:
     stdout: str
     stderr: str
     new_entries: list     # files or folders left behind that were not there before
+    unwhole: list = ()    # why the outputs the line says were written in full are not
 
     def problems(self):
         """Why this run broke the contract ([] when it kept it; None when it ended before the
@@ -64,7 +70,7 @@ class Interrupted:
         found = []
         if self.status != 130:
             found.append(f"exit status {self.status}, not 130")
-        if self.stderr.strip().splitlines()[-1:] != ["sma-fmu: interrupted"]:
+        if _LINE.fullmatch((self.stderr.strip().splitlines() or [""])[-1]) is None:
             found.append(f"stderr does not end with 'sma-fmu: interrupted': {self.stderr[-600:]!r}")
         other = [line for line in self.stderr.strip().splitlines()[:-1]
                  if not line.startswith("sma-fmu: ") or line.startswith("sma-fmu: error")]
@@ -72,9 +78,32 @@ class Interrupted:
             found.append(f"stderr has other lines: {other[:5]}")
         if "Traceback" in self.stderr + self.stdout or "KeyboardInterrupt" in self.stderr + self.stdout:
             found.append("a traceback or KeyboardInterrupt was printed")
-        if self.new_entries:
-            found.append(f"left behind: {self.new_entries[:8]}")
-        return found
+        written = _written(self.stderr)
+        left = [entry for entry in self.new_entries
+                if not any(entry == out or entry.startswith(f"{out}/") for out in written)]
+        if left:
+            found.append(f"left behind: {left[:8]}")
+        return found + list(self.unwhole)
+
+
+def _written(stderr):
+    """The outputs the last line of ``stderr`` says were written in full (a list)."""
+    last = _LINE.fullmatch((stderr.strip().splitlines() or [""])[-1])
+    return last.group(1).split(", ") if last and last.group(1) else []
+
+
+def _incomplete(out):
+    """Why the output ``out`` is not whole ([] for a file, written by a rename, and for a
+    folder holding exactly the entries its marker lists)."""
+    if not out.is_dir():
+        return [] if out.is_file() else ["not there"]
+    try:
+        listed = set(json.loads((out / _MARKER).read_text(encoding="utf-8"))["entries"])
+    except (OSError, ValueError, KeyError) as error:
+        return [f"no readable {_MARKER} ({error})"]
+    held = {entry.name for entry in out.iterdir()} - {_MARKER}
+    return [f"{problem}: {sorted(names)[:5]}" for problem, names in
+            (("missing", listed - held), ("not listed", held - listed)) if names]
 
 
 def interrupt(args, work, after_s, timeout_s=120.0, environment=None, group=True):
@@ -102,13 +131,15 @@ def interrupt(args, work, after_s, timeout_s=120.0, environment=None, group=True
         stdout, stderr = process.communicate()
         stderr += f"\n(no end {timeout_s} s after the interrupt: killed)"
     left = sorted(tree(work, _CACHE_PREFIXES) - before)
+    unwhole = [f"{out}: said written in full, {problem}"
+               for out in _written(stderr) for problem in _incomplete(work / out)]
     for name in left:   # the next run starts from the same inputs
         path = work / name
         if path.is_dir() and not path.is_symlink():
             shutil.rmtree(path, ignore_errors=True)
         elif path.exists() or path.is_symlink():
             path.unlink()
-    return Interrupted(list(args), after_s, process.returncode, stdout, stderr, left)
+    return Interrupted(list(args), after_s, process.returncode, stdout, stderr, left, unwhole)
 
 
 def interrupt_in_time(args, work, after_s, earliest_s=0.3, **options):
