@@ -39,8 +39,8 @@ import sys
 import tempfile
 import threading
 
-__all__ = ["handle_interrupts", "deferred", "seen", "placed_output", "outputs_placed",
-           "in_fmu_code", "run_child", "CHILD_GRACE_S"]
+__all__ = ["handle_interrupts", "deferred", "children_spared", "seen", "placed_output",
+           "outputs_placed", "in_fmu_code", "run_child", "CHILD_GRACE_S"]
 
 CHILD_GRACE_S = 5.0   # how long a child (a compiler) may take to end when asked [s]
 # modules of a pythonfmu FMU's own code, as pythonfmu_build names them: <script>_<stamp> and
@@ -185,6 +185,29 @@ def deferred():
             _State.pending = False
             _State.raised = True
             raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def children_spared():
+    """Start processes that a terminal's Ctrl-C must not reach (Dask's worker processes): the
+    body runs with SIGINT blocked in this thread, and the threads and processes it starts
+    inherit the block, so the Ctrl-C (sent to the whole process group) reaches this process
+    alone, which shuts them down in order. A Ctrl-C meanwhile arrives when the body ends.
+    Without ``signal.pthread_sigmask`` (Windows) or off the main thread: a no-op."""
+    if not hasattr(signal, "pthread_sigmask") or \
+            threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    # multiprocessing's resource tracker starts with SIGINT blocked, then *unblocks* it in the
+    # starting thread (not restored): started here first, before the block, it is not
+    # started again in the thread that spawns the workers (Dask's IO loop)
+    import multiprocessing.resource_tracker
+    multiprocessing.resource_tracker.ensure_running()
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def placed_output(path):

@@ -20,10 +20,13 @@ import json
 import logging
 import math
 import os
+import signal
+import tempfile
 from pathlib import Path
 
 import pandas as pd
 
+from sma_fmu.console.interrupts import children_spared, deferred
 from sma_fmu.files.json_output import json_text
 from sma_fmu.files.output_folder import check_folder, write_file
 from sma_fmu.studies.overrides import StudyError
@@ -40,6 +43,7 @@ MOST_RUNS_PER_TASK = 1000
 def dask_client(scheduler=None, workers=None):
     """A ``dask.distributed.Client``: of ``scheduler`` (an address), or of a new LocalCluster
     with ``workers`` single-threaded worker processes (default: one per core)."""
+    import dask
     from dask.distributed import Client, LocalCluster
     if scheduler is not None:
         try:
@@ -50,10 +54,50 @@ def dask_client(scheduler=None, workers=None):
             yield client
         return
     count = workers or os.cpu_count() or 1
-    with LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
-            Client(cluster) as client:
-        yield client
+    # A terminal's Ctrl-C reaches this process alone (children_spared), never a cluster half
+    # started or half closed (deferred): cut there, the workers printed their
+    # KeyboardInterrupts and Dask, at exit, "AssertionError: Status.init". After a Ctrl-C the
+    # workers are ended at once (they would finish their task first, seconds).
+    # the workers' scratch space in a folder of the sweep's own, removed after it (Dask's
+    # default, TMPDIR/dask-scratch-space, stays, with locks of workers a Ctrl-C ended)
+    cluster = client = None
+    with tempfile.TemporaryDirectory(prefix="dask-sweep-", ignore_cleanup_errors=True) as scratch, \
+            dask.config.set({"temporary-directory": scratch}), contextlib.ExitStack() as quiet:
+        try:
+            with deferred(), children_spared():
+                cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+                client = Client(cluster)
+            yield client
+        except KeyboardInterrupt:
+            quiet.enter_context(_logs_silenced())   # Dask's lost connections to them
+            _end_workers(cluster)
+            raise
+        finally:
+            with deferred():
+                for part in (client, cluster):
+                    if part is not None:
+                        part.close()
+
+
+@contextlib.contextmanager
+def _logs_silenced():
+    """No logger prints in the body (``logging.disable``; what was disabled before, after)."""
+    before = logging.root.manager.disable
+    logging.disable(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logging.disable(before)
+
+
+def _end_workers(cluster):
+    """End the worker processes of the LocalCluster ``cluster`` at once (SIGTERM)."""
+    for nanny in getattr(cluster, "workers", {}).values():
+        pid = getattr(nanny, "pid", None)   # the worker process's (its nanny runs in here)
+        if pid:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGTERM)
 
 
 def task_size(remaining, workers, requested=None):

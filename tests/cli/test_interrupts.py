@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from interrupting import interrupt_in_time
+from interrupting import interrupt, interrupt_in_time
 from sma_fmu.console import interrupts
 from sma_fmu.cli import main
 from sma_fmu.console.interrupts import run_child
@@ -91,6 +91,24 @@ def test_only_results_still_there_count_as_placed_not_a_sweeps_parts(tmp_path):
         assert interrupts.outputs_placed() == [str(tmp_path / "result.ssp")]
     with interrupts.handle_interrupts():   # a new command starts with none
         assert interrupts.outputs_placed() == []
+
+
+@pytest.mark.parametrize("once, after_s", [("sweep/study.json", 0.0), ("sweep/study.json", 0.3),
+                                            ("sweep/runs/part-*", 0.0)],
+                         ids=["cluster starting", "cluster started", "runs under way"])
+def test_a_ctrl_c_to_a_sweep_reaches_its_dask_workers_through_it_alone(tmp_path, once, after_s):
+    """A sweep keeps the runs it finished (study.json, runs/) and says one line. Its Dask
+    worker processes, in the terminal's process group, once printed their KeyboardInterrupts
+    and Dask at exit "AssertionError: Status.init" (a cluster cut mid-start); mid-run they
+    took their task to its end (seconds)."""
+    spec = shipped_file("examples", "gain-grid.toml")
+    result = interrupt(["sweep", spec, "--out", "sweep", "--workers", "2"], tmp_path, after_s,
+                       once=once)
+    assert result.status == 130, (result.status, result.stderr[-2000:])
+    kept = [entry for entry in result.new_entries if entry not in ("sweep", "sweep/study.json")
+            and not (entry == "sweep/runs" or entry.startswith("sweep/runs/part-"))]
+    problems = [p for p in result.problems() if not p.startswith("left behind")]
+    assert problems == [] and kept == [], (problems, kept, result.stderr[-2000:])
 
 
 def _frame_of(module_name):

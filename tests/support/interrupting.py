@@ -106,11 +106,12 @@ def _incomplete(out):
             (("missing", listed - held), ("not listed", held - listed)) if names]
 
 
-def interrupt(args, work, after_s, timeout_s=120.0, environment=None, group=True):
+def interrupt(args, work, after_s, timeout_s=120.0, environment=None, group=True, once=None):
     """Run ``sma-fmu args`` in the folder ``work`` and Ctrl-C it after ``after_s`` seconds;
     returns :class:`Interrupted`. ``work`` holds the inputs; its ``tmp/`` is made the
     process's temporary folder. ``group``: SIGINT to the whole process group (a terminal's
-    Ctrl-C), else to sma-fmu alone (``kill -INT``, ``timeout -s INT``)."""
+    Ctrl-C), else to sma-fmu alone (``kill -INT``, ``timeout -s INT``). ``once``: a glob
+    pattern under ``work``; the ``after_s`` seconds count from when a file matches it."""
     work = Path(work)
     temporary = work / "tmp"
     temporary.mkdir(exist_ok=True)
@@ -122,6 +123,8 @@ def interrupt(args, work, after_s, timeout_s=120.0, environment=None, group=True
                                stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
+        while once and process.poll() is None and not any(work.glob(once)):
+            time.sleep(0.001)
         time.sleep(after_s)
         if process.poll() is None:
             (os.killpg if group else os.kill)(process.pid, signal.SIGINT)
