@@ -1,6 +1,6 @@
 """Ctrl-C for the command line: one line, exit status 130, no traceback, nothing half-written.
 
-Python raises KeyboardInterrupt wherever the main thread is when SIGINT arrives. Two places
+Python raises KeyboardInterrupt wherever the main thread is when SIGINT arrives. Three places
 must not get it:
 
 - Python code running *inside* an FMU call: a pythonfmu slave (in-process, its modules named
@@ -11,6 +11,8 @@ must not get it:
   on. The handler installed by :func:`handle_interrupts` leaves such code alone and raises
   the KeyboardInterrupt in the frame that called into the FMU, when the call returns (it
   traces that frame, as a debugger does).
+- :mod:`tempfile` making or removing a temporary folder (pythonfmu's build folder, cut
+  mid-removal, stayed behind): treated as FMU code, the KeyboardInterrupt comes when it returns.
 - A section that must finish once started, :func:`deferred`: moving a command's results into
   place, removing its temporary folder (:mod:`sma_fmu.files.output_folder`). The
   KeyboardInterrupt comes at its end.
@@ -47,6 +49,9 @@ CHILD_GRACE_S = 5.0   # how long a child (a compiler) may take to end when asked
 # <script>_<suffix>_<stamp>.<module>, the stamp 10 hex digits
 _FMU_MODULE = re.compile(r"^[A-Za-z_]\w*_[0-9a-f]{10}(\.|$)")
 _BUILD_TIME = ("pythonfmu.builder", "pythonfmu.csvbuilder", "pythonfmu.deploy")
+# modules a Ctrl-C does not cut either, as FMU code: tempfile, making or removing a temporary
+# folder (a TemporaryDirectory's removal cut mid-way left pythonfmu's build folder behind)
+_UNCUT = ("tempfile",)
 
 
 class _State:
@@ -71,16 +76,17 @@ def _fmu_code(name):
         name.startswith("pythonfmu") and not name.startswith(_BUILD_TIME))
 
 
-def _outside_fmu(frame):
+def _outside_fmu(frame, also=()):
     """``frame`` if it runs no FMU code, else the frame just outside the outermost frame of
     FMU code on the stack (the master's, which called into the FMU); importlib frames called
-    from fmpy (pythonfmu importing a slave in fmi2Instantiate) count as FMU code."""
+    from fmpy (pythonfmu importing a slave in fmi2Instantiate) count as FMU code, and so do
+    the frames of the modules ``also``."""
     stack = []
     while frame is not None:
         stack.append(frame)
         frame = frame.f_back
     names = [_module(each) for each in stack]
-    inside = [index for index, name in enumerate(names) if _fmu_code(name)]
+    inside = [index for index, name in enumerate(names) if _fmu_code(name) or name in also]
     last = max(inside, default=-1)
     imports = sum(1 for _ in itertools.takewhile(lambda name: name.startswith("importlib"), names))
     if 0 < imports < len(names) and names[imports].startswith("fmpy"):
@@ -128,7 +134,7 @@ def _handler(signum, frame):
     if _State.depth:
         _State.pending = True        # delivered at the end of the section
         return
-    outside = None if frame is None else _outside_fmu(frame)
+    outside = None if frame is None else _outside_fmu(frame, _UNCUT)
     if outside is not None and outside is not frame:
         _interrupt_in(outside)       # when the FMU call returns
         return
@@ -141,7 +147,7 @@ def _unraisable(unraisable):
     is raised in the frame that called into C, when the call returns."""
     if isinstance(unraisable.exc_value, KeyboardInterrupt) and _State.installed:
         _State.raised = False
-        _interrupt_in(_outside_fmu(sys._getframe(1)))
+        _interrupt_in(_outside_fmu(sys._getframe(1), _UNCUT))
         return
     _State.previous[1](unraisable)
 

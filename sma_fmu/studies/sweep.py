@@ -28,6 +28,7 @@ import pandas as pd
 
 from sma_fmu.console.interrupts import children_spared, deferred
 from sma_fmu.files.json_output import json_text
+from sma_fmu.fmi.driving.unpacked import remove_stale
 from sma_fmu.files.output_folder import check_folder, write_file
 from sma_fmu.studies.overrides import StudyError
 from sma_fmu.studies.results import PARTS, read_parts, write_results
@@ -72,6 +73,7 @@ def dask_client(scheduler=None, workers=None):
         except KeyboardInterrupt:
             quiet.enter_context(_logs_silenced())   # Dask's lost connections to them
             _end_workers(cluster)
+            quiet.callback(remove_stale)   # the FMU folders they unpacked (--fmus), once closed
             raise
         finally:
             with deferred():
@@ -92,7 +94,8 @@ def _logs_silenced():
 
 
 def _end_workers(cluster):
-    """End the worker processes of the LocalCluster ``cluster`` at once (SIGTERM)."""
+    """End the worker processes of the LocalCluster ``cluster`` at once (SIGTERM: their
+    exit handlers do not run; what they leave, :func:`remove_stale` removes)."""
     for nanny in getattr(cluster, "workers", {}).values():
         pid = getattr(nanny, "pid", None)   # the worker process's (its nanny runs in here)
         if pid:

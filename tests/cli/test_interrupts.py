@@ -9,6 +9,7 @@ import random
 import shutil
 import signal
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -93,17 +94,26 @@ def test_only_results_still_there_count_as_placed_not_a_sweeps_parts(tmp_path):
         assert interrupts.outputs_placed() == []
 
 
-@pytest.mark.parametrize("once, after_s", [("sweep/study.json", 0.0), ("sweep/study.json", 0.3),
-                                            ("sweep/runs/part-*", 0.0)],
-                         ids=["cluster starting", "cluster started", "runs under way"])
-def test_a_ctrl_c_to_a_sweep_reaches_its_dask_workers_through_it_alone(tmp_path, once, after_s):
+@pytest.mark.parametrize("once, after_s, path", [("sweep/study.json", 0.0, "batch"),
+                                                  ("sweep/study.json", 0.3, "batch"),
+                                                  ("sweep/runs/part-*", 0.0, "batch"),
+                                                  ("sweep/runs/part-*", 0.0, "fmu")],
+                         ids=["cluster starting", "cluster started", "runs under way",
+                              "runs under way, --fmus"])
+def test_a_ctrl_c_to_a_sweep_reaches_its_dask_workers_through_it_alone(tmp_path, native_fmus,
+                                                                       once, after_s, path):
     """A sweep keeps the runs it finished (study.json, runs/) and says one line. Its Dask
     worker processes, in the terminal's process group, once printed their KeyboardInterrupts
     and Dask at exit "AssertionError: Status.init" (a cluster cut mid-start); mid-run they
-    took their task to its end (seconds)."""
-    spec = shipped_file("examples", "gain-grid.toml")
-    result = interrupt(["sweep", spec, "--out", "sweep", "--workers", "2"], tmp_path, after_s,
-                       once=once)
+    took their task to its end (seconds). Ended at once, the FMUs they unpacked go too."""
+    arguments = ["sweep", shipped_file("examples", "gain-grid.toml"), "--out", "sweep",
+                 "--workers", "2"]
+    if path == "fmu":
+        (tmp_path / "native").mkdir()
+        for fmu in native_fmus.values():
+            shutil.copyfile(fmu, tmp_path / "native" / fmu.name)
+        arguments += ["--fmus", "native"]
+    result = interrupt(arguments, tmp_path, after_s, once=once)
     assert result.status == 130, (result.status, result.stderr[-2000:])
     kept = [entry for entry in result.new_entries if entry not in ("sweep", "sweep/study.json")
             and not (entry == "sweep/runs" or entry.startswith("sweep/runs/part-"))]
@@ -161,6 +171,28 @@ def test_a_ctrl_c_inside_fmu_code_comes_when_the_fmu_call_returns():
             namespace["step"](log)
             log.append("the master went on")   # never: the interrupt comes here
     assert log == ["the step ran to its end"] and sys.gettrace() is None
+
+
+def test_a_temporary_folder_being_removed_is_removed_whole_before_the_interrupt(monkeypatch):
+    """pythonfmu's build folder (a TemporaryDirectory) once stayed behind, half removed: the
+    Ctrl-C came inside its removal."""
+    def rmtree_after_a_ctrl_c(*arguments, **options):
+        signal.raise_signal(signal.SIGINT)
+        rmtree(*arguments, **options)
+
+    def build(made):
+        with tempfile.TemporaryDirectory(prefix="removed-whole-") as folder:
+            made.append(Path(folder))
+            (made[0] / "a.txt").write_text("a")
+            monkeypatch.setattr(tempfile._shutil, "rmtree", rmtree_after_a_ctrl_c)
+        made.append("the removal ended")   # the interrupt comes here, in its caller's next line
+
+    rmtree, made = tempfile._shutil.rmtree, []
+    with interrupts.handle_interrupts():
+        with pytest.raises(KeyboardInterrupt):
+            build(made)
+    monkeypatch.undo()
+    assert made == [made[0]] and not made[0].exists()
 
 
 def test_a_process_about_to_exit_ignores_a_late_ctrl_c():
