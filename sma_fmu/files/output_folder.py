@@ -86,6 +86,7 @@ def staged_folder(out, argument="--out", report=True):
         yield stage
         with deferred():
             _commit(stage, out, argument, report)
+            placed_output(out)
     finally:
         if stage is not None:
             with deferred():
@@ -108,7 +109,6 @@ def _commit(stage, out, argument, report):
     try:
         if not out.exists():
             os.replace(stage, out)
-            placed_output(out)
             return
         previous = [name for name in _written_before(out)   # names only, never a path
                     if name not in ("", ".", "..", MARKER) and Path(name).name == name
@@ -120,7 +120,6 @@ def _commit(stage, out, argument, report):
             if target.is_dir() and not target.is_symlink():
                 shutil.rmtree(target)
             os.replace(entry, target)
-        placed_output(out)
     except OSError as error:
         raise OutputError(f"{argument} {out}: cannot move the results into place: "
                           f"{error.strerror or error}") from None

@@ -21,13 +21,14 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from sma_fmu.files.output_folder import MARKER
+
 __all__ = ["Interrupted", "interrupt", "sma_fmu_command", "tree"]
 
 # caches under the temporary folder, kept across runs on purpose, each filled atomically: the
 # C family's compiler cache, the C hosts (sma-fmu-<host>-<key>), zig's
 _CACHE_PREFIXES = ("sma-fmu-", "zig")
 _LINE = re.compile(r"sma-fmu: interrupted(?: after writing (.+) in full)?")
-_MARKER = ".sma-fmu-output.json"   # sma_fmu.files.output_folder.MARKER, read here as a user would
 
 
 def sma_fmu_command():
@@ -98,10 +99,10 @@ def _incomplete(out):
     if not out.is_dir():
         return [] if out.is_file() else ["not there"]
     try:
-        listed = set(json.loads((out / _MARKER).read_text(encoding="utf-8"))["entries"])
+        listed = set(json.loads((out / MARKER).read_text(encoding="utf-8"))["entries"])
     except (OSError, ValueError, KeyError) as error:
-        return [f"no readable {_MARKER} ({error})"]
-    held = {entry.name for entry in out.iterdir()} - {_MARKER}
+        return [f"no readable {MARKER} ({error})"]
+    held = {entry.name for entry in out.iterdir()} - {MARKER}
     return [f"{problem}: {sorted(names)[:5]}" for problem, names in
             (("missing", listed - held), ("not listed", held - listed)) if names]
 
