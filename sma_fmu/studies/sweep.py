@@ -118,7 +118,9 @@ def finished_runs(out):
 
 
 def _check_folder(out, spec, path="batch"):
-    """Create ``out`` for ``spec``, or check that it holds a sweep of the same spec and path."""
+    """Check that ``out`` is new or holds a sweep of the same spec and path; the text of the
+    ``study.json`` to write there (None: it is there), written once the cluster is up, so a
+    sweep that cannot start (no scheduler at ``--scheduler``) leaves no folder."""
     out = Path(out)
     check_folder(out)
     marker = out / "study.json"
@@ -131,9 +133,9 @@ def _check_folder(out, spec, path="batch"):
         if recorded.get("path", "batch") != path:
             raise StudyError(f"--out {out}: holds runs of the {recorded.get('path', 'batch')} path, "
                              f"not {path} (--fmus); give another --out, or remove that folder")
-        return
-    write_file(marker, json_text({"spec": str(spec.path), "fingerprint": fingerprint,
-                                  "runs": len(spec.runs()), "path": path}), final=False)
+        return None
+    return json_text({"spec": str(spec.path), "fingerprint": fingerprint,
+                      "runs": len(spec.runs()), "path": path})
 
 
 def _check_fmus(spec, fmu_dir):
@@ -173,11 +175,13 @@ def run_sweep(spec_path, out, scheduler=None, workers=None, progress=True, fmu_d
     if fmu_dir is not None:
         fmu_dir = str(Path(fmu_dir).resolve())   # the workers' working folder may differ
         _check_fmus(spec, fmu_dir)
-    _check_folder(out, spec, "batch" if fmu_dir is None else "fmu")
+    marker = _check_folder(out, spec, "batch" if fmu_dir is None else "fmu")
     done = finished_runs(out)
     todo = [run for run in runs if run.run_id not in done]
     if todo:
         with dask_client(scheduler, workers) as client:
+            if marker is not None:
+                write_file(Path(out) / "study.json", marker, final=False)
             count = len(client.scheduler_info().get("workers", {})) or 1
             size = task_size(len(todo), count, spec.runs_per_task)
             chunks = [todo[i:i + size] for i in range(0, len(todo), size)]

@@ -94,8 +94,8 @@ def test_only_results_still_there_count_as_placed_not_a_sweeps_parts(tmp_path):
         assert interrupts.outputs_placed() == []
 
 
-@pytest.mark.parametrize("once, after_s, path", [("sweep/study.json", 0.0, "batch"),
-                                                  ("sweep/study.json", 0.3, "batch"),
+@pytest.mark.parametrize("once, after_s, path", [("tmp/dask-sweep-*", 0.0, "batch"),
+                                                  ("sweep/study.json", 0.0, "batch"),
                                                   ("sweep/runs/part-*", 0.0, "batch"),
                                                   ("sweep/runs/part-*", 0.0, "fmu")],
                          ids=["cluster starting", "cluster started", "runs under way",

@@ -257,3 +257,15 @@ def test_a_final_status_beats_a_task_error(grid_spec, tmp_path):
     assert list(table["status"]) == ["error", "ok", "failed"]
     assert table["error"][0] == "task failed: KilledWorker: gone"
     assert table["rmse_ohm"][1] == rows[0]["rmse_ohm"] and table["error"][2] == rows[1]["error"]
+
+
+def test_a_sweep_that_cannot_reach_its_scheduler_leaves_no_folder(grid_spec, tmp_path):
+    """study.json is written once the cluster is up: a failed start left it, alone, in a new
+    --out folder (a failed command leaves its output folder as it was)."""
+    import socket
+    with socket.socket() as probe:   # a loopback port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    with pytest.raises(StudyError, match="cannot connect"):
+        run_sweep(grid_spec, tmp_path / "out", scheduler=f"tcp://127.0.0.1:{port}", progress=False)
+    assert list(tmp_path.iterdir()) == []
