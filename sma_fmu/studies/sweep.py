@@ -66,8 +66,12 @@ def dask_client(scheduler=None, workers=None):
             dask.config.set({"temporary-directory": scratch}), contextlib.ExitStack() as quiet:
         try:
             with deferred(), children_spared():
+                # no dashboard; the scheduler's HTTP server (always started) on a free port:
+                # on its default, 8787, a second sweep at the same time printed Dask's
+                # "Port 8787 is already in use" warning
                 cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.ERROR)
+                                       dashboard_address=None, silence_logs=logging.ERROR,
+                                       scheduler_kwargs={"dashboard_address": ":0"})
                 client = Client(cluster)
             yield client
         except KeyboardInterrupt:

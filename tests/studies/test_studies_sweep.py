@@ -269,3 +269,20 @@ def test_a_sweep_that_cannot_reach_its_scheduler_leaves_no_folder(grid_spec, tmp
     with pytest.raises(StudyError, match="cannot connect"):
         run_sweep(grid_spec, tmp_path / "out", scheduler=f"tcp://127.0.0.1:{port}", progress=False)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sweep_beside_another_cluster_prints_nothing_of_dask(tmp_path):
+    """The scheduler's HTTP server took Dask's default port, 8787: with it in use (another
+    sweep, a notebook's cluster), Dask printed a four-line 'Port 8787 is already in use'."""
+    import socket
+    with socket.socket() as holder:
+        try:
+            holder.bind(("0.0.0.0", 8787))
+            holder.listen()
+        except OSError:
+            pass   # in use already: the case itself
+        result = subprocess.run([sys.executable, "-m", "sma_fmu", "sweep",
+                                 str(shipped_file("examples", "gain-grid.toml")), "--out",
+                                 str(tmp_path / "out"), "--workers", "2", "--quiet"],
+                                capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert result.returncode == 0 and result.stderr == "", result.stderr[-2000:]
